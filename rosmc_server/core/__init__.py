@@ -1,0 +1,76 @@
+"""The mission core: the ROSMC mission model and its rules, in pure Python.
+
+No rospy, genpy, generated messages, Qt or pybullet are imported here; the
+ROS adapters in :mod:`rosmc_server.ros` translate between this and the wire.
+"""
+
+from .changes import Change, EventKind, MissionEvent, PlacedSkill
+from .errors import (
+    InvalidRequest,
+    LibraryError,
+    MissionFileError,
+    NotFound,
+    RosmcError,
+    RuleViolation,
+    StaleRevision,
+    Unavailable,
+)
+from .library import (
+    AgentKind,
+    AgentSpec,
+    Library,
+    ParameterSpec,
+    SkillSpec,
+    load_library,
+)
+from .mission import Mission, random_ids
+from .model import Barrier, Resolution, SkillInstance, SkillStatus, TaskMarker, Transfer
+from .params import MarkerType, ParamType, Pose, Value
+from .persistence import (
+    dump_mission,
+    load_mission,
+    mission_to_dict,
+    parse_mission,
+    save_mission,
+)
+from .state import MissionContent, MissionState
+
+__all__ = [
+    "AgentKind",
+    "AgentSpec",
+    "Barrier",
+    "Change",
+    "EventKind",
+    "InvalidRequest",
+    "Library",
+    "LibraryError",
+    "MarkerType",
+    "Mission",
+    "MissionContent",
+    "MissionEvent",
+    "MissionFileError",
+    "MissionState",
+    "NotFound",
+    "ParamType",
+    "ParameterSpec",
+    "PlacedSkill",
+    "Pose",
+    "Resolution",
+    "RosmcError",
+    "RuleViolation",
+    "SkillInstance",
+    "SkillSpec",
+    "SkillStatus",
+    "StaleRevision",
+    "TaskMarker",
+    "Transfer",
+    "Unavailable",
+    "Value",
+    "dump_mission",
+    "load_library",
+    "load_mission",
+    "mission_to_dict",
+    "parse_mission",
+    "random_ids",
+    "save_mission",
+]

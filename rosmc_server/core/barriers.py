@@ -1,0 +1,193 @@
+"""Skill barriers: adding and removing them, and refusing any that would deadlock.
+
+A barrier makes its members start together, so it merges them into one point
+in time. Each task orders its skills. A set of barriers deadlocks exactly when
+the graph of "runs before" edges between these points has a cycle, e.g.
+A:[x1, y1], B:[y2, x2] with barriers {x1, x2} and {y1, y2}.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+
+from .changes import Change, EventKind, Proposal
+from .errors import InvalidRequest, RuleViolation
+from .model import Barrier, SkillInstance, SkillStatus, Transfer
+from .state import MissionState
+
+
+@dataclass(frozen=True)
+class OrderEdge:
+    """``before`` runs before ``after`` on ``agent``."""
+
+    agent: str
+    before: str
+    after: str
+
+
+def find_deadlock(
+    tasks: Mapping[str, Sequence[str]], groups: Iterable[Sequence[str]]
+) -> list[OrderEdge] | None:
+    """Return the task-order edges of a cycle through the barrier groups, or None.
+
+    ``tasks`` maps each agent to its skill ids in order; ``groups`` are the
+    barriers' member ids. Only agents with barrier members can take part in a
+    cycle, so the others are skipped.
+    """
+    point: dict[str, str] = {}
+    for number, members in enumerate(groups):
+        for skill_id in members:
+            point[skill_id] = f"barrier#{number}"
+    graph: dict[str, list[tuple[str, OrderEdge]]] = {}
+    for agent, ids in tasks.items():
+        if not any(skill_id in point for skill_id in ids):
+            continue
+        for before, after in itertools.pairwise(ids):
+            source, target = point.get(before, before), point.get(after, after)
+            graph.setdefault(source, []).append(
+                (target, OrderEdge(agent, before, after))
+            )
+    return _find_cycle(graph)
+
+
+def _find_cycle(
+    graph: Mapping[str, list[tuple[str, OrderEdge]]],
+) -> list[OrderEdge] | None:
+    done: set[str] = set()
+    for root in graph:
+        if root in done:
+            continue
+        on_path: dict[str, int] = {root: 0}
+        path_edges: list[OrderEdge] = []
+        stack = [(root, iter(graph.get(root, ())))]
+        while stack:
+            node, edges = stack[-1]
+            step = next(edges, None)
+            if step is None:
+                stack.pop()
+                on_path.pop(node)
+                done.add(node)
+                if path_edges:
+                    path_edges.pop()
+                continue
+            target, edge = step
+            if target in on_path:
+                return [*path_edges[on_path[target] :], edge]
+            if target not in done:
+                on_path[target] = len(path_edges) + 1
+                path_edges.append(edge)
+                stack.append((target, iter(graph.get(target, ()))))
+    return None
+
+
+def describe_cycle(cycle: Sequence[OrderEdge]) -> str:
+    """Name a deadlock cycle in words, e.g. ``A runs x1 before y1, B runs y2 before x2``."""
+    return ", ".join(f"{e.agent} runs '{e.before}' before '{e.after}'" for e in cycle)
+
+
+def check_no_deadlock(
+    state: MissionState,
+    extra_group: Sequence[str] = (),
+    order: tuple[str, Sequence[str]] | None = None,
+) -> None:
+    """Raise RuleViolation if the barriers (plus ``extra_group``) would deadlock.
+
+    ``order`` replaces one agent's editable blueprint order, to check a reorder.
+    """
+    tasks: dict[str, list[str]] = {}
+    for agent in state.agents:
+        ids = [skill.id for skill in state.task(agent)]
+        if order is not None and order[0] == agent:
+            ids[len(ids) - len(order[1]) :] = order[1]
+        tasks[agent] = ids
+    groups = [barrier.skill_ids for barrier in state.barriers]
+    if extra_group:
+        groups.append(tuple(extra_group))
+    cycle = find_deadlock(tasks, groups)
+    if cycle is not None:
+        raise RuleViolation(
+            "the barriers would deadlock, because each waits for another: "
+            + describe_cycle(cycle)
+        )
+
+
+def plan_add_barrier(
+    state: MissionState, skill_ids: Sequence[str], barrier_id: str
+) -> Proposal:
+    """Barrier over ``skill_ids``: at least two skills on distinct agents, none started."""
+    if len(skill_ids) < 2:
+        raise InvalidRequest("a barrier needs at least two skills")
+    if len(set(skill_ids)) != len(skill_ids):
+        raise InvalidRequest("a barrier lists the same skill twice")
+    members = [state.skill(skill_id) for skill_id in skill_ids]
+    seen_agents: dict[str, str] = {}
+    for skill in members:
+        if skill.agent in seen_agents:
+            raise RuleViolation(
+                f"skills '{seen_agents[skill.agent]}' and '{skill.id}' are both on "
+                f"{skill.agent}; barrier members must be on distinct agents"
+            )
+        seen_agents[skill.agent] = skill.id
+        _check_member_changeable(state, skill, "join a barrier")
+        existing = state.barrier_of(skill.id)
+        if existing is not None:
+            raise RuleViolation(
+                f"skill '{skill.id}' is already in barrier '{existing.id}'"
+            )
+    check_no_deadlock(state, extra_group=skill_ids)
+    barrier = Barrier(barrier_id, tuple(skill_ids))
+    agents = ", ".join(skill.agent for skill in members)
+    return Proposal(
+        EventKind.BARRIER_ADDED,
+        "",
+        f"barrier '{barrier_id}' makes {agents} start {', '.join(skill_ids)} together",
+        Change(put_barriers=(barrier,)),
+    )
+
+
+def plan_delete_barrier(state: MissionState, barrier_id: str) -> Proposal:
+    """Remove a barrier none of whose members has started."""
+    barrier = state.barrier(barrier_id)
+    for skill_id in barrier.skill_ids:
+        _check_member_changeable(state, state.skill(skill_id), "leave its barrier")
+    return Proposal(
+        EventKind.BARRIER_DELETED,
+        "",
+        f"barrier '{barrier_id}' removed",
+        Change(removed_barrier_ids=(barrier_id,)),
+    )
+
+
+def _check_member_changeable(
+    state: MissionState, skill: SkillInstance, action: str
+) -> None:
+    if skill.status not in (SkillStatus.IDLE, SkillStatus.IDLE_SYNCHRONIZED):
+        raise RuleViolation(
+            f"skill '{skill.id}' is {skill.status.name} and can no longer {action}"
+        )
+    if skill.transfer is not Transfer.NONE:
+        raise RuleViolation(
+            f"skill '{skill.id}' is being {_transfer_word(skill.transfer)}; "
+            f"it can {action} once the robot has answered"
+        )
+
+
+def _transfer_word(transfer: Transfer) -> str:
+    return "uploaded" if transfer is Transfer.UPLOADING else "removed from the robot"
+
+
+def barrier_without(state: MissionState, removed: set[str]) -> Change:
+    """Barrier updates for deleting skills ``removed``: shrink, or drop below two members."""
+    put: list[Barrier] = []
+    dropped: list[str] = []
+    for barrier in state.barriers:
+        if not removed.intersection(barrier.skill_ids):
+            continue
+        remaining = tuple(s for s in barrier.skill_ids if s not in removed)
+        if len(remaining) >= 2:
+            put.append(Barrier(barrier.id, remaining))
+        else:
+            dropped.append(barrier.id)
+    return Change(put_barriers=tuple(put), removed_barrier_ids=tuple(dropped))

@@ -1,0 +1,46 @@
+"""The one exception family of ROSMC.
+
+Every rejection the mission core makes is a :class:`RosmcError` whose message
+is one sentence an operator can act on. The subclasses say *why* a request
+failed, so adapters can map them to an error code without parsing text.
+"""
+
+
+class RosmcError(Exception):
+    """Root of every error ROSMC raises on purpose."""
+
+
+class InvalidRequest(RosmcError):
+    """A request is malformed: empty, of the wrong type, or out of range."""
+
+
+class NotFound(RosmcError):
+    """A request names an agent, skill, barrier or marker that does not exist."""
+
+
+class RuleViolation(RosmcError):
+    """A well-formed request that the mission rules forbid in the current state."""
+
+
+class StaleRevision(RosmcError):
+    """A request was made against an older revision of the mission."""
+
+    def __init__(self, base_revision: int, current_revision: int) -> None:
+        super().__init__(
+            f"the mission changed since revision {base_revision} (it is now at revision "
+            f"{current_revision}); fetch the mission and try again"
+        )
+        self.base_revision = base_revision
+        self.current_revision = current_revision
+
+
+class Unavailable(RosmcError):
+    """The robot a request needs cannot be reached right now."""
+
+
+class LibraryError(RosmcError):
+    """A skill library file is malformed; the message names the file and the key."""
+
+
+class MissionFileError(RosmcError):
+    """A mission file cannot be loaded; the message names the file and the problem."""

@@ -1,0 +1,345 @@
+"""Execution-side operations: synchronize, unsynchronize, robot reports, stop, retry, skip.
+
+Synchronization is a two-step exchange with the robot: the ground marks
+skills as being uploaded (or removed), and they change section only when the
+robot confirms. Robot status reports are checked against the legal transitions
+and the task order, so the ground never shows an impossible history.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import replace
+
+from .changes import Change, EventKind, PlacedSkill, Proposal
+from .errors import InvalidRequest, RuleViolation
+from .model import Resolution, SkillInstance, SkillStatus, Transfer
+from .state import MissionState
+
+S = SkillStatus
+
+# Status changes a robot may report, from -> allowed targets. Reporting the
+# same active status again updates attempt or progress text.
+REPORTABLE: Mapping[SkillStatus, frozenset[SkillStatus]] = {
+    S.IDLE_SYNCHRONIZED: frozenset({S.SYNCWAITING, S.RUNNING, S.FAILURE}),
+    S.SYNCWAITING: frozenset(
+        {S.SYNCWAITING, S.RUNNING, S.PAUSED, S.IDLE_SYNCHRONIZED, S.FAILURE}
+    ),
+    S.RUNNING: frozenset(
+        {S.RUNNING, S.PAUSED, S.SUCCESS, S.FAILURE, S.IDLE_SYNCHRONIZED}
+    ),
+    S.PAUSED: frozenset(
+        {S.PAUSED, S.RUNNING, S.SYNCWAITING, S.IDLE_SYNCHRONIZED, S.FAILURE}
+    ),
+}
+
+
+def plan_synchronize(state: MissionState, agent: str, upto_id: str | None) -> Proposal:
+    """Mark ``agent``'s editable blueprint up to ``upto_id`` (all if None) as uploading."""
+    task = state.task(agent)
+    sections = state.sections(agent)
+    if _pending(task, Transfer.REMOVING):
+        raise RuleViolation(
+            f"an unsynchronize on {agent} awaits the robot's answer; synchronize after it"
+        )
+    editable = task[sections.editable_start :]
+    if not editable:
+        raise RuleViolation(f"{agent} has no blueprint skills to synchronize")
+    if upto_id:
+        ids = [skill.id for skill in editable]
+        if upto_id not in ids:
+            state.skill(upto_id)  # NotFound for an unknown id
+            raise RuleViolation(
+                f"skill '{upto_id}' is not in {agent}'s editable blueprint"
+            )
+        editable = editable[: ids.index(upto_id) + 1]
+    start = sections.editable_start
+    puts = tuple(
+        PlacedSkill(start + offset, replace(skill, transfer=Transfer.UPLOADING))
+        for offset, skill in enumerate(editable)
+    )
+    return Proposal(
+        EventKind.SYNC_REQUESTED,
+        agent,
+        f"uploading {len(puts)} skill(s) to {agent}: {_ids(editable)}",
+        Change(put_skills=puts),
+    )
+
+
+def plan_confirm_sync(
+    state: MissionState, agent: str, skill_ids: Sequence[str]
+) -> Proposal:
+    """The robot stored these uploading skills: they become IDLE_SYNCHRONIZED."""
+    uploading = _pending(state.task(agent), Transfer.UPLOADING)
+    _require_run(uploading, skill_ids, agent, "uploads", from_front=True)
+    puts = _placed(
+        state,
+        [
+            replace(s, status=S.IDLE_SYNCHRONIZED, transfer=Transfer.NONE)
+            for s in uploading[: len(skill_ids)]
+        ],
+    )
+    return Proposal(
+        EventKind.SYNC_CONFIRMED,
+        agent,
+        f"{agent} stored {_ids(uploading[: len(skill_ids)])}",
+        Change(put_skills=puts),
+    )
+
+
+def plan_decline_sync(
+    state: MissionState, agent: str, skill_ids: Sequence[str], reason: str
+) -> Proposal:
+    """The robot refused these uploads (or cannot be reached): back to the blueprint."""
+    uploading = _pending(state.task(agent), Transfer.UPLOADING)
+    _require_run(uploading, skill_ids, agent, "uploads", from_front=False)
+    declined = uploading[len(uploading) - len(skill_ids) :]
+    text = reason.strip() or "declined by the robot"
+    puts = _placed(
+        state, [replace(s, transfer=Transfer.NONE, status_text=text) for s in declined]
+    )
+    return Proposal(
+        EventKind.SYNC_DECLINED,
+        agent,
+        f"{agent} did not take {_ids(declined)}: {text}",
+        Change(put_skills=puts),
+    )
+
+
+def plan_request_unsync(
+    state: MissionState, agent: str, from_id: str | None
+) -> Proposal:
+    """Ask the robot to give back ``from_id`` and every later synchronized skill."""
+    task = state.task(agent)
+    sections = state.sections(agent)
+    if _pending(task, Transfer.UPLOADING):
+        raise RuleViolation(
+            f"an upload to {agent} awaits the robot's answer; unsynchronize after it"
+        )
+    if _pending(task, Transfer.REMOVING):
+        raise RuleViolation(
+            f"an unsynchronize on {agent} already awaits the robot's answer"
+        )
+    synced = task[: sections.synced_end]
+    start = len(synced)
+    while start > 0 and synced[start - 1].status is S.IDLE_SYNCHRONIZED:
+        start -= 1
+    if from_id:
+        agent_of, index = state.locate(from_id)
+        if agent_of != agent or index >= len(synced):
+            raise RuleViolation(
+                f"skill '{from_id}' is not in {agent}'s synchronized section"
+            )
+        if index < start:
+            raise RuleViolation(
+                f"skill '{from_id}' or a later one has started; only skills after the last "
+                "started one can be unsynchronized"
+            )
+        start = index
+    pulled = synced[start:]
+    if not pulled:
+        raise RuleViolation(f"{agent} has no synchronized skills that have not started")
+    puts = tuple(
+        PlacedSkill(start + offset, replace(skill, transfer=Transfer.REMOVING))
+        for offset, skill in enumerate(pulled)
+    )
+    return Proposal(
+        EventKind.UNSYNC_REQUESTED,
+        agent,
+        f"asking {agent} to give back {_ids(pulled)}",
+        Change(put_skills=puts),
+    )
+
+
+def plan_confirm_unsync(
+    state: MissionState, agent: str, removed_ids: Sequence[str]
+) -> Proposal:
+    """The robot removed ``removed_ids``; they return to the blueprint, the rest stay."""
+    removing = _pending(state.task(agent), Transfer.REMOVING)
+    if not removing:
+        raise RuleViolation(f"no unsynchronize on {agent} awaits an answer")
+    _require_run(
+        removing, removed_ids, agent, "removals", from_front=False, allow_empty=True
+    )
+    kept = removing[: len(removing) - len(removed_ids)]
+    removed = removing[len(kept) :]
+    updated = [replace(s, transfer=Transfer.NONE) for s in kept]
+    updated += [
+        replace(s, status=S.IDLE, transfer=Transfer.NONE, status_text="")
+        for s in removed
+    ]
+    summary = f"{agent} gave back {_ids(removed) or 'nothing'}"
+    if kept:
+        summary += f"; kept {_ids(kept)}, which had started"
+    return Proposal(
+        EventKind.UNSYNC_CONFIRMED,
+        agent,
+        summary,
+        Change(put_skills=_placed(state, updated)),
+    )
+
+
+def plan_report(
+    state: MissionState,
+    skill_id: str,
+    status: SkillStatus,
+    attempt: int | None = None,
+    text: str = "",
+    stamp: float = 0.0,
+) -> Proposal:
+    """Apply a robot's status report after checking it is legal and in task order."""
+    skill = state.skill(skill_id)
+    agent, index = state.locate(skill_id)
+    if skill.status is S.IDLE:
+        raise RuleViolation(
+            f"skill '{skill_id}' is not synchronized; the report is refused"
+        )
+    allowed = REPORTABLE.get(skill.status, frozenset())
+    if status not in allowed:
+        raise RuleViolation(
+            f"skill '{skill_id}' cannot go from {skill.status.name} to {status.name}"
+        )
+    new_attempt = skill.attempt if attempt is None else attempt
+    if new_attempt < skill.attempt:
+        raise RuleViolation(
+            f"skill '{skill_id}' is at attempt {skill.attempt}, not {new_attempt}"
+        )
+    if (
+        status is skill.status
+        and new_attempt == skill.attempt
+        and text == skill.status_text
+    ):
+        raise RuleViolation(f"the report for skill '{skill_id}' changes nothing")
+    if status is not S.IDLE_SYNCHRONIZED:
+        _require_turn(state, agent, index, skill_id)
+    started = skill.started or (stamp if status.has_started else 0.0)
+    new = replace(
+        skill,
+        status=status,
+        attempt=new_attempt,
+        status_text=text,
+        transfer=Transfer.NONE,
+        started=0.0 if status is S.IDLE_SYNCHRONIZED else started,
+        finished=stamp if status.is_final else 0.0,
+    )
+    return Proposal(
+        EventKind.STATUS_CHANGED,
+        agent,
+        f"'{skill_id}' on {agent}: {skill.status.name} -> {status.name}"
+        + (f" ({text})" if text else ""),
+        Change(put_skills=(PlacedSkill(index, new),)),
+    )
+
+
+def plan_stop(state: MissionState, agent: str) -> Proposal:
+    """The active skill of ``agent`` goes back to IDLE_SYNCHRONIZED (restarts next time)."""
+    for index, skill in enumerate(state.task(agent)):
+        if skill.status.is_active:
+            new = replace(
+                skill, status=S.IDLE_SYNCHRONIZED, status_text="stopped", started=0.0
+            )
+            return Proposal(
+                EventKind.SKILL_STOPPED,
+                agent,
+                f"'{skill.id}' on {agent} stopped",
+                Change(put_skills=(PlacedSkill(index, new),)),
+            )
+    raise RuleViolation(f"{agent} has no running, paused or waiting skill to stop")
+
+
+def plan_retry(state: MissionState, skill_id: str, new_id: str) -> Proposal:
+    """A fresh synchronized instance of a failed skill, right after it (attempt + 1)."""
+    failed = _unresolved_failure(state, skill_id, "retried")
+    agent, index = state.locate(skill_id)
+    fresh = replace(
+        failed,
+        id=new_id,
+        status=S.IDLE_SYNCHRONIZED,
+        attempt=failed.attempt + 1,
+        status_text="",
+        started=0.0,
+        finished=0.0,
+    )
+    resolved = replace(failed, resolution=Resolution.RETRIED)
+    return Proposal(
+        EventKind.SKILL_RETRIED,
+        agent,
+        f"'{skill_id}' on {agent} retried as '{new_id}' (attempt {fresh.attempt})",
+        Change(
+            put_skills=(PlacedSkill(index, resolved), PlacedSkill(index + 1, fresh))
+        ),
+    )
+
+
+def plan_skip(state: MissionState, skill_id: str) -> Proposal:
+    """Leave a failed skill behind; the robot goes on with the next one."""
+    failed = _unresolved_failure(state, skill_id, "skipped")
+    agent, index = state.locate(skill_id)
+    return Proposal(
+        EventKind.SKILL_SKIPPED,
+        agent,
+        f"failed '{skill_id}' on {agent} skipped",
+        Change(
+            put_skills=(
+                PlacedSkill(index, replace(failed, resolution=Resolution.SKIPPED)),
+            )
+        ),
+    )
+
+
+def _unresolved_failure(state: MissionState, skill_id: str, verb: str) -> SkillInstance:
+    skill = state.skill(skill_id)
+    if skill.status is not S.FAILURE:
+        raise RuleViolation(
+            f"skill '{skill_id}' is {skill.status.name}; only a FAILURE can be {verb}"
+        )
+    if skill.resolution is not Resolution.NONE:
+        raise RuleViolation(
+            f"failed skill '{skill_id}' was already {skill.resolution.name.lower()}"
+        )
+    return skill
+
+
+def _require_turn(state: MissionState, agent: str, index: int, skill_id: str) -> None:
+    """Only the first unsettled synchronized skill of a robot may run or finish."""
+    for earlier in state.task(agent)[:index]:
+        if not earlier.is_settled:
+            raise RuleViolation(
+                f"skill '{skill_id}' cannot progress before '{earlier.id}' "
+                f"({earlier.status.name}) on {agent} is done"
+            )
+
+
+def _pending(task: Sequence[SkillInstance], transfer: Transfer) -> list[SkillInstance]:
+    return [skill for skill in task if skill.transfer is transfer]
+
+
+def _require_run(
+    pending: Sequence[SkillInstance],
+    skill_ids: Sequence[str],
+    agent: str,
+    what: str,
+    from_front: bool,
+    allow_empty: bool = False,
+) -> None:
+    """Check ``skill_ids`` are the first (or last) of the pending skills, in order."""
+    if not skill_ids and not allow_empty:
+        raise InvalidRequest(f"the answer about {agent}'s {what} names no skills")
+    ids = [skill.id for skill in pending]
+    expected = ids[: len(skill_ids)] if from_front else ids[len(ids) - len(skill_ids) :]
+    if len(skill_ids) > len(ids) or list(skill_ids) != expected:
+        end = "first" if from_front else "last"
+        raise RuleViolation(
+            f"{', '.join(skill_ids) or 'nothing'} are not the {end} of {agent}'s pending "
+            f"{what} ({', '.join(ids) or 'none'})"
+        )
+
+
+def _placed(
+    state: MissionState, skills: Sequence[SkillInstance]
+) -> tuple[PlacedSkill, ...]:
+    return tuple(PlacedSkill(state.locate(skill.id)[1], skill) for skill in skills)
+
+
+def _ids(skills: Sequence[SkillInstance]) -> str:
+    return ", ".join(skill.id for skill in skills)

@@ -1,0 +1,350 @@
+"""The skill library: which agents exist and what each can be asked to do.
+
+A library is a YAML file (``rosmc_library: 1``) with ``models`` (the skills of
+each agent model, each with typed parameters) and ``agents`` (the team: name,
+dynamic or static, model). A malformed file is refused with an error naming
+the file, the key and the problem.
+"""
+
+from __future__ import annotations
+
+import enum
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, NoReturn
+
+import yaml
+
+from .errors import InvalidRequest, LibraryError, NotFound, RuleViolation
+from .params import (
+    COMPATIBLE_MARKERS,
+    MARKER_PARAM_TYPE,
+    MarkerType,
+    ParamType,
+    Value,
+    check_value,
+)
+
+LIBRARY_VERSION = 1
+
+
+class AgentKind(enum.IntEnum):
+    """Dynamic agents (robots) execute skills; static agents are known objects."""
+
+    DYNAMIC = 0
+    STATIC = 1
+
+
+@dataclass(frozen=True)
+class ParameterSpec:
+    """Schema of one skill parameter."""
+
+    name: str
+    type: ParamType
+    default: Value
+    minimum: float | None = None
+    maximum: float | None = None
+    choices: tuple[Value, ...] = ()
+    unit: str = ""
+    description: str = ""
+    marker_type: MarkerType | None = None
+
+    def check(self, raw: object, skill: str) -> Value:
+        """Check a value for this parameter of ``skill``; return it normalized."""
+        what = f"parameter '{self.name}' of skill '{skill}'"
+        return check_value(
+            self.type, raw, what, self.minimum, self.maximum, self.choices
+        )
+
+    def accepts_marker(self, marker_type: MarkerType) -> bool:
+        """Whether a task marker of ``marker_type`` may fill this parameter."""
+        if self.marker_type is None:
+            return False
+        return marker_type in COMPATIBLE_MARKERS[self.marker_type]
+
+
+@dataclass(frozen=True)
+class SkillSpec:
+    """A skill an agent model implements."""
+
+    name: str
+    parameters: tuple[ParameterSpec, ...] = ()
+    description: str = ""
+    estimated_duration: float = 0.0
+
+    def parameter(self, name: str) -> ParameterSpec:
+        """The parameter called ``name``; NotFound if the skill has none."""
+        for spec in self.parameters:
+            if spec.name == name:
+                return spec
+        known = ", ".join(spec.name for spec in self.parameters) or "none"
+        raise NotFound(
+            f"skill '{self.name}' has no parameter '{name}' (it has: {known})"
+        )
+
+    def defaults(self) -> dict[str, Value]:
+        """Every parameter's default value."""
+        return {spec.name: spec.default for spec in self.parameters}
+
+
+@dataclass(frozen=True)
+class AgentSpec:
+    """One member of the team."""
+
+    name: str
+    kind: AgentKind
+    model: str
+    description: str = ""
+
+
+@dataclass(frozen=True)
+class Library:
+    """Agents and the skills of each agent model."""
+
+    name: str
+    agents: tuple[AgentSpec, ...]
+    models: Mapping[str, Mapping[str, SkillSpec]] = field(default_factory=dict)
+
+    def agent(self, name: str) -> AgentSpec:
+        """The agent called ``name``; NotFound otherwise."""
+        for agent in self.agents:
+            if agent.name == name:
+                return agent
+        known = ", ".join(agent.name for agent in self.agents)
+        raise NotFound(f"there is no agent '{name}' (agents: {known})")
+
+    @property
+    def dynamic_agents(self) -> tuple[str, ...]:
+        """Names of the agents that execute skills, in library order."""
+        return tuple(a.name for a in self.agents if a.kind is AgentKind.DYNAMIC)
+
+    def skills_of(self, agent: str) -> Mapping[str, SkillSpec]:
+        """The skills ``agent`` can execute."""
+        return self.models.get(self.agent(agent).model, {})
+
+    def skill(self, agent: str, skill: str) -> SkillSpec:
+        """The skill ``skill`` of ``agent``; NotFound or RuleViolation otherwise."""
+        spec = self.agent(agent)
+        if spec.kind is AgentKind.STATIC:
+            raise RuleViolation(
+                f"'{agent}' is a static agent and cannot execute skills"
+            )
+        skills = self.models.get(spec.model, {})
+        if skill not in skills:
+            known = ", ".join(sorted(skills)) or "none"
+            raise NotFound(f"agent '{agent}' has no skill '{skill}' (it has: {known})")
+        return skills[skill]
+
+
+def load_library(path: str | Path) -> Library:
+    """Read a library YAML file; LibraryError names the file, key and problem."""
+    source = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as error:
+        raise LibraryError(
+            f"{source}: cannot read the library file ({error.strerror})"
+        ) from error
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as error:
+        raise LibraryError(
+            f"{source}: not valid YAML ({_yaml_problem(error)})"
+        ) from error
+    return library_from_dict(data, source)
+
+
+def _yaml_problem(error: yaml.YAMLError) -> str:
+    mark = getattr(error, "problem_mark", None)
+    problem = getattr(error, "problem", None) or str(error).splitlines()[0]
+    return f"{problem} at line {mark.line + 1}" if mark is not None else str(problem)
+
+
+def library_from_dict(data: object, source: str = "<library>") -> Library:
+    """Build a library from parsed YAML data, checking every key."""
+    reader = _Reader(source)
+    top = reader.mapping(
+        data, "", required={"rosmc_library", "name", "models", "agents"}
+    )
+    if top["rosmc_library"] != LIBRARY_VERSION:
+        reader.fail("rosmc_library", f"unsupported version {top['rosmc_library']!r}")
+    name = reader.text(top["name"], "name")
+    models_data = reader.mapping(top["models"], "models")
+    models = {
+        reader.text(model, f"models.{model}"): _read_model(
+            reader, raw, f"models.{model}"
+        )
+        for model, raw in models_data.items()
+    }
+    agents = _read_agents(reader, top["agents"], models)
+    return Library(name=name, agents=agents, models=models)
+
+
+def _read_agents(
+    reader: _Reader, raw: object, models: Mapping[str, Mapping[str, SkillSpec]]
+) -> tuple[AgentSpec, ...]:
+    agents: list[AgentSpec] = []
+    for name, entry in reader.mapping(raw, "agents").items():
+        key = f"agents.{name}"
+        body = reader.mapping(
+            entry, key, required={"kind", "model"}, optional={"description"}
+        )
+        kinds = {kind.name.lower(): kind for kind in AgentKind}
+        if body["kind"] not in kinds:
+            reader.fail(
+                f"{key}.kind", f"must be dynamic or static, got {body['kind']!r}"
+            )
+        model = reader.text(body["model"], f"{key}.model")
+        if model not in models and kinds[body["kind"]] is AgentKind.DYNAMIC:
+            reader.fail(f"{key}.model", f"names no model in 'models' ({model!r})")
+        description = reader.text(
+            body.get("description", ""), f"{key}.description", empty=True
+        )
+        agents.append(AgentSpec(str(name), kinds[body["kind"]], model, description))
+    if not agents:
+        reader.fail("agents", "the library declares no agents")
+    return tuple(agents)
+
+
+def _read_model(reader: _Reader, raw: object, key: str) -> dict[str, SkillSpec]:
+    body = reader.mapping(raw, key, required={"skills"}, optional={"description"})
+    skills: dict[str, SkillSpec] = {}
+    for name, entry in reader.mapping(body["skills"], f"{key}.skills").items():
+        skills[name] = _read_skill(reader, name, entry, f"{key}.skills.{name}")
+    return skills
+
+
+def _read_skill(reader: _Reader, name: str, raw: object, key: str) -> SkillSpec:
+    body = reader.mapping(
+        raw, key, optional={"description", "duration", "parameters"}, allow_none=True
+    )
+    params_raw = reader.mapping(body.get("parameters") or {}, f"{key}.parameters")
+    parameters = tuple(
+        _read_parameter(reader, name, pname, entry, f"{key}.parameters.{pname}")
+        for pname, entry in params_raw.items()
+    )
+    duration = reader.number(body.get("duration", 0.0), f"{key}.duration")
+    if duration < 0:
+        reader.fail(f"{key}.duration", "must not be negative")
+    description = reader.text(
+        body.get("description", ""), f"{key}.description", empty=True
+    )
+    return SkillSpec(name, parameters, description, duration)
+
+
+def _read_parameter(
+    reader: _Reader, skill: str, name: str, raw: object, key: str
+) -> ParameterSpec:
+    body = reader.mapping(
+        raw,
+        key,
+        required={"type", "default"},
+        optional={"min", "max", "choices", "unit", "description", "marker"},
+    )
+    types = {ptype.name.lower(): ptype for ptype in ParamType}
+    if body["type"] not in types:
+        reader.fail(
+            f"{key}.type", f"must be one of {', '.join(types)}, got {body['type']!r}"
+        )
+    ptype = types[body["type"]]
+    minimum = reader.number(body["min"], f"{key}.min") if "min" in body else None
+    maximum = reader.number(body["max"], f"{key}.max") if "max" in body else None
+    if minimum is not None and maximum is not None and minimum > maximum:
+        reader.fail(key, f"min {minimum:g} is greater than max {maximum:g}")
+    if (minimum is not None or maximum is not None) and ptype not in (
+        ParamType.INT,
+        ParamType.FLOAT,
+    ):
+        reader.fail(key, "min and max apply to int and float parameters only")
+    choices = reader.sequence(body.get("choices", []), f"{key}.choices")
+    try:
+        checked_choices = tuple(
+            check_value(ptype, c, f"{key}.choices") for c in choices
+        )
+        spec = ParameterSpec(
+            name=name,
+            type=ptype,
+            default=check_value(ptype, body["default"], f"{key}.default"),
+            minimum=minimum,
+            maximum=maximum,
+            choices=checked_choices,
+            unit=reader.text(body.get("unit", ""), f"{key}.unit", empty=True),
+            description=reader.text(
+                body.get("description", ""), f"{key}.description", empty=True
+            ),
+            marker_type=_read_marker_type(
+                reader, body.get("marker"), ptype, f"{key}.marker"
+            ),
+        )
+        spec.check(spec.default, skill)
+    except InvalidRequest as error:
+        reader.fail(f"{key}.default", str(error))
+    return spec
+
+
+def _read_marker_type(
+    reader: _Reader, raw: object, ptype: ParamType, key: str
+) -> MarkerType | None:
+    if raw is None:
+        return None
+    names = {marker.name.lower(): marker for marker in MarkerType}
+    if raw not in names:
+        reader.fail(key, f"must be one of {', '.join(names)}, got {raw!r}")
+    marker = names[str(raw)]
+    if MARKER_PARAM_TYPE[marker] is not ptype:
+        expected = MARKER_PARAM_TYPE[marker].name.lower()
+        reader.fail(
+            key, f"a {marker.name.lower()} marker fills {expected} parameters only"
+        )
+    return marker
+
+
+class _Reader:
+    """Checks pieces of a parsed YAML document and names the key on failure."""
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+
+    def fail(self, key: str, problem: str) -> NoReturn:
+        where = f"{self.source}: {key}" if key else self.source
+        raise LibraryError(f"{where}: {problem}")
+
+    def mapping(
+        self,
+        raw: object,
+        key: str,
+        required: set[str] | frozenset[str] = frozenset(),
+        optional: set[str] | frozenset[str] | None = None,
+        allow_none: bool = False,
+    ) -> dict[str, Any]:
+        if raw is None and allow_none:
+            raw = {}
+        if not isinstance(raw, dict):
+            self.fail(key, f"must be a mapping, got {type(raw).__name__}")
+        for name in raw:
+            if not isinstance(name, str):
+                self.fail(key, f"has a non-text key {name!r}")
+        missing = sorted(required - raw.keys())
+        if missing:
+            self.fail(key, f"is missing {', '.join(missing)}")
+        if optional is not None:
+            unknown = sorted(raw.keys() - required - optional)
+            if unknown:
+                self.fail(key, f"has unknown keys {', '.join(unknown)}")
+        return raw
+
+    def sequence(self, raw: object, key: str) -> list[Any]:
+        if not isinstance(raw, list):
+            self.fail(key, f"must be a list, got {type(raw).__name__}")
+        return raw
+
+    def text(self, raw: object, key: str, empty: bool = False) -> str:
+        if not isinstance(raw, str) or (not empty and not raw.strip()):
+            self.fail(key, f"must be non-empty text, got {raw!r}")
+        return raw
+
+    def number(self, raw: object, key: str) -> float:
+        if isinstance(raw, bool) or not isinstance(raw, (int, float)):
+            self.fail(key, f"must be a number, got {raw!r}")
+        return float(raw)

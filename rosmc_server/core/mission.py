@@ -1,0 +1,364 @@
+"""The mission: one object that owns the state and accepts or refuses every change.
+
+Each public operation validates its request completely, then commits exactly
+one :class:`MissionEvent` that increments the revision. A refused request
+raises a :class:`RosmcError` and leaves the mission as it was. Clock and id
+generation are injected so tests and replays are deterministic.
+"""
+
+from __future__ import annotations
+
+import secrets
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import replace
+
+from . import barriers, editing, execution, markers
+from .changes import Change, EventKind, MissionEvent, Proposal
+from .errors import RuleViolation, StaleRevision
+from .library import Library
+from .model import SkillStatus, TaskMarker, Transfer
+from .params import Pose
+from .state import MissionContent, MissionState
+
+IdFactory = Callable[[str], str]
+
+
+def random_ids(prefix: str) -> str:
+    """Short random ids like ``drone-3fa9c1``: easy to type, unique in practice."""
+    return f"{prefix}-{secrets.token_hex(3)}"
+
+
+class Mission:
+    """The authoritative mission of a team, as the mission server holds it.
+
+    Not thread-safe: an adapter that calls it from several threads serializes
+    the calls behind one lock.
+    """
+
+    def __init__(
+        self,
+        library: Library,
+        content: MissionContent | None = None,
+        revision: int = 0,
+        clock: Callable[[], float] = time.time,
+        new_id: IdFactory = random_ids,
+    ) -> None:
+        self.library = library
+        self.state = MissionState(content or MissionContent.empty(library), revision)
+        self._clock = clock
+        self._new_id = new_id
+
+    @property
+    def revision(self) -> int:
+        """Increments by one with every accepted change."""
+        return self.state.revision
+
+    # -- blueprint editing ---------------------------------------------------
+    def add_skill(
+        self,
+        agent: str,
+        skill: str,
+        params: Mapping[str, object] | None = None,
+        *,
+        bindings: Mapping[str, str] | None = None,
+        label: str = "",
+        index: int | None = None,
+        timeout: float = 0.0,
+        max_retries: int = 0,
+        base_revision: int | None = None,
+    ) -> MissionEvent:
+        """Add a skill with library defaults for every parameter not given."""
+        self._check_revision(base_revision)
+        proposal = editing.plan_add_skill(
+            self.state,
+            self.library,
+            self._unique_id(agent),
+            agent,
+            skill,
+            params or {},
+            bindings or {},
+            label,
+            index,
+            timeout,
+            max_retries,
+        )
+        return self._commit(proposal)
+
+    def edit_skill(
+        self,
+        skill_id: str,
+        params: Mapping[str, object] | None = None,
+        *,
+        bindings: Mapping[str, str | None] | None = None,
+        label: str | None = None,
+        timeout: float | None = None,
+        max_retries: int | None = None,
+        base_revision: int | None = None,
+    ) -> MissionEvent:
+        """Change a blueprint skill's parameters, bindings, label or options."""
+        self._check_revision(base_revision)
+        return self._commit(
+            editing.plan_edit_skill(
+                self.state,
+                self.library,
+                skill_id,
+                params or {},
+                bindings or {},
+                label,
+                timeout,
+                max_retries,
+            )
+        )
+
+    def delete_skills(
+        self, skill_ids: Sequence[str], *, base_revision: int | None = None
+    ) -> MissionEvent:
+        """Delete blueprint skills."""
+        self._check_revision(base_revision)
+        return self._commit(editing.plan_delete_skills(self.state, skill_ids))
+
+    def reorder(
+        self, agent: str, order: Sequence[str], *, base_revision: int | None = None
+    ) -> MissionEvent:
+        """Give an agent's editable blueprint a new order."""
+        self._check_revision(base_revision)
+        return self._commit(editing.plan_reorder(self.state, agent, order))
+
+    # -- synchronization and execution ------------------------------------------
+    def synchronize(
+        self,
+        agent: str,
+        upto_id: str | None = None,
+        *,
+        base_revision: int | None = None,
+    ) -> MissionEvent:
+        """Start uploading a prefix of the agent's blueprint to its robot."""
+        self._check_revision(base_revision)
+        return self._commit(execution.plan_synchronize(self.state, agent, upto_id))
+
+    def confirm_synchronized(
+        self, agent: str, skill_ids: Sequence[str]
+    ) -> MissionEvent:
+        """The robot acknowledged the upload of these skills."""
+        return self._commit(execution.plan_confirm_sync(self.state, agent, skill_ids))
+
+    def decline_synchronize(
+        self, agent: str, skill_ids: Sequence[str], reason: str
+    ) -> MissionEvent:
+        """The robot refused these uploads, or cannot be reached."""
+        return self._commit(
+            execution.plan_decline_sync(self.state, agent, skill_ids, reason)
+        )
+
+    def unsynchronize(
+        self,
+        agent: str,
+        from_id: str | None = None,
+        *,
+        base_revision: int | None = None,
+    ) -> MissionEvent:
+        """Ask the robot to give back not-started skills from ``from_id`` on."""
+        self._check_revision(base_revision)
+        return self._commit(execution.plan_request_unsync(self.state, agent, from_id))
+
+    def confirm_unsynchronized(
+        self, agent: str, removed_ids: Sequence[str]
+    ) -> MissionEvent:
+        """The robot removed ``removed_ids`` (the others had started)."""
+        return self._commit(
+            execution.plan_confirm_unsync(self.state, agent, removed_ids)
+        )
+
+    def report_status(
+        self,
+        skill_id: str,
+        status: SkillStatus,
+        *,
+        attempt: int | None = None,
+        text: str = "",
+        stamp: float | None = None,
+    ) -> MissionEvent:
+        """A robot's status report for one of its synchronized skills."""
+        when = self._clock() if stamp is None else stamp
+        return self._commit(
+            execution.plan_report(self.state, skill_id, status, attempt, text, when)
+        )
+
+    def stop(self, agent: str, *, base_revision: int | None = None) -> MissionEvent:
+        """The agent's active skill goes back to IDLE_SYNCHRONIZED."""
+        self._check_revision(base_revision)
+        return self._commit(execution.plan_stop(self.state, agent))
+
+    def retry(self, skill_id: str, *, base_revision: int | None = None) -> MissionEvent:
+        """Run a failed skill again as a fresh instance right after it."""
+        self._check_revision(base_revision)
+        agent, _ = self.state.locate(skill_id)
+        return self._commit(
+            execution.plan_retry(self.state, skill_id, self._unique_id(agent))
+        )
+
+    def skip(self, skill_id: str, *, base_revision: int | None = None) -> MissionEvent:
+        """Leave a failed skill behind."""
+        self._check_revision(base_revision)
+        return self._commit(execution.plan_skip(self.state, skill_id))
+
+    # -- barriers ------------------------------------------------------------
+    def add_barrier(
+        self, skill_ids: Sequence[str], *, base_revision: int | None = None
+    ) -> MissionEvent:
+        """Make skills on distinct agents start together."""
+        self._check_revision(base_revision)
+        new_id = self._unique_id("barrier")
+        return self._commit(barriers.plan_add_barrier(self.state, skill_ids, new_id))
+
+    def delete_barrier(
+        self, barrier_id: str, *, base_revision: int | None = None
+    ) -> MissionEvent:
+        """Remove a barrier whose skills have not started."""
+        self._check_revision(base_revision)
+        return self._commit(barriers.plan_delete_barrier(self.state, barrier_id))
+
+    # -- task markers ----------------------------------------------------------
+    def add_marker(
+        self, marker: TaskMarker, *, base_revision: int | None = None
+    ) -> MissionEvent:
+        """Add a task marker (an empty name gets a generated one)."""
+        self._check_revision(base_revision)
+        return self._commit(markers.plan_add_marker(self.state, marker))
+
+    def move_marker(
+        self,
+        name: str,
+        pose: Pose,
+        vertices: Sequence[Pose] = (),
+        *,
+        base_revision: int | None = None,
+    ) -> MissionEvent:
+        """Move a task marker; bound parameters follow."""
+        self._check_revision(base_revision)
+        return self._commit(
+            markers.plan_move_marker(self.state, self.library, name, pose, vertices)
+        )
+
+    def rename_marker(
+        self, name: str, new_name: str, *, base_revision: int | None = None
+    ) -> MissionEvent:
+        """Rename a task marker; bindings follow."""
+        self._check_revision(base_revision)
+        return self._commit(markers.plan_rename_marker(self.state, name, new_name))
+
+    def delete_marker(
+        self, name: str, *, base_revision: int | None = None
+    ) -> MissionEvent:
+        """Delete a task marker no skill is bound to."""
+        self._check_revision(base_revision)
+        return self._commit(markers.plan_delete_marker(self.state, name))
+
+    # -- whole missions ----------------------------------------------------------
+    def new_mission(
+        self, *, keep_markers: bool = True, base_revision: int | None = None
+    ) -> MissionEvent:
+        """Start over with empty tasks (and markers unless ``keep_markers``)."""
+        self._check_revision(base_revision)
+        self._require_robots_idle("start a new mission")
+        content = MissionContent.empty(self.library)
+        if keep_markers:
+            content.markers = {m.name: m for m in self.state.markers}
+        return self._commit(
+            Proposal(
+                EventKind.MISSION_REPLACED,
+                "",
+                "new mission",
+                Change(replacement=content),
+            )
+        )
+
+    def load(
+        self, content: MissionContent, source: str, *, base_revision: int | None = None
+    ) -> MissionEvent:
+        """Replace the mission with a loaded one (checked by persistence).
+
+        Skills the file shows as synchronized but unfinished return to the
+        blueprint: no robot holds them now. SUCCESS and FAILURE stay as logs.
+        """
+        self._check_revision(base_revision)
+        self._require_robots_idle("load a mission")
+        tasks = {
+            agent: [
+                s
+                if s.status.is_final
+                or s.status is SkillStatus.IDLE
+                and s.transfer is Transfer.NONE
+                else replace(
+                    s,
+                    status=SkillStatus.IDLE,
+                    transfer=Transfer.NONE,
+                    status_text="",
+                    started=0.0,
+                )
+                for s in task
+            ]
+            for agent, task in content.tasks.items()
+        }
+        loaded = MissionContent(
+            content.library, tasks, dict(content.barriers), dict(content.markers)
+        )
+        return self._commit(
+            Proposal(
+                EventKind.MISSION_REPLACED,
+                "",
+                f"mission loaded from {source}",
+                Change(replacement=loaded),
+            )
+        )
+
+    def replay(self, event: MissionEvent) -> None:
+        """Apply a journaled event; it must be the next revision."""
+        if event.revision != self.revision + 1:
+            raise RuleViolation(
+                f"event revision {event.revision} does not follow revision {self.revision}"
+            )
+        self.state.apply(event.change)
+        self.state.revision = event.revision
+
+    # -- internals ---------------------------------------------------------------
+    def _commit(self, proposal: Proposal) -> MissionEvent:
+        self.state.apply(proposal.change)
+        self.state.revision += 1
+        return MissionEvent(
+            self.state.revision,
+            proposal.kind,
+            proposal.agent,
+            proposal.summary,
+            self._clock(),
+            proposal.change,
+        )
+
+    def _check_revision(self, base_revision: int | None) -> None:
+        if base_revision is not None and base_revision != self.state.revision:
+            raise StaleRevision(base_revision, self.state.revision)
+
+    def _unique_id(self, prefix: str) -> str:
+        for _ in range(100):
+            candidate = self._new_id(prefix)
+            if not self.state.has_skill(candidate) and not self._is_barrier(candidate):
+                return candidate
+        raise RuleViolation(
+            "could not find a free id; the id factory keeps repeating itself"
+        )
+
+    def _is_barrier(self, candidate: str) -> bool:
+        return any(barrier.id == candidate for barrier in self.state.barriers)
+
+    def _require_robots_idle(self, action: str) -> None:
+        for skill in self.state.skills():
+            busy = (
+                skill.status in (SkillStatus.IDLE_SYNCHRONIZED,)
+                or skill.status.is_active
+            )
+            if busy or skill.transfer is not Transfer.NONE:
+                raise RuleViolation(
+                    f"cannot {action} while {skill.agent} holds unfinished skill '{skill.id}'; "
+                    "unsynchronize or stop it first"
+                )

@@ -1,0 +1,396 @@
+"""Mission files: versioned YAML, read with ``yaml.safe_load`` only.
+
+A file holds the mission's tasks, barriers, task markers, revision and the
+name of its library. Loading checks everything against the library and the
+mission rules and fails with one sentence naming the file and the problem;
+nothing is half-loaded. Python object tags are refused, never executed.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import replace
+from pathlib import Path
+from typing import Any, NoReturn
+
+import yaml
+
+from .barriers import describe_cycle, find_deadlock
+from .errors import MissionFileError, RosmcError
+from .library import Library
+from .model import Barrier, Resolution, SkillInstance, SkillStatus, TaskMarker, Transfer
+from .params import MarkerType, Pose, value_to_data
+from .state import MissionContent
+
+MISSION_VERSION = 1
+
+
+def mission_to_dict(content: MissionContent, revision: int) -> dict[str, Any]:
+    """The mission as plain data, ready for ``yaml.safe_dump``."""
+    return {
+        "rosmc_mission": MISSION_VERSION,
+        "library": content.library,
+        "revision": revision,
+        "tasks": {
+            agent: [_skill_to_dict(skill) for skill in task]
+            for agent, task in content.tasks.items()
+        },
+        "barriers": [
+            {"id": b.id, "skills": list(b.skill_ids)} for b in content.barriers.values()
+        ],
+        "markers": [_marker_to_dict(m) for m in content.markers.values()],
+    }
+
+
+def dump_mission(content: MissionContent, revision: int) -> str:
+    """The mission as a YAML document."""
+    return yaml.safe_dump(
+        mission_to_dict(content, revision), sort_keys=False, width=100
+    )
+
+
+def save_mission(path: str | Path, content: MissionContent, revision: int) -> None:
+    """Write the mission to ``path`` atomically (write a temporary file, then rename)."""
+    target = Path(path)
+    temporary = target.with_name(f".{target.name}.tmp")
+    try:
+        temporary.write_text(dump_mission(content, revision), encoding="utf-8")
+        temporary.replace(target)
+    except OSError as error:
+        raise MissionFileError(
+            f"{target}: cannot write the mission ({error.strerror})"
+        ) from error
+
+
+def load_mission(path: str | Path, library: Library) -> tuple[MissionContent, int]:
+    """Read and check a mission file; return its content and revision."""
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as error:
+        raise MissionFileError(
+            f"{path}: cannot read the mission ({error.strerror})"
+        ) from error
+    return parse_mission(text, library, str(path))
+
+
+def parse_mission(
+    text: str, library: Library, source: str
+) -> tuple[MissionContent, int]:
+    """Parse and check a mission document; return its content and revision."""
+    try:
+        data = yaml.safe_load(text)
+    except yaml.constructor.ConstructorError as error:
+        raise MissionFileError(
+            f"{source}: refused a YAML tag that is not plain data ({error.problem})"
+        ) from error
+    except yaml.YAMLError as error:
+        raise MissionFileError(f"{source}: not valid YAML ({error})") from error
+    return mission_from_dict(data, library, source)
+
+
+def mission_from_dict(
+    data: object, library: Library, source: str = "<mission>"
+) -> tuple[MissionContent, int]:
+    """Build and check a mission from plain data."""
+    reader = _FileReader(source)
+    top = reader.fields(
+        data,
+        "",
+        {"rosmc_mission", "library", "revision", "tasks"},
+        {"barriers", "markers"},
+    )
+    if top["rosmc_mission"] != MISSION_VERSION:
+        reader.fail(
+            "rosmc_mission",
+            f"unsupported mission file version {top['rosmc_mission']!r}",
+        )
+    if top["library"] != library.name:
+        reader.fail(
+            "library", f"written for library {top['library']!r}, not {library.name!r}"
+        )
+    revision = top["revision"]
+    if isinstance(revision, bool) or not isinstance(revision, int) or revision < 0:
+        reader.fail("revision", f"must be a whole number >= 0, got {revision!r}")
+    markers = _read_markers(reader, top.get("markers", []))
+    tasks = _read_tasks(reader, top["tasks"], library, markers)
+    barriers = _read_barriers(reader, top.get("barriers", []), tasks)
+    return MissionContent(library.name, tasks, barriers, markers), revision
+
+
+def _read_markers(reader: _FileReader, raw: object) -> dict[str, TaskMarker]:
+    from .markers import check_marker
+
+    markers: dict[str, TaskMarker] = {}
+    for i, entry in enumerate(reader.items(raw, "markers")):
+        key = f"markers[{i}]"
+        body = reader.fields(entry, key, {"name", "type", "pose"}, {"vertices"})
+        marker_type = reader.enum(MarkerType, body["type"], f"{key}.type")
+        try:
+            marker = check_marker(
+                TaskMarker(
+                    reader.text(body["name"], f"{key}.name"),
+                    marker_type,
+                    Pose.from_any(body["pose"], f"{key}.pose"),
+                    tuple(
+                        Pose.from_any(v, f"{key}.vertices")
+                        for v in body.get("vertices", [])
+                    ),
+                )
+            )
+        except RosmcError as error:
+            reader.fail(key, str(error))
+        if marker.name in markers:
+            reader.fail(key, f"marker name {marker.name!r} appears twice")
+        markers[marker.name] = marker
+    return markers
+
+
+def _read_tasks(
+    reader: _FileReader,
+    raw: object,
+    library: Library,
+    markers: Mapping[str, TaskMarker],
+) -> dict[str, list[SkillInstance]]:
+    from .editing import bound_values, check_params
+
+    body = reader.fields(raw, "tasks", set(), None)
+    tasks: dict[str, list[SkillInstance]] = {
+        agent: [] for agent in library.dynamic_agents
+    }
+    seen: set[str] = set()
+    for agent, entries in body.items():
+        if agent not in tasks:
+            reader.fail(f"tasks.{agent}", "names no dynamic agent of the library")
+        for i, entry in enumerate(reader.items(entries, f"tasks.{agent}")):
+            key = f"tasks.{agent}[{i}]"
+            skill = _read_skill(reader, entry, agent, key)
+            if skill.id in seen:
+                reader.fail(f"{key}.id", f"skill id {skill.id!r} appears twice")
+            seen.add(skill.id)
+            try:
+                spec = library.skill(agent, skill.skill)
+                skill = replace(skill, params=check_params(spec, skill.params))
+                missing = sorted({p.name for p in spec.parameters} - set(skill.params))
+                if missing:
+                    reader.fail(f"{key}.params", f"is missing {', '.join(missing)}")
+                bound_values(lambda name: _marker(markers, name), spec, skill.bindings)
+            except RosmcError as error:
+                reader.fail(key, str(error))
+            tasks[agent].append(skill)
+        _check_sections(reader, tasks[agent], f"tasks.{agent}")
+    return tasks
+
+
+def _marker(markers: Mapping[str, TaskMarker], name: str) -> TaskMarker:
+    if name not in markers:
+        raise MissionFileError(f"binds marker {name!r}, which the file does not define")
+    return markers[name]
+
+
+def _read_skill(
+    reader: _FileReader, raw: object, agent: str, key: str
+) -> SkillInstance:
+    body = reader.fields(
+        raw,
+        key,
+        {"id", "skill", "params"},
+        {
+            "label",
+            "bindings",
+            "status",
+            "transfer",
+            "resolution",
+            "attempt",
+            "timeout",
+            "max_retries",
+            "status_text",
+            "started",
+            "finished",
+        },
+    )
+    params = reader.fields(body["params"], f"{key}.params", set(), None)
+    bindings = reader.fields(body.get("bindings", {}), f"{key}.bindings", set(), None)
+    for name, marker in bindings.items():
+        reader.text(marker, f"{key}.bindings.{name}")
+    return SkillInstance(
+        id=reader.text(body["id"], f"{key}.id"),
+        agent=agent,
+        skill=reader.text(body["skill"], f"{key}.skill"),
+        label=reader.text(body.get("label", body["skill"]), f"{key}.label"),
+        params=dict(params),
+        bindings=dict(bindings),
+        status=reader.enum(SkillStatus, body.get("status", "IDLE"), f"{key}.status"),
+        transfer=reader.enum(Transfer, body.get("transfer", "NONE"), f"{key}.transfer"),
+        resolution=reader.enum(
+            Resolution, body.get("resolution", "NONE"), f"{key}.resolution"
+        ),
+        attempt=reader.whole(body.get("attempt", 1), f"{key}.attempt", minimum=1),
+        timeout=reader.number(body.get("timeout", 0.0), f"{key}.timeout"),
+        max_retries=reader.whole(
+            body.get("max_retries", 0), f"{key}.max_retries", minimum=0
+        ),
+        status_text=reader.text(
+            body.get("status_text", ""), f"{key}.status_text", empty=True
+        ),
+        started=reader.number(body.get("started", 0.0), f"{key}.started"),
+        finished=reader.number(body.get("finished", 0.0), f"{key}.finished"),
+    )
+
+
+def _check_sections(reader: _FileReader, task: list[SkillInstance], key: str) -> None:
+    """Synchronized skills first, then uploading blueprint skills, then the rest."""
+    rank_seen = 0
+    for i, skill in enumerate(task):
+        if skill.status is not SkillStatus.IDLE:
+            rank = 0
+        else:
+            rank = 1 if skill.transfer is Transfer.UPLOADING else 2
+        if rank < rank_seen:
+            reader.fail(f"{key}[{i}]", "a synchronized skill follows a blueprint skill")
+        if (
+            skill.transfer is Transfer.REMOVING
+            and skill.status is not SkillStatus.IDLE_SYNCHRONIZED
+        ):
+            reader.fail(
+                f"{key}[{i}].transfer", "only IDLE_SYNCHRONIZED skills can be removing"
+            )
+        if (
+            skill.resolution is not Resolution.NONE
+            and skill.status is not SkillStatus.FAILURE
+        ):
+            reader.fail(
+                f"{key}[{i}].resolution", "only a FAILURE can be retried or skipped"
+            )
+        rank_seen = max(rank_seen, rank)
+
+
+def _read_barriers(
+    reader: _FileReader, raw: object, tasks: Mapping[str, list[SkillInstance]]
+) -> dict[str, Barrier]:
+    agent_of = {skill.id: agent for agent, task in tasks.items() for skill in task}
+    barriers: dict[str, Barrier] = {}
+    member_of: dict[str, str] = {}
+    for i, entry in enumerate(reader.items(raw, "barriers")):
+        key = f"barriers[{i}]"
+        body = reader.fields(entry, key, {"id", "skills"}, set())
+        barrier_id = reader.text(body["id"], f"{key}.id")
+        members = tuple(
+            reader.text(s, f"{key}.skills") for s in reader.items(body["skills"], key)
+        )
+        if barrier_id in barriers or barrier_id in agent_of:
+            reader.fail(f"{key}.id", f"id {barrier_id!r} appears twice")
+        if len(members) < 2:
+            reader.fail(f"{key}.skills", "a barrier needs at least two skills")
+        for skill_id in members:
+            if skill_id not in agent_of:
+                reader.fail(f"{key}.skills", f"refers to unknown skill {skill_id!r}")
+            if skill_id in member_of:
+                reader.fail(
+                    f"{key}.skills", f"skill {skill_id!r} is already in another barrier"
+                )
+            member_of[skill_id] = barrier_id
+        if len({agent_of[s] for s in members}) != len(members):
+            reader.fail(f"{key}.skills", "barrier members must be on distinct agents")
+        barriers[barrier_id] = Barrier(barrier_id, members)
+    order = {agent: [s.id for s in task] for agent, task in tasks.items()}
+    cycle = find_deadlock(order, [b.skill_ids for b in barriers.values()])
+    if cycle:
+        reader.fail("barriers", f"the barriers deadlock: {describe_cycle(cycle)}")
+    return barriers
+
+
+def _skill_to_dict(skill: SkillInstance) -> dict[str, Any]:
+    data: dict[str, Any] = {
+        "id": skill.id,
+        "skill": skill.skill,
+        "label": skill.label,
+        "params": {name: value_to_data(value) for name, value in skill.params.items()},
+        "status": skill.status.name,
+    }
+    if skill.bindings:
+        data["bindings"] = dict(skill.bindings)
+    optional = {
+        "transfer": (skill.transfer.name, "NONE"),
+        "resolution": (skill.resolution.name, "NONE"),
+        "attempt": (skill.attempt, 1),
+        "timeout": (skill.timeout, 0.0),
+        "max_retries": (skill.max_retries, 0),
+        "status_text": (skill.status_text, ""),
+        "started": (skill.started, 0.0),
+        "finished": (skill.finished, 0.0),
+    }
+    data.update(
+        {key: value for key, (value, default) in optional.items() if value != default}
+    )
+    return data
+
+
+def _marker_to_dict(marker: TaskMarker) -> dict[str, Any]:
+    data: dict[str, Any] = {
+        "name": marker.name,
+        "type": marker.type.name,
+        "pose": marker.pose.to_dict(),
+    }
+    if marker.vertices:
+        data["vertices"] = [v.to_dict() for v in marker.vertices]
+    return data
+
+
+class _FileReader:
+    """Checks pieces of a parsed mission document and names the key on failure."""
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+
+    def fail(self, key: str, problem: str) -> NoReturn:
+        raise MissionFileError(
+            f"{self.source}: {key}: {problem}" if key else f"{self.source}: {problem}"
+        )
+
+    def fields(
+        self, raw: object, key: str, required: set[str], optional: set[str] | None
+    ) -> dict[str, Any]:
+        if not isinstance(raw, dict):
+            self.fail(key, f"must be a mapping, got {type(raw).__name__}")
+        if any(not isinstance(name, str) for name in raw):
+            self.fail(key, "has a key that is not text")
+        missing = sorted(required - raw.keys())
+        if missing:
+            self.fail(key, f"is missing {', '.join(missing)}")
+        if optional is not None:
+            unknown = sorted(raw.keys() - required - optional)
+            if unknown:
+                self.fail(key, f"has unknown keys {', '.join(unknown)}")
+        return raw
+
+    def items(self, raw: object, key: str) -> list[Any]:
+        if not isinstance(raw, list):
+            self.fail(key, f"must be a list, got {type(raw).__name__}")
+        return raw
+
+    def text(self, raw: object, key: str, empty: bool = False) -> str:
+        if not isinstance(raw, str) or (not empty and not raw.strip()):
+            self.fail(key, f"must be non-empty text, got {raw!r}")
+        return raw
+
+    def number(self, raw: object, key: str) -> float:
+        if (
+            isinstance(raw, bool)
+            or not isinstance(raw, (int, float))
+            or not math.isfinite(raw)
+            or raw < 0
+        ):
+            self.fail(key, f"must be a non-negative number, got {raw!r}")
+        return float(raw)
+
+    def whole(self, raw: object, key: str, minimum: int) -> int:
+        if isinstance(raw, bool) or not isinstance(raw, int) or raw < minimum:
+            self.fail(key, f"must be a whole number >= {minimum}, got {raw!r}")
+        return raw
+
+    def enum(self, kind: Any, raw: object, key: str) -> Any:
+        names = [member.name for member in kind]
+        if raw not in names:
+            self.fail(key, f"must be one of {', '.join(names)}, got {raw!r}")
+        return kind[raw]
