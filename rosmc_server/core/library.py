@@ -9,6 +9,7 @@ the file, the key and the problem.
 from __future__ import annotations
 
 import enum
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -146,6 +147,8 @@ def load_library(path: str | Path) -> Library:
         raise LibraryError(
             f"{source}: cannot read the library file ({error.strerror})"
         ) from error
+    except UnicodeDecodeError as error:
+        raise LibraryError(f"{source}: the file is not UTF-8 text (byte {error.start})") from error
     try:
         data = yaml.safe_load(text)
     except yaml.YAMLError as error:
@@ -165,9 +168,10 @@ def library_from_dict(data: object, source: str = "<library>") -> Library:
     """Build a library from parsed YAML data, checking every key."""
     reader = _Reader(source)
     top = reader.mapping(
-        data, "", required={"rosmc_library", "name", "models", "agents"}
+        data, "", required={"rosmc_library", "name", "models", "agents"}, optional=set()
     )
-    if top["rosmc_library"] != LIBRARY_VERSION:
+    version = top["rosmc_library"]
+    if isinstance(version, bool) or version != LIBRARY_VERSION:
         reader.fail("rosmc_library", f"unsupported version {top['rosmc_library']!r}")
     name = reader.text(top["name"], "name")
     models_data = reader.mapping(top["models"], "models")
@@ -347,4 +351,6 @@ class _Reader:
     def number(self, raw: object, key: str) -> float:
         if isinstance(raw, bool) or not isinstance(raw, (int, float)):
             self.fail(key, f"must be a number, got {raw!r}")
+        if not math.isfinite(raw):
+            self.fail(key, f"must be a finite number, got {raw!r}")
         return float(raw)
