@@ -179,13 +179,20 @@ def _transfer_word(transfer: Transfer) -> str:
 
 
 def barrier_without(state: MissionState, removed: set[str]) -> Change:
-    """Barrier updates for deleting skills ``removed``: shrink, or drop below two members."""
+    """Barrier updates for deleting skills ``removed``: shrink, or drop below two members.
+
+    Raises RuleViolation if a member that stays has started or awaits a transfer,
+    as for deleting the barrier itself.
+    """
     put: list[Barrier] = []
     dropped: list[str] = []
     for barrier in state.barriers:
         if not removed.intersection(barrier.skill_ids):
             continue
         remaining = tuple(s for s in barrier.skill_ids if s not in removed)
+        for skill_id in remaining:
+            # The robots hold this barrier too; once a member has started it is fixed.
+            _check_member_changeable(state, state.skill(skill_id), "have its barrier changed")
         if len(remaining) >= 2:
             put.append(Barrier(barrier.id, remaining))
         else:
