@@ -47,6 +47,9 @@ def plan_add_skill(
             f"index {index} is outside {agent}'s editable blueprint "
             f"(positions {editable_start} to {len(task)})"
         )
+    overlap = sorted(set(params) & set(bindings))
+    if overlap:
+        raise InvalidRequest(f"parameter '{overlap[0]}' is given both a value and a marker")
     values = spec.defaults()
     values.update(check_params(spec, params))
     values.update(bound_values(state.marker, spec, bindings))
