@@ -19,6 +19,7 @@ from .errors import RuleViolation, StaleRevision
 from .library import Library
 from .model import SkillStatus, TaskMarker, Transfer
 from .params import Pose
+from .reconcile import Reconciliation, RobotSkill, plan_reconcile
 from .state import MissionContent, MissionState
 
 IdFactory = Callable[[str], str]
@@ -137,9 +138,7 @@ class Mission:
         self._check_revision(base_revision)
         return self._commit(execution.plan_synchronize(self.state, agent, upto_id))
 
-    def confirm_synchronized(
-        self, agent: str, skill_ids: Sequence[str]
-    ) -> MissionEvent:
+    def confirm_synchronized(self, agent: str, skill_ids: Sequence[str]) -> MissionEvent:
         """The robot acknowledged the upload of these skills."""
         return self._commit(execution.plan_confirm_sync(self.state, agent, skill_ids))
 
@@ -147,9 +146,7 @@ class Mission:
         self, agent: str, skill_ids: Sequence[str], reason: str
     ) -> MissionEvent:
         """The robot refused these uploads, or cannot be reached."""
-        return self._commit(
-            execution.plan_decline_sync(self.state, agent, skill_ids, reason)
-        )
+        return self._commit(execution.plan_decline_sync(self.state, agent, skill_ids, reason))
 
     def unsynchronize(
         self,
@@ -162,13 +159,9 @@ class Mission:
         self._check_revision(base_revision)
         return self._commit(execution.plan_request_unsync(self.state, agent, from_id))
 
-    def confirm_unsynchronized(
-        self, agent: str, removed_ids: Sequence[str]
-    ) -> MissionEvent:
+    def confirm_unsynchronized(self, agent: str, removed_ids: Sequence[str]) -> MissionEvent:
         """The robot removed ``removed_ids`` (the others had started)."""
-        return self._commit(
-            execution.plan_confirm_unsync(self.state, agent, removed_ids)
-        )
+        return self._commit(execution.plan_confirm_unsync(self.state, agent, removed_ids))
 
     def report_status(
         self,
@@ -194,14 +187,20 @@ class Mission:
         """Run a failed skill again as a fresh instance right after it."""
         self._check_revision(base_revision)
         agent, _ = self.state.locate(skill_id)
-        return self._commit(
-            execution.plan_retry(self.state, skill_id, self._unique_id(agent))
-        )
+        return self._commit(execution.plan_retry(self.state, skill_id, self._unique_id(agent)))
 
     def skip(self, skill_id: str, *, base_revision: int | None = None) -> MissionEvent:
         """Leave a failed skill behind."""
         self._check_revision(base_revision)
         return self._commit(execution.plan_skip(self.state, skill_id))
+
+    def reconcile(
+        self, agent: str, robot_queue: Sequence[RobotSkill]
+    ) -> tuple[MissionEvent | None, Reconciliation]:
+        """Adopt the statuses a robot's snapshot shows; None if nothing differs."""
+        result = plan_reconcile(self.state, agent, robot_queue)
+        event = None if result.proposal is None else self._commit(result.proposal)
+        return event, result
 
     # -- barriers ------------------------------------------------------------
     def add_barrier(
@@ -212,17 +211,13 @@ class Mission:
         new_id = self._unique_id("barrier")
         return self._commit(barriers.plan_add_barrier(self.state, skill_ids, new_id))
 
-    def delete_barrier(
-        self, barrier_id: str, *, base_revision: int | None = None
-    ) -> MissionEvent:
+    def delete_barrier(self, barrier_id: str, *, base_revision: int | None = None) -> MissionEvent:
         """Remove a barrier whose skills have not started."""
         self._check_revision(base_revision)
         return self._commit(barriers.plan_delete_barrier(self.state, barrier_id))
 
     # -- task markers ----------------------------------------------------------
-    def add_marker(
-        self, marker: TaskMarker, *, base_revision: int | None = None
-    ) -> MissionEvent:
+    def add_marker(self, marker: TaskMarker, *, base_revision: int | None = None) -> MissionEvent:
         """Add a task marker (an empty name gets a generated one)."""
         self._check_revision(base_revision)
         return self._commit(markers.plan_add_marker(self.state, marker))
@@ -248,9 +243,7 @@ class Mission:
         self._check_revision(base_revision)
         return self._commit(markers.plan_rename_marker(self.state, name, new_name))
 
-    def delete_marker(
-        self, name: str, *, base_revision: int | None = None
-    ) -> MissionEvent:
+    def delete_marker(self, name: str, *, base_revision: int | None = None) -> MissionEvent:
         """Delete a task marker no skill is bound to."""
         self._check_revision(base_revision)
         return self._commit(markers.plan_delete_marker(self.state, name))
@@ -288,8 +281,7 @@ class Mission:
             agent: [
                 s
                 if s.status.is_final
-                or s.status is SkillStatus.IDLE
-                and s.transfer is Transfer.NONE
+                or (s.status is SkillStatus.IDLE and s.transfer is Transfer.NONE)
                 else replace(
                     s,
                     status=SkillStatus.IDLE,
@@ -344,19 +336,14 @@ class Mission:
             candidate = self._new_id(prefix)
             if not self.state.has_skill(candidate) and not self._is_barrier(candidate):
                 return candidate
-        raise RuleViolation(
-            "could not find a free id; the id factory keeps repeating itself"
-        )
+        raise RuleViolation("could not find a free id; the id factory keeps repeating itself")
 
     def _is_barrier(self, candidate: str) -> bool:
         return any(barrier.id == candidate for barrier in self.state.barriers)
 
     def _require_robots_idle(self, action: str) -> None:
         for skill in self.state.skills():
-            busy = (
-                skill.status in (SkillStatus.IDLE_SYNCHRONIZED,)
-                or skill.status.is_active
-            )
+            busy = skill.status in (SkillStatus.IDLE_SYNCHRONIZED,) or skill.status.is_active
             if busy or skill.transfer is not Transfer.NONE:
                 raise RuleViolation(
                     f"cannot {action} while {skill.agent} holds unfinished skill '{skill.id}'; "

@@ -1,0 +1,100 @@
+"""Which robot-link commands each accepted mission change requires.
+
+The mission server turns events into commands with :func:`commands_for_event`;
+the robot executor applies them. Both sides compute the queue hash from the
+same ordered ids (:func:`synced_ids`), so a disagreement shows at once.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+from .changes import EventKind, MissionEvent
+from .model import Barrier, SkillInstance, SkillStatus
+from .state import MissionState
+
+
+class CommandKind(enum.IntEnum):
+    """Robot-link command types (numbers match ``rosmc/RobotCommand``)."""
+
+    UPLOAD = 0
+    UNSYNC = 1
+    START = 2
+    PAUSE = 3
+    RESUME = 4
+    STOP = 5
+    RETRY = 6
+    SKIP = 7
+    BARRIERS = 8
+    SET_OPTIONS = 9
+    SYNC_STATE = 10
+
+
+@dataclass(frozen=True)
+class CommandSpec:
+    """A command for one agent's robot, before the link numbers it.
+
+    ``barriers``, where given (UPLOAD, BARRIERS, SYNC_STATE), is the complete
+    set of barriers of the skills the robot holds or is being sent; it replaces
+    the robot's set.
+    """
+
+    agent: str
+    kind: CommandKind
+    skills: tuple[SkillInstance, ...] = ()
+    skill_ids: tuple[str, ...] = ()
+    barriers: tuple[Barrier, ...] = ()
+    argument: str = ""
+
+
+def synced_ids(state: MissionState, agent: str) -> list[str]:
+    """Ids of the skills the robot holds, in order: the synchronized section."""
+    task = state.task(agent)
+    return [skill.id for skill in task[: state.sections(agent).synced_end]]
+
+
+def barriers_for(state: MissionState, skill_ids: set[str]) -> tuple[Barrier, ...]:
+    """Barriers that have a member among ``skill_ids``."""
+    return tuple(b for b in state.barriers if skill_ids.intersection(b.skill_ids))
+
+
+def queued_barriers(state: MissionState, agent: str) -> tuple[Barrier, ...]:
+    """Barriers of the skills ``agent``'s robot holds or is being sent."""
+    held = {s.id for s in state.task(agent) if s.status is not SkillStatus.IDLE or s.transfer}
+    return barriers_for(state, held)
+
+
+def commands_for_event(event: MissionEvent, state: MissionState) -> list[CommandSpec]:
+    """The commands an event (already applied to ``state``) requires."""
+    change = event.change
+    kind = event.kind
+    if kind is EventKind.SYNC_REQUESTED:
+        skills = tuple(placed.skill for placed in change.put_skills)
+        barriers = queued_barriers(state, event.agent)
+        return [CommandSpec(event.agent, CommandKind.UPLOAD, skills, barriers=barriers)]
+    if kind is EventKind.UNSYNC_REQUESTED:
+        ids = tuple(placed.skill.id for placed in change.put_skills)
+        return [CommandSpec(event.agent, CommandKind.UNSYNC, skill_ids=ids)]
+    if kind is EventKind.SKILL_RETRIED:
+        failed, fresh = change.put_skills[0].skill, change.put_skills[1].skill
+        return [CommandSpec(event.agent, CommandKind.RETRY, (fresh,), (failed.id,))]
+    if kind is EventKind.SKILL_SKIPPED:
+        failed_id = change.put_skills[0].skill.id
+        return [CommandSpec(event.agent, CommandKind.SKIP, skill_ids=(failed_id,))]
+    if change.put_barriers or change.removed_barrier_ids:
+        return [
+            CommandSpec(agent, CommandKind.BARRIERS, barriers=queued_barriers(state, agent))
+            for agent in state.agents
+            if synced_ids(state, agent)
+        ]
+    return []
+
+
+def repair_command(state: MissionState, agent: str) -> CommandSpec:
+    """Replace the robot's queue with the ground's synchronized section."""
+    task = state.task(agent)
+    skills = tuple(task[: state.sections(agent).synced_end])
+    return CommandSpec(
+        agent, CommandKind.SYNC_STATE, skills, barriers=queued_barriers(state, agent)
+    )

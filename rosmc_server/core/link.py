@@ -1,0 +1,202 @@
+"""The robot link's bookkeeping, free of ROS: sequence numbers, retransmission, liveness.
+
+Both ends speak the same rules:
+
+* Commands are numbered 1, 2, ... per agent. The robot executes a command only
+  when its number is the next one (``last + 1``); an older number is a
+  duplicate it acknowledges again without executing; a newer one waits until
+  the missing commands arrive. The ground retransmits every unacknowledged
+  command, oldest first, with exponential backoff.
+* Reports go the other way under the same rules (:class:`InboundSequence`).
+* Until the ground has heard a robot's snapshot it does not know where the
+  robot's numbering stands, so it sends nothing (the commands wait in order).
+"""
+
+from __future__ import annotations
+
+import enum
+import hashlib
+from collections import deque
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from typing import Generic, TypeVar
+
+Payload = TypeVar("Payload")
+
+
+class LinkStatus(enum.IntEnum):
+    """Ground view of a link (numbers match ``rosmc/LinkState``)."""
+
+    UNKNOWN = 0
+    UP = 1
+    DOWN = 2
+
+
+def queue_hash(skill_ids: Iterable[str]) -> str:
+    """Short digest of a robot's synchronized queue: the ordered ids it holds."""
+    digest = hashlib.sha1(usedforsecurity=False)
+    for skill_id in skill_ids:
+        digest.update(skill_id.encode("utf-8"))
+        digest.update(b"\n")
+    return digest.hexdigest()[:12]
+
+
+@dataclass
+class Outgoing(Generic[Payload]):
+    """A command waiting for its acknowledgement."""
+
+    payload: Payload
+    seq: int = 0  # 0 until first transmitted
+    attempts: int = 0
+    first_sent: float = 0.0
+    next_send: float = 0.0
+
+
+@dataclass(frozen=True)
+class LinkReport:
+    """A snapshot of the link for display."""
+
+    status: LinkStatus
+    last_heard: float  # seconds ago, -1 if never
+    round_trip: float  # seconds, -1 if unknown
+    in_flight: int
+
+
+@dataclass
+class Outbox(Generic[Payload]):
+    """Ground side of one robot link: numbering, retransmission and liveness.
+
+    ``timeout`` is how long the robot may stay silent before the link is DOWN;
+    retransmissions start after ``first_retry`` seconds and back off up to
+    ``max_retry``.
+    """
+
+    timeout: float = 3.0
+    first_retry: float = 0.25
+    max_retry: float = 5.0
+    _pending: deque[Outgoing[Payload]] = field(default_factory=deque)
+    _last_seq: int | None = None  # robot's numbering; None until a snapshot is heard
+    _last_heard: float | None = None
+    _rtt: float | None = None
+
+    @property
+    def synchronized(self) -> bool:
+        """Whether the robot's command numbering is known (a snapshot was heard)."""
+        return self._last_seq is not None
+
+    def enqueue(self, payload: Payload) -> Outgoing[Payload]:
+        """Queue a command; it is sent by :meth:`due` in order."""
+        item = Outgoing(payload)
+        self._pending.append(item)
+        return item
+
+    def pending(self) -> Sequence[Outgoing[Payload]]:
+        """Commands not yet acknowledged, oldest first."""
+        return tuple(self._pending)
+
+    def due(self, now: float) -> list[Outgoing[Payload]]:
+        """Commands to transmit now, oldest first; numbers them on first send.
+
+        When one command is due, every later unacknowledged one goes with it,
+        so the robot always receives a gap-free run.
+        """
+        if self._last_seq is None or not self._pending:
+            return []
+        if not any(item.next_send <= now for item in self._pending):
+            return []
+        out = []
+        for item in self._pending:
+            if item.seq == 0:
+                self._last_seq += 1
+                item.seq = self._last_seq
+                item.first_sent = now
+            delay = min(self.max_retry, self.first_retry * 2**item.attempts)
+            item.attempts += 1
+            item.next_send = now + delay
+            out.append(item)
+        return out
+
+    def acknowledge(self, seq: int, now: float) -> Outgoing[Payload] | None:
+        """The robot acknowledged command ``seq``; returns it the first time, else None.
+
+        Acknowledgements are per command (not cumulative): each carries the
+        robot's answer to that command, and a robot answers a retransmitted
+        command with the answer it gave the first time.
+        """
+        self.heard(now)
+        for item in self._pending:
+            if item.seq == seq and seq > 0:
+                self._pending.remove(item)
+                if item.attempts == 1:  # only unambiguous samples update the round trip
+                    sample = now - item.first_sent
+                    self._rtt = sample if self._rtt is None else 0.8 * self._rtt + 0.2 * sample
+                return item
+        return None
+
+    def robot_numbering(self, last_executed: int, now: float) -> bool:
+        """Learn where the robot's numbering stands from its snapshot.
+
+        On first contact, or when the robot has lost its state (its number went
+        back), pending commands are renumbered after the robot's; returns True then.
+        """
+        self.heard(now)
+        if self._last_seq is not None and last_executed >= self._acked_floor():
+            return False
+        self._last_seq = last_executed
+        for item in self._pending:
+            item.seq = 0
+            item.attempts = 0
+            item.next_send = now
+        return True
+
+    def _acked_floor(self) -> int:
+        """Highest number the robot must already have executed."""
+        assert self._last_seq is not None
+        unacked = [item.seq for item in self._pending if item.seq]
+        return (min(unacked) - 1) if unacked else self._last_seq
+
+    def heard(self, now: float) -> None:
+        """Anything arrived from the robot."""
+        self._last_heard = now
+
+    def status(self, now: float) -> LinkStatus:
+        """UNKNOWN until first heard, then UP or DOWN by ``timeout``."""
+        if self._last_heard is None:
+            return LinkStatus.UNKNOWN
+        return LinkStatus.UP if now - self._last_heard <= self.timeout else LinkStatus.DOWN
+
+    def report(self, now: float) -> LinkReport:
+        """The link's state for display."""
+        return LinkReport(
+            self.status(now),
+            -1.0 if self._last_heard is None else now - self._last_heard,
+            -1.0 if self._rtt is None else self._rtt,
+            len(self._pending),
+        )
+
+
+class Arrival(enum.Enum):
+    """What to do with a numbered message that arrived."""
+
+    NEXT = "next"  # process it
+    DUPLICATE = "duplicate"  # already processed: acknowledge again, do nothing
+    EARLY = "early"  # a message before it is missing: drop, the sender resends in order
+
+
+@dataclass
+class InboundSequence:
+    """Receiver side of a numbered stream: accepts each number once, in order."""
+
+    last: int = 0
+
+    def classify(self, seq: int) -> Arrival:
+        """Classify an arriving message number."""
+        if seq <= self.last:
+            return Arrival.DUPLICATE
+        return Arrival.NEXT if seq == self.last + 1 else Arrival.EARLY
+
+    def accept(self, seq: int) -> None:
+        """Mark ``seq`` processed (it must be the next one)."""
+        if seq != self.last + 1:
+            raise ValueError(f"message {seq} accepted out of order after {self.last}")
+        self.last = seq

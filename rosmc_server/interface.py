@@ -1,0 +1,103 @@
+"""Every ROS graph name ROSMC uses, in one place.
+
+The mission server, the robot executors, the GUIs, the simulator and the CLI
+all import their topic, service and parameter names from here, so a rename
+happens once. Names are plain strings; nothing here imports rospy.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+NAMESPACE = "/rosmc"
+SERVER_NODE = f"{NAMESPACE}/mission_server"
+
+# Published by the mission server.
+MISSION_TOPIC = f"{NAMESPACE}/mission"  # rosmc/Mission, latched snapshot
+EVENTS_TOPIC = f"{NAMESPACE}/mission_events"  # rosmc/MissionEvent, one per change
+AGENT_STATES_TOPIC = f"{NAMESPACE}/agent_states"  # rosmc/AgentStates, steady rate
+# Published by robots (or the simulator), one topic per agent.
+TELEMETRY_TOPIC = "/{agent}/telemetry"  # rosmc/Telemetry
+
+# Operator services of the mission server: name -> srv type name.
+SERVICES = {
+    "add_skill": "AddSkill",
+    "edit_skill": "EditSkill",
+    "delete_skills": "DeleteSkills",
+    "reorder_skills": "ReorderSkills",
+    "synchronize": "Synchronize",
+    "unsynchronize": "Unsynchronize",
+    "control": "Control",
+    "retry_skill": "RetrySkill",
+    "skip_skill": "SkipSkill",
+    "add_barrier": "AddBarrier",
+    "delete_barrier": "DeleteBarrier",
+    "add_task_marker": "AddTaskMarker",
+    "move_task_marker": "MoveTaskMarker",
+    "rename_task_marker": "RenameTaskMarker",
+    "delete_task_marker": "DeleteTaskMarker",
+    "new_mission": "NewMission",
+    "save_mission": "SaveMission",
+    "load_mission": "LoadMission",
+    "get_mission": "GetMission",
+    "get_library": "GetLibrary",
+}
+
+
+def service_name(operation: str) -> str:
+    """Full name of an operator service, e.g. ``/rosmc/add_skill``."""
+    if operation not in SERVICES:
+        raise KeyError(f"unknown operator service {operation!r}")
+    return f"{NAMESPACE}/{operation}"
+
+
+# Robot-to-robot barrier coordination (never through the ground station).
+BARRIER_TOPIC = f"{NAMESPACE}/barriers"  # rosmc/BarrierSignal
+
+
+@dataclass(frozen=True)
+class LinkTopics:
+    """The five topics of one agent's robot link.
+
+    The ground station uses the names under ``/rosmc/link/<agent>``. A robot's
+    executor uses the same names, unless a link emulator relays between the
+    ground names and robot-side names (``/<agent>/link``) to add latency,
+    loss and blackouts; then the executor is started with the robot prefix.
+    """
+
+    command: str  # rosmc/RobotCommand, ground -> robot
+    ack: str  # rosmc/RobotAck, robot -> ground
+    report: str  # rosmc/RobotReport, robot -> ground
+    report_ack: str  # rosmc/ReportAck, ground -> robot
+    snapshot: str  # rosmc/ExecutorSnapshot, robot -> ground
+
+    @classmethod
+    def under(cls, prefix: str) -> LinkTopics:
+        """The link topics below ``prefix``."""
+        base = prefix.rstrip("/")
+        return cls(
+            f"{base}/command",
+            f"{base}/ack",
+            f"{base}/report",
+            f"{base}/report_ack",
+            f"{base}/snapshot",
+        )
+
+
+def ground_link(agent: str) -> LinkTopics:
+    """The ground station's side of ``agent``'s robot link."""
+    return LinkTopics.under(f"{NAMESPACE}/link/{agent}")
+
+
+def robot_link(agent: str) -> LinkTopics:
+    """The robot's side of ``agent``'s link when an emulator relays it."""
+    return LinkTopics.under(f"/{agent}/link")
+
+
+# Private parameters of the mission server (~name).
+PARAM_LIBRARY = "library"  # path of the skill library YAML
+PARAM_JOURNAL = "journal"  # journal file to write ("" = new file under journal_dir)
+PARAM_JOURNAL_DIR = "journal_dir"  # directory for new journals
+PARAM_RESUME = "resume"  # resume from the journal file given in ~journal
+PARAM_LINK_TIMEOUT = "link_timeout"  # seconds without hearing a robot before DOWN
+PARAM_STATE_RATE = "agent_state_rate"  # Hz of /rosmc/agent_states

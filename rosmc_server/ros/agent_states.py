@@ -1,0 +1,100 @@
+"""The aggregated state of every agent, published at a steady rate.
+
+Publishes ``/rosmc/agent_states`` (rosmc/AgentStates); subscribes
+``/<agent>/telemetry`` (rosmc/Telemetry) for every agent of the library.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from typing import TYPE_CHECKING
+
+import rosmc.msg as wire
+import rospy
+
+from .. import interface
+from ..core import SkillStatus
+
+if TYPE_CHECKING:
+    from .server_node import MissionServer
+
+
+class AgentStatePublisher:
+    """Merges telemetry, link state and mission progress per agent."""
+
+    def __init__(self, server: MissionServer, rate: float) -> None:
+        self._server = server
+        self._period = 1.0 / rate if rate > 0 else 0.5
+        self._telemetry: dict[str, wire.Telemetry] = {}
+        self._telemetry_lock = threading.Lock()
+        self._publisher = rospy.Publisher(
+            interface.AGENT_STATES_TOPIC, wire.AgentStates, queue_size=10
+        )
+        self._subscribers = [
+            rospy.Subscriber(
+                interface.TELEMETRY_TOPIC.format(agent=agent.name),
+                wire.Telemetry,
+                self._on_telemetry,
+                callback_args=agent.name,
+                queue_size=10,
+            )
+            for agent in server.library.agents
+        ]
+        self._timer: rospy.Timer | None = None
+
+    def start(self) -> None:
+        """Start publishing at the configured rate."""
+        self._timer = rospy.Timer(rospy.Duration(self._period), lambda _event: self.publish())
+
+    def _on_telemetry(self, msg: wire.Telemetry, agent: str) -> None:
+        with self._telemetry_lock:
+            self._telemetry[agent] = msg
+
+    def build(self) -> wire.AgentStates:
+        """The current state of every dynamic agent."""
+        server = self._server
+        out = wire.AgentStates(stamp=rospy.Time.now())
+        with server.locked():
+            out.revision = server.mission.revision
+            for agent in server.library.dynamic_agents:
+                out.agents.append(self._agent_state(agent))
+        return out
+
+    def publish(self) -> None:
+        """Publish one AgentStates message."""
+        if not rospy.is_shutdown():
+            self._publisher.publish(self.build())
+
+    def _agent_state(self, agent: str) -> wire.AgentState:
+        server = self._server
+        report, link = server.link.details(agent)
+        with self._telemetry_lock:
+            telemetry = self._telemetry.get(agent) or wire.Telemetry(
+                agent=agent, battery=math.nan, wifi_signal=math.nan
+            )
+        state = wire.AgentState(agent=agent, telemetry=telemetry)
+        state.link = wire.LinkState(
+            state=int(report.status),
+            last_heard=report.last_heard,
+            round_trip=report.round_trip,
+            commands_in_flight=report.in_flight,
+            queue_hash=server.link.expected_hash(agent),
+            robot_queue_hash=link.robot_hash,
+            hash_mismatch=link.mismatch,
+        )
+        current = next(
+            (
+                s
+                for s in server.mission.state.task(agent)
+                if s.status is not SkillStatus.IDLE and not s.is_settled
+            ),
+            None,
+        )
+        if current is not None:
+            state.current_skill_id = current.id
+            state.current_status = wire.SkillStatus(int(current.status))
+        if link.snapshot is not None:
+            state.executor_state = link.snapshot.state
+            state.waiting_on = link.snapshot.waiting_on
+        return state

@@ -1,0 +1,310 @@
+"""Ground side of the robot links: commands out, acknowledgements and reports in.
+
+Per dynamic agent, on the topics of :func:`rosmc_server.interface.ground_link`:
+
+* publishes ``command`` (rosmc/RobotCommand) and ``report_ack`` (rosmc/ReportAck);
+* subscribes ``ack`` (rosmc/RobotAck), ``report`` (rosmc/RobotReport) and
+  ``snapshot`` (rosmc/ExecutorSnapshot).
+
+Commands are retransmitted with backoff until acknowledged; reports are
+applied once each and in order; the robot's periodic snapshot re-synchronizes
+numbering after restarts and reconciles statuses after outages, and its queue
+hash is checked against the ground's, with a repair sent on a mismatch.
+
+Every method expects the server lock to be held; the subscriber callbacks take it.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable, Iterable
+from contextlib import AbstractContextManager
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import rosmc.msg as wire
+import rospy
+
+from ..core import Barrier, Mission, MissionEvent, RosmcError, SkillStatus, Transfer
+from ..core.commands import CommandKind, CommandSpec, queued_barriers, repair_command, synced_ids
+from ..core.link import Arrival, InboundSequence, LinkReport, LinkStatus, Outbox, queue_hash
+from ..core.reconcile import RobotSkill
+from ..interface import ground_link
+from .conversions import barrier_to_msg, skill_to_msg, time_to_msg
+
+_log = logging.getLogger(__name__)
+
+Operation = Callable[[Mission], MissionEvent | None]
+
+
+class LinkHost(Protocol):
+    """What the ground link needs from the mission server."""
+
+    mission: Mission
+
+    def apply(self, operation: Operation) -> MissionEvent | None:
+        """Run a mission operation and record its event; the lock is held by the caller."""
+
+    def locked(self) -> AbstractContextManager[object]:
+        """The server lock, as a context manager."""
+
+    def record_report(self, msg: wire.RobotReport) -> None:
+        """Journal a robot report for the audit trail."""
+
+
+@dataclass
+class AgentLink:
+    """Everything the ground tracks about one agent's link."""
+
+    agent: str
+    outbox: Outbox[wire.RobotCommand]
+    command_pub: rospy.Publisher
+    report_ack_pub: rospy.Publisher
+    reports: InboundSequence | None = None  # None until the robot's numbering is known
+    snapshot: wire.ExecutorSnapshot | None = None
+    robot_hash: str = ""
+    mismatch: bool = False
+    barriers_sent: tuple[Barrier, ...] = ()
+    last_error: str = ""
+    subscribers: list[rospy.Subscriber] = field(default_factory=list)
+
+
+class GroundLink:
+    """The ground station's end of every robot link."""
+
+    def __init__(
+        self,
+        host: LinkHost,
+        agents: Iterable[str],
+        timeout: float = 3.0,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self._host = host
+        self._clock = clock
+        self._links: dict[str, AgentLink] = {}
+        for agent in agents:
+            topics = ground_link(agent)
+            link = AgentLink(
+                agent,
+                Outbox(timeout=timeout),
+                rospy.Publisher(topics.command, wire.RobotCommand, queue_size=100),
+                rospy.Publisher(topics.report_ack, wire.ReportAck, queue_size=100),
+            )
+            handlers = (
+                (topics.ack, wire.RobotAck, self._on_ack),
+                (topics.report, wire.RobotReport, self._on_report),
+                (topics.snapshot, wire.ExecutorSnapshot, self._on_snapshot),
+            )
+            link.subscribers = [
+                rospy.Subscriber(topic, msg_type, self._guarded(handler, agent), queue_size=100)
+                for topic, msg_type, handler in handlers
+            ]
+            self._links[agent] = link
+
+    @property
+    def _mission(self) -> Mission:
+        return self._host.mission
+
+    # -- queries -------------------------------------------------------------
+    def status(self, agent: str) -> LinkStatus:
+        """UNKNOWN, UP or DOWN for ``agent``."""
+        return self._links[agent].outbox.status(self._clock())
+
+    def details(self, agent: str) -> tuple[LinkReport, AgentLink]:
+        """The link report and tracked details of ``agent``, for display."""
+        link = self._links[agent]
+        return link.outbox.report(self._clock()), link
+
+    def expected_hash(self, agent: str) -> str:
+        """The queue hash the ground expects the robot to have."""
+        return queue_hash(synced_ids(self._mission.state, agent))
+
+    # -- sending -------------------------------------------------------------
+    def send(self, spec: CommandSpec) -> None:
+        """Queue a command for its robot; it goes out as soon as the link allows."""
+        link = self._links[spec.agent]
+        if spec.kind is CommandKind.BARRIERS and spec.barriers == link.barriers_sent:
+            return  # the robot already has exactly these barriers
+        if spec.kind in (CommandKind.UPLOAD, CommandKind.BARRIERS, CommandKind.SYNC_STATE):
+            link.barriers_sent = spec.barriers
+        state = self._mission.state
+        msg = wire.RobotCommand(
+            agent=spec.agent,
+            type=int(spec.kind),
+            skills=[skill_to_msg(s) for s in spec.skills],
+            skill_ids=list(spec.skill_ids),
+            barriers=[barrier_to_msg(b, lambda s: state.locate(s)[0]) for b in spec.barriers],
+            argument=spec.argument,
+        )
+        link.outbox.enqueue(msg)
+        self._transmit(link)
+
+    def tick(self) -> None:
+        """Retransmit whatever is due (called periodically)."""
+        for link in self._links.values():
+            self._transmit(link)
+
+    def resend_pending_transfers(self) -> None:
+        """After a restart, ask again for the uploads and removals the journal shows pending."""
+        state = self._mission.state
+        for agent in self._links:
+            task = state.task(agent)
+            uploading = tuple(s for s in task if s.transfer is Transfer.UPLOADING)
+            removing = tuple(s.id for s in task if s.transfer is Transfer.REMOVING)
+            if uploading:
+                barriers = queued_barriers(state, agent)
+                self.send(CommandSpec(agent, CommandKind.UPLOAD, uploading, barriers=barriers))
+            if removing:
+                self.send(CommandSpec(agent, CommandKind.UNSYNC, skill_ids=removing))
+
+    def _transmit(self, link: AgentLink) -> None:
+        for item in link.outbox.due(self._clock()):
+            item.payload.seq = item.seq
+            item.payload.stamp = time_to_msg(time.time())
+            link.command_pub.publish(item.payload)
+
+    # -- receiving -----------------------------------------------------------
+    def _guarded(
+        self, handler: Callable[[str, object], None], agent: str
+    ) -> Callable[[object], None]:
+        def callback(msg: object) -> None:
+            try:
+                with self._host.locked():
+                    handler(agent, msg)
+            except Exception:  # a bad message must never kill the subscriber thread
+                _log.exception("link %s: failed to handle a %s", agent, type(msg).__name__)
+
+        return callback
+
+    def _on_ack(self, agent: str, msg: wire.RobotAck) -> None:
+        link = self._links[agent]
+        item = link.outbox.acknowledge(msg.seq, self._clock())
+        if item is None:
+            return  # the answer to a retransmission already processed
+        if msg.result != wire.RobotAck.ACCEPTED:
+            link.last_error = msg.error or "; ".join(msg.rejection_reasons)
+            _log.warning("link %s: command %d refused: %s", agent, msg.seq, link.last_error)
+        command = item.payload
+        if command.type == CommandKind.UPLOAD:
+            self._upload_answered(agent, command, msg)
+        elif command.type == CommandKind.UNSYNC:
+            removed = [] if msg.result == wire.RobotAck.REJECTED else list(msg.accepted_ids)
+            self._apply(lambda m: m.confirm_unsynchronized(agent, removed))
+        link.robot_hash = msg.queue_hash
+        self._check_hash(link)
+
+    def _upload_answered(self, agent: str, command: wire.RobotCommand, ack: wire.RobotAck) -> None:
+        sent = [s.id for s in command.skills]
+        uploading = self._uploading(agent)
+        taken = set() if ack.result == wire.RobotAck.REJECTED else set(ack.accepted_ids)
+        accepted = [i for i in sent if i in taken and i in uploading]
+        if accepted and uploading[: len(accepted)] == accepted:
+            self._apply(lambda m: m.confirm_synchronized(agent, accepted))
+        refused = [i for i in sent if i not in taken and i in self._uploading(agent)]
+        if refused:
+            # Everything after a refused skill goes back too: the synchronized
+            # section must stay a prefix of the task.
+            pending = self._uploading(agent)
+            tail = pending[pending.index(refused[0]) :]
+            reason = ack.error or next(iter(ack.rejection_reasons), "refused by the robot")
+            self._apply(lambda m: m.decline_synchronize(agent, tail, reason))
+
+    def _uploading(self, agent: str) -> list[str]:
+        return [s.id for s in self._mission.state.task(agent) if s.transfer is Transfer.UPLOADING]
+
+    def _on_report(self, agent: str, msg: wire.RobotReport) -> None:
+        link = self._links[agent]
+        link.outbox.heard(self._clock())
+        if link.reports is None:
+            return  # wait for the robot's snapshot to learn its numbering
+        if link.reports.classify(msg.seq) is Arrival.NEXT:
+            link.reports.accept(msg.seq)
+            self._host.record_report(msg)
+            self._apply_report(msg)
+        link.report_ack_pub.publish(wire.ReportAck(agent=agent, seq=link.reports.last))
+
+    def _apply_report(self, msg: wire.RobotReport) -> None:
+        try:
+            status = SkillStatus(msg.status.value)
+        except ValueError:
+            _log.warning("link %s: report with unknown status %d", msg.agent, msg.status.value)
+            return
+        stamp = msg.stamp.to_sec()
+        self._apply(
+            lambda m: m.report_status(
+                msg.skill_id,
+                status,
+                attempt=msg.attempt or None,
+                text=msg.status_text,
+                stamp=stamp,
+            )
+        )
+
+    def _on_snapshot(self, agent: str, msg: wire.ExecutorSnapshot) -> None:
+        link = self._links[agent]
+        if link.outbox.robot_numbering(msg.last_command_seq, self._clock()):
+            _log.info("link %s: robot executed commands up to %d", agent, msg.last_command_seq)
+        fresh = link.reports is None or msg.last_report_seq < link.reports.last
+        if fresh:
+            # Every report up to last_report_seq is reflected in the snapshot itself.
+            link.reports = InboundSequence(msg.last_report_seq)
+            link.report_ack_pub.publish(wire.ReportAck(agent=agent, seq=msg.last_report_seq))
+        assert link.reports is not None
+        if fresh or msg.last_report_seq == link.reports.last:
+            self._reconcile(agent, msg)
+        link.snapshot = msg
+        link.robot_hash = msg.queue_hash
+        self._check_hash(link)
+        self._transmit(link)
+
+    def _reconcile(self, agent: str, msg: wire.ExecutorSnapshot) -> None:
+        queue = [
+            RobotSkill(
+                s.id,
+                SkillStatus(s.status.value),
+                max(1, s.attempt),
+                s.status_text,
+                s.started,
+                s.finished,
+            )
+            for s in msg.queue
+            if s.status.value in SkillStatus._value2member_map_
+        ]
+        conflicts: tuple[str, ...] = ()
+
+        def reconcile(mission: Mission) -> MissionEvent | None:
+            nonlocal conflicts
+            event, result = mission.reconcile(agent, queue)
+            conflicts = result.conflicts
+            return event
+
+        self._apply(reconcile)
+        for conflict in conflicts:
+            _log.warning("link %s: %s", agent, conflict)
+
+    def _check_hash(self, link: AgentLink) -> None:
+        if link.outbox.pending() or not link.robot_hash:
+            return  # commands in flight: the hashes may differ for now
+        expected = self.expected_hash(link.agent)
+        if expected == link.robot_hash:
+            if link.mismatch:
+                _log.info("link %s: queue hash agrees again (%s)", link.agent, expected)
+            link.mismatch = False
+            return
+        if not link.mismatch:
+            _log.warning(
+                "link %s: robot queue hash %s differs from the ground's %s; repairing",
+                link.agent,
+                link.robot_hash,
+                expected,
+            )
+        link.mismatch = True
+        self.send(repair_command(self._mission.state, link.agent))
+
+    def _apply(self, operation: Operation) -> None:
+        """Apply a robot-driven change; a refusal is logged, never raised into rospy."""
+        try:
+            self._host.apply(operation)
+        except RosmcError as error:
+            _log.warning("robot link: %s", error)

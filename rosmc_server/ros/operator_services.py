@@ -1,0 +1,300 @@
+"""The operator services of the mission server: one per operation.
+
+Advertises every service of :data:`rosmc_server.interface.SERVICES` under
+``/rosmc/`` (types ``rosmc/<Name>``). Each handler checks its request, runs
+the operation through :meth:`MissionServer.apply` and answers with the new
+revision; a refused request answers with an error code and one sentence, and
+the mission is unchanged. No handler lets an exception reach rospy: a server
+fault is logged with its traceback and answered as an INTERNAL error.
+Services never wait for robots.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+import rosmc.srv as srv
+import rospy
+from rosmc.msg import ErrorCode
+
+from .. import interface
+from ..core import (
+    InvalidRequest,
+    LibraryError,
+    Mission,
+    MissionEvent,
+    MissionFileError,
+    NotFound,
+    RosmcError,
+    RuleViolation,
+    StaleRevision,
+    Unavailable,
+    dump_mission,
+    parse_mission,
+    save_mission,
+)
+from ..core.commands import CommandKind, CommandSpec
+from ..core.link import LinkStatus
+from .conversions import library_to_msg, marker_from_msg, params_from_msgs, pose_from_msg
+
+if TYPE_CHECKING:
+    from .server_node import MissionServer
+
+_log = logging.getLogger(__name__)
+
+_CODES: tuple[tuple[type[RosmcError], int], ...] = (
+    (StaleRevision, ErrorCode.CONFLICT),
+    (NotFound, ErrorCode.NOT_FOUND),
+    (RuleViolation, ErrorCode.RULE),
+    (Unavailable, ErrorCode.UNAVAILABLE),
+    (InvalidRequest, ErrorCode.INVALID),
+    (MissionFileError, ErrorCode.INVALID),
+    (LibraryError, ErrorCode.INVALID),
+)
+
+_CONTROL = {
+    srv.ControlRequest.START: CommandKind.START,
+    srv.ControlRequest.PAUSE: CommandKind.PAUSE,
+    srv.ControlRequest.RESUME: CommandKind.RESUME,
+    srv.ControlRequest.STOP: CommandKind.STOP,
+}
+
+
+def error_code(error: RosmcError) -> int:
+    """The ErrorCode constant for a core error."""
+    for kind, code in _CODES:
+        if isinstance(error, kind):
+            return code
+    return ErrorCode.INVALID
+
+
+def _text(value: str, what: str) -> str:
+    if not value.strip():
+        raise InvalidRequest(f"{what} is empty")
+    return value
+
+
+class OperatorServices:
+    """Request handlers of every operator service."""
+
+    def __init__(self, server: MissionServer) -> None:
+        self._server = server
+        self._library_msg = library_to_msg(server.library)
+        self._services: list[rospy.Service] = []
+
+    def advertise(self) -> None:
+        """Advertise every operator service."""
+        for operation, type_name in interface.SERVICES.items():
+            service_class = getattr(srv, type_name)
+            handler = getattr(self, f"_{operation}")
+            self._services.append(
+                rospy.Service(
+                    interface.service_name(operation),
+                    service_class,
+                    self._answer(handler, service_class._response_class, operation),
+                )
+            )
+
+    def _answer(
+        self, handler: Callable[[Any, Any], MissionEvent | None], response_class: Any, name: str
+    ) -> Callable[[Any], Any]:
+        def callback(request: Any) -> Any:
+            response = response_class()
+            try:
+                event = handler(request, response)
+            except RosmcError as error:
+                self._fail(response, error_code(error), str(error))
+            except Exception:  # a server fault must not reach the caller as a stack trace
+                _log.exception("service %s failed", name)
+                self._fail(
+                    response, ErrorCode.INTERNAL, f"internal error in {name}; see the server log"
+                )
+            else:
+                if hasattr(response, "revision"):
+                    response.revision = event.revision if event else self._server.mission.revision
+            return response
+
+        return callback
+
+    def _fail(self, response: Any, code: int, message: str) -> None:
+        if hasattr(response, "error"):
+            response.error_code = code
+            response.error = message
+            response.revision = self._server.mission.revision
+
+    def _apply(self, operation: Callable[[Mission], MissionEvent]) -> MissionEvent:
+        event = self._server.apply(operation)
+        assert event is not None
+        return event
+
+    def _require_link(self, agent: str) -> None:
+        if agent not in self._server.library.dynamic_agents:
+            self._server.library.agent(_text(agent, "the agent name"))
+            raise RuleViolation(f"'{agent}' is a static agent and has no robot link")
+        if self._server.link.status(agent) is LinkStatus.DOWN:
+            raise Unavailable(f"{agent} cannot be reached (its link is down); try again later")
+
+    # -- blueprint ----------------------------------------------------------------
+    def _add_skill(self, req: Any, resp: Any) -> MissionEvent:
+        values, bindings = params_from_msgs(req.parameters)
+        event = self._apply(
+            lambda m: m.add_skill(
+                _text(req.agent, "the agent name"),
+                _text(req.skill, "the skill name"),
+                values,
+                bindings=bindings,
+                label=req.label,
+                index=None if req.index < 0 else req.index,
+                timeout=req.timeout,
+                max_retries=req.max_retries,
+                base_revision=req.base_revision,
+            )
+        )
+        resp.skill_id = event.change.put_skills[0].skill.id
+        return event
+
+    def _edit_skill(self, req: Any, resp: Any) -> MissionEvent:
+        values, bindings = params_from_msgs(req.parameters)
+        return self._apply(
+            lambda m: m.edit_skill(
+                _text(req.skill_id, "the skill id"),
+                values,
+                bindings=dict(bindings),
+                label=req.label or None,
+                timeout=req.timeout if req.set_options else None,
+                max_retries=req.max_retries if req.set_options else None,
+                base_revision=req.base_revision,
+            )
+        )
+
+    def _delete_skills(self, req: Any, resp: Any) -> MissionEvent:
+        return self._apply(
+            lambda m: m.delete_skills(req.skill_ids, base_revision=req.base_revision)
+        )
+
+    def _reorder_skills(self, req: Any, resp: Any) -> MissionEvent:
+        agent = _text(req.agent, "the agent name")
+        return self._apply(lambda m: m.reorder(agent, req.order, base_revision=req.base_revision))
+
+    # -- synchronization and execution ---------------------------------------------
+    def _synchronize(self, req: Any, resp: Any) -> MissionEvent:
+        with self._server.locked():
+            self._require_link(req.agent)
+            event = self._apply(
+                lambda m: m.synchronize(
+                    req.agent, req.upto_id or None, base_revision=req.base_revision
+                )
+            )
+        resp.skill_ids = [placed.skill.id for placed in event.change.put_skills]
+        return event
+
+    def _unsynchronize(self, req: Any, resp: Any) -> MissionEvent:
+        with self._server.locked():
+            self._require_link(req.agent)
+            event = self._apply(
+                lambda m: m.unsynchronize(
+                    req.agent, req.from_id or None, base_revision=req.base_revision
+                )
+            )
+        resp.skill_ids = [placed.skill.id for placed in event.change.put_skills]
+        return event
+
+    def _control(self, req: Any, resp: Any) -> None:
+        if req.command not in _CONTROL:
+            raise InvalidRequest(f"unknown control command {req.command}")
+        agents = [req.agent] if req.agent else list(self._server.library.dynamic_agents)
+        with self._server.locked():
+            for agent in agents:
+                self._require_link(agent)
+            for agent in agents:
+                self._server.link.send(CommandSpec(agent, _CONTROL[req.command]))
+        resp.agents = agents
+        return None
+
+    def _retry_skill(self, req: Any, resp: Any) -> MissionEvent:
+        with self._server.locked():
+            agent, _ = self._server.mission.state.locate(_text(req.skill_id, "the skill id"))
+            self._require_link(agent)
+            event = self._apply(lambda m: m.retry(req.skill_id, base_revision=req.base_revision))
+        resp.new_skill_id = event.change.put_skills[1].skill.id
+        return event
+
+    def _skip_skill(self, req: Any, resp: Any) -> MissionEvent:
+        with self._server.locked():
+            agent, _ = self._server.mission.state.locate(_text(req.skill_id, "the skill id"))
+            self._require_link(agent)
+            return self._apply(lambda m: m.skip(req.skill_id, base_revision=req.base_revision))
+
+    # -- barriers and markers ---------------------------------------------------
+    def _add_barrier(self, req: Any, resp: Any) -> MissionEvent:
+        event = self._apply(lambda m: m.add_barrier(req.skill_ids, base_revision=req.base_revision))
+        resp.barrier_id = event.change.put_barriers[0].id
+        return event
+
+    def _delete_barrier(self, req: Any, resp: Any) -> MissionEvent:
+        barrier_id = _text(req.barrier_id, "the barrier id")
+        return self._apply(lambda m: m.delete_barrier(barrier_id, base_revision=req.base_revision))
+
+    def _add_task_marker(self, req: Any, resp: Any) -> MissionEvent:
+        marker = marker_from_msg(req.marker)
+        event = self._apply(lambda m: m.add_marker(marker, base_revision=req.base_revision))
+        resp.name = event.change.put_markers[0].name
+        return event
+
+    def _move_task_marker(self, req: Any, resp: Any) -> MissionEvent:
+        pose = pose_from_msg(req.pose)
+        vertices = [pose_from_msg(v) for v in req.vertices]
+        name = _text(req.name, "the marker name")
+        return self._apply(
+            lambda m: m.move_marker(name, pose, vertices, base_revision=req.base_revision)
+        )
+
+    def _rename_task_marker(self, req: Any, resp: Any) -> MissionEvent:
+        name = _text(req.name, "the marker name")
+        return self._apply(
+            lambda m: m.rename_marker(name, req.new_name, base_revision=req.base_revision)
+        )
+
+    def _delete_task_marker(self, req: Any, resp: Any) -> MissionEvent:
+        name = _text(req.name, "the marker name")
+        return self._apply(lambda m: m.delete_marker(name, base_revision=req.base_revision))
+
+    # -- whole missions -------------------------------------------------------------
+    def _new_mission(self, req: Any, resp: Any) -> MissionEvent:
+        return self._apply(
+            lambda m: m.new_mission(keep_markers=req.keep_markers, base_revision=req.base_revision)
+        )
+
+    def _save_mission(self, req: Any, resp: Any) -> None:
+        with self._server.locked():
+            content = self._server.mission.state.content()
+            revision = self._server.mission.revision
+        resp.document = dump_mission(content, revision)
+        if req.path:
+            save_mission(req.path, content, revision)
+            resp.path_written = req.path
+        resp.revision = revision
+        return None
+
+    def _load_mission(self, req: Any, resp: Any) -> MissionEvent:
+        if bool(req.path) == bool(req.document):
+            raise InvalidRequest("give exactly one of a path and a document to load")
+        if req.path:
+            from ..core import load_mission
+
+            content, _ = load_mission(req.path, self._server.library)
+            source = req.path
+        else:
+            content, _ = parse_mission(req.document, self._server.library, "the document")
+            source = "a document"
+        return self._apply(lambda m: m.load(content, source, base_revision=req.base_revision))
+
+    def _get_mission(self, req: Any, resp: Any) -> None:
+        resp.mission = self._server.snapshot_msg()
+        return None
+
+    def _get_library(self, req: Any, resp: Any) -> None:
+        resp.library = self._library_msg
+        return None

@@ -1,0 +1,232 @@
+"""The mission server node: owns the mission, journals every change, talks to robots.
+
+Node ``/rosmc/mission_server``.
+
+Services: one per operator operation, see :mod:`rosmc_server.ros.operator_services`
+(``/rosmc/add_skill`` ... ``/rosmc/get_library``).
+
+Publishes:
+    ``/rosmc/mission_events`` (rosmc/MissionEvent): one per accepted change.
+    ``/rosmc/mission`` (rosmc/Mission, latched): full snapshot, coalesced.
+    ``/rosmc/agent_states`` (rosmc/AgentStates): every agent's state at ``~agent_state_rate``.
+    The robot links' command and report_ack topics (see :mod:`.ground_link`).
+
+Subscribes:
+    ``/<agent>/telemetry`` (rosmc/Telemetry) and the robot links' ack, report and
+    snapshot topics.
+
+Parameters (private):
+    ``~library`` (str): skill library YAML (default: the shipped Mars team library).
+    ``~journal`` (str): journal file; "" = a new timestamped file in ``~journal_dir``.
+    ``~journal_dir`` (str): where new journals go (default: ``bags/`` of the package).
+    ``~resume`` (bool): continue from ``~journal`` (recovering a damaged tail).
+    ``~link_timeout`` (float, s): silence after which a robot link is DOWN (3.0).
+    ``~agent_state_rate`` (float, Hz): rate of ``/rosmc/agent_states`` (2.0).
+    ``~fsync`` (bool): fsync the journal on every change (survives power loss).
+
+Every accepted change is journaled (and flushed) before its service answers.
+If the journal cannot be written, the change is reported as failed and the
+node shuts down, so that no change is ever acknowledged without being durable.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+import threading
+import time
+from collections.abc import Callable, Sequence
+from contextlib import AbstractContextManager
+from dataclasses import dataclass
+from pathlib import Path
+
+import rosmc.msg as wire
+import rospy
+
+from .. import interface
+from ..core import Library, Mission, MissionContent, MissionEvent, load_library
+from ..core.changes import EventKind
+from ..core.commands import commands_for_event
+from ..recording import JournalOptions, JournalWriter, default_journal_path, latest_state
+from .agent_states import AgentStatePublisher
+from .conversions import event_from_msg, event_to_msg, mission_from_msg, mission_to_msg
+from .ground_link import GroundLink
+from .logging_bridge import bridge_logging_to_rosout
+from .operator_services import OperatorServices
+from .publishing import SnapshotPublisher
+
+_log = logging.getLogger(__name__)
+
+PACKAGE_ROOT = Path(__file__).resolve().parents[2]
+DEFAULT_LIBRARY = PACKAGE_ROOT / "rosmc_server" / "config" / "mars_team.yaml"
+DEFAULT_JOURNAL_DIR = PACKAGE_ROOT / "bags"
+
+
+@dataclass(frozen=True)
+class ServerConfig:
+    """The server's settings, read once at start."""
+
+    library: Path = DEFAULT_LIBRARY
+    journal: Path | None = None
+    journal_dir: Path = DEFAULT_JOURNAL_DIR
+    resume: bool = False
+    link_timeout: float = 3.0
+    agent_state_rate: float = 2.0
+    fsync: bool = False
+
+    @classmethod
+    def from_params(cls) -> ServerConfig:
+        """Read the private parameters (``~name``)."""
+        journal = str(rospy.get_param("~journal", ""))
+        return cls(
+            library=Path(str(rospy.get_param("~library", str(DEFAULT_LIBRARY)))).expanduser(),
+            journal=Path(journal).expanduser() if journal else None,
+            journal_dir=Path(str(rospy.get_param("~journal_dir", str(DEFAULT_JOURNAL_DIR)))),
+            resume=bool(rospy.get_param("~resume", False)),
+            link_timeout=float(rospy.get_param("~link_timeout", 3.0)),
+            agent_state_rate=float(rospy.get_param("~agent_state_rate", 2.0)),
+            fsync=bool(rospy.get_param("~fsync", False)),
+        )
+
+
+class MissionServer:
+    """Owns the mission; every change goes through :meth:`apply` under one lock."""
+
+    def __init__(self, config: ServerConfig, library: Library) -> None:
+        self.config = config
+        self.library = library
+        self._lock = threading.RLock()
+        self.mission, self._journal = self._open_journal()
+        self._events = rospy.Publisher(interface.EVENTS_TOPIC, wire.MissionEvent, queue_size=1000)
+        self._snapshots = SnapshotPublisher(interface.MISSION_TOPIC, self.snapshot_msg)
+        self.link = GroundLink(self, library.dynamic_agents, timeout=config.link_timeout)
+        self._agent_states = AgentStatePublisher(self, config.agent_state_rate)
+        self._services = OperatorServices(self)
+        self._stopping = False
+
+    # -- lifecycle -----------------------------------------------------------------
+    def start(self) -> None:
+        """Start publishing, serving and talking to robots."""
+        with self._lock:
+            self.link.resend_pending_transfers()
+        self._snapshots.start()
+        self._agent_states.start()
+        self._services.advertise()
+        threading.Thread(target=self._tick_link, name="link", daemon=True).start()
+        _log.info(
+            "mission server ready: library %s, %d agents, revision %d, journal %s",
+            self.library.name, len(self.library.dynamic_agents), self.mission.revision,
+            self._journal.path,
+        )  # fmt: skip
+
+    def shutdown(self) -> None:
+        """Close the journal cleanly (a complete, indexed MCAP file)."""
+        with self._lock:
+            self._stopping = True
+            self._snapshots.stop()
+            if not self._journal.closed:
+                self._journal.close()
+
+    def _tick_link(self) -> None:
+        while not rospy.is_shutdown() and not self._stopping:
+            with self._lock:
+                self.link.tick()
+            time.sleep(0.05)
+
+    # -- the one way to change the mission ------------------------------------------
+    def locked(self) -> AbstractContextManager[object]:
+        """The server lock (re-entrant)."""
+        return self._lock
+
+    def apply(self, operation: Callable[[Mission], MissionEvent | None]) -> MissionEvent | None:
+        """Run ``operation`` on the mission and record the event it returns.
+
+        The event is journaled (flushed) and published, and the robot commands
+        it implies are queued, all before this returns. A RosmcError raised by
+        the operation propagates with the mission unchanged.
+        """
+        with self._lock:
+            if self._stopping:
+                raise RuntimeError("the mission server is shutting down")
+            event = operation(self.mission)
+            if event is not None:
+                self._record(event)
+            return event
+
+    def _record(self, event: MissionEvent) -> None:
+        state = self.mission.state
+        msg = event_to_msg(event, lambda skill_id: state.locate(skill_id)[0])
+        stamp_ns = time.time_ns()
+        try:
+            self._journal.append_event(msg, stamp_ns)
+            if event.kind is EventKind.MISSION_REPLACED or self._journal.snapshot_due:
+                self._journal.append_snapshot(self.snapshot_msg(), stamp_ns)
+        except Exception:
+            _log.critical("cannot write the journal; shutting down to protect the mission")
+            self._stopping = True
+            rospy.signal_shutdown("journal write failed")
+            raise
+        self._events.publish(msg)
+        self._snapshots.changed()
+        for spec in commands_for_event(event, state):
+            self.link.send(spec)
+
+    def record_report(self, msg: wire.RobotReport) -> None:
+        """Journal a robot report (the audit trail of what robots said)."""
+        self._journal.append_report(msg, time.time_ns())
+
+    def snapshot_msg(self) -> wire.Mission:
+        """The full mission as a message (content copied under the lock)."""
+        with self._lock:
+            content = self.mission.state.content()
+            revision = self.mission.revision
+        return mission_to_msg(content, revision, rospy.get_time())
+
+    # -- journal -------------------------------------------------------------------
+    def _open_journal(self) -> tuple[Mission, JournalWriter]:
+        options = JournalOptions(fsync=self.config.fsync)
+        clock = rospy.get_time
+        if self.config.resume:
+            if self.config.journal is None:
+                raise ValueError("~resume needs ~journal: the journal file to continue")
+            writer = JournalWriter.resume(self.config.journal, options)
+            assert writer.recovered is not None
+            for warning in writer.recovered.warnings:
+                _log.warning("%s", warning)
+            latest = latest_state(writer.recovered)
+            for problem in latest.problems:
+                _log.error("%s", problem)
+            content, revision = mission_from_msg(latest.snapshot)
+            mission = Mission(self.library, content, revision, clock=clock)
+            for event_msg in latest.events:
+                mission.replay(event_from_msg(event_msg))
+            _log.info("resumed from %s at revision %d", writer.path, mission.revision)
+            return mission, writer
+        mission = Mission(self.library, MissionContent.empty(self.library), clock=clock)
+        path = self.config.journal or default_journal_path(self.config.journal_dir)
+        snapshot = mission_to_msg(mission.state.content(), 0, time.time())
+        return mission, JournalWriter.create(path, snapshot, time.time_ns(), options)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``mission_server``."""
+    args = rospy.myargv(argv if argv is not None else sys.argv)
+    parser = argparse.ArgumentParser(
+        prog="mission_server",
+        description="ROSMC mission server. Settings are private ROS parameters "
+        "(_library:=..., _journal:=..., _resume:=true).",
+    )
+    parser.parse_args(args[1:])
+    rospy.init_node("mission_server", anonymous=False)
+    bridge_logging_to_rosout()
+    config = ServerConfig.from_params()
+    try:
+        server = MissionServer(config, load_library(config.library))
+    except Exception as error:  # report start-up failures in one line, then exit
+        _log.critical("mission server cannot start: %s", error)
+        return 1
+    rospy.on_shutdown(server.shutdown)
+    server.start()
+    rospy.spin()
+    return 0
