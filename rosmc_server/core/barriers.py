@@ -46,9 +46,7 @@ def find_deadlock(
             continue
         for before, after in itertools.pairwise(ids):
             source, target = point.get(before, before), point.get(after, after)
-            graph.setdefault(source, []).append(
-                (target, OrderEdge(agent, before, after))
-            )
+            graph.setdefault(source, []).append((target, OrderEdge(agent, before, after)))
     return _find_cycle(graph)
 
 
@@ -108,14 +106,11 @@ def check_no_deadlock(
     cycle = find_deadlock(tasks, groups)
     if cycle is not None:
         raise RuleViolation(
-            "the barriers would deadlock, because each waits for another: "
-            + describe_cycle(cycle)
+            "the barriers would deadlock, because each waits for another: " + describe_cycle(cycle)
         )
 
 
-def plan_add_barrier(
-    state: MissionState, skill_ids: Sequence[str], barrier_id: str
-) -> Proposal:
+def plan_add_barrier(state: MissionState, skill_ids: Sequence[str], barrier_id: str) -> Proposal:
     """Barrier over ``skill_ids``: at least two skills on distinct agents, none started."""
     if len(skill_ids) < 2:
         raise InvalidRequest("a barrier needs at least two skills")
@@ -133,9 +128,7 @@ def plan_add_barrier(
         _check_member_changeable(state, skill, "join a barrier")
         existing = state.barrier_of(skill.id)
         if existing is not None:
-            raise RuleViolation(
-                f"skill '{skill.id}' is already in barrier '{existing.id}'"
-            )
+            raise RuleViolation(f"skill '{skill.id}' is already in barrier '{existing.id}'")
     check_no_deadlock(state, extra_group=skill_ids)
     barrier = Barrier(barrier_id, tuple(skill_ids))
     agents = ", ".join(skill.agent for skill in members)
@@ -160,13 +153,9 @@ def plan_delete_barrier(state: MissionState, barrier_id: str) -> Proposal:
     )
 
 
-def _check_member_changeable(
-    state: MissionState, skill: SkillInstance, action: str
-) -> None:
+def _check_member_changeable(state: MissionState, skill: SkillInstance, action: str) -> None:
     if skill.status not in (SkillStatus.IDLE, SkillStatus.IDLE_SYNCHRONIZED):
-        raise RuleViolation(
-            f"skill '{skill.id}' is {skill.status.name} and can no longer {action}"
-        )
+        raise RuleViolation(f"skill '{skill.id}' is {skill.status.name} and can no longer {action}")
     if skill.transfer is not Transfer.NONE:
         raise RuleViolation(
             f"skill '{skill.id}' is being {_transfer_word(skill.transfer)}; "

@@ -89,25 +89,15 @@ def plan_edit_skill(
     """
     old = state.skill(skill_id)
     require_editable(old, "edited")
-    if (
-        not params
-        and not bindings
-        and label is None
-        and timeout is None
-        and max_retries is None
-    ):
+    if not params and not bindings and label is None and timeout is None and max_retries is None:
         raise InvalidRequest(f"the edit of '{skill_id}' changes nothing")
     overlap = sorted(set(params) & set(bindings))
     if overlap:
-        raise InvalidRequest(
-            f"parameter '{overlap[0]}' is given both a value and a marker"
-        )
+        raise InvalidRequest(f"parameter '{overlap[0]}' is given both a value and a marker")
     spec = library.skill(old.agent, old.skill)
     values = dict(old.params)
     values.update(check_params(spec, params))
-    new_bindings = {
-        name: marker for name, marker in old.bindings.items() if name not in params
-    }
+    new_bindings = {name: marker for name, marker in old.bindings.items() if name not in params}
     to_bind = {name: marker for name, marker in bindings.items() if marker}
     for name in bindings:
         spec.parameter(name)
@@ -120,9 +110,7 @@ def plan_edit_skill(
         bindings=new_bindings,
         label=old.label if label is None else check_label(label, default=None),
         timeout=old.timeout if timeout is None else check_timeout(timeout),
-        max_retries=old.max_retries
-        if max_retries is None
-        else check_retries(max_retries),
+        max_retries=old.max_retries if max_retries is None else check_retries(max_retries),
     )
     _, index = state.locate(skill_id)
     return Proposal(
@@ -147,9 +135,7 @@ def plan_delete_skills(state: MissionState, skill_ids: Sequence[str]) -> Proposa
     barriers = barrier_without(state, set(skill_ids))
     change = replace(barriers, removed_skill_ids=tuple(skill_ids))
     agent = agents[0] if len(set(agents)) == 1 else ""
-    return Proposal(
-        EventKind.SKILL_DELETED, agent, f"deleted {', '.join(skill_ids)}", change
-    )
+    return Proposal(EventKind.SKILL_DELETED, agent, f"deleted {', '.join(skill_ids)}", change)
 
 
 def plan_reorder(state: MissionState, agent: str, order: Sequence[str]) -> Proposal:
@@ -174,16 +160,12 @@ def require_editable(skill: SkillInstance, verb: str) -> None:
     """Raise RuleViolation unless the skill is in the editable blueprint."""
     if not skill.is_editable:
         state = "being uploaded" if skill.status.name == "IDLE" else skill.status.name
-        raise RuleViolation(
-            f"skill '{skill.id}' is {state}; only blueprint skills can be {verb}"
-        )
+        raise RuleViolation(f"skill '{skill.id}' is {state}; only blueprint skills can be {verb}")
 
 
 def check_params(spec: SkillSpec, params: Mapping[str, object]) -> dict[str, Value]:
     """Check each named value against the skill's schema."""
-    return {
-        name: spec.parameter(name).check(raw, spec.name) for name, raw in params.items()
-    }
+    return {name: spec.parameter(name).check(raw, spec.name) for name, raw in params.items()}
 
 
 def bound_values(
@@ -202,9 +184,7 @@ def bound_values(
                 f"parameter '{name}' of skill '{spec.name}' takes {wanted} markers, "
                 f"not the {marker.type.name.lower()} marker '{marker_name}'"
             )
-        values[name] = param.check(
-            marker.value_for(param.type is ParamType.LIST), spec.name
-        )
+        values[name] = param.check(marker.value_for(param.type is ParamType.LIST), spec.name)
     return values
 
 
@@ -218,9 +198,7 @@ def check_label(label: str, default: str | None) -> str:
             raise InvalidRequest("a label must not be empty")
         return default
     if len(stripped) > MAX_LABEL or any(ch in stripped for ch in "\n\r\t"):
-        raise InvalidRequest(
-            f"a label must be one line of at most {MAX_LABEL} characters"
-        )
+        raise InvalidRequest(f"a label must be one line of at most {MAX_LABEL} characters")
     return stripped
 
 
@@ -229,18 +207,14 @@ def check_timeout(timeout: float) -> float:
     if isinstance(timeout, bool) or not isinstance(timeout, (int, float)):
         raise InvalidRequest(f"a timeout must be a number of seconds, got {timeout!r}")
     if not math.isfinite(timeout) or timeout < 0:
-        raise InvalidRequest(
-            f"a timeout must be a finite, non-negative number, got {timeout!r}"
-        )
+        raise InvalidRequest(f"a timeout must be a finite, non-negative number, got {timeout!r}")
     return float(timeout)
 
 
 def check_retries(max_retries: int) -> int:
     """An automatic retry count between 0 and MAX_RETRIES."""
     if isinstance(max_retries, bool) or not isinstance(max_retries, int):
-        raise InvalidRequest(
-            f"a retry count must be a whole number, got {max_retries!r}"
-        )
+        raise InvalidRequest(f"a retry count must be a whole number, got {max_retries!r}")
     if not 0 <= max_retries <= MAX_RETRIES:
         raise InvalidRequest(f"a retry count must be between 0 and {MAX_RETRIES}")
     return max_retries

@@ -22,15 +22,9 @@ S = SkillStatus
 # same active status again updates attempt or progress text.
 REPORTABLE: Mapping[SkillStatus, frozenset[SkillStatus]] = {
     S.IDLE_SYNCHRONIZED: frozenset({S.SYNCWAITING, S.RUNNING, S.FAILURE}),
-    S.SYNCWAITING: frozenset(
-        {S.SYNCWAITING, S.RUNNING, S.PAUSED, S.IDLE_SYNCHRONIZED, S.FAILURE}
-    ),
-    S.RUNNING: frozenset(
-        {S.RUNNING, S.PAUSED, S.SUCCESS, S.FAILURE, S.IDLE_SYNCHRONIZED}
-    ),
-    S.PAUSED: frozenset(
-        {S.PAUSED, S.RUNNING, S.SYNCWAITING, S.IDLE_SYNCHRONIZED, S.FAILURE}
-    ),
+    S.SYNCWAITING: frozenset({S.SYNCWAITING, S.RUNNING, S.PAUSED, S.IDLE_SYNCHRONIZED, S.FAILURE}),
+    S.RUNNING: frozenset({S.RUNNING, S.PAUSED, S.SUCCESS, S.FAILURE, S.IDLE_SYNCHRONIZED}),
+    S.PAUSED: frozenset({S.PAUSED, S.RUNNING, S.SYNCWAITING, S.IDLE_SYNCHRONIZED, S.FAILURE}),
 }
 
 
@@ -49,9 +43,7 @@ def plan_synchronize(state: MissionState, agent: str, upto_id: str | None) -> Pr
         ids = [skill.id for skill in editable]
         if upto_id not in ids:
             state.skill(upto_id)  # NotFound for an unknown id
-            raise RuleViolation(
-                f"skill '{upto_id}' is not in {agent}'s editable blueprint"
-            )
+            raise RuleViolation(f"skill '{upto_id}' is not in {agent}'s editable blueprint")
         editable = editable[: ids.index(upto_id) + 1]
     start = sections.editable_start
     puts = tuple(
@@ -66,9 +58,7 @@ def plan_synchronize(state: MissionState, agent: str, upto_id: str | None) -> Pr
     )
 
 
-def plan_confirm_sync(
-    state: MissionState, agent: str, skill_ids: Sequence[str]
-) -> Proposal:
+def plan_confirm_sync(state: MissionState, agent: str, skill_ids: Sequence[str]) -> Proposal:
     """The robot stored these uploading skills: they become IDLE_SYNCHRONIZED."""
     uploading = _pending(state.task(agent), Transfer.UPLOADING)
     _require_run(uploading, skill_ids, agent, "uploads", from_front=True)
@@ -95,9 +85,7 @@ def plan_decline_sync(
     _require_run(uploading, skill_ids, agent, "uploads", from_front=False)
     declined = uploading[len(uploading) - len(skill_ids) :]
     text = reason.strip() or "declined by the robot"
-    puts = _placed(
-        state, [replace(s, transfer=Transfer.NONE, status_text=text) for s in declined]
-    )
+    puts = _placed(state, [replace(s, transfer=Transfer.NONE, status_text=text) for s in declined])
     return Proposal(
         EventKind.SYNC_DECLINED,
         agent,
@@ -106,9 +94,7 @@ def plan_decline_sync(
     )
 
 
-def plan_request_unsync(
-    state: MissionState, agent: str, from_id: str | None
-) -> Proposal:
+def plan_request_unsync(state: MissionState, agent: str, from_id: str | None) -> Proposal:
     """Ask the robot to give back ``from_id`` and every later synchronized skill."""
     task = state.task(agent)
     sections = state.sections(agent)
@@ -117,9 +103,7 @@ def plan_request_unsync(
             f"an upload to {agent} awaits the robot's answer; unsynchronize after it"
         )
     if _pending(task, Transfer.REMOVING):
-        raise RuleViolation(
-            f"an unsynchronize on {agent} already awaits the robot's answer"
-        )
+        raise RuleViolation(f"an unsynchronize on {agent} already awaits the robot's answer")
     synced = task[: sections.synced_end]
     start = len(synced)
     while start > 0 and synced[start - 1].status is S.IDLE_SYNCHRONIZED:
@@ -127,9 +111,7 @@ def plan_request_unsync(
     if from_id:
         agent_of, index = state.locate(from_id)
         if agent_of != agent or index >= len(synced):
-            raise RuleViolation(
-                f"skill '{from_id}' is not in {agent}'s synchronized section"
-            )
+            raise RuleViolation(f"skill '{from_id}' is not in {agent}'s synchronized section")
         if index < start:
             raise RuleViolation(
                 f"skill '{from_id}' or a later one has started; only skills after the last "
@@ -151,23 +133,16 @@ def plan_request_unsync(
     )
 
 
-def plan_confirm_unsync(
-    state: MissionState, agent: str, removed_ids: Sequence[str]
-) -> Proposal:
+def plan_confirm_unsync(state: MissionState, agent: str, removed_ids: Sequence[str]) -> Proposal:
     """The robot removed ``removed_ids``; they return to the blueprint, the rest stay."""
     removing = _pending(state.task(agent), Transfer.REMOVING)
     if not removing:
         raise RuleViolation(f"no unsynchronize on {agent} awaits an answer")
-    _require_run(
-        removing, removed_ids, agent, "removals", from_front=False, allow_empty=True
-    )
+    _require_run(removing, removed_ids, agent, "removals", from_front=False, allow_empty=True)
     kept = removing[: len(removing) - len(removed_ids)]
     removed = removing[len(kept) :]
     updated = [replace(s, transfer=Transfer.NONE) for s in kept]
-    updated += [
-        replace(s, status=S.IDLE, transfer=Transfer.NONE, status_text="")
-        for s in removed
-    ]
+    updated += [replace(s, status=S.IDLE, transfer=Transfer.NONE, status_text="") for s in removed]
     summary = f"{agent} gave back {_ids(removed) or 'nothing'}"
     if kept:
         summary += f"; kept {_ids(kept)}, which had started"
@@ -191,9 +166,7 @@ def plan_report(
     skill = state.skill(skill_id)
     agent, index = state.locate(skill_id)
     if skill.status is S.IDLE:
-        raise RuleViolation(
-            f"skill '{skill_id}' is not synchronized; the report is refused"
-        )
+        raise RuleViolation(f"skill '{skill_id}' is not synchronized; the report is refused")
     allowed = REPORTABLE.get(skill.status, frozenset())
     if status not in allowed:
         raise RuleViolation(
@@ -201,14 +174,8 @@ def plan_report(
         )
     new_attempt = skill.attempt if attempt is None else attempt
     if new_attempt < skill.attempt:
-        raise RuleViolation(
-            f"skill '{skill_id}' is at attempt {skill.attempt}, not {new_attempt}"
-        )
-    if (
-        status is skill.status
-        and new_attempt == skill.attempt
-        and text == skill.status_text
-    ):
+        raise RuleViolation(f"skill '{skill_id}' is at attempt {skill.attempt}, not {new_attempt}")
+    if status is skill.status and new_attempt == skill.attempt and text == skill.status_text:
         raise RuleViolation(f"the report for skill '{skill_id}' changes nothing")
     if status is not S.IDLE_SYNCHRONIZED:
         _require_turn(state, agent, index, skill_id)
@@ -235,9 +202,7 @@ def plan_stop(state: MissionState, agent: str) -> Proposal:
     """The active skill of ``agent`` goes back to IDLE_SYNCHRONIZED (restarts next time)."""
     for index, skill in enumerate(state.task(agent)):
         if skill.status.is_active:
-            new = replace(
-                skill, status=S.IDLE_SYNCHRONIZED, status_text="stopped", started=0.0
-            )
+            new = replace(skill, status=S.IDLE_SYNCHRONIZED, status_text="stopped", started=0.0)
             return Proposal(
                 EventKind.SKILL_STOPPED,
                 agent,
@@ -265,9 +230,7 @@ def plan_retry(state: MissionState, skill_id: str, new_id: str) -> Proposal:
         EventKind.SKILL_RETRIED,
         agent,
         f"'{skill_id}' on {agent} retried as '{new_id}' (attempt {fresh.attempt})",
-        Change(
-            put_skills=(PlacedSkill(index, resolved), PlacedSkill(index + 1, fresh))
-        ),
+        Change(put_skills=(PlacedSkill(index, resolved), PlacedSkill(index + 1, fresh))),
     )
 
 
@@ -279,11 +242,7 @@ def plan_skip(state: MissionState, skill_id: str) -> Proposal:
         EventKind.SKILL_SKIPPED,
         agent,
         f"failed '{skill_id}' on {agent} skipped",
-        Change(
-            put_skills=(
-                PlacedSkill(index, replace(failed, resolution=Resolution.SKIPPED)),
-            )
-        ),
+        Change(put_skills=(PlacedSkill(index, replace(failed, resolution=Resolution.SKIPPED)),)),
     )
 
 
@@ -335,9 +294,7 @@ def _require_run(
         )
 
 
-def _placed(
-    state: MissionState, skills: Sequence[SkillInstance]
-) -> tuple[PlacedSkill, ...]:
+def _placed(state: MissionState, skills: Sequence[SkillInstance]) -> tuple[PlacedSkill, ...]:
     return tuple(PlacedSkill(state.locate(skill.id)[1], skill) for skill in skills)
 
 

@@ -54,9 +54,7 @@ class ParameterSpec:
     def check(self, raw: object, skill: str) -> Value:
         """Check a value for this parameter of ``skill``; return it normalized."""
         what = f"parameter '{self.name}' of skill '{skill}'"
-        return check_value(
-            self.type, raw, what, self.minimum, self.maximum, self.choices
-        )
+        return check_value(self.type, raw, what, self.minimum, self.maximum, self.choices)
 
     def accepts_marker(self, marker_type: MarkerType) -> bool:
         """Whether a task marker of ``marker_type`` may fill this parameter."""
@@ -80,9 +78,7 @@ class SkillSpec:
             if spec.name == name:
                 return spec
         known = ", ".join(spec.name for spec in self.parameters) or "none"
-        raise NotFound(
-            f"skill '{self.name}' has no parameter '{name}' (it has: {known})"
-        )
+        raise NotFound(f"skill '{self.name}' has no parameter '{name}' (it has: {known})")
 
     def defaults(self) -> dict[str, Value]:
         """Every parameter's default value."""
@@ -128,9 +124,7 @@ class Library:
         """The skill ``skill`` of ``agent``; NotFound or RuleViolation otherwise."""
         spec = self.agent(agent)
         if spec.kind is AgentKind.STATIC:
-            raise RuleViolation(
-                f"'{agent}' is a static agent and cannot execute skills"
-            )
+            raise RuleViolation(f"'{agent}' is a static agent and cannot execute skills")
         skills = self.models.get(spec.model, {})
         if skill not in skills:
             known = ", ".join(sorted(skills)) or "none"
@@ -144,17 +138,13 @@ def load_library(path: str | Path) -> Library:
     try:
         text = Path(path).read_text(encoding="utf-8")
     except OSError as error:
-        raise LibraryError(
-            f"{source}: cannot read the library file ({error.strerror})"
-        ) from error
+        raise LibraryError(f"{source}: cannot read the library file ({error.strerror})") from error
     except UnicodeDecodeError as error:
         raise LibraryError(f"{source}: the file is not UTF-8 text (byte {error.start})") from error
     try:
         data = yaml.safe_load(text)
     except yaml.YAMLError as error:
-        raise LibraryError(
-            f"{source}: not valid YAML ({_yaml_problem(error)})"
-        ) from error
+        raise LibraryError(f"{source}: not valid YAML ({_yaml_problem(error)})") from error
     return library_from_dict(data, source)
 
 
@@ -176,9 +166,7 @@ def library_from_dict(data: object, source: str = "<library>") -> Library:
     name = reader.text(top["name"], "name")
     models_data = reader.mapping(top["models"], "models")
     models = {
-        reader.text(model, f"models.{model}"): _read_model(
-            reader, raw, f"models.{model}"
-        )
+        reader.text(model, f"models.{model}"): _read_model(reader, raw, f"models.{model}")
         for model, raw in models_data.items()
     }
     agents = _read_agents(reader, top["agents"], models)
@@ -191,20 +179,14 @@ def _read_agents(
     agents: list[AgentSpec] = []
     for name, entry in reader.mapping(raw, "agents").items():
         key = f"agents.{name}"
-        body = reader.mapping(
-            entry, key, required={"kind", "model"}, optional={"description"}
-        )
+        body = reader.mapping(entry, key, required={"kind", "model"}, optional={"description"})
         kinds = {kind.name.lower(): kind for kind in AgentKind}
         if body["kind"] not in kinds:
-            reader.fail(
-                f"{key}.kind", f"must be dynamic or static, got {body['kind']!r}"
-            )
+            reader.fail(f"{key}.kind", f"must be dynamic or static, got {body['kind']!r}")
         model = reader.text(body["model"], f"{key}.model")
         if model not in models and kinds[body["kind"]] is AgentKind.DYNAMIC:
             reader.fail(f"{key}.model", f"names no model in 'models' ({model!r})")
-        description = reader.text(
-            body.get("description", ""), f"{key}.description", empty=True
-        )
+        description = reader.text(body.get("description", ""), f"{key}.description", empty=True)
         agents.append(AgentSpec(str(name), kinds[body["kind"]], model, description))
     if not agents:
         reader.fail("agents", "the library declares no agents")
@@ -231,15 +213,11 @@ def _read_skill(reader: _Reader, name: str, raw: object, key: str) -> SkillSpec:
     duration = reader.number(body.get("duration", 0.0), f"{key}.duration")
     if duration < 0:
         reader.fail(f"{key}.duration", "must not be negative")
-    description = reader.text(
-        body.get("description", ""), f"{key}.description", empty=True
-    )
+    description = reader.text(body.get("description", ""), f"{key}.description", empty=True)
     return SkillSpec(name, parameters, description, duration)
 
 
-def _read_parameter(
-    reader: _Reader, skill: str, name: str, raw: object, key: str
-) -> ParameterSpec:
+def _read_parameter(reader: _Reader, skill: str, name: str, raw: object, key: str) -> ParameterSpec:
     body = reader.mapping(
         raw,
         key,
@@ -248,9 +226,7 @@ def _read_parameter(
     )
     types = {ptype.name.lower(): ptype for ptype in ParamType}
     if body["type"] not in types:
-        reader.fail(
-            f"{key}.type", f"must be one of {', '.join(types)}, got {body['type']!r}"
-        )
+        reader.fail(f"{key}.type", f"must be one of {', '.join(types)}, got {body['type']!r}")
     ptype = types[body["type"]]
     minimum = reader.number(body["min"], f"{key}.min") if "min" in body else None
     maximum = reader.number(body["max"], f"{key}.max") if "max" in body else None
@@ -263,9 +239,7 @@ def _read_parameter(
         reader.fail(key, "min and max apply to int and float parameters only")
     choices = reader.sequence(body.get("choices", []), f"{key}.choices")
     try:
-        checked_choices = tuple(
-            check_value(ptype, c, f"{key}.choices") for c in choices
-        )
+        checked_choices = tuple(check_value(ptype, c, f"{key}.choices") for c in choices)
         spec = ParameterSpec(
             name=name,
             type=ptype,
@@ -274,12 +248,8 @@ def _read_parameter(
             maximum=maximum,
             choices=checked_choices,
             unit=reader.text(body.get("unit", ""), f"{key}.unit", empty=True),
-            description=reader.text(
-                body.get("description", ""), f"{key}.description", empty=True
-            ),
-            marker_type=_read_marker_type(
-                reader, body.get("marker"), ptype, f"{key}.marker"
-            ),
+            description=reader.text(body.get("description", ""), f"{key}.description", empty=True),
+            marker_type=_read_marker_type(reader, body.get("marker"), ptype, f"{key}.marker"),
         )
         spec.check(spec.default, skill)
     except InvalidRequest as error:
@@ -298,9 +268,7 @@ def _read_marker_type(
     marker = names[str(raw)]
     if MARKER_PARAM_TYPE[marker] is not ptype:
         expected = MARKER_PARAM_TYPE[marker].name.lower()
-        reader.fail(
-            key, f"a {marker.name.lower()} marker fills {expected} parameters only"
-        )
+        reader.fail(key, f"a {marker.name.lower()} marker fills {expected} parameters only")
     return marker
 
 

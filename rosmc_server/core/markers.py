@@ -27,13 +27,10 @@ def check_marker(marker: TaskMarker) -> TaskMarker:
     """Check a marker's shape; return it with an AREA's pose set to its centroid."""
     name = marker.name.strip()
     if not name or len(name) > MAX_NAME or any(ch in name for ch in "\n\r\t"):
-        raise InvalidRequest(
-            f"a marker name must be one line of 1 to {MAX_NAME} characters"
-        )
+        raise InvalidRequest(f"a marker name must be one line of 1 to {MAX_NAME} characters")
     pose = Pose.from_any(marker.pose, f"the pose of marker '{name}'")
     vertices = tuple(
-        Pose.from_any(v, f"vertex {i} of marker '{name}'")
-        for i, v in enumerate(marker.vertices)
+        Pose.from_any(v, f"vertex {i} of marker '{name}'") for i, v in enumerate(marker.vertices)
     )
     if marker.type is MarkerType.AREA:
         if len(vertices) < 3:
@@ -44,9 +41,7 @@ def check_marker(marker: TaskMarker) -> TaskMarker:
             sum(v.z for v in vertices) / len(vertices),
         )
     elif vertices:
-        raise InvalidRequest(
-            f"{marker.type.name.lower()} marker '{name}' takes no vertices"
-        )
+        raise InvalidRequest(f"{marker.type.name.lower()} marker '{name}' takes no vertices")
     return TaskMarker(name, MarkerType(marker.type), pose, vertices)
 
 
@@ -98,14 +93,10 @@ def plan_move_marker(
     puts = []
     for skill in bound:
         spec = library.skill(skill.agent, skill.skill)
-        names = {
-            param: marker for param, marker in skill.bindings.items() if marker == name
-        }
+        names = {param: marker for param, marker in skill.bindings.items() if marker == name}
         values = dict(skill.params)
         values.update(bound_values(find_marker, spec, names))
-        puts.append(
-            PlacedSkill(state.locate(skill.id)[1], replace(skill, params=values))
-        )
+        puts.append(PlacedSkill(state.locate(skill.id)[1], replace(skill, params=values)))
     follow = f"; {len(puts)} bound skill(s) follow" if puts else ""
     return Proposal(
         EventKind.MARKER_MOVED,

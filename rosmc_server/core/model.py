@@ -93,10 +93,7 @@ class SkillInstance:
         """Finished for good: SUCCESS, or a FAILURE the operator retried or skipped."""
         if self.status is SkillStatus.SUCCESS:
             return True
-        return (
-            self.status is SkillStatus.FAILURE
-            and self.resolution is not Resolution.NONE
-        )
+        return self.status is SkillStatus.FAILURE and self.resolution is not Resolution.NONE
 
 
 @dataclass(frozen=True)

@@ -64,18 +64,11 @@ class Pose:
         elif isinstance(raw, Mapping):
             unknown = sorted(str(key) for key in raw if key not in cls.FIELDS)
             if unknown:
-                raise InvalidRequest(
-                    f"{what} has unknown pose fields {', '.join(unknown)}"
-                )
+                raise InvalidRequest(f"{what} has unknown pose fields {', '.join(unknown)}")
             values = {name: raw.get(name, 0.0) for name in cls.FIELDS}
         else:
             raise InvalidRequest(f"{what} must be a pose (x, y, z, roll, pitch, yaw)")
-        return cls(
-            **{
-                name: _finite(value, f"{name} of {what}")
-                for name, value in values.items()
-            }
-        )
+        return cls(**{name: _finite(value, f"{name} of {what}") for name, value in values.items()})
 
 
 Value = bool | int | float | str | list[Any] | dict[str, Any] | Pose
@@ -122,9 +115,7 @@ def check_json_data(raw: object, what: str) -> Any:
                 raise InvalidRequest(f"{what} has a non-text key {key!r}")
             out[key] = check_json_data(item, f"{what}.{key}")
         return out
-    raise InvalidRequest(
-        f"{what} holds a {type(raw).__name__}, which is not list/dict data"
-    )
+    raise InvalidRequest(f"{what} holds a {type(raw).__name__}, which is not list/dict data")
 
 
 def check_value(
@@ -168,9 +159,7 @@ def check_value(
     return value
 
 
-def _check_range(
-    value: Value, what: str, minimum: float | None, maximum: float | None
-) -> None:
+def _check_range(value: Value, what: str, minimum: float | None, maximum: float | None) -> None:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         return
     if minimum is not None and value < minimum:
@@ -205,15 +194,11 @@ def parse_text(ptype: ParamType, text: str, what: str) -> object:
         if ptype is ParamType.POSE and not stripped.startswith("{"):
             numbers = [float(part) for part in stripped.split(",")]
             if not 2 <= len(numbers) <= 6:
-                raise InvalidRequest(
-                    f"{what} needs 2 to 6 numbers: x,y[,z,roll,pitch,yaw]"
-                )
-            return dict(zip(Pose.FIELDS, numbers))
+                raise InvalidRequest(f"{what} needs 2 to 6 numbers: x,y[,z,roll,pitch,yaw]")
+            return dict(zip(Pose.FIELDS, numbers, strict=False))
         return yaml.safe_load(stripped)
     except ValueError as error:
-        raise InvalidRequest(
-            f"{what}: cannot read {text!r} as {ptype.name.lower()}"
-        ) from error
+        raise InvalidRequest(f"{what}: cannot read {text!r} as {ptype.name.lower()}") from error
     except yaml.YAMLError as error:
         raise InvalidRequest(f"{what}: {text!r} is not valid YAML or JSON") from error
 

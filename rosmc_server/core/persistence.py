@@ -36,18 +36,14 @@ def mission_to_dict(content: MissionContent, revision: int) -> dict[str, Any]:
             agent: [_skill_to_dict(skill) for skill in task]
             for agent, task in content.tasks.items()
         },
-        "barriers": [
-            {"id": b.id, "skills": list(b.skill_ids)} for b in content.barriers.values()
-        ],
+        "barriers": [{"id": b.id, "skills": list(b.skill_ids)} for b in content.barriers.values()],
         "markers": [_marker_to_dict(m) for m in content.markers.values()],
     }
 
 
 def dump_mission(content: MissionContent, revision: int) -> str:
     """The mission as a YAML document."""
-    return yaml.safe_dump(
-        mission_to_dict(content, revision), sort_keys=False, width=100
-    )
+    return yaml.safe_dump(mission_to_dict(content, revision), sort_keys=False, width=100)
 
 
 def save_mission(path: str | Path, content: MissionContent, revision: int) -> None:
@@ -58,9 +54,7 @@ def save_mission(path: str | Path, content: MissionContent, revision: int) -> No
         temporary.write_text(dump_mission(content, revision), encoding="utf-8")
         temporary.replace(target)
     except OSError as error:
-        raise MissionFileError(
-            f"{target}: cannot write the mission ({error.strerror})"
-        ) from error
+        raise MissionFileError(f"{target}: cannot write the mission ({error.strerror})") from error
 
 
 def load_mission(path: str | Path, library: Library) -> tuple[MissionContent, int]:
@@ -68,15 +62,11 @@ def load_mission(path: str | Path, library: Library) -> tuple[MissionContent, in
     try:
         text = Path(path).read_text(encoding="utf-8")
     except OSError as error:
-        raise MissionFileError(
-            f"{path}: cannot read the mission ({error.strerror})"
-        ) from error
+        raise MissionFileError(f"{path}: cannot read the mission ({error.strerror})") from error
     return parse_mission(text, library, str(path))
 
 
-def parse_mission(
-    text: str, library: Library, source: str
-) -> tuple[MissionContent, int]:
+def parse_mission(text: str, library: Library, source: str) -> tuple[MissionContent, int]:
     """Parse and check a mission document; return its content and revision."""
     try:
         data = yaml.safe_load(text)
@@ -106,9 +96,7 @@ def mission_from_dict(
             f"unsupported mission file version {top['rosmc_mission']!r}",
         )
     if top["library"] != library.name:
-        reader.fail(
-            "library", f"written for library {top['library']!r}, not {library.name!r}"
-        )
+        reader.fail("library", f"written for library {top['library']!r}, not {library.name!r}")
     revision = top["revision"]
     if isinstance(revision, bool) or not isinstance(revision, int) or revision < 0:
         reader.fail("revision", f"must be a whole number >= 0, got {revision!r}")
@@ -132,10 +120,7 @@ def _read_markers(reader: _FileReader, raw: object) -> dict[str, TaskMarker]:
                     reader.text(body["name"], f"{key}.name"),
                     marker_type,
                     Pose.from_any(body["pose"], f"{key}.pose"),
-                    tuple(
-                        Pose.from_any(v, f"{key}.vertices")
-                        for v in body.get("vertices", [])
-                    ),
+                    tuple(Pose.from_any(v, f"{key}.vertices") for v in body.get("vertices", [])),
                 )
             )
         except RosmcError as error:
@@ -155,9 +140,7 @@ def _read_tasks(
     from .editing import bound_values, check_params
 
     body = reader.fields(raw, "tasks", set(), None)
-    tasks: dict[str, list[SkillInstance]] = {
-        agent: [] for agent in library.dynamic_agents
-    }
+    tasks: dict[str, list[SkillInstance]] = {agent: [] for agent in library.dynamic_agents}
     seen: set[str] = set()
     for agent, entries in body.items():
         if agent not in tasks:
@@ -188,9 +171,7 @@ def _marker(markers: Mapping[str, TaskMarker], name: str) -> TaskMarker:
     return markers[name]
 
 
-def _read_skill(
-    reader: _FileReader, raw: object, agent: str, key: str
-) -> SkillInstance:
+def _read_skill(reader: _FileReader, raw: object, agent: str, key: str) -> SkillInstance:
     body = reader.fields(
         raw,
         key,
@@ -222,17 +203,11 @@ def _read_skill(
         bindings=dict(bindings),
         status=reader.enum(SkillStatus, body.get("status", "IDLE"), f"{key}.status"),
         transfer=reader.enum(Transfer, body.get("transfer", "NONE"), f"{key}.transfer"),
-        resolution=reader.enum(
-            Resolution, body.get("resolution", "NONE"), f"{key}.resolution"
-        ),
+        resolution=reader.enum(Resolution, body.get("resolution", "NONE"), f"{key}.resolution"),
         attempt=reader.whole(body.get("attempt", 1), f"{key}.attempt", minimum=1),
         timeout=reader.number(body.get("timeout", 0.0), f"{key}.timeout"),
-        max_retries=reader.whole(
-            body.get("max_retries", 0), f"{key}.max_retries", minimum=0
-        ),
-        status_text=reader.text(
-            body.get("status_text", ""), f"{key}.status_text", empty=True
-        ),
+        max_retries=reader.whole(body.get("max_retries", 0), f"{key}.max_retries", minimum=0),
+        status_text=reader.text(body.get("status_text", ""), f"{key}.status_text", empty=True),
         started=reader.number(body.get("started", 0.0), f"{key}.started"),
         finished=reader.number(body.get("finished", 0.0), f"{key}.finished"),
     )
@@ -252,16 +227,9 @@ def _check_sections(reader: _FileReader, task: list[SkillInstance], key: str) ->
             skill.transfer is Transfer.REMOVING
             and skill.status is not SkillStatus.IDLE_SYNCHRONIZED
         ):
-            reader.fail(
-                f"{key}[{i}].transfer", "only IDLE_SYNCHRONIZED skills can be removing"
-            )
-        if (
-            skill.resolution is not Resolution.NONE
-            and skill.status is not SkillStatus.FAILURE
-        ):
-            reader.fail(
-                f"{key}[{i}].resolution", "only a FAILURE can be retried or skipped"
-            )
+            reader.fail(f"{key}[{i}].transfer", "only IDLE_SYNCHRONIZED skills can be removing")
+        if skill.resolution is not Resolution.NONE and skill.status is not SkillStatus.FAILURE:
+            reader.fail(f"{key}[{i}].resolution", "only a FAILURE can be retried or skipped")
         rank_seen = max(rank_seen, rank)
 
 
@@ -275,9 +243,7 @@ def _read_barriers(
         key = f"barriers[{i}]"
         body = reader.fields(entry, key, {"id", "skills"}, set())
         barrier_id = reader.text(body["id"], f"{key}.id")
-        members = tuple(
-            reader.text(s, f"{key}.skills") for s in reader.items(body["skills"], key)
-        )
+        members = tuple(reader.text(s, f"{key}.skills") for s in reader.items(body["skills"], key))
         if barrier_id in barriers or barrier_id in agent_of:
             reader.fail(f"{key}.id", f"id {barrier_id!r} appears twice")
         if len(members) < 2:
@@ -286,9 +252,7 @@ def _read_barriers(
             if skill_id not in agent_of:
                 reader.fail(f"{key}.skills", f"refers to unknown skill {skill_id!r}")
             if skill_id in member_of:
-                reader.fail(
-                    f"{key}.skills", f"skill {skill_id!r} is already in another barrier"
-                )
+                reader.fail(f"{key}.skills", f"skill {skill_id!r} is already in another barrier")
             member_of[skill_id] = barrier_id
         if len({agent_of[s] for s in members}) != len(members):
             reader.fail(f"{key}.skills", "barrier members must be on distinct agents")
@@ -320,9 +284,7 @@ def _skill_to_dict(skill: SkillInstance) -> dict[str, Any]:
         "started": (skill.started, 0.0),
         "finished": (skill.finished, 0.0),
     }
-    data.update(
-        {key: value for key, (value, default) in optional.items() if value != default}
-    )
+    data.update({key: value for key, (value, default) in optional.items() if value != default})
     return data
 
 

@@ -90,9 +90,7 @@ class MissionState:
             return self._content.tasks[agent]
         except KeyError:
             known = ", ".join(self._content.tasks) or "none"
-            raise NotFound(
-                f"agent '{agent}' has no task (agents with tasks: {known})"
-            ) from None
+            raise NotFound(f"agent '{agent}' has no task (agents with tasks: {known})") from None
 
     def skills(self) -> Iterator[SkillInstance]:
         """Every skill of every agent, task by task."""
@@ -112,9 +110,7 @@ class MissionState:
         for index, skill in enumerate(task):
             if skill.id == skill_id:
                 return agent, index
-        raise AssertionError(
-            f"index out of date for skill {skill_id}"
-        )  # pragma: no cover
+        raise AssertionError(f"index out of date for skill {skill_id}")  # pragma: no cover
 
     def skill(self, skill_id: str) -> SkillInstance:
         """The skill with this id; NotFound if there is none."""
@@ -125,15 +121,10 @@ class MissionState:
         """Where ``agent``'s task splits into synchronized, uploading and editable parts."""
         task = self.task(agent)
         synced_end = 0
-        while (
-            synced_end < len(task) and task[synced_end].status is not SkillStatus.IDLE
-        ):
+        while synced_end < len(task) and task[synced_end].status is not SkillStatus.IDLE:
             synced_end += 1
         editable_start = synced_end
-        while (
-            editable_start < len(task)
-            and task[editable_start].transfer is Transfer.UPLOADING
-        ):
+        while editable_start < len(task) and task[editable_start].transfer is Transfer.UPLOADING:
             editable_start += 1
         return Sections(synced_end, editable_start)
 
@@ -184,10 +175,7 @@ class MissionState:
             self._put_skill(placed.index, placed.skill)
         if change.order_agent:
             task = content.tasks[change.order_agent]
-            by_id = {
-                skill.id: skill
-                for skill in task[len(task) - len(change.blueprint_order) :]
-            }
+            by_id = {skill.id: skill for skill in task[len(task) - len(change.blueprint_order) :]}
             task[len(task) - len(change.blueprint_order) :] = [
                 by_id[skill_id] for skill_id in change.blueprint_order
             ]
@@ -236,8 +224,6 @@ class MissionState:
                 self._barrier_of[skill_id] = barrier.id
 
 
-def with_status(
-    skill: SkillInstance, status: SkillStatus, **changes: object
-) -> SkillInstance:
+def with_status(skill: SkillInstance, status: SkillStatus, **changes: object) -> SkillInstance:
     """A copy of ``skill`` with a new status (and any other field changes)."""
     return replace(skill, status=status, **changes)  # type: ignore[arg-type]
