@@ -1,0 +1,55 @@
+"""The MCAP mission journal: every accepted change, durably, for crash recovery and replay.
+
+The mission server appends each accepted change (``rosmc/MissionEvent``) and
+periodic full snapshots (``rosmc/Mission``) to one MCAP file in ROS 1 encoding
+with the ``rosmc`` message definitions embedded, so Foxglove and the ``mcap``
+tools read it. After a crash, :meth:`JournalWriter.resume` recovers every intact
+record and continues the same file; :func:`latest_state` gives the snapshot and
+events to rebuild the mission from.
+
+Typical use::
+
+    writer = JournalWriter.create(default_journal_path("bags"), mission_msg, now_ns)
+    writer.append_event(event_msg, now_ns)  # before replying to the operator
+    if writer.snapshot_due:
+        writer.append_snapshot(mission_msg, now_ns)
+    writer.close()
+
+    writer = JournalWriter.resume(path)  # after a crash
+    state = latest_state(writer.recovered)
+"""
+
+from rosmc_server.recording._files import default_journal_path
+from rosmc_server.recording.errors import JournalError
+from rosmc_server.recording.reader import (
+    JournalRecord,
+    JournalResult,
+    LatestState,
+    latest_state,
+    read_journal,
+)
+from rosmc_server.recording.topics import (
+    AGENT_STATES_TOPIC,
+    JOURNAL_TOPICS,
+    MISSION_EVENTS_TOPIC,
+    MISSION_TOPIC,
+    ROBOT_REPORTS_TOPIC,
+)
+from rosmc_server.recording.writer import JournalOptions, JournalWriter
+
+__all__ = [
+    "AGENT_STATES_TOPIC",
+    "JOURNAL_TOPICS",
+    "MISSION_EVENTS_TOPIC",
+    "MISSION_TOPIC",
+    "ROBOT_REPORTS_TOPIC",
+    "JournalError",
+    "JournalOptions",
+    "JournalRecord",
+    "JournalResult",
+    "JournalWriter",
+    "LatestState",
+    "default_journal_path",
+    "latest_state",
+    "read_journal",
+]

@@ -1,0 +1,107 @@
+"""ROS 1 serialisation of journal messages and their schemas.
+
+genpy and the generated ``rosmc.msg`` classes come without type information;
+they are imported through ``importlib`` so that only this module deals in
+``Any``. A recorded message decodes into the installed generated class when
+the recorded definition is the installed one (so it compares equal to messages
+the server builds), and otherwise into a class generated from the definition
+embedded in the journal, with a note saying so.
+"""
+
+import importlib
+from collections.abc import Callable
+from io import BytesIO
+from typing import Any
+
+from mcap.records import Schema
+from mcap_ros1.decoder import DecoderFactory
+
+from rosmc_server.recording import _format as fmt
+from rosmc_server.recording.errors import JournalError
+from rosmc_server.recording.topics import SCHEMA_ENCODING
+
+RosMessage = Any
+"""A genpy message instance (generated classes carry no type information)."""
+
+_genpy = importlib.import_module("genpy")
+_genmsg = importlib.import_module("genmsg")
+MessageException: type[Exception] = _genpy.MessageException
+"""genpy's root of (de)serialisation errors."""
+DefinitionErrors: tuple[type[Exception], ...] = (
+    _genmsg.InvalidMsgSpec,
+    _genmsg.MsgNotFound,
+    _genmsg.MsgGenerationException,
+)
+"""What genmsg raises for a message definition it cannot parse."""
+
+
+def serialize(msg: RosMessage) -> bytes:
+    """Return the ROS 1 wire bytes of ``msg``; raise JournalError if it cannot be encoded."""
+    buffer = BytesIO()
+    try:
+        msg.serialize(buffer)
+    except MessageException as err:
+        raise JournalError(f"cannot serialise a {msg._type} message: {err}") from err
+    return buffer.getvalue()
+
+
+def schema_of(type_name: str) -> bytes:
+    """Return the full ``ros1msg`` definition of an installed type, e.g. ``rosmc/Mission``."""
+    return str(installed_class(type_name)._full_text).encode()
+
+
+def installed_class(type_name: str) -> Any:
+    """Return the generated class of ``pkg/Type``; raise JournalError if it is not installed."""
+    package, _, name = type_name.partition("/")
+    try:
+        cls = getattr(importlib.import_module(f"{package}.msg"), name)
+    except (ImportError, AttributeError) as err:
+        raise JournalError(f"message type {type_name} is not installed: {err}") from err
+    return cls
+
+
+class Decoder:
+    """Decodes message payloads per schema; collects notes about how it had to decode."""
+
+    def __init__(self) -> None:
+        self._decoders: dict[int, Callable[[bytes], RosMessage]] = {}
+        self._dynamic = DecoderFactory()
+        self.notes: list[str] = []
+
+    def decode(self, schema: fmt.SchemaRecord, data: bytes) -> RosMessage:
+        """Decode ``data``; raise JournalError if the schema or the bytes do not fit."""
+        decoder = self._decoders.get(schema.id)
+        if decoder is None:
+            decoder = self._decoders[schema.id] = self._make(schema)
+        try:
+            return decoder(data)
+        except MessageException as err:
+            raise JournalError(f"a {schema.name} message does not decode: {err}") from err
+
+    def _make(self, schema: fmt.SchemaRecord) -> Callable[[bytes], RosMessage]:
+        if schema.encoding != SCHEMA_ENCODING:
+            raise JournalError(
+                f"schema {schema.name} has encoding {schema.encoding!r}, not ros1msg"
+            )
+        try:
+            cls = installed_class(schema.name)
+        except JournalError:
+            cls = None
+        if cls is not None and str(cls._full_text).encode() == schema.data:
+            return lambda data: cls().deserialize(data)
+        self.notes.append(
+            f"the recorded definition of {schema.name} differs from the installed one "
+            "(or none is installed); its messages were decoded with the recorded definition"
+        )
+        mcap_schema = Schema(
+            id=schema.id, name=schema.name, encoding=schema.encoding, data=schema.data
+        )
+        try:
+            decoder = self._dynamic.decoder_for("ros1", mcap_schema)
+        except DefinitionErrors as err:
+            raise JournalError(
+                f"the recorded definition of {schema.name} is invalid: {err}"
+            ) from err
+        if decoder is None:
+            raise JournalError(f"no ROS 1 decoder for schema {schema.name}")
+        return decoder
