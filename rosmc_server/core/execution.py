@@ -8,6 +8,7 @@ and the task order, so the ground never shows an impossible history.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 
@@ -163,6 +164,8 @@ def plan_report(
     stamp: float = 0.0,
 ) -> Proposal:
     """Apply a robot's status report after checking it is legal and in task order."""
+    _check_report_fields(status, attempt, text, stamp)
+    stamp = float(stamp)
     skill = state.skill(skill_id)
     agent, index = state.locate(skill_id)
     if skill.status is S.IDLE:
@@ -196,6 +199,25 @@ def plan_report(
         + (f" ({text})" if text else ""),
         Change(put_skills=(PlacedSkill(index, new),)),
     )
+
+
+def _check_report_fields(status: object, attempt: object, text: object, stamp: object) -> None:
+    """Refuse report fields the mission could not hold (or save and load again)."""
+    if not isinstance(status, SkillStatus):
+        raise InvalidRequest(f"{status!r} is not a skill status")
+    if attempt is not None and (
+        isinstance(attempt, bool) or not isinstance(attempt, int) or attempt < 1
+    ):
+        raise InvalidRequest(f"an attempt must be a whole number of at least 1, got {attempt!r}")
+    if not isinstance(text, str):
+        raise InvalidRequest(f"a status text must be text, got {text!r}")
+    if (
+        isinstance(stamp, bool)
+        or not isinstance(stamp, (int, float))
+        or not math.isfinite(stamp)
+        or stamp < 0
+    ):
+        raise InvalidRequest(f"a report stamp must be a finite time >= 0, got {stamp!r}")
 
 
 def plan_stop(state: MissionState, agent: str) -> Proposal:
