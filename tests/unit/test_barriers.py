@@ -167,8 +167,8 @@ def test_three_agent_deadlock_is_refused(mission: Any, drv: Any, rejected: Any) 
 
 
 def test_deadlock_through_intermediate_skills(mission: Any, drv: Any, rejected: Any) -> None:
-    x1, m, y1 = drv.adds("alpha", 3)
-    y2, n, x2 = drv.adds("bravo", 3)
+    x1, _, y1 = drv.adds("alpha", 3)
+    y2, _, x2 = drv.adds("bravo", 3)
     mission.add_barrier([x1, x2])
     rejected(mission, RuleViolation, mission.add_barrier, [y1, y2], match="deadlock")
 
