@@ -1,0 +1,109 @@
+# ROSMC developer commands. `make demo` and `make test` are all a new machine needs; both run
+# `make setup` first, which installs only what is missing and is a no-op the second time.
+#
+#   make setup   Debian packages, .venv (pinned PyPI packages), messages built into build/
+#   make demo    setup, then the demo mission (scripts/rosmc_demo); DEMO_ARGS=... passes options
+#   make test    setup, lint, then pytest over tests/; PYTEST_ARGS=... passes options
+#   make lint    ruff check, ruff format --check, mypy --strict on every core/ package
+#   make format  ruff format and the safe ruff fixes, in place
+#   make clean   remove build/ and the tool caches (keeps .venv)
+
+SHELL := /bin/bash
+.SHELLFLAGS := -euo pipefail -c
+.DEFAULT_GOAL := help
+.DELETE_ON_ERROR:
+
+SYSTEM_PYTHON := /usr/bin/python3
+VENV := .venv
+BUILD := build
+
+# ROS 1 from Debian, message generation, Qt bindings; rviz, a virtual screen and imagemagick
+# for the GUIs and their screenshots.
+APT_PACKAGES := \
+	python3-rospy python3-rosmaster python3-interactive-markers python3-visualization-msgs \
+	python3-geometry-msgs python3-std-msgs python3-std-srvs python3-rosbag python3-rostest \
+	python3-roslaunch python3-rosservice python3-rostopic catkin python3-genpy python3-genmsg \
+	ros-message-generation ros-message-runtime python3-tf2-ros python3-python-qt-binding \
+	ros-geometry-msgs ros-std-msgs ros-visualization-msgs ros-std-srvs rosbash \
+	python3-venv cmake make \
+	xvfb rviz python3-rviz imagemagick
+
+# Everything the standalone message build reads. A new script, package or data folder at the
+# top also counts: catkin makes devel-space relays for scripts and top-level packages.
+BUILD_INPUTS := CMakeLists.txt package.xml setup.py \
+	$(wildcard rosmc_msgs/msg/*.msg rosmc_msgs/srv/*.srv scripts/* rosmc_*/__init__.py)
+
+# Every core/ package, at any depth below a rosmc_* package (rosmc_server/core,
+# rosmc_server/executor/core, ...): these are type-checked with mypy --strict.
+CORE_PACKAGES = $(patsubst %/__init__.py,%,$(wildcard rosmc_*/core/__init__.py \
+	rosmc_*/*/core/__init__.py rosmc_*/*/*/core/__init__.py))
+
+# Run a command inside the environment of env.sh.
+IN_ENV := source ./env.sh &&
+
+.PHONY: help setup apt venv requirements msgs demo test pytest lint format clean
+
+help:
+	@sed -n '1,/^$$/s/^# \{0,1\}//p' Makefile
+
+setup: apt requirements msgs
+
+apt:
+	@tools/ensure_apt_packages.sh $(APT_PACKAGES)
+
+# A venv made from Debian's python with --system-site-packages, so it sees ROS 1. One made
+# from another python (or without system packages) is replaced.
+venv: apt
+	@if ! grep -qx 'include-system-site-packages = true' $(VENV)/pyvenv.cfg 2>/dev/null \
+	   || [[ "$$(readlink -f $(VENV)/bin/python)" != "$$(readlink -f $(SYSTEM_PYTHON))" ]]; then \
+	  echo "Creating $(VENV) from $(SYSTEM_PYTHON)"; \
+	  rm -rf $(VENV); \
+	  $(SYSTEM_PYTHON) -m venv --system-site-packages $(VENV); \
+	fi
+
+# pip runs only when requirements.txt differs from what the venv was last installed from.
+requirements: venv
+	@want="$$(sha256sum requirements.txt | cut -d' ' -f1)"; \
+	if [[ "$$(cat $(VENV)/.requirements.sha256 2>/dev/null)" != "$$want" ]]; then \
+	  echo "Installing requirements.txt into $(VENV)"; \
+	  $(VENV)/bin/python -m pip install --quiet --disable-pip-version-check -r requirements.txt; \
+	  echo "$$want" > $(VENV)/.requirements.sha256; \
+	fi
+
+msgs: $(BUILD)/rosmc.stamp
+
+# Standalone catkin build of the messages (devel space in build/devel), redone only when one
+# of its inputs changed. A build/ configured for another checkout is removed first.
+$(BUILD)/rosmc.stamp: $(BUILD_INPUTS) | apt
+	@if [[ -f $(BUILD)/CMakeCache.txt ]] && ! grep -qx 'CMAKE_HOME_DIRECTORY:INTERNAL=$(CURDIR)' \
+	     $(BUILD)/CMakeCache.txt; then echo "Removing $(BUILD)/ of another checkout"; rm -rf $(BUILD); fi
+	@mkdir -p $(BUILD)
+	@echo "Building messages into $(BUILD)/devel (log: $(BUILD)/rosmc-build.log)"
+	@{ cmake -S . -B $(BUILD) -DPYTHON_EXECUTABLE=$(SYSTEM_PYTHON) && $(MAKE) -C $(BUILD); } \
+	  > $(BUILD)/rosmc-build.log 2>&1 \
+	  || { tail -n 40 $(BUILD)/rosmc-build.log; echo "Message build failed"; exit 1; }
+	@touch $@
+
+demo: setup
+	$(IN_ENV) rosmc_demo $(DEMO_ARGS)
+
+test: setup lint pytest
+
+# pytest's own exit codes pass through: 5 (no test collected) fails the target.
+pytest: setup
+	$(IN_ENV) python -m pytest $(PYTEST_ARGS)
+
+lint: setup
+	$(IN_ENV) ruff check .
+	$(IN_ENV) ruff format --check .
+	@if [[ -n "$(strip $(CORE_PACKAGES))" ]]; then \
+	  echo "mypy --strict $(CORE_PACKAGES)"; \
+	  $(IN_ENV) mypy --strict $(CORE_PACKAGES); \
+	else echo "mypy: no core/ package yet"; fi
+
+format: setup
+	$(IN_ENV) ruff check --fix .
+	$(IN_ENV) ruff format .
+
+clean:
+	rm -rf $(BUILD) .mypy_cache .ruff_cache .pytest_cache

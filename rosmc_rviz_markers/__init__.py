@@ -1,0 +1,1 @@
+"""ROSMC interactive-marker servers for rviz: agents, static agents, task markers, icons."""

@@ -1,0 +1,1 @@
+"""ROSMC mission server: mission model, robot link, MCAP journal and replay, CLI."""

@@ -1,0 +1,1 @@
+"""ROSMC simulation: pybullet world, robot kinds, simulated skills and comm-link model."""

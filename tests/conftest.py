@@ -1,0 +1,209 @@
+"""Fixtures shared by every test tier.
+
+Tiers: ``tests/unit`` (pure Python, no ROS), ``tests/ros`` (generated messages, no master),
+``tests/integration`` (real ROS tools and a real ``rosmaster``). Run through ``make test``
+or, after ``source env.sh``, plain ``python -m pytest``.
+
+``ros_master``
+    One real ``rosmaster --core`` per test session on a free loopback port, with a private
+    ``ROS_HOME``. ``ros_master.env`` is the environment for node subprocesses; the fixture
+    also points this process's ``ROS_MASTER_URI`` at it for in-process rospy use.
+``launch_process``
+    Starts a process (a node, ``roslaunch``, a CLI) with its output in a log file, and stops
+    it, with all of its children, when the test ends.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import socket
+import subprocess
+import time
+import xmlrpc.client
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+REPO_ROOT = Path(__file__).resolve().parent.parent
+LOOPBACK = "127.0.0.1"
+MASTER_START_TIMEOUT = 20.0
+STOP_TIMEOUT = 10.0
+
+
+def free_port() -> int:
+    """A TCP port on the loopback interface that nothing listens on right now."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
+        sock.bind((LOOPBACK, 0))
+        port: int = sock.getsockname()[1]
+        return port
+
+
+def master_answers(uri: str) -> bool:
+    """Whether a ROS master at ``uri`` answers ``getSystemState``."""
+    proxy = xmlrpc.client.ServerProxy(uri)
+    try:
+        code, _, _ = proxy.getSystemState("/pytest")
+    except (OSError, xmlrpc.client.Error):
+        return False
+    return bool(code == 1)
+
+
+def stop_process(process: subprocess.Popen[bytes], timeout: float = STOP_TIMEOUT) -> None:
+    """Stop ``process`` and its process group: SIGINT (as roslaunch expects), then SIGKILL.
+
+    The process must have been started with ``start_new_session=True``.
+    """
+    if process.poll() is None:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(process.pid, signal.SIGINT)
+        with contextlib.suppress(subprocess.TimeoutExpired):
+            process.wait(timeout)
+    # Children that outlived their parent go too.
+    with contextlib.suppress(ProcessLookupError):
+        os.killpg(process.pid, signal.SIGKILL)
+    with contextlib.suppress(subprocess.TimeoutExpired):
+        process.wait(timeout)
+
+
+def log_tail(path: Path, lines: int = 40) -> str:
+    """The last ``lines`` lines of a log file, for failure messages."""
+    try:
+        text = path.read_text(errors="replace")
+    except OSError:
+        return f"<no log at {path}>"
+    return "\n".join(text.splitlines()[-lines:])
+
+
+@dataclass(frozen=True)
+class RosMaster:
+    """A running ``rosmaster`` that the tests share.
+
+    Attributes:
+        uri: ``http://127.0.0.1:PORT/`` of the master.
+        port: Its TCP port.
+        env: The environment for subprocesses that should talk to this master.
+        home: Its private ``ROS_HOME`` (logs under ``home / "log"``).
+    """
+
+    uri: str
+    port: int
+    env: Mapping[str, str]
+    home: Path
+
+    def proxy(self) -> xmlrpc.client.ServerProxy:
+        """A fresh XML-RPC proxy of the master API."""
+        return xmlrpc.client.ServerProxy(self.uri)
+
+
+def _master_env(uri: str, home: Path) -> dict[str, str]:
+    env = dict(os.environ)
+    env.pop("ROS_HOSTNAME", None)  # would win over ROS_IP
+    env.update(
+        ROS_MASTER_URI=uri,
+        ROS_IP=LOOPBACK,
+        ROS_HOME=str(home),
+        ROS_LOG_DIR=str(home / "log"),
+        PYTHONUNBUFFERED="1",
+    )
+    return env
+
+
+@pytest.fixture(scope="session")
+def ros_master(tmp_path_factory: pytest.TempPathFactory) -> Iterator[RosMaster]:
+    """A real ``rosmaster --core`` on a free loopback port, for the whole session."""
+    home = tmp_path_factory.mktemp("ros_home")
+    (home / "log").mkdir()
+    failures = []
+    for _attempt in range(3):  # the free port may be taken before the master binds it
+        port = free_port()
+        uri = f"http://{LOOPBACK}:{port}/"
+        env = _master_env(uri, home)
+        log_path = home / f"rosmaster-{port}.log"
+        with log_path.open("wb") as log:
+            process = subprocess.Popen(
+                ["rosmaster", "--core", "-p", str(port)],
+                env=env,
+                stdin=subprocess.DEVNULL,
+                stdout=log,
+                stderr=subprocess.STDOUT,
+                start_new_session=True,
+            )
+        deadline = time.monotonic() + MASTER_START_TIMEOUT
+        while process.poll() is None and time.monotonic() < deadline:
+            if master_answers(uri):
+                break
+            time.sleep(0.05)
+        if process.poll() is None and master_answers(uri):
+            break
+        stop_process(process)
+        failures.append(f"port {port}:\n{log_tail(log_path)}")
+    else:
+        pytest.fail("rosmaster did not start:\n" + "\n".join(failures))
+
+    master = RosMaster(uri=uri, port=port, env=env, home=home)
+    with pytest.MonkeyPatch.context() as patch:
+        for name in ("ROS_MASTER_URI", "ROS_IP", "ROS_HOME", "ROS_LOG_DIR"):
+            patch.setenv(name, env[name])
+        patch.delenv("ROS_HOSTNAME", raising=False)
+        try:
+            yield master
+        finally:
+            stop_process(process)
+
+
+class LoggedProcess(subprocess.Popen[bytes]):
+    """A ``Popen`` whose stdout and stderr go to ``log_path``."""
+
+    log_path: Path
+
+    def log(self) -> str:
+        """Everything the process printed so far."""
+        return self.log_path.read_text(errors="replace")
+
+
+LaunchProcess = Callable[..., LoggedProcess]
+
+
+@pytest.fixture
+def launch_process(tmp_path: Path) -> Iterator[LaunchProcess]:
+    """Start processes that are stopped (with their children) when the test ends.
+
+    Call it as ``launch_process(argv, env=None, name=None, cwd=None)``; ``env`` defaults to
+    this process's environment (pass ``ros_master.env`` for nodes). Returns the
+    :class:`LoggedProcess`. A process's log tail is printed at teardown, so a failing test
+    shows what its nodes said.
+    """
+    started: list[LoggedProcess] = []
+
+    def launch(
+        argv: Sequence[str],
+        env: Mapping[str, str] | None = None,
+        name: str | None = None,
+        cwd: Path | None = None,
+    ) -> LoggedProcess:
+        label = name or Path(argv[0]).name
+        log_path = tmp_path / f"{len(started):02d}-{label}.log"
+        with log_path.open("wb") as log:
+            process = LoggedProcess(
+                list(argv),
+                env=dict(env if env is not None else os.environ),
+                cwd=cwd,
+                stdin=subprocess.DEVNULL,
+                stdout=log,
+                stderr=subprocess.STDOUT,
+                start_new_session=True,
+            )
+        process.log_path = log_path
+        started.append(process)
+        return process
+
+    yield launch
+
+    for process in reversed(started):
+        stop_process(process)
+        print(f"--- {process.log_path.name} (exit {process.returncode}) ---")
+        print(log_tail(process.log_path))
