@@ -30,6 +30,15 @@ class MissionContent:
         """A mission with an empty task for every dynamic agent of ``library``."""
         return cls(library.name, {agent: [] for agent in library.dynamic_agents})
 
+    def copy(self) -> MissionContent:
+        """A copy whose tasks and mappings can change without touching this one."""
+        return MissionContent(
+            self.library,
+            {agent: list(task) for agent, task in self.tasks.items()},
+            dict(self.barriers),
+            dict(self.markers),
+        )
+
 
 @dataclass(frozen=True)
 class Sections:
@@ -48,7 +57,9 @@ class MissionState:
 
     def __init__(self, content: MissionContent, revision: int = 0) -> None:
         self.revision = revision
-        self._content = content
+        # Own copies: the state changes its content in place, and neither the
+        # caller's content nor an event's replacement may change with it.
+        self._content = content.copy()
         self._agent_of: dict[str, str] = {}
         self._barrier_of: dict[str, str] = {}
         self._bound: dict[str, set[str]] = {}
@@ -77,12 +88,7 @@ class MissionState:
 
     def content(self) -> MissionContent:
         """A copy of the content (safe to keep while the state changes)."""
-        return MissionContent(
-            self._content.library,
-            {agent: list(task) for agent, task in self._content.tasks.items()},
-            dict(self._content.barriers),
-            dict(self._content.markers),
-        )
+        return self._content.copy()
 
     def task(self, agent: str) -> Sequence[SkillInstance]:
         """The ordered skills of ``agent``."""
@@ -160,7 +166,7 @@ class MissionState:
     def apply(self, change: Change) -> None:
         """Apply a change that the operations have validated (see :class:`Change`)."""
         if change.replacement is not None:
-            self._content = change.replacement
+            self._content = change.replacement.copy()
             self._reindex()
             return
         content = self._content
