@@ -14,42 +14,16 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from .core import Mission, MissionEvent, Pose, SkillStatus, TaskMarker, Transfer, load_library
+from .core import Mission, MissionEvent, Pose, SkillStatus, TaskMarker, load_library
 from .core.params import MarkerType
+from .text import format_schedule
 
 LIBRARY = Path(__file__).resolve().parent / "config" / "mars_team.yaml"
-
-_STATUS_MARK = {
-    SkillStatus.IDLE: "  ",
-    SkillStatus.IDLE_SYNCHRONIZED: "==",
-    SkillStatus.SYNCWAITING: "..",
-    SkillStatus.RUNNING: ">>",
-    SkillStatus.PAUSED: "||",
-    SkillStatus.SUCCESS: "ok",
-    SkillStatus.FAILURE: "!!",
-}
 
 
 def print_schedule(mission: Mission, title: str) -> None:
     """Print every robot's task: synchronized section, a rule, then the blueprint."""
-    print(f"\n=== {title} (revision {mission.revision}) ===")
-    for agent in mission.state.agents:
-        print(f"  {agent}")
-        task = mission.state.task(agent)
-        synced_end = mission.state.sections(agent).synced_end
-        for index, skill in enumerate(task):
-            if index == synced_end:
-                print("    " + "-" * 56 + " blueprint")
-            barrier = mission.state.barrier_of(skill.id)
-            tags = [f"barrier {barrier.id}"] if barrier else []
-            if skill.transfer is Transfer.UPLOADING:
-                tags.append("uploading")
-            if skill.status_text:
-                tags.append(skill.status_text)
-            mark = _STATUS_MARK[skill.status]
-            print(f"    {mark} {skill.id:<24} {skill.label:<20} {', '.join(tags)}")
-        if synced_end == len(task):
-            print("    " + "-" * 56 + " blueprint (empty)")
+    print("\n" + format_schedule(mission.state, title))
 
 
 def run(out_events: list[MissionEvent]) -> Mission:

@@ -1,0 +1,363 @@
+"""Plain-text and JSON views of a mission, its library and its events.
+
+Pure functions over core objects (no rospy): the ``rosmc`` command line, the
+scripted demo and tests share them. Text is for people (one robot's schedule
+under another, status marks, tags); the ``*_to_json`` functions return plain
+data with stable keys for ``--json`` output.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from .core import (
+    AgentKind,
+    Library,
+    MissionEvent,
+    MissionState,
+    ParameterSpec,
+    Pose,
+    SkillInstance,
+    SkillSpec,
+    SkillStatus,
+    TaskMarker,
+    Transfer,
+    Value,
+)
+from .core.params import value_to_data
+
+STATUS_MARK = {
+    SkillStatus.IDLE: "  ",
+    SkillStatus.IDLE_SYNCHRONIZED: "==",
+    SkillStatus.SYNCWAITING: "..",
+    SkillStatus.RUNNING: ">>",
+    SkillStatus.PAUSED: "||",
+    SkillStatus.SUCCESS: "ok",
+    SkillStatus.FAILURE: "!!",
+}
+_RULE = "    " + "-" * 56
+
+
+@dataclass(frozen=True)
+class AgentStatus:
+    """What the mission server reports about one agent's robot (``/rosmc/agent_states``).
+
+    ``link`` is ``"up"``, ``"down"`` or ``"unknown"``; times are seconds, -1 if unknown.
+    ``battery`` (0..1), ``wifi_signal`` (dBm) and ``pose`` are None without telemetry.
+    """
+
+    agent: str
+    link: str = "unknown"
+    last_heard: float = -1.0
+    round_trip: float = -1.0
+    commands_in_flight: int = 0
+    hash_mismatch: bool = False
+    battery: float | None = None
+    wifi_signal: float | None = None
+    in_coverage: bool = False
+    pose: Pose | None = None
+    current_skill: str = ""
+    current_status: SkillStatus | None = None
+    executor_state: str = ""
+    waiting_on: str = ""
+
+
+# -- text --------------------------------------------------------------------------
+def format_schedule(
+    state: MissionState,
+    title: str | None = None,
+    statuses: Mapping[str, AgentStatus] | None = None,
+    verbose: bool = False,
+) -> str:
+    """Every robot's task: synchronized section, a rule, then the blueprint.
+
+    With ``statuses`` (even empty), each robot gets a link/telemetry line; with
+    ``verbose``, each skill its parameter values in ``key=value`` form.
+    """
+    if title is None:
+        header = f"mission at revision {state.revision} (library {state.library})"
+    else:
+        header = f"=== {title} (revision {state.revision}) ==="
+    lines = [header]
+    for agent in state.agents:
+        lines.append(f"  {agent}")
+        if statuses is not None:
+            lines.append(f"    {format_agent_status(statuses.get(agent))}")
+        task = state.task(agent)
+        synced_end = state.sections(agent).synced_end
+        for index, skill in enumerate(task):
+            if index == synced_end:
+                lines.append(_RULE + " blueprint")
+            lines.append(_skill_line(state, skill))
+            if verbose and skill.params:
+                lines.append(f"         {format_params(skill)}")
+        if synced_end == len(task):
+            lines.append(_RULE + " blueprint (empty)")
+    return "\n".join(lines)
+
+
+def _skill_line(state: MissionState, skill: SkillInstance) -> str:
+    barrier = state.barrier_of(skill.id)
+    tags = [f"barrier {barrier.id}"] if barrier else []
+    if skill.transfer is Transfer.UPLOADING:
+        tags.append("uploading")
+    elif skill.transfer is Transfer.REMOVING:
+        tags.append("removing")
+    if skill.attempt > 1:
+        tags.append(f"attempt {skill.attempt}")
+    if skill.resolution:
+        tags.append(skill.resolution.name.lower())
+    if skill.status_text:
+        tags.append(skill.status_text)
+    mark = STATUS_MARK[skill.status]
+    return f"    {mark} {skill.id:<24} {skill.label:<20} {', '.join(tags)}"
+
+
+def format_agent_status(status: AgentStatus | None) -> str:
+    """One line: link state, telemetry and executor state of a robot ("link unknown" if None)."""
+    if status is None:
+        return "link unknown"
+    link = f"link {status.link}"
+    details = []
+    if status.last_heard >= 0:
+        details.append(f"heard {status.last_heard:.1f} s ago")
+    if status.round_trip >= 0:
+        details.append(f"round trip {status.round_trip * 1000:.0f} ms")
+    if status.commands_in_flight:
+        details.append(f"{status.commands_in_flight} command(s) in flight")
+    if status.hash_mismatch:
+        details.append("repairing queue")
+    parts = [f"{link} ({', '.join(details)})" if details else link]
+    if status.battery is not None:
+        parts.append(f"battery {status.battery * 100:.0f}%")
+    if status.wifi_signal is not None:
+        parts.append(f"Wi-Fi {status.wifi_signal:.0f} dBm")
+    if status.pose is not None:
+        parts.append(f"at ({_num(status.pose.x)}, {_num(status.pose.y)}, {_num(status.pose.z)})")
+        parts.append("in coverage" if status.in_coverage else "out of coverage")
+    if status.executor_state:
+        parts.append(f"executor {status.executor_state}")
+    if status.waiting_on:
+        parts.append(f"waiting on {status.waiting_on}")
+    return ", ".join(parts)
+
+
+def format_value(value: Value) -> str:
+    """A parameter value in the form ``rosmc add key=value`` reads back."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return _num(value)
+    if isinstance(value, Pose):
+        return ",".join(_num(getattr(value, name)) for name in Pose.FIELDS)
+    if isinstance(value, (list, dict)):
+        return json.dumps(value, separators=(",", ":"))
+    return str(value)
+
+
+def format_params(skill: SkillInstance) -> str:
+    """A skill's parameters as ``key=value`` (``key=@MARKER`` for bound ones)."""
+    return "  ".join(
+        f"{name}=@{skill.bindings[name]}" if name in skill.bindings else f"{name}={format_value(v)}"
+        for name, v in skill.params.items()
+    )
+
+
+def _num(number: float) -> str:
+    if math.isfinite(number) and number == int(number) and abs(number) < 1e15:
+        return str(int(number))
+    return repr(float(number))
+
+
+def format_markers(markers: Iterable[TaskMarker]) -> str:
+    """One line per task marker: name, type and where it is."""
+    lines = []
+    for marker in markers:
+        pose = marker.pose
+        where = f"({_num(pose.x)}, {_num(pose.y)}, {_num(pose.z)})"
+        if marker.vertices:
+            where = f"{len(marker.vertices)} vertices around {where}"
+        elif pose.yaw:
+            where += f" yaw {_num(pose.yaw)}"
+        lines.append(f"{marker.name:<24} {marker.type.name.lower():<9} {where}")
+    return "\n".join(lines) if lines else "(no task markers)"
+
+
+def format_library(library: Library, agent: str | None = None) -> str:
+    """Agents, their skills and every parameter's schema (one agent if ``agent`` is given)."""
+    lines = [f"library {library.name}"]
+    agents = [library.agent(agent)] if agent else list(library.agents)
+    for spec in agents:
+        about = f": {spec.description}" if spec.description else ""
+        lines.append(f"{spec.name} ({spec.kind.name.lower()}, model {spec.model}){about}")
+        if spec.kind is AgentKind.DYNAMIC:
+            for skill in library.skills_of(spec.name).values():
+                lines.extend(_skill_spec_lines(skill))
+    return "\n".join(lines)
+
+
+def _skill_spec_lines(skill: SkillSpec) -> list[str]:
+    about = f": {skill.description}" if skill.description else ""
+    lines = [f"  {skill.name} (about {_num(skill.estimated_duration)} s){about}"]
+    for param in skill.parameters:
+        text = f"    {param.name}: {param.type.name.lower()} = {format_value(param.default)}"
+        if param.unit:
+            text += f" {param.unit}"
+        if param.minimum is not None or param.maximum is not None:
+            low = "" if param.minimum is None else _num(param.minimum)
+            high = "" if param.maximum is None else _num(param.maximum)
+            text += f", range {low}..{high}"
+        if param.choices:
+            text += f", one of {'|'.join(format_value(c) for c in param.choices)}"
+        if param.marker_type is not None:
+            text += f", marker {param.marker_type.name.lower()}"
+        if param.description:
+            text += f"  # {param.description}"
+        lines.append(text)
+    return lines
+
+
+def format_event(event: MissionEvent) -> str:
+    """One line per mission event: revision, kind, agent and summary."""
+    return f"r{event.revision:<5} {event.kind.name:<17} {event.agent or '-':<18} {event.summary}"
+
+
+# -- JSON-ready data ----------------------------------------------------------------------
+def mission_to_json(
+    state: MissionState,
+    library: Library | None = None,
+    statuses: Mapping[str, AgentStatus] | None = None,
+) -> dict[str, Any]:
+    """The mission as plain data: revision, library, agents, barriers, markers.
+
+    Agents come in library order (static ones with no skills); each has a
+    ``link`` entry (None if unknown) when ``statuses`` is given.
+    """
+    kinds = {a.name: (a.kind.name.lower(), a.model) for a in library.agents} if library else {}
+    names = list(kinds) + [agent for agent in state.agents if agent not in kinds]
+    agents = []
+    for name in names:
+        kind, model = kinds.get(name, ("dynamic", ""))
+        entry: dict[str, Any] = {"name": name, "kind": kind, "model": model}
+        if statuses is not None:
+            status = statuses.get(name)
+            entry["link"] = agent_status_to_json(status) if status else None
+        task = state.task(name) if name in state.agents else ()
+        entry["skills"] = [skill_to_json(skill) for skill in task]
+        agents.append(entry)
+    return {
+        "revision": state.revision,
+        "library": state.library,
+        "agents": agents,
+        "barriers": [
+            {
+                "id": b.id,
+                "skills": list(b.skill_ids),
+                "agents": [state.locate(s)[0] if state.has_skill(s) else "" for s in b.skill_ids],
+            }
+            for b in state.barriers
+        ],
+        "markers": [marker_to_json(marker) for marker in state.markers],
+    }
+
+
+def skill_to_json(skill: SkillInstance) -> dict[str, Any]:
+    """One skill instance as plain data (statuses and transfers by name)."""
+    return {
+        "id": skill.id,
+        "skill": skill.skill,
+        "label": skill.label,
+        "status": skill.status.name,
+        "transfer": skill.transfer.name,
+        "resolution": skill.resolution.name,
+        "attempt": skill.attempt,
+        "params": {name: value_to_data(value) for name, value in skill.params.items()},
+        "bindings": dict(skill.bindings),
+        "status_text": skill.status_text,
+        "timeout": skill.timeout,
+        "max_retries": skill.max_retries,
+    }
+
+
+def marker_to_json(marker: TaskMarker) -> dict[str, Any]:
+    """One task marker as plain data."""
+    return {
+        "name": marker.name,
+        "type": marker.type.name.lower(),
+        "pose": marker.pose.to_dict(),
+        "vertices": [vertex.to_dict() for vertex in marker.vertices],
+    }
+
+
+def agent_status_to_json(status: AgentStatus) -> dict[str, Any]:
+    """A robot's link and telemetry state as plain data."""
+    return {
+        "state": status.link,
+        "last_heard": status.last_heard,
+        "round_trip": status.round_trip,
+        "commands_in_flight": status.commands_in_flight,
+        "hash_mismatch": status.hash_mismatch,
+        "battery": status.battery,
+        "wifi_signal": status.wifi_signal,
+        "in_coverage": status.in_coverage,
+        "pose": status.pose.to_dict() if status.pose else None,
+        "current_skill": status.current_skill,
+        "current_status": status.current_status.name if status.current_status else None,
+        "executor_state": status.executor_state,
+        "waiting_on": status.waiting_on,
+    }
+
+
+def library_to_json(library: Library) -> dict[str, Any]:
+    """The library as plain data: every agent with its skills and parameter schemas."""
+    agents = []
+    for agent in library.agents:
+        skills = library.skills_of(agent.name) if agent.kind is AgentKind.DYNAMIC else {}
+        agents.append(
+            {
+                "name": agent.name,
+                "kind": agent.kind.name.lower(),
+                "model": agent.model,
+                "description": agent.description,
+                "skills": [_skill_spec_to_json(skill) for skill in skills.values()],
+            }
+        )
+    return {"name": library.name, "agents": agents}
+
+
+def _skill_spec_to_json(skill: SkillSpec) -> dict[str, Any]:
+    return {
+        "name": skill.name,
+        "description": skill.description,
+        "estimated_duration": skill.estimated_duration,
+        "parameters": [_parameter_to_json(p) for p in skill.parameters],
+    }
+
+
+def _parameter_to_json(param: ParameterSpec) -> dict[str, Any]:
+    return {
+        "name": param.name,
+        "type": param.type.name.lower(),
+        "default": value_to_data(param.default),
+        "min": param.minimum,
+        "max": param.maximum,
+        "choices": [value_to_data(c) for c in param.choices],
+        "unit": param.unit,
+        "description": param.description,
+        "marker": param.marker_type.name.lower() if param.marker_type is not None else None,
+    }
+
+
+def event_to_json(event: MissionEvent) -> dict[str, Any]:
+    """One mission event as plain data (for ``rosmc watch --json``)."""
+    return {
+        "revision": event.revision,
+        "kind": event.kind.name,
+        "agent": event.agent,
+        "summary": event.summary,
+        "stamp": event.stamp,
+    }
