@@ -8,6 +8,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import threading
 from datetime import datetime
 from io import BytesIO
 from pathlib import Path
@@ -461,6 +462,28 @@ def test_failed_write_leaves_a_valid_journal(
     writer.close()
     result = read_journal(path)
     assert result.clean and [r.message for r in result.records] == [mission(0), event(2)]
+    assert len(mcap_messages(path)) == 2  # the failed chunk is not in the summary either
+
+
+def test_appends_from_several_threads_stay_whole(tmp_path: Path) -> None:
+    path = tmp_path / "j.mcap"
+    writer = JournalWriter.create(path, mission(0), T0)
+
+    def report(agent: str) -> None:
+        for seq in range(200):
+            writer.append_report(msg.RobotReport(agent=agent, seq=seq), T0 + seq)
+
+    threads = [threading.Thread(target=report, args=(f"r{i}",)) for i in range(4)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    writer.close()
+    reports = read_journal(path).messages(ROBOT_REPORTS_TOPIC)
+    assert sorted((r.agent, r.seq) for r in reports) == [
+        (f"r{i}", seq) for i in range(4) for seq in range(200)
+    ]
+    assert len(mcap_messages(path)) == 801
 
 
 def test_big_snapshots_are_compressed_and_read_back(tmp_path: Path) -> None:
