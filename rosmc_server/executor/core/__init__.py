@@ -1,0 +1,23 @@
+"""Executor logic in pure Python: queue, barriers, skills, store-and-forward reports."""
+
+from .engine import Engine, EngineOutputs
+from .protocol import Ack, AckResult, BarrierInfo, Command, Report, Signal, SignalKind, Snapshot
+from .skills import Outcome, SkillBehavior, SkillContext, SkillType, ThreadedSkill
+
+__all__ = [
+    "Ack",
+    "AckResult",
+    "BarrierInfo",
+    "Command",
+    "Engine",
+    "EngineOutputs",
+    "Outcome",
+    "Report",
+    "Signal",
+    "SignalKind",
+    "SkillBehavior",
+    "SkillContext",
+    "SkillType",
+    "Snapshot",
+    "ThreadedSkill",
+]

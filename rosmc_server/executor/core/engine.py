@@ -1,0 +1,521 @@
+"""The executor engine: runs a robot's synchronized skills in order, without the ground.
+
+It reacts to numbered ground commands (executing each once, answering
+duplicates with the stored answer), to peers' barrier signals, and to time
+(:meth:`Engine.tick`: skill progress, timeouts, retries, lost-link policy).
+Every status change becomes a numbered :class:`Report` kept until the ground
+acknowledges it, so an outage delays reports but never loses or reorders them.
+The engine is single-threaded; the ROS adapter serializes calls with a lock.
+"""
+
+from __future__ import annotations
+
+import enum
+import logging
+from collections import OrderedDict
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, replace
+from typing import Protocol
+
+from rosmc_server.core import SkillInstance, SkillStatus
+from rosmc_server.core.commands import CommandKind
+from rosmc_server.core.link import queue_hash
+
+from . import queueing
+from .barriers import BarrierBoard
+from .policy import LostLinkPolicy
+from .protocol import Ack, AckResult, BarrierInfo, Command, Report, Signal, SignalKind, Snapshot
+from .skills import Outcome, SkillBehavior, SkillContext, SkillType
+
+_log = logging.getLogger(__name__)
+S = SkillStatus
+ANNOUNCE_PERIOD = 0.5  # seconds between READY re-announcements while waiting
+KEPT_ACKS = 256
+
+
+class Mode(enum.Enum):
+    """Whether the operator let the robot execute."""
+
+    STOPPED = "stopped"
+    STARTED = "started"
+    PAUSED = "paused"
+
+
+class EngineOutputs(Protocol):
+    """Where the engine's messages go (the ROS adapter publishes them)."""
+
+    def report(self, report: Report) -> None:
+        """A new status report (also kept in ``Engine.unacked`` until acknowledged)."""
+
+    def signal(self, signal: Signal) -> None:
+        """A barrier signal for the peers."""
+
+    def changed(self) -> None:
+        """The engine's state changed and should be persisted."""
+
+
+@dataclass
+class _Active:
+    """The skill being worked on: waiting at its barrier, running or paused."""
+
+    skill_id: str
+    behavior: SkillBehavior | None = None
+    barrier: BarrierInfo | None = None
+    paused_from: SkillStatus | None = None
+    deadline: float = 0.0
+    retries_used: int = 0
+    last_announce: float = 0.0
+
+
+class Engine:
+    """One robot's mission executor."""
+
+    def __init__(
+        self,
+        agent: str,
+        skill_types: Mapping[str, SkillType],
+        clock: Callable[[], float],
+        outputs: EngineOutputs,
+    ) -> None:
+        self.agent = agent
+        self.skill_types = dict(skill_types)
+        self.clock = clock
+        self.outputs = outputs
+        self.queue: list[SkillInstance] = []
+        self.mode = Mode.STOPPED
+        self.last_command_seq = 0
+        self.last_report_seq = 0
+        self.unacked: list[Report] = []
+        self.acks: OrderedDict[int, Ack] = OrderedDict()
+        self.board = BarrierBoard(agent)
+        self.policy = LostLinkPolicy()
+        self.policy_note = ""
+        self._active: _Active | None = None
+        self._ground_contact = clock()
+        self._policy_triggered = False
+        self._contingency: SkillBehavior | None = None
+
+    # -- ground commands -----------------------------------------------------------
+    def handle_command(self, cmd: Command) -> Ack | None:
+        """Execute the next command once; answer duplicates again; ignore early ones."""
+        self.ground_contact()
+        if cmd.seq <= self.last_command_seq:
+            return self.acks.get(cmd.seq) or self._ack(cmd.seq, error="already executed")
+        if cmd.seq != self.last_command_seq + 1:
+            return None  # an earlier command is missing; the ground resends in order
+        handlers: Mapping[CommandKind, Callable[[Command], Ack]] = {
+            CommandKind.UPLOAD: self._upload,
+            CommandKind.UNSYNC: self._unsync,
+            CommandKind.START: self._start,
+            CommandKind.RESUME: self._start,
+            CommandKind.PAUSE: self._pause_command,
+            CommandKind.STOP: self._stop,
+            CommandKind.RETRY: self._retry,
+            CommandKind.SKIP: self._skip,
+            CommandKind.BARRIERS: self._set_barriers,
+            CommandKind.SET_OPTIONS: self._set_options,
+            CommandKind.SYNC_STATE: self._sync_state,
+        }
+        ack = handlers[cmd.kind](cmd)
+        self.last_command_seq = cmd.seq
+        self.acks[cmd.seq] = ack
+        while len(self.acks) > KEPT_ACKS:
+            self.acks.popitem(last=False)
+        self.outputs.changed()
+        return ack
+
+    def _ack(self, seq: int, **fields: object) -> Ack:
+        rejected = fields.get("rejected_ids", ())
+        accepted = fields.get("accepted_ids", ())
+        result = AckResult.ACCEPTED
+        if rejected:
+            result = AckResult.PARTIAL if accepted else AckResult.REJECTED
+        return Ack(seq, result, queue_hash=self.queue_hash(), **fields)  # type: ignore[arg-type]
+
+    def _upload(self, cmd: Command) -> Ack:
+        answer = queueing.upload(self.queue, cmd.skills, self._why_not)
+        self.queue = answer.queue
+        self.board.replace(cmd.barriers)
+        self._advance()
+        return self._answer(cmd.seq, answer, error=next(iter(answer.reasons), ""))
+
+    def _answer(self, seq: int, answer: queueing.Answer, error: str = "") -> Ack:
+        return self._ack(
+            seq,
+            accepted_ids=answer.accepted,
+            rejected_ids=answer.rejected,
+            rejection_reasons=answer.reasons,
+            error=error,
+        )
+
+    def _why_not(self, skill: SkillInstance) -> str:
+        if skill.agent != self.agent:
+            return f"skill '{skill.id}' is for {skill.agent}, not {self.agent}"
+        kind = self.skill_types.get(skill.skill)
+        if kind is None:
+            return f"{self.agent} does not implement skill '{skill.skill}'"
+        return kind.check(skill.params)
+
+    def _unsync(self, cmd: Command) -> Ack:
+        active_id = self._active.skill_id if self._active else ""
+        answer = queueing.unsync(self.queue, cmd.skill_ids, active_id)
+        self.queue = answer.queue
+        return self._answer(cmd.seq, answer)
+
+    def _start(self, cmd: Command) -> Ack:
+        self.mode = Mode.STARTED
+        active = self._active
+        if active is not None and self._status(active.skill_id) is S.PAUSED:
+            self._resume_active(active)
+        self._advance()
+        holding = queueing.holding(self.queue)
+        note = f"holding after the failure of '{holding.id}': retry or skip it" if holding else ""
+        return self._ack(cmd.seq, error=note)
+
+    def _pause_command(self, cmd: Command) -> Ack:
+        self.pause("paused by the operator")
+        return self._ack(cmd.seq)
+
+    def _stop(self, cmd: Command) -> Ack:
+        self.mode = Mode.STOPPED
+        active = self._active
+        if active is not None:
+            self._drop_active(active, "stopped by the operator")
+        return self._ack(cmd.seq)
+
+    def _retry(self, cmd: Command) -> Ack:
+        if not cmd.skill_ids or not cmd.skills:
+            return self._ack(cmd.seq, error="a retry names the failed skill and its new instance")
+        answer = queueing.retry(self.queue, cmd.skill_ids[0], cmd.skills[0])
+        return self._queue_changed(cmd.seq, answer)
+
+    def _skip(self, cmd: Command) -> Ack:
+        if not cmd.skill_ids:
+            return self._ack(cmd.seq, error="a skip names the failed skill")
+        return self._queue_changed(cmd.seq, queueing.skip(self.queue, cmd.skill_ids[0]))
+
+    def _queue_changed(self, seq: int, answer: queueing.Answer) -> Ack:
+        self.queue = answer.queue
+        self._advance()
+        return self._answer(seq, answer, error=next(iter(answer.reasons), ""))
+
+    def _set_barriers(self, cmd: Command) -> Ack:
+        self.board.replace(cmd.barriers)
+        active = self._active
+        if active is not None and active.behavior is None and active.barrier is not None:
+            active.barrier = self.board.barrier_of(active.skill_id)
+            self._try_release(active)
+        return self._ack(cmd.seq)
+
+    def _set_options(self, cmd: Command) -> Ack:
+        try:
+            self.policy = LostLinkPolicy.from_json(cmd.argument, set(self.skill_types))
+        except ValueError as error:
+            return self._ack(cmd.seq, error=str(error), rejected_ids=("options",))
+        return self._ack(cmd.seq)
+
+    def _sync_state(self, cmd: Command) -> Ack:
+        """Make the queue the ground's list, keeping whatever has started here."""
+        self.board.replace(cmd.barriers)
+        return self._queue_changed(cmd.seq, queueing.adopt(self.queue, cmd.skills, self._why_not))
+
+    # -- peers and the ground -------------------------------------------------------------
+    def hear(self, signal: Signal) -> None:
+        """A peer's barrier signal."""
+        self.board.hear(signal)
+        active = self._active
+        if active is not None and active.barrier is not None and active.behavior is None:
+            self._try_release(active)
+
+    def report_acknowledged(self, seq: int) -> None:
+        """The ground has every report up to ``seq``."""
+        self.ground_contact()
+        before = len(self.unacked)
+        self.unacked = [r for r in self.unacked if r.seq > seq]
+        if len(self.unacked) != before:
+            self.outputs.changed()
+
+    def ground_contact(self) -> None:
+        """Something arrived from the ground station."""
+        self._ground_contact = self.clock()
+        if self._policy_triggered:
+            self._policy_triggered = False
+            self.policy_note += "; ground contact is back"
+            self.outputs.changed()
+
+    # -- time ---------------------------------------------------------------------
+    def tick(self) -> None:
+        """Advance the active skill, timeouts, retries, announcements and the link policy."""
+        now = self.clock()
+        self._check_link_policy(now)
+        if self._contingency is not None:
+            self._run_contingency(now)
+        active = self._active
+        if active is None:
+            return
+        if active.behavior is not None and self._status(active.skill_id) is S.RUNNING:
+            self._update_running(active, now)
+        elif (
+            self._status(active.skill_id) is S.SYNCWAITING
+            and now - active.last_announce >= ANNOUNCE_PERIOD
+        ):
+            self._announce(active, SignalKind.READY)
+
+    def _update_running(self, active: _Active, now: float) -> None:
+        assert active.behavior is not None
+        try:
+            outcome = active.behavior.update(now)
+        except Exception as error:  # a broken skill implementation fails the skill
+            outcome = Outcome.failed(f"skill crashed: {type(error).__name__}: {error}")
+        if outcome is None and active.deadline and now >= active.deadline:
+            active.behavior.cancel()
+            skill = self._find(active.skill_id)
+            outcome = Outcome.failed(
+                f"timed out after {skill.timeout:g} s" if skill else "timed out"
+            )
+        if outcome is not None:
+            self._finish(active, outcome)
+
+    # -- execution -------------------------------------------------------------------
+    def _advance(self) -> None:
+        """Start the next skill if the robot may execute and nothing is active."""
+        if self.mode is not Mode.STARTED or self._active is not None or self._contingency:
+            return
+        upcoming = queueing.upcoming(self.queue)
+        if upcoming is None or upcoming.status is S.FAILURE:
+            return  # finished, or holding after a failure
+        active = _Active(upcoming.id, barrier=self.board.barrier_of(upcoming.id))
+        self._active = active
+        if active.barrier is None:
+            self._run(active)
+            return
+        self._set(upcoming.id, S.SYNCWAITING, text=self._waiting_text(active.barrier))
+        self._announce(active, SignalKind.READY)
+        self._try_release(active)
+
+    def _try_release(self, active: _Active) -> None:
+        barrier = active.barrier
+        if barrier is None or self.mode is not Mode.STARTED:
+            if barrier is None and active.behavior is None:
+                self._run(active)
+            return
+        missing = self.board.missing(barrier)
+        if missing:
+            self._set(active.skill_id, S.SYNCWAITING, text=self._waiting_text(barrier))
+            return
+        self._announce(active, SignalKind.RELEASED)
+        self._run(active)
+
+    def _waiting_text(self, barrier: BarrierInfo) -> str:
+        missing = self.board.missing(barrier)
+        return f"waiting for {', '.join(missing)}" if missing else ""
+
+    def _announce(self, active: _Active, kind: SignalKind) -> None:
+        if active.barrier is None:
+            return
+        now = self.clock()
+        active.last_announce = now
+        self.outputs.signal(Signal(self.agent, active.barrier.id, active.skill_id, kind, now))
+
+    def _run(self, active: _Active) -> None:
+        skill = self._find(active.skill_id)
+        assert skill is not None
+        kind = self.skill_types[skill.skill]
+        behavior = kind.create()
+        now = self.clock()
+        ctx = SkillContext(
+            self.agent,
+            skill.id,
+            skill.params,
+            skill.attempt + active.retries_used,
+            self.clock,
+            lambda text: self._progress(skill.id, text),
+        )
+        active.behavior = behavior
+        active.deadline = now + skill.timeout if skill.timeout > 0 else 0.0
+        started = now if active.retries_used == 0 else skill.started
+        text = f"retry {active.retries_used} of {skill.max_retries}" if active.retries_used else ""
+        self._set(skill.id, S.RUNNING, text=text, started=started, attempt=ctx.attempt)
+        try:
+            behavior.start(ctx)
+        except Exception as error:  # a skill that cannot start fails cleanly
+            self._finish(active, Outcome.failed(f"could not start: {error}"))
+
+    def _finish(self, active: _Active, outcome: Outcome) -> None:
+        skill = self._find(active.skill_id)
+        assert skill is not None
+        if outcome.success:
+            self._active = None
+            self._set(skill.id, S.SUCCESS, text=outcome.reason, finished=self.clock())
+            self._advance()
+            return
+        if active.retries_used < skill.max_retries:
+            active.retries_used += 1
+            _log.info("%s: '%s' failed (%s); retrying", self.agent, skill.id, outcome.reason)
+            self._run(active)
+            return
+        self._active = None
+        self._set(skill.id, S.FAILURE, text=outcome.reason, finished=self.clock())
+
+    def _progress(self, skill_id: str, text: str) -> None:
+        skill = self._find(skill_id)
+        active = self._active
+        if skill is None or active is None or active.skill_id != skill_id:
+            return
+        if skill.status is S.RUNNING and text != skill.status_text:
+            self._set(skill_id, S.RUNNING, text=text)
+
+    def pause(self, why: str) -> None:
+        """Hold the robot: the active skill pauses (or leaves its barrier wait)."""
+        self.mode = Mode.PAUSED
+        active = self._active
+        if active is None:
+            return
+        status = self._status(active.skill_id)
+        if status is S.RUNNING and active.behavior is not None:
+            active.behavior.pause()
+        elif status is S.SYNCWAITING:
+            self._announce(active, SignalKind.WITHDRAWN)
+        else:
+            return
+        active.paused_from = status
+        self._set(active.skill_id, S.PAUSED, text=why)
+
+    def _resume_active(self, active: _Active) -> None:
+        if active.paused_from is S.RUNNING and active.behavior is not None:
+            active.behavior.resume()
+            self._set(active.skill_id, S.RUNNING, text="")
+        elif active.barrier is not None:
+            # Back to waiting at the barrier, not to PAUSED (and not straight to running).
+            self._set(active.skill_id, S.SYNCWAITING, text=self._waiting_text(active.barrier))
+            self._announce(active, SignalKind.READY)
+            self._try_release(active)
+        active.paused_from = None
+
+    def _drop_active(self, active: _Active, why: str) -> None:
+        if active.behavior is not None:
+            active.behavior.cancel()
+        if active.barrier is not None and active.behavior is None:
+            self._announce(active, SignalKind.WITHDRAWN)
+        self._active = None
+        self._set(active.skill_id, S.IDLE_SYNCHRONIZED, text=why, started=0.0)
+
+    # -- lost-link policy --------------------------------------------------------------
+    def _check_link_policy(self, now: float) -> None:
+        policy = self.policy
+        silent = now - self._ground_contact
+        if policy.kind == "continue" or self._policy_triggered or silent < policy.after:
+            return
+        self._policy_triggered = True
+        if policy.kind == "hold" or (self._active is None and not queueing.upcoming(self.queue)):
+            self.policy_note = f"held after {silent:.0f} s without ground contact"
+            self.pause(self.policy_note)
+        else:
+            self.policy_note = f"ran '{policy.skill}' after {silent:.0f} s without ground contact"
+            self.pause(self.policy_note)
+            self._contingency = self.skill_types[policy.skill].create()
+            ctx = SkillContext(self.agent, "", policy.params, 1, self.clock)
+            self._contingency.start(ctx)
+        _log.warning("%s: %s", self.agent, self.policy_note)
+        self.outputs.changed()
+
+    def _run_contingency(self, now: float) -> None:
+        assert self._contingency is not None
+        outcome = self._contingency.update(now)
+        if outcome is not None:
+            done = "done" if outcome.success else f"failed: {outcome.reason}"
+            self.policy_note += f" ({done}); holding"
+            self._contingency = None
+            self.outputs.changed()
+
+    # -- state helpers -----------------------------------------------------------------
+    def _find(self, skill_id: str) -> SkillInstance | None:
+        return next((s for s in self.queue if s.id == skill_id), None)
+
+    def _status(self, skill_id: str) -> SkillStatus | None:
+        skill = self._find(skill_id)
+        return None if skill is None else skill.status
+
+    def _replace(self, skill: SkillInstance) -> None:
+        self.queue = [skill if s.id == skill.id else s for s in self.queue]
+
+    def _set(
+        self,
+        skill_id: str,
+        status: SkillStatus,
+        text: str | None = None,
+        started: float | None = None,
+        finished: float | None = None,
+        attempt: int | None = None,
+    ) -> None:
+        """Change a skill's status and emit the report."""
+        old = self._find(skill_id)
+        assert old is not None
+        new = replace(
+            old,
+            status=status,
+            status_text=old.status_text if text is None else text,
+            started=old.started if started is None else started,
+            finished=old.finished if finished is None else finished,
+            attempt=old.attempt if attempt is None else attempt,
+        )
+        if new == old:
+            return
+        self._replace(new)
+        self.last_report_seq += 1
+        report = Report(
+            self.last_report_seq,
+            self.clock(),
+            new.id,
+            new.status,
+            new.attempt,
+            new.status_text,
+            new.started,
+            new.finished,
+        )
+        self.unacked.append(report)
+        self.outputs.report(report)
+        self.outputs.changed()
+
+    def interrupted_by_restart(self) -> list[str]:
+        """After loading a saved state: skills that were active go back to IDLE_SYNCHRONIZED."""
+        interrupted = [s.id for s in self.queue if s.status.is_active]
+        for skill_id in interrupted:
+            self._set(skill_id, S.IDLE_SYNCHRONIZED, text="interrupted by an executor restart",
+                      started=0.0)  # fmt: skip
+        return interrupted
+
+    def queue_hash(self) -> str:
+        """Hash of the ids this robot holds, in order (the ground computes the same)."""
+        return queue_hash(s.id for s in self.queue)
+
+    def state_name(self) -> str:
+        """A one-word state for operators."""
+        if self._contingency is not None:
+            return "contingency"
+        if self.mode is not Mode.STARTED:
+            return str(self.mode.value)
+        if queueing.holding(self.queue):
+            return "holding"
+        active = self._active
+        if active is None:
+            return "idle"
+        return "waiting" if active.behavior is None else "running"
+
+    def snapshot(self) -> Snapshot:
+        """The whole state, for the periodic snapshot."""
+        active = self._active
+        waiting = ""
+        if active is not None and active.barrier is not None and active.behavior is None:
+            waiting = ", ".join(self.board.missing(active.barrier))
+        return Snapshot(
+            self.clock(),
+            self.last_command_seq,
+            self.last_report_seq,
+            self.queue_hash(),
+            tuple(self.queue),
+            self.state_name(),
+            active.skill_id if active else "",
+            waiting,
+            self.policy.describe() + (f"; {self.policy_note}" if self.policy_note else ""),
+        )

@@ -1,0 +1,1 @@
+"""ROS adapter of the mission executor."""

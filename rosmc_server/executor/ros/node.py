@@ -1,0 +1,224 @@
+"""The mission executor node of one robot: ``/<robot>/mission_executor``.
+
+Subscribes:
+    ``<link>/command`` (rosmc/RobotCommand), ``<link>/report_ack`` (rosmc/ReportAck),
+    ``/rosmc/barriers`` (rosmc/BarrierSignal, robot-to-robot).
+Publishes:
+    ``<link>/ack`` (rosmc/RobotAck), ``<link>/report`` (rosmc/RobotReport, retransmitted
+    until acknowledged), ``<link>/snapshot`` (rosmc/ExecutorSnapshot, every
+    ``~snapshot_period``), ``/rosmc/barriers``.
+
+``<link>`` is ``/rosmc/link/<robot>`` (talking to the ground directly) or, with
+``~robot_side:=true``, ``/<robot>/link`` (behind a link emulator).
+
+Parameters (private):
+    ``~agent`` (str, required): the robot's agent name in the mission.
+    ``~skills`` (str): ``module:function`` returning the robot's SkillTypes
+        (default: the basic skills, ``rosmc_server.executor.basic_skills:skill_types``).
+    ``~state_file`` (str): where the executor keeps its state across restarts
+        (default ``$ROS_HOME/rosmc/<agent>_executor.json``; "" = keep nothing).
+    ``~snapshot_period`` (float, s, 1.0), ``~report_retry`` (float, s, 0.5),
+    ``~tick_rate`` (float, Hz, 50), ``~robot_side`` (bool, false).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import logging
+import os
+import sys
+import threading
+import time
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+
+import rosmc.msg as wire
+import rospy
+
+from rosmc_server import interface
+from rosmc_server.ros.logging_bridge import bridge_logging_to_rosout
+
+from ..core import Engine, Report, Signal, SkillType
+from ..core.state_file import load_state, save_state
+from .conversions import (
+    ack_to_msg,
+    command_from_msg,
+    report_to_msg,
+    signal_from_msg,
+    signal_to_msg,
+    snapshot_to_msg,
+)
+
+_log = logging.getLogger(__name__)
+DEFAULT_SKILLS = "rosmc_server.executor.basic_skills:skill_types"
+
+
+def load_skill_types(spec: str) -> dict[str, SkillType]:
+    """Import ``module:function`` and call it for the robot's skill types."""
+    module_name, _, function = spec.partition(":")
+    factory = getattr(importlib.import_module(module_name), function or "skill_types")
+    types: Iterable[SkillType] = factory()
+    return {kind.name: kind for kind in types}
+
+
+class ExecutorNode:
+    """Wires an :class:`Engine` to the robot link and the barrier topic."""
+
+    def __init__(
+        self,
+        agent: str,
+        skill_types: dict[str, SkillType],
+        state_file: Path | None,
+        robot_side: bool = False,
+    ) -> None:
+        self.agent = agent
+        self._lock = threading.RLock()
+        self._state_file = state_file
+        self._dirty = False
+        topics = interface.robot_link(agent) if robot_side else interface.ground_link(agent)
+        self._ack_pub = rospy.Publisher(topics.ack, wire.RobotAck, queue_size=100)
+        self._report_pub = rospy.Publisher(topics.report, wire.RobotReport, queue_size=1000)
+        self._snapshot_pub = rospy.Publisher(topics.snapshot, wire.ExecutorSnapshot, queue_size=5)
+        self._barrier_pub = rospy.Publisher(
+            interface.BARRIER_TOPIC, wire.BarrierSignal, queue_size=100
+        )
+        self.engine = Engine(agent, skill_types, rospy.get_time, self)
+        if state_file is not None and state_file.exists():
+            try:
+                interrupted = load_state(self.engine, state_file)
+            except (ValueError, KeyError, OSError) as error:
+                _log.error("%s: ignoring unreadable executor state: %s", agent, error)
+            else:
+                _log.info(
+                    "%s: restored %d queued skills from %s (interrupted: %s)",
+                    agent,
+                    len(self.engine.queue),
+                    state_file,
+                    ", ".join(interrupted) or "none",
+                )
+        self._subscribers = [
+            rospy.Subscriber(topics.command, wire.RobotCommand, self._on_command, queue_size=100),
+            rospy.Subscriber(
+                topics.report_ack, wire.ReportAck, self._on_report_ack, queue_size=100
+            ),
+            rospy.Subscriber(
+                interface.BARRIER_TOPIC,
+                wire.BarrierSignal,
+                self._on_signal,
+                queue_size=1000,
+                tcp_nodelay=True,
+            ),
+        ]
+
+    # -- engine outputs (called with the lock held) ------------------------------------
+    def report(self, report: Report) -> None:
+        """Publish a new report now (it is retransmitted until acknowledged)."""
+        self._report_pub.publish(report_to_msg(self.agent, report))
+
+    def signal(self, signal: Signal) -> None:
+        """Publish a barrier signal to the peers."""
+        self._barrier_pub.publish(signal_to_msg(signal))
+
+    def changed(self) -> None:
+        """Persist soon."""
+        self._dirty = True
+
+    # -- inputs ------------------------------------------------------------------------
+    def _on_command(self, msg: wire.RobotCommand) -> None:
+        if msg.agent != self.agent:
+            _log.warning("%s: ignoring a command for %s", self.agent, msg.agent)
+            return
+        try:
+            command = command_from_msg(msg)
+        except ValueError as error:
+            _log.warning("%s: refusing malformed command %d: %s", self.agent, msg.seq, error)
+            return
+        with self._lock:
+            ack = self.engine.handle_command(command)
+            self._persist()  # before answering: an acknowledged command survives a crash
+            if ack is not None:
+                self._ack_pub.publish(ack_to_msg(self.agent, ack, rospy.get_time()))
+
+    def _on_report_ack(self, msg: wire.ReportAck) -> None:
+        if msg.agent == self.agent:
+            with self._lock:
+                self.engine.report_acknowledged(msg.seq)
+
+    def _on_signal(self, msg: wire.BarrierSignal) -> None:
+        try:
+            signal = signal_from_msg(msg)
+        except ValueError:
+            _log.warning("%s: ignoring a malformed barrier signal", self.agent)
+            return
+        with self._lock:
+            self.engine.hear(signal)
+
+    # -- the loop ------------------------------------------------------------------------
+    def spin(self, tick_rate: float, snapshot_period: float, report_retry: float) -> None:
+        """Tick the engine, retransmit reports and publish snapshots until shutdown."""
+        next_snapshot = next_retry = 0.0
+        period = 1.0 / tick_rate
+        while not rospy.is_shutdown():
+            now = time.monotonic()
+            with self._lock:
+                try:
+                    self.engine.tick()
+                except Exception:  # keep the robot's executor alive whatever a skill does
+                    _log.exception("%s: executor tick failed", self.agent)
+                if now >= next_retry:
+                    next_retry = now + report_retry
+                    for report in self.engine.unacked:
+                        self._report_pub.publish(report_to_msg(self.agent, report))
+                if now >= next_snapshot:
+                    next_snapshot = now + snapshot_period
+                    self._snapshot_pub.publish(snapshot_to_msg(self.agent, self.engine.snapshot()))
+                self._persist()
+            time.sleep(max(0.0, period - (time.monotonic() - now)))
+
+    def _persist(self) -> None:
+        if self._dirty and self._state_file is not None:
+            save_state(self.engine, self._state_file)
+        self._dirty = False
+
+
+def default_state_file(agent: str) -> Path:
+    """``$ROS_HOME/rosmc/<agent>_executor.json``."""
+    ros_home = os.environ.get("ROS_HOME") or os.path.join(os.path.expanduser("~"), ".ros")
+    return Path(ros_home) / "rosmc" / f"{agent}_executor.json"
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``mission_executor``."""
+    args = rospy.myargv(list(argv) if argv is not None else sys.argv)
+    parser = argparse.ArgumentParser(
+        prog="mission_executor",
+        description="ROSMC on-robot mission executor. Settings are private parameters "
+        "(_agent:=NAME, _skills:=module:function, _state_file:=PATH).",
+    )
+    parser.parse_args(args[1:])
+    rospy.init_node("mission_executor")
+    bridge_logging_to_rosout()
+    agent = str(rospy.get_param("~agent", ""))
+    if not agent:
+        _log.critical("mission executor: set ~agent to the robot's agent name")
+        return 2
+    state = str(rospy.get_param("~state_file", str(default_state_file(agent))))
+    try:
+        skill_types = load_skill_types(str(rospy.get_param("~skills", DEFAULT_SKILLS)))
+    except (ImportError, AttributeError, ValueError) as error:
+        _log.critical("mission executor %s: cannot load skills: %s", agent, error)
+        return 1
+    node = ExecutorNode(
+        agent,
+        skill_types,
+        Path(state) if state else None,
+        bool(rospy.get_param("~robot_side", False)),
+    )
+    _log.info("%s: mission executor ready with skills %s", agent, ", ".join(sorted(skill_types)))
+    node.spin(
+        float(rospy.get_param("~tick_rate", 50.0)),
+        float(rospy.get_param("~snapshot_period", 1.0)),
+        float(rospy.get_param("~report_retry", 0.5)),
+    )
+    return 0
