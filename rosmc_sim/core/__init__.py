@@ -1,0 +1,1 @@
+"""Simulation in pure Python (pybullet allowed here): world, robots, skills, link model."""
