@@ -36,6 +36,7 @@ from .conversions import barrier_to_msg, skill_to_msg, time_to_msg
 _log = logging.getLogger(__name__)
 
 Operation = Callable[[Mission], MissionEvent | None]
+HEARTBEAT_PERIOD = 1.0  # seconds between report-ack heartbeats to each robot
 
 
 class LinkHost(Protocol):
@@ -83,6 +84,7 @@ class GroundLink:
         self._host = host
         self._clock = clock
         self._links: dict[str, AgentLink] = {}
+        self._next_heartbeat = 0.0
         for agent in agents:
             topics = ground_link(agent)
             link = AgentLink(
@@ -141,9 +143,17 @@ class GroundLink:
         self._transmit(link)
 
     def tick(self) -> None:
-        """Retransmit whatever is due (called periodically)."""
+        """Retransmit whatever is due; repeat report acks as the ground's heartbeat."""
+        now = self._clock()
+        heartbeat = now >= self._next_heartbeat
+        if heartbeat:
+            self._next_heartbeat = now + HEARTBEAT_PERIOD
         for link in self._links.values():
             self._transmit(link)
+            if heartbeat and link.reports is not None:
+                # Robots judge ground contact by what they hear; this keeps a quiet
+                # but healthy link from looking lost.
+                link.report_ack_pub.publish(wire.ReportAck(agent=link.agent, seq=link.reports.last))
 
     def resend_pending_transfers(self) -> None:
         """After a restart, ask again for the uploads and removals the journal shows pending."""
