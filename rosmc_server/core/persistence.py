@@ -63,6 +63,9 @@ def load_mission(path: str | Path, library: Library) -> tuple[MissionContent, in
         text = Path(path).read_text(encoding="utf-8")
     except OSError as error:
         raise MissionFileError(f"{path}: cannot read the mission ({error.strerror})") from error
+    except UnicodeDecodeError as error:
+        problem = f"the file is not UTF-8 text (byte {error.start})"
+        raise MissionFileError(f"{path}: {problem}") from error
     return parse_mission(text, library, str(path))
 
 
@@ -75,8 +78,15 @@ def parse_mission(text: str, library: Library, source: str) -> tuple[MissionCont
             f"{source}: refused a YAML tag that is not plain data ({error.problem})"
         ) from error
     except yaml.YAMLError as error:
-        raise MissionFileError(f"{source}: not valid YAML ({error})") from error
+        raise MissionFileError(f"{source}: not valid YAML ({_yaml_problem(error)})") from error
     return mission_from_dict(data, library, source)
+
+
+def _yaml_problem(error: yaml.YAMLError) -> str:
+    """The problem of a YAML error and its line, on one line (str(error) spans several)."""
+    problem = getattr(error, "problem", None) or str(error).splitlines()[0]
+    mark = getattr(error, "problem_mark", None)
+    return f"{problem} at line {mark.line + 1}" if mark is not None else str(problem)
 
 
 def mission_from_dict(
