@@ -19,6 +19,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable, Sequence
+from functools import partial
 from io import BytesIO
 from pathlib import Path
 from typing import Any
@@ -124,7 +125,7 @@ def bench_appends(directory: Path, chunked: bool, fsync: bool, count: int) -> di
         writer.append_event(small_event(rev), time.time_ns())
     events = [small_event(rev) for rev in range(51, count + 51)]
     start_offset = writer.offset
-    latencies = [timed(lambda e=e: writer.append_event(e, time.time_ns())) for e in events]
+    latencies = [timed(partial(writer.append_event, e, time.time_ns())) for e in events]
     data_end = writer.offset
     writer.close()
     return {
@@ -146,11 +147,11 @@ def bench_snapshot(directory: Path) -> dict[str, Any]:
             path, wire.Mission(), 0, JournalOptions(compress_from=compress_from)
         )
         before = writer.offset
-        seconds = timed(lambda w=writer: w.append_snapshot(mission, time.time_ns()))
+        seconds = timed(partial(writer.append_snapshot, mission, time.time_ns()))
         result[f"{name}_bytes"] = writer.offset - before
         result[f"{name}_append_ms"] = round(seconds * 1e3, 1)
         writer.close()
-        result[f"{name}_read_ms"] = round(timed(lambda p=path: read_journal(p)) * 1e3, 1)
+        result[f"{name}_read_ms"] = round(timed(partial(read_journal, path)) * 1e3, 1)
     buffer_size = len(_serialized(mission))
     result["serialized_bytes"] = buffer_size
     return result

@@ -7,11 +7,13 @@ buffering. The layout follows https://mcap.dev/spec; the tests check every file
 against the ``mcap`` package's own readers.
 """
 
+import importlib
 import mmap
 import struct
 import zlib
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import zstandard
 from mcap.opcode import Opcode
@@ -194,6 +196,14 @@ def decompress(compression: str, data: bytes, size: int) -> bytes:
     """Return a chunk's records; raise FormatError for an unknown or corrupt compression."""
     if compression == "":
         return data
+    if compression == "lz4":  # not written by the journal; other MCAP writers use it
+        try:
+            lz4: Any = importlib.import_module("lz4.frame")
+            return bytes(lz4.decompress(data))
+        except ImportError as err:
+            raise FormatError("an lz4-compressed chunk needs the lz4 package") from err
+        except RuntimeError as err:
+            raise FormatError(f"lz4: {err}") from err
     if compression != "zstd":
         raise FormatError(f"unsupported chunk compression {compression!r}")
     try:

@@ -25,6 +25,7 @@ class ScanResult:
 
     path: Path
     size: int
+    profile: str
     schemas: dict[int, fmt.SchemaRecord] = field(default_factory=dict)
     channels: dict[int, fmt.ChannelRecord] = field(default_factory=dict)
     messages: list[fmt.MessageRecord] = field(default_factory=list)
@@ -68,7 +69,13 @@ def _scan(path: Path, data: Data) -> ScanResult:
         )
     if head[0] != Opcode.HEADER:
         raise JournalError(f"{path} is not a valid MCAP file (its first record is not a header)")
-    result = ScanResult(path=path, size=size)
+    try:
+        fmt.parse_header(head[1])
+    except fmt.FormatError as err:
+        raise JournalError(
+            f"{path} is not a valid MCAP file (its header is damaged: {err})"
+        ) from err
+    result = ScanResult(path=path, size=size, profile=fmt.parse_header(head[1]))
     _Walker(result, data).walk()
     return result
 
@@ -89,10 +96,11 @@ class _Walker:
         self._after_chunk = False  # message index records may follow a chunk
 
     def walk(self) -> None:
+        """Read every record; then set the data end, dropped bytes and warnings."""
         r = self._r
-        end = r.data_end = len(fmt.MAGIC)
+        r.data_end = len(fmt.MAGIC)
         damage = ""
-        for offset, opcode, body in fmt.iter_records(self._data, end):
+        for offset, opcode, body in fmt.iter_records(self._data, r.data_end):
             end = offset + fmt.RECORD_HEAD.size + len(body)
             if self._in_summary:
                 if opcode == Opcode.FOOTER:
@@ -103,7 +111,6 @@ class _Walker:
                 self._record(offset, opcode, body)
             except (_Damage, fmt.FormatError) as err:
                 damage = f"a damaged {_name(opcode)} record at offset {offset}: {err}"
-                end = offset
                 break
             if opcode == Opcode.DATA_END:
                 self._in_summary = True
@@ -151,7 +158,7 @@ class _Walker:
             raise _Damage("a second header")
         if opcode in (Opcode.SCHEMA, Opcode.CHANNEL, Opcode.MESSAGE):
             _data_record(opcode, body, r.schemas, r.channels, r.messages)
-            r.top_level_messages += opcode == Opcode.MESSAGE
+            r.top_level_messages += int(opcode == Opcode.MESSAGE)
         elif opcode == Opcode.CHUNK:
             self._chunk(offset, body)
             self._after_chunk = True

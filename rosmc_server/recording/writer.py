@@ -133,6 +133,10 @@ class JournalWriter:
         fd = open_locked(path, os.O_RDWR)
         try:
             scan = _scan.scan(path)
+            if scan.profile != PROFILE:
+                raise JournalError(
+                    f"{path} is an MCAP file of profile {scan.profile!r}, not a journal"
+                )
             if scan.top_level_messages and scan.chunk_indexes:
                 raise JournalError(f"journal {path} mixes chunked and bare messages")
             chunked = bool(scan.chunk_indexes) if scan.messages else options.chunked

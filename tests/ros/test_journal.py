@@ -20,8 +20,10 @@ from hypothesis import strategies as st
 from mcap.exceptions import EndOfFile
 from mcap.reader import NonSeekingReader, SeekingReader
 from mcap.stream_reader import StreamReader
+from mcap.writer import CompressionType
 from mcap.writer import Writer as McapWriter
 from mcap_ros1.decoder import DecoderFactory
+from mcap_ros1.writer import Writer as Ros1Writer
 
 msg = pytest.importorskip("rosmc.msg", reason="rosmc messages are not built (source build/devel)")
 
@@ -162,7 +164,8 @@ def test_closed_journal_is_standard_mcap(tmp_path: Path, chunked: bool) -> None:
         assert reader.get_header().profile == "ros1"
         decoded = list(reader.iter_decoded_messages(topics=[MISSION_EVENTS_TOPIC]))
     assert [d.decoded_message.revision for d in decoded] == list(range(1, 9))
-    assert decoded[0].schema.data == msg.MissionEvent._full_text.encode()
+    schema = decoded[0].schema
+    assert schema is not None and schema.data == msg.MissionEvent._full_text.encode()
 
 
 @pytest.mark.parametrize("chunked", LAYOUTS)
@@ -522,6 +525,39 @@ def test_foreign_mcap_with_unknown_schema_decodes_with_the_recorded_definition(
     assert any("recorded definition of rosmc_test/Extra" in w for w in result.warnings)
 
 
+@pytest.mark.parametrize("compression", [CompressionType.ZSTD, CompressionType.LZ4])
+def test_mcap_ros1_recording_reads_and_resumes(tmp_path: Path, compression: Any) -> None:
+    """A file of mcap_ros1's writer (several messages per chunk, schemas inside chunks)."""
+    path = tmp_path / "ros1.mcap"
+    with path.open("wb") as file:
+        writer = Ros1Writer(file, chunk_size=2000, compression=compression)
+        writer.write_message(MISSION_TOPIC, mission(0), log_time=T0)
+        for rev in range(1, 20):
+            writer.write_message(MISSION_EVENTS_TOPIC, event(rev), log_time=T0 + rev)
+        writer.finish()
+    result = read_journal(path)
+    assert result.clean, result.warnings
+    assert [r.message for r in result.records] == [mission(0)] + [event(r) for r in range(1, 20)]
+    with JournalWriter.resume(path) as resumed:
+        assert resumed.chunked
+        resumed.append_event(event(20), T0 + 20)
+        resumed.append_report(msg.RobotReport(agent="drone"), T0 + 21)
+    assert latest_state(read_journal(path)).revision == 20
+    assert len(mcap_messages(path)) == 22
+
+
+def test_resume_refuses_an_mcap_file_of_another_profile(tmp_path: Path) -> None:
+    path = tmp_path / "ros2.mcap"
+    with path.open("wb") as file:
+        writer = McapWriter(file)
+        writer.start(profile="ros2", library="test")
+        writer.finish()
+    before = path.read_bytes()
+    with pytest.raises(JournalError, match="profile 'ros2', not a journal"):
+        JournalWriter.resume(path)
+    assert path.read_bytes() == before
+
+
 def test_rosbags_decodes_the_journal_with_its_embedded_definitions(tmp_path: Path) -> None:
     typesys = pytest.importorskip("rosbags.typesys")
     path = tmp_path / "j.mcap"
@@ -531,6 +567,7 @@ def test_rosbags_decodes_the_journal_with_its_embedded_definitions(tmp_path: Pat
     decoded = []
     with path.open("rb") as file:
         for schema, _channel, message in SeekingReader(file).iter_messages():
+            assert schema is not None
             name = schema.name.replace("/", "/msg/")
             if name not in store.fielddefs:
                 store.register(typesys.get_types_from_msg(schema.data.decode(), name))
