@@ -100,7 +100,8 @@ def mission_from_dict(
         {"rosmc_mission", "library", "revision", "tasks"},
         {"barriers", "markers"},
     )
-    if top["rosmc_mission"] != MISSION_VERSION:
+    version = top["rosmc_mission"]
+    if isinstance(version, bool) or version != MISSION_VERSION:
         reader.fail(
             "rosmc_mission",
             f"unsupported mission file version {top['rosmc_mission']!r}",
@@ -124,13 +125,14 @@ def _read_markers(reader: _FileReader, raw: object) -> dict[str, TaskMarker]:
         key = f"markers[{i}]"
         body = reader.fields(entry, key, {"name", "type", "pose"}, {"vertices"})
         marker_type = reader.enum(MarkerType, body["type"], f"{key}.type")
+        vertices = reader.items(body.get("vertices", []), f"{key}.vertices")
         try:
             marker = check_marker(
                 TaskMarker(
                     reader.text(body["name"], f"{key}.name"),
                     marker_type,
                     Pose.from_any(body["pose"], f"{key}.pose"),
-                    tuple(Pose.from_any(v, f"{key}.vertices") for v in body.get("vertices", [])),
+                    tuple(Pose.from_any(v, f"{key}.vertices") for v in vertices),
                 )
             )
         except RosmcError as error:
