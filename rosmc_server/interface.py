@@ -28,6 +28,7 @@ SERVICES = {
     "synchronize": "Synchronize",
     "unsynchronize": "Unsynchronize",
     "control": "Control",
+    "set_robot_options": "SetRobotOptions",
     "retry_skill": "RetrySkill",
     "skip_skill": "SkipSkill",
     "add_barrier": "AddBarrier",

@@ -97,4 +97,5 @@ class AgentStatePublisher:
         if link.snapshot is not None:
             state.executor_state = link.snapshot.state
             state.waiting_on = link.snapshot.waiting_on
+            state.policy = link.snapshot.policy
         return state

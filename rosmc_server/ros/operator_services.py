@@ -11,7 +11,9 @@ Services never wait for robots.
 
 from __future__ import annotations
 
+import json
 import logging
+import math
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
@@ -37,6 +39,7 @@ from ..core import (
 )
 from ..core.commands import CommandKind, CommandSpec
 from ..core.link import LinkStatus
+from ..core.params import value_to_data
 from .conversions import library_to_msg, marker_from_msg, params_from_msgs, pose_from_msg
 
 if TYPE_CHECKING:
@@ -211,6 +214,32 @@ class OperatorServices:
             for agent in agents:
                 self._server.link.send(CommandSpec(agent, _CONTROL[req.command]))
         resp.agents = agents
+        return None
+
+    def _set_robot_options(self, req: Any, resp: Any) -> None:
+        agent = _text(req.agent, "the agent name")
+        policy = req.lost_link_policy or "continue"
+        if policy not in ("continue", "hold", "safe_skill"):
+            raise InvalidRequest(
+                f"the lost-link policy must be continue, hold or safe_skill, not {policy!r}"
+            )
+        if not (math.isfinite(req.after) and req.after > 0):
+            raise InvalidRequest("the lost-link delay must be a positive number of seconds")
+        values, bindings = params_from_msgs(req.safe_skill_parameters)
+        if bindings:
+            raise InvalidRequest("safe-skill parameters cannot be bound to task markers")
+        options: dict[str, Any] = {"policy": policy, "after": req.after}
+        if policy == "safe_skill":
+            spec = self._server.library.skill(agent, _text(req.safe_skill, "the safe skill"))
+            params = spec.defaults()
+            params.update(
+                {name: spec.parameter(name).check(raw, spec.name) for name, raw in values.items()}
+            )
+            options.update(skill=spec.name, params={k: value_to_data(v) for k, v in params.items()})
+        with self._server.locked():
+            self._require_link(agent)
+            argument = json.dumps({"lost_link": options})
+            self._server.link.send(CommandSpec(agent, CommandKind.SET_OPTIONS, argument=argument))
         return None
 
     def _retry_skill(self, req: Any, resp: Any) -> MissionEvent:

@@ -413,8 +413,9 @@ class Engine:
         else:
             self.policy_note = f"ran '{policy.skill}' after {silent:.0f} s without ground contact"
             self.pause(self.policy_note)
-            self._contingency = self.skill_types[policy.skill].create()
-            ctx = SkillContext(self.agent, "", policy.params, 1, self.clock)
+            kind = self.skill_types[policy.skill]
+            self._contingency = kind.create()
+            ctx = SkillContext(self.agent, "", kind.coerce(policy.params), 1, self.clock)
             self._contingency.start(ctx)
         _log.warning("%s: %s", self.agent, self.policy_note)
         self.outputs.changed()

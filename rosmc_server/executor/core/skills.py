@@ -94,6 +94,18 @@ class SkillType:
     parameters: Mapping[str, ParamType] = field(default_factory=dict)
     description: str = ""
 
+    def coerce(self, params: Mapping[str, object]) -> dict[str, Value]:
+        """Parameters from plain data (JSON): pose mappings become poses."""
+        from rosmc_server.core.params import Pose
+
+        out: dict[str, Value] = {}
+        for name, value in params.items():
+            if self.parameters.get(name) is ParamType.POSE and isinstance(value, Mapping):
+                out[name] = Pose.from_any(value, f"parameter '{name}'")
+            else:
+                out[name] = value  # type: ignore[assignment]
+        return out
+
     def check(self, params: Mapping[str, Value]) -> str:
         """Why ``params`` cannot run this skill, or "" if they can."""
         for name, ptype in self.parameters.items():
