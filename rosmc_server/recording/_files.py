@@ -51,6 +51,10 @@ def save_tail(path: Path, start: int) -> Path:
         file.seek(start)
         tail = file.read()
     saved = path.with_name(f"{path.name}.dropped-{start}")
+    number = 1
+    while saved.exists():  # the same offset cut twice: keep both tails
+        number += 1
+        saved = path.with_name(f"{path.name}.dropped-{start}.{number}")
     saved.write_bytes(tail)
     _log.warning(
         "journal %s: saved the %d bytes cut off at byte %d to %s", path, len(tail), start, saved

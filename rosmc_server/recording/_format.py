@@ -8,7 +8,6 @@ against the ``mcap`` package's own readers.
 """
 
 import importlib
-import mmap
 import struct
 import zlib
 from collections.abc import Iterator, Mapping
@@ -17,9 +16,6 @@ from typing import Any
 
 import zstandard
 from mcap.opcode import Opcode
-
-Data = bytes | mmap.mmap
-"""A whole file in memory or mapped; both slice to bytes."""
 
 MAGIC = b"\x89MCAP0\r\n"
 RECORD_HEAD = struct.Struct("<BQ")  # opcode, body length
@@ -287,7 +283,7 @@ def parse_chunk(body: bytes) -> ChunkRecord:
     return ChunkRecord(start, end, size, crc, compression, data)
 
 
-def iter_records(data: Data, start: int = 0) -> Iterator[tuple[int, int, bytes]]:
+def iter_records(data: bytes, start: int = 0) -> Iterator[tuple[int, int, bytes]]:
     """Yield (offset, opcode, body) of the complete records in ``data`` from ``start``.
 
     Stops at the first record that does not fit; the caller compares the last end

@@ -8,14 +8,12 @@ file (schemas, channels, chunk indexes, statistics and the offset to continue
 at) and everything the reader needs to decode the messages.
 """
 
-import mmap
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from mcap.opcode import Opcode
 
 from rosmc_server.recording import _format as fmt
-from rosmc_server.recording._format import Data
 from rosmc_server.recording.errors import JournalError
 
 
@@ -47,18 +45,13 @@ class _Damage(Exception):
 def scan(path: Path) -> ScanResult:
     """Scan ``path`` from the start; raise JournalError if it is not a journal at all."""
     try:
-        with path.open("rb") as file:
-            size = file.seek(0, 2)
-            if size == 0:
-                raise JournalError(f"journal {path} is empty (0 bytes)")
-            with mmap.mmap(file.fileno(), 0, access=mmap.ACCESS_READ) as data:
-                return _scan(path, data)
+        # Read, not mapped: a writer truncating the file meanwhile must not kill us (SIGBUS).
+        data = path.read_bytes()
     except OSError as err:
         raise JournalError(f"cannot read journal {path}: {err.strerror or err}") from err
-
-
-def _scan(path: Path, data: Data) -> ScanResult:
     size = len(data)
+    if size == 0:
+        raise JournalError(f"journal {path} is empty (0 bytes)")
     if data[: len(fmt.MAGIC)] != fmt.MAGIC[:size]:
         raise JournalError(f"{path} is not an MCAP file (it does not start with the MCAP magic)")
     head = _first_record(data)
@@ -80,7 +73,7 @@ def _scan(path: Path, data: Data) -> ScanResult:
     return result
 
 
-def _first_record(data: Data) -> tuple[int, bytes] | None:
+def _first_record(data: bytes) -> tuple[int, bytes] | None:
     for _offset, opcode, body in fmt.iter_records(data, len(fmt.MAGIC)):
         return opcode, body
     return None
@@ -89,7 +82,7 @@ def _first_record(data: Data) -> tuple[int, bytes] | None:
 class _Walker:
     """Walks the records once, filling a ScanResult."""
 
-    def __init__(self, result: ScanResult, data: Data) -> None:
+    def __init__(self, result: ScanResult, data: bytes) -> None:
         self._r = result
         self._data = data
         self._in_summary = False

@@ -620,3 +620,10 @@ def test_copy_of_an_open_journal_reads_as_unclosed(tmp_path: Path) -> None:
     result = read_journal(tmp_path / "copy.mcap")
     assert_prefix(result, rows)
     assert not result.complete and result.dropped_bytes == 0
+
+
+def test_journal_topics_are_the_graph_names() -> None:
+    interface = pytest.importorskip("rosmc_server.interface")
+    assert MISSION_TOPIC == interface.MISSION_TOPIC
+    assert MISSION_EVENTS_TOPIC == interface.EVENTS_TOPIC
+    assert AGENT_STATES_TOPIC == interface.AGENT_STATES_TOPIC
