@@ -226,8 +226,13 @@ def _read_skill(reader: _FileReader, raw: object, agent: str, key: str) -> Skill
 
 
 def _check_sections(reader: _FileReader, task: list[SkillInstance], key: str) -> None:
-    """Synchronized skills first, then uploading blueprint skills, then the rest."""
+    """Synchronized skills first, then uploading blueprint skills, then the rest.
+
+    A robot runs its skills in order, so a skill that has started follows only
+    settled ones (SUCCESS, or a FAILURE that was retried or skipped).
+    """
     rank_seen = 0
+    unsettled = ""
     for i, skill in enumerate(task):
         if skill.status is not SkillStatus.IDLE:
             rank = 0
@@ -242,6 +247,15 @@ def _check_sections(reader: _FileReader, task: list[SkillInstance], key: str) ->
             reader.fail(f"{key}[{i}].transfer", "only IDLE_SYNCHRONIZED skills can be removing")
         if skill.resolution is not Resolution.NONE and skill.status is not SkillStatus.FAILURE:
             reader.fail(f"{key}[{i}].resolution", "only a FAILURE can be retried or skipped")
+        if skill.transfer is Transfer.UPLOADING and skill.status is not SkillStatus.IDLE:
+            reader.fail(f"{key}[{i}].transfer", "only blueprint (IDLE) skills can be uploading")
+        if skill.status.has_started and unsettled:
+            reader.fail(
+                f"{key}[{i}]",
+                f"skill {skill.id!r} has started although the earlier {unsettled!r} is not done",
+            )
+        if not unsettled and not skill.is_settled:
+            unsettled = skill.id
         rank_seen = max(rank_seen, rank)
 
 
