@@ -41,9 +41,22 @@ def mission_to_dict(content: MissionContent, revision: int) -> dict[str, Any]:
     }
 
 
+class _PlainDumper(yaml.SafeDumper):
+    """A safe dumper that writes shared values out in full instead of as anchors and aliases.
+
+    A retried skill shares its parameter values with the original; aliases would
+    make the file harder to read and not come back identical after a load.
+    """
+
+    def ignore_aliases(self, data: Any) -> bool:
+        return True
+
+
 def dump_mission(content: MissionContent, revision: int) -> str:
     """The mission as a YAML document."""
-    return yaml.safe_dump(mission_to_dict(content, revision), sort_keys=False, width=100)
+    return yaml.dump(
+        mission_to_dict(content, revision), Dumper=_PlainDumper, sort_keys=False, width=100
+    )
 
 
 def save_mission(path: str | Path, content: MissionContent, revision: int) -> None:
