@@ -170,9 +170,11 @@ class Driver:
     def __init__(self, mission: Mission) -> None:
         self.mission = mission
 
-    def add(self, agent: str, skill: str = "move", **kwargs: Any) -> str:
+    def add(
+        self, agent: str, skill: str = "move", params: dict[str, Any] | None = None, **kwargs: Any
+    ) -> str:
         """Add a skill; return its id."""
-        event = self.mission.add_skill(agent, skill, **kwargs)
+        event = self.mission.add_skill(agent, skill, params, **kwargs)
         return event.change.put_skills[0].skill.id
 
     def adds(self, agent: str, count: int, skill: str = "move") -> list[str]:
