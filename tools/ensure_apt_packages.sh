@@ -3,13 +3,18 @@
 # Runs `apt-get update` only when something must be installed. No TTY needed.
 set -euo pipefail
 
+# One dpkg-query for all of them; unknown names are simply absent from its output.
+declare -A installed=()
+while IFS=$'\t' read -r pkg status; do
+    # "install ok installed" or "hold ok installed"; not "... config-files" / "half-installed"
+    if [[ "$status" == *" ok installed" ]]; then installed["$pkg"]=1; fi
+done < <(dpkg-query -W -f='${Package}\t${Status}\n' "$@" 2>/dev/null || true)
+
 missing=()
 for pkg in "$@"; do
-    status="$(dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null || true)"
-    # "install ok installed" or "hold ok installed"; not "... config-files" / "half-installed"
-    [[ "$status" == *" ok installed" ]] || missing+=("$pkg")
+    if [[ -z "${installed[$pkg]:-}" ]]; then missing+=("$pkg"); fi
 done
-((${#missing[@]} == 0)) && exit 0
+if ((${#missing[@]} == 0)); then exit 0; fi
 
 sudo=()
 if ((EUID != 0)); then
