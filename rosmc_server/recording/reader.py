@@ -61,12 +61,14 @@ class LatestState:
         events: The ``rosmc/MissionEvent`` messages after it with a higher revision, in order.
         problems: Error-level findings (missing revisions, a replaced mission without its
             snapshot); a state with problems is not a faithful copy of the last mission.
+        notes: What was left out on purpose (a change recorded but never acknowledged).
     """
 
     snapshot: RosMessage
     snapshot_time: int
     events: tuple[RosMessage, ...]
     problems: tuple[str, ...]
+    notes: tuple[str, ...] = ()
 
     @property
     def revision(self) -> int:
@@ -126,6 +128,11 @@ def latest_state(result: JournalResult) -> LatestState:
     A missing revision, a revision that goes backwards, or a mission replacement
     whose snapshot is missing is reported in ``problems`` and logged as an error.
 
+    A ``MISSION_REPLACED`` event carries no content, so the writer must append the new
+    mission's snapshot right after it and acknowledge the change only then. A journal
+    that *ends* with such an event lost that snapshot before the change was
+    acknowledged: the event is left out (and said so in ``notes``).
+
     Raises:
         JournalError: The journal holds no snapshot.
     """
@@ -139,10 +146,14 @@ def latest_state(result: JournalResult) -> LatestState:
     expected = int(snapshot.message.revision) + 1
     events: list[RosMessage] = []
     problems: list[str] = []
-    for record in result.records[last + 1 :]:
-        if record.topic != MISSION_EVENTS_TOPIC:
-            continue
-        event = record.message
+    tail = [r.message for r in result.records[last + 1 :] if r.topic == MISSION_EVENTS_TOPIC]
+    notes: list[str] = []
+    if tail and tail[-1].kind == tail[-1].MISSION_REPLACED:
+        notes.append(
+            f"revision {tail.pop().revision} replaced the mission, but the journal ends before "
+            "the new mission's snapshot: that change was never acknowledged and is left out"
+        )
+    for event in tail:
         revision = int(event.revision)
         if revision < expected:
             if events:  # only a repeat *after* the snapshot is suspicious
@@ -159,6 +170,11 @@ def latest_state(result: JournalResult) -> LatestState:
         events.append(event)
         expected = revision + 1
     problems = [f"journal {result.path}: {text}" for text in problems]
+    notes = [f"journal {result.path}: {text}" for text in notes]
     for text in problems:
         _log.error("%s", text)
-    return LatestState(snapshot.message, snapshot.log_time, tuple(events), tuple(problems))
+    for text in notes:
+        _log.warning("%s", text)
+    return LatestState(
+        snapshot.message, snapshot.log_time, tuple(events), tuple(problems), tuple(notes)
+    )

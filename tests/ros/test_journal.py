@@ -390,14 +390,28 @@ def test_latest_state_picks_the_last_snapshot_and_reports_gaps(tmp_path: Path) -
         for rev in (2, 4, 5, 7):  # 2 is older than the snapshot; 6 is missing
             writer.append_event(event(rev), T0 + 10 + rev)
         replaced = event(8, kind=msg.MissionEvent.MISSION_REPLACED)
-        writer.append_event(replaced, T0 + 20)
+        writer.append_event(replaced, T0 + 20)  # its snapshot is missing...
+        writer.append_event(event(9), T0 + 21)  # ...and the journal goes on
     state = latest_state(read_journal(path))
     assert state.snapshot == mission(3) and state.snapshot_time == T0 + 4
-    assert [e.revision for e in state.events] == [4, 5, 7, 8]
-    assert state.revision == 8
+    assert [e.revision for e in state.events] == [4, 5, 7, 8, 9]
+    assert state.revision == 9
     assert len(state.problems) == 2
     assert "revision 6 is missing before revision 7" in state.problems[0]
-    assert "replaced the mission" in state.problems[1]
+    assert "revision 8 replaced the mission" in state.problems[1]
+    assert state.notes == ()
+
+
+def test_latest_state_leaves_out_a_replacement_cut_off_before_its_snapshot(tmp_path: Path) -> None:
+    path = tmp_path / "j.mcap"
+    with JournalWriter.create(path, mission(0), T0) as writer:
+        writer.append_event(event(1), T0 + 1)
+        writer.append_event(event(2, kind=msg.MissionEvent.MISSION_REPLACED), T0 + 2)
+        # killed here, before the server appended the new mission and replied
+    state = latest_state(read_journal(path))
+    assert [e.revision for e in state.events] == [1]
+    assert state.revision == 1 and state.problems == ()
+    assert len(state.notes) == 1 and "revision 2 replaced the mission" in state.notes[0]
 
 
 def test_latest_state_without_events_and_without_snapshot(tmp_path: Path) -> None:
