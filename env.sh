@@ -57,7 +57,8 @@ _rosmc_env_main() {
     unset -f _rosmc_prepend
 
     # Devel setup.bash defaults the master to localhost; ours is explicit loopback unless the
-    # caller chose one. ROS_IP / ROS_HOSTNAME stay whatever the caller set.
+    # caller chose one. ROS_IP defaults to loopback unless the caller set ROS_IP or
+    # ROS_HOSTNAME (for a team spread over several machines, set them before sourcing).
     if [[ -n "$had_master_uri" ]]; then
         export ROS_MASTER_URI="$had_master_uri"
     else
