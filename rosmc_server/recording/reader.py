@@ -122,7 +122,7 @@ def decode_scan(scan: _scan.ScanResult, topics: Collection[str] | None = None) -
 
 
 def latest_state(result: JournalResult) -> LatestState:
-    """Pick the last snapshot and the events after it, to rebuild the mission from.
+    """Pick the newest snapshot and the events after it, to rebuild the mission from.
 
     Events at or below the snapshot's revision are already part of it and left out.
     A missing revision, a revision that goes backwards, or a mission replacement
@@ -138,7 +138,12 @@ def latest_state(result: JournalResult) -> LatestState:
     """
     last = None
     for index, record in enumerate(result.records):
-        if record.topic == MISSION_TOPIC:
+        # The newest snapshot by revision: a periodic one built off the service path
+        # can land in the file after a newer one (e.g. after a mission replacement).
+        if record.topic == MISSION_TOPIC and (
+            last is None
+            or int(record.message.revision) >= int(result.records[last].message.revision)
+        ):
             last = index
     if last is None:
         raise JournalError(f"journal {result.path} holds no mission snapshot to start from")
@@ -146,7 +151,15 @@ def latest_state(result: JournalResult) -> LatestState:
     expected = int(snapshot.message.revision) + 1
     events: list[RosMessage] = []
     problems: list[str] = []
-    tail = [r.message for r in result.records[last + 1 :] if r.topic == MISSION_EVENTS_TOPIC]
+    # A periodic snapshot may be written a moment after the events that followed the
+    # revision it shows (the server builds it off the service path), so events with a
+    # higher revision count wherever they stand in the file.
+    after = int(snapshot.message.revision)
+    tail = [
+        r.message
+        for r in result.records
+        if r.topic == MISSION_EVENTS_TOPIC and int(r.message.revision) > after
+    ]
     notes: list[str] = []
     if tail and tail[-1].kind == tail[-1].MISSION_REPLACED:
         notes.append(

@@ -29,9 +29,11 @@ class SnapshotPublisher:
         build: Callable[[], wire.Mission],
         quiet: float = 0.05,
         max_delay: float = 0.25,
+        on_published: Callable[[wire.Mission], None] | None = None,
     ) -> None:
         self._publisher = rospy.Publisher(topic, wire.Mission, queue_size=1, latch=True)
         self._build = build
+        self._on_published = on_published
         self._quiet = quiet
         self._max_delay = max_delay
         self._changed = threading.Condition()
@@ -72,7 +74,10 @@ class SnapshotPublisher:
                 self._wait_for_pause()
                 self._dirty_since = None
             try:
-                self._publisher.publish(self._build())
+                snapshot = self._build()
+                self._publisher.publish(snapshot)
+                if self._on_published is not None:
+                    self._on_published(snapshot)
             except Exception:  # keep publishing later snapshots whatever happened
                 _log.exception("could not publish the mission snapshot")
 

@@ -99,7 +99,9 @@ class MissionServer:
         self._lock = threading.RLock()
         self.mission, self._journal = self._open_journal()
         self._events = rospy.Publisher(interface.EVENTS_TOPIC, wire.MissionEvent, queue_size=1000)
-        self._snapshots = SnapshotPublisher(interface.MISSION_TOPIC, self.snapshot_msg)
+        self._snapshots = SnapshotPublisher(
+            interface.MISSION_TOPIC, self.snapshot_msg, on_published=self._journal_snapshot
+        )
         self.link = GroundLink(self, library.dynamic_agents, timeout=config.link_timeout)
         self._agent_states = AgentStatePublisher(self, config.agent_state_rate)
         self._services = OperatorServices(self)
@@ -160,7 +162,8 @@ class MissionServer:
         stamp_ns = time.time_ns()
         try:
             self._journal.append_event(msg, stamp_ns)
-            if event.kind is EventKind.MISSION_REPLACED or self._journal.snapshot_due:
+            if event.kind is EventKind.MISSION_REPLACED:
+                # The new mission is only in the snapshot: it must be durable now.
                 self._journal.append_snapshot(self.snapshot_msg(), stamp_ns)
         except Exception:
             _log.critical("cannot write the journal; shutting down to protect the mission")
@@ -171,6 +174,16 @@ class MissionServer:
         self._snapshots.changed()
         for spec in commands_for_event(event, state):
             self.link.send(spec)
+
+    def _journal_snapshot(self, snapshot: wire.Mission) -> None:
+        """Journal a published snapshot when one is due, off the service path.
+
+        Building a snapshot of a large mission takes far longer than a service
+        call may; the journal's reader accepts events written before a snapshot
+        of an older revision.
+        """
+        if self._journal.snapshot_due and not self._journal.closed:
+            self._journal.append_snapshot(snapshot, time.time_ns())
 
     def record_report(self, msg: wire.RobotReport) -> None:
         """Journal a robot report (the audit trail of what robots said)."""
@@ -192,11 +205,7 @@ class MissionServer:
                 raise ValueError("~resume needs ~journal: the journal file to continue")
             writer = JournalWriter.resume(self.config.journal, options)
             assert writer.recovered is not None
-            for warning in writer.recovered.warnings:
-                _log.warning("%s", warning)
-            latest = latest_state(writer.recovered)
-            for problem in latest.problems:
-                _log.error("%s", problem)
+            latest = latest_state(writer.recovered)  # logs what was dropped or is missing
             content, revision = mission_from_msg(latest.snapshot)
             mission = Mission(self.library, content, revision, clock=clock)
             for event_msg in latest.events:

@@ -641,3 +641,33 @@ def test_journal_topics_are_the_graph_names() -> None:
     assert MISSION_TOPIC == interface.MISSION_TOPIC
     assert MISSION_EVENTS_TOPIC == interface.EVENTS_TOPIC
     assert AGENT_STATES_TOPIC == interface.AGENT_STATES_TOPIC
+
+
+def test_latest_state_takes_a_late_snapshot_with_the_events_written_before_it(
+    tmp_path: Path,
+) -> None:
+    """A periodic snapshot of revision 3, written after events 4 and 5, still recovers 5."""
+    path = tmp_path / "late.mcap"
+    with JournalWriter.create(path, mission(0), 1) as writer:
+        for revision in range(1, 6):
+            writer.append_event(event(revision), 10 + revision)
+        writer.append_snapshot(mission(3), 20)
+    state = latest_state(read_journal(path))
+    assert state.snapshot.revision == 3
+    assert [e.revision for e in state.events] == [4, 5]
+    assert not state.problems
+
+
+def test_latest_state_prefers_the_newest_snapshot_over_a_late_older_one(tmp_path: Path) -> None:
+    """A replacement's snapshot (revision 2) wins over a periodic one of revision 1 after it."""
+    path = tmp_path / "replaced.mcap"
+    with JournalWriter.create(path, mission(0), 1) as writer:
+        writer.append_event(event(1), 2)
+        writer.append_event(event(2, kind=msg.MissionEvent.MISSION_REPLACED), 3)
+        writer.append_snapshot(mission(2, agents=3), 4)
+        writer.append_snapshot(mission(1), 5)
+        writer.append_event(event(3), 6)
+    state = latest_state(read_journal(path))
+    assert state.snapshot.revision == 2 and len(state.snapshot.tasks) == 3
+    assert [e.revision for e in state.events] == [3]
+    assert not state.problems
