@@ -137,7 +137,8 @@ def format_agent_status(status: AgentStatus | None) -> str:
     if status.wifi_signal is not None:
         parts.append(f"Wi-Fi {status.wifi_signal:.0f} dBm")
     if status.pose is not None:
-        parts.append(f"at ({_num(status.pose.x)}, {_num(status.pose.y)}, {_num(status.pose.z)})")
+        pose = status.pose
+        parts.append(f"at ({_short(pose.x)}, {_short(pose.y)}, {_short(pose.z)})")
         parts.append("in coverage" if status.in_coverage else "out of coverage")
     if status.executor_state:
         parts.append(f"executor {status.executor_state}")
@@ -173,16 +174,21 @@ def _num(number: float) -> str:
     return repr(float(number))
 
 
+def _short(number: float) -> str:
+    """A coordinate for display: at most three decimals."""
+    return _num(round(number, 3)) if math.isfinite(number) else str(number)
+
+
 def format_markers(markers: Iterable[TaskMarker]) -> str:
     """One line per task marker: name, type and where it is."""
     lines = []
     for marker in markers:
         pose = marker.pose
-        where = f"({_num(pose.x)}, {_num(pose.y)}, {_num(pose.z)})"
+        where = f"({_short(pose.x)}, {_short(pose.y)}, {_short(pose.z)})"
         if marker.vertices:
             where = f"{len(marker.vertices)} vertices around {where}"
         elif pose.yaw:
-            where += f" yaw {_num(pose.yaw)}"
+            where += f" yaw {_short(pose.yaw)}"
         lines.append(f"{marker.name:<24} {marker.type.name.lower():<9} {where}")
     return "\n".join(lines) if lines else "(no task markers)"
 

@@ -1,0 +1,60 @@
+"""What every ``rosmc`` command works with: the parsed arguments, a client and the output."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from dataclasses import asdict, dataclass, field
+from typing import Any, TextIO
+
+from ..ros.client import MissionClient, MissionWatch, Result, init_node
+from ..text import AgentStatus
+
+# How long `rosmc status` waits for the robots' states (the server publishes at 2 Hz).
+STATES_WAIT = 1.5
+
+
+class UsageError(Exception):
+    """The command line is malformed in a way argparse cannot see (exit code 2)."""
+
+
+@dataclass
+class Context:
+    """The parsed arguments, the mission client and where output goes."""
+
+    args: argparse.Namespace
+    client: MissionClient
+    out: TextIO = field(default_factory=lambda: sys.stdout)
+
+    @property
+    def json(self) -> bool:
+        """Whether to print JSON instead of text."""
+        return bool(self.args.json)
+
+    @property
+    def revision(self) -> int | None:
+        """The base revision the user gave (--revision), if any."""
+        revision: int | None = self.args.revision
+        return revision
+
+    def emit(self, text: str, data: Any) -> None:
+        """Print ``text``, or ``data`` as JSON with --json."""
+        if self.json:
+            print(json.dumps(data, indent=2), file=self.out, flush=True)
+        elif text:
+            print(text, file=self.out, flush=True)
+
+    def emit_result(self, result: Result, text: str | None = None) -> int:
+        """Print a result (default text: the new revision); return exit code 0."""
+        self.emit(text if text is not None else f"revision {result.revision}", asdict(result))
+        return 0
+
+    def agent_states(self) -> dict[str, AgentStatus]:
+        """The robots' latest states, waiting briefly for them; empty if none arrive."""
+        init_node()
+        watch = MissionWatch(events=False, states=True)
+        try:
+            return watch.wait_agent_states(min(self.client.timeout, STATES_WAIT)) or {}
+        finally:
+            watch.close()

@@ -1,0 +1,192 @@
+"""The commands that change the mission or control the robots."""
+
+from __future__ import annotations
+
+import os
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+from ..core import InvalidRequest, MarkerType, MissionFileError, SkillSpec, TaskMarker
+from ..ros.client import ControlCommand
+from .context import Context, UsageError
+from .values import marker_shape, typed_values
+
+
+def _values(spec: SkillSpec, words: list[str]) -> tuple[dict[str, object], dict[str, str | None]]:
+    try:
+        return typed_values(spec, words)
+    except ValueError as error:
+        raise UsageError(str(error)) from error
+
+
+def add(ctx: Context) -> int:
+    """Add a skill to a robot's blueprint; print its id."""
+    args = ctx.args
+    spec = ctx.client.library().skill(args.agent, args.skill)
+    values, bindings = _values(spec, args.params)
+    if any(marker is None for marker in bindings.values()):
+        raise InvalidRequest("key=@ (unbind) applies to 'rosmc edit' only; give a marker name")
+    result = ctx.client.add_skill(
+        args.agent,
+        args.skill,
+        values,
+        bindings={name: marker for name, marker in bindings.items() if marker},
+        label=args.label,
+        index=args.index,
+        timeout=args.skill_timeout or 0.0,
+        max_retries=args.retries or 0,
+        base_revision=ctx.revision,
+    )
+    return ctx.emit_result(result, result.skill_id)
+
+
+def edit(ctx: Context) -> int:
+    """Change a blueprint skill's parameters, label or options."""
+    args = ctx.args
+    values, bindings = _values(ctx.client.skill_spec(args.skill_id), args.params)
+    result = ctx.client.edit_skill(
+        args.skill_id,
+        values,
+        bindings=bindings,
+        label=args.label,
+        timeout=args.skill_timeout,
+        max_retries=args.retries,
+        base_revision=ctx.revision,
+    )
+    return ctx.emit_result(result)
+
+
+def delete(ctx: Context) -> int:
+    """Delete blueprint skills."""
+    return ctx.emit_result(ctx.client.delete_skills(ctx.args.skill_ids, base_revision=ctx.revision))
+
+
+def reorder(ctx: Context) -> int:
+    """Give a robot's blueprint a new order."""
+    args = ctx.args
+    return ctx.emit_result(ctx.client.reorder(args.agent, args.order, base_revision=ctx.revision))
+
+
+def barrier(ctx: Context) -> int:
+    """Add a barrier; print its id."""
+    result = ctx.client.add_barrier(ctx.args.skill_ids, base_revision=ctx.revision)
+    return ctx.emit_result(result, result.barrier_id)
+
+
+def unbarrier(ctx: Context) -> int:
+    """Remove a barrier."""
+    result = ctx.client.delete_barrier(ctx.args.barrier_id, base_revision=ctx.revision)
+    return ctx.emit_result(result)
+
+
+def sync(ctx: Context) -> int:
+    """Upload a robot's blueprint (up to --upto)."""
+    args = ctx.args
+    result = ctx.client.synchronize(args.agent, args.upto, base_revision=ctx.revision)
+    ids = ", ".join(result.skill_ids)
+    return ctx.emit_result(result, f"uploading to {args.agent}: {ids} (revision {result.revision})")
+
+
+def unsync(ctx: Context) -> int:
+    """Pull synchronized skills back to the blueprint."""
+    args = ctx.args
+    result = ctx.client.unsynchronize(args.agent, args.from_id, base_revision=ctx.revision)
+    ids = ", ".join(result.skill_ids)
+    return ctx.emit_result(
+        result, f"removing from {args.agent}: {ids} (revision {result.revision})"
+    )
+
+
+def control(ctx: Context) -> int:
+    """Start, pause, resume or stop robots."""
+    command = ControlCommand[ctx.args.command.upper()]
+    result = ctx.client.control(command, ctx.args.agent)
+    return ctx.emit_result(result, f"{ctx.args.command} sent to {', '.join(result.agents)}")
+
+
+def retry(ctx: Context) -> int:
+    """Retry a failed skill; print the new instance's id."""
+    result = ctx.client.retry(ctx.args.skill_id, base_revision=ctx.revision)
+    return ctx.emit_result(result, result.new_skill_id)
+
+
+def skip(ctx: Context) -> int:
+    """Skip a failed skill."""
+    return ctx.emit_result(ctx.client.skip(ctx.args.skill_id, base_revision=ctx.revision))
+
+
+def marker(ctx: Context) -> int:
+    """Add, move, rename or delete a task marker."""
+    args, client, base = ctx.args, ctx.client, ctx.revision
+    if args.marker_command == "add":
+        kind = MarkerType[args.type.upper()]
+        pose, vertices = marker_shape(kind, args.where, f"the {args.type} of the marker")
+        added = client.add_marker(TaskMarker(args.name, kind, pose, vertices), base_revision=base)
+        return ctx.emit_result(added, added.name)
+    if args.marker_command == "move":
+        old = next((m for m in client.fetch_mission().markers if m.name == args.name), None)
+        kind = old.type if old is not None else MarkerType.POSE  # the server names a missing one
+        pose, vertices = marker_shape(kind, args.where, f"the new place of '{args.name}'")
+        return ctx.emit_result(client.move_marker(args.name, pose, vertices, base_revision=base))
+    if args.marker_command == "rename":
+        return ctx.emit_result(client.rename_marker(args.name, args.new_name, base_revision=base))
+    return ctx.emit_result(client.delete_marker(args.name, base_revision=base))
+
+
+def new(ctx: Context) -> int:
+    """Start an empty mission."""
+    keep = not ctx.args.drop_markers
+    return ctx.emit_result(ctx.client.new_mission(keep_markers=keep, base_revision=ctx.revision))
+
+
+def save(ctx: Context) -> int:
+    """Write the mission as YAML into a local file (or standard output)."""
+    saved = ctx.client.save_mission()
+    if ctx.args.file == "-":
+        sys.stdout.write(saved.document)
+        sys.stdout.flush()
+        return 0
+    target = Path(ctx.args.file)
+    temporary = target.with_name(f".{target.name}.{os.getpid()}.tmp")
+    try:
+        temporary.write_text(saved.document, encoding="utf-8")
+        temporary.replace(target)
+    except OSError as error:
+        temporary.unlink(missing_ok=True)
+        raise MissionFileError(f"{target}: cannot write the mission ({error.strerror})") from error
+    return ctx.emit_result(saved, f"saved revision {saved.revision} to {target}")
+
+
+def load(ctx: Context) -> int:
+    """Replace the mission with a saved one read from a local file (or standard input)."""
+    name = ctx.args.file
+    try:
+        document = sys.stdin.read() if name == "-" else Path(name).read_text(encoding="utf-8")
+    except OSError as error:
+        raise MissionFileError(f"{name}: cannot read the mission ({error.strerror})") from error
+    except UnicodeDecodeError as error:
+        raise MissionFileError(f"{name}: the file is not UTF-8 text") from error
+    return ctx.emit_result(ctx.client.load_mission(document, base_revision=ctx.revision))
+
+
+COMMANDS: dict[str, Callable[[Context], int]] = {
+    "add": add,
+    "edit": edit,
+    "delete": delete,
+    "reorder": reorder,
+    "barrier": barrier,
+    "unbarrier": unbarrier,
+    "sync": sync,
+    "unsync": unsync,
+    "start": control,
+    "pause": control,
+    "resume": control,
+    "stop": control,
+    "retry": retry,
+    "skip": skip,
+    "marker": marker,
+    "new": new,
+    "save": save,
+    "load": load,
+}

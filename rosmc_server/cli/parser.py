@@ -1,0 +1,197 @@
+"""The ``rosmc`` command line: every subcommand, its arguments and its help."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable
+
+DEFAULT_TIMEOUT = 5.0
+
+# add_command(name, summary, epilog=None): a new subcommand parser.
+_Command = Callable[..., argparse.ArgumentParser]
+
+DESCRIPTION = """\
+Scriptable client of the ROSMC mission server: inspect and edit the mission,
+synchronize it to the robots and control their execution.
+
+Exit codes: 0 success, 1 refused by the server (the reason on stderr),
+2 usage error, 3 server not reachable within --timeout."""
+
+PARAMS_HELP = """\
+Parameters are key=value, read per the library schema: altitude=12,
+target=3,4,0,0,0,1.57 (x,y[,z,roll,pitch,yaw]) or target='{x: 3, y: 4}',
+area='[{x: 0, y: 0}, {x: 5, y: 0}, {x: 5, y: 5}]', mode=quick, flag=true.
+key=@MARKER binds the parameter to a task marker (key=@ unbinds it in edit);
+key=@@text is the text '@text'. See 'rosmc library' for every schema."""
+
+
+def _positive(text: str) -> float:
+    value = float(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be a positive number of seconds, got {text}")
+    return value
+
+
+def _count(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, got {text}")
+    return value
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of ``rosmc`` with all its subcommands."""
+    parser = argparse.ArgumentParser(
+        prog="rosmc",
+        description=DESCRIPTION,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument(
+        "--timeout",
+        type=_positive,
+        default=DEFAULT_TIMEOUT,
+        metavar="SECONDS",
+        help=f"how long to wait for the mission server (default {DEFAULT_TIMEOUT:g})",
+    )
+    parser.add_argument("--json", action="store_true", help="print machine-readable JSON")
+    parser.add_argument(
+        "--revision",
+        type=int,
+        metavar="N",
+        help="make changes against mission revision N: refused if the mission has changed "
+        "since (default: the current revision)",
+    )
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("--json", action="store_true", default=argparse.SUPPRESS, help="print JSON")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+
+    def command(name: str, summary: str, epilog: str | None = None) -> argparse.ArgumentParser:
+        return sub.add_parser(
+            name,
+            help=summary,
+            description=summary,
+            epilog=epilog,
+            parents=[common],
+            formatter_class=argparse.RawDescriptionHelpFormatter,
+        )
+
+    _add_views(command)
+    _add_editing(command)
+    _add_execution(command)
+    _add_markers(command, common)
+    _add_files(command)
+    return parser
+
+
+def _add_views(command: _Command) -> None:
+    status = command("status", "print every robot's schedule, link and telemetry")
+    status.add_argument("-v", "--verbose", action="store_true", help="show parameter values")
+    status.add_argument(
+        "--no-states", action="store_true", help="do not wait for the robots' link states"
+    )
+    library = command("library", "print the agents, their skills and parameter schemas")
+    library.add_argument("agent", nargs="?", metavar="AGENT", help="only this agent")
+    watch = command("watch", "print mission events as they happen (Ctrl-C stops)")
+    watch.add_argument(
+        "--states",
+        type=_positive,
+        nargs="?",
+        const=5.0,
+        metavar="SECONDS",
+        help="also print the robots' states, at most every SECONDS (default 5)",
+    )
+    watch.add_argument("--count", type=_count, metavar="N", help="stop after N events")
+
+
+def _add_editing(command: _Command) -> None:
+    add = command("add", "add a skill to a robot's blueprint", PARAMS_HELP)
+    add.add_argument("agent", metavar="ROBOT")
+    add.add_argument("skill", metavar="SKILL")
+    add.add_argument("params", nargs="*", metavar="KEY=VALUE", help="parameter values")
+    add.add_argument("--label", default="", help="name shown to operators (default: SKILL)")
+    add.add_argument(
+        "--index", type=int, help="insert at this position of the task (default: append)"
+    )
+    _add_options(add)
+    edit = command("edit", "change a blueprint skill", PARAMS_HELP)
+    edit.add_argument("skill_id", metavar="ID")
+    edit.add_argument("params", nargs="*", metavar="KEY=VALUE", help="parameters to change")
+    edit.add_argument("--label", help="new label")
+    _add_options(edit)
+    delete = command("delete", "delete blueprint skills")
+    delete.add_argument("skill_ids", nargs="+", metavar="ID")
+    reorder = command("reorder", "give a robot's blueprint a new order")
+    reorder.add_argument("agent", metavar="ROBOT")
+    reorder.add_argument("order", nargs="+", metavar="ID", help="every blueprint skill, in order")
+    barrier = command("barrier", "make skills on different robots start together")
+    barrier.add_argument("skill_ids", nargs="+", metavar="ID")
+    unbarrier = command("unbarrier", "remove a barrier whose skills have not started")
+    unbarrier.add_argument("barrier_id", metavar="BARRIER_ID")
+
+
+def _add_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--timeout",
+        dest="skill_timeout",
+        type=float,
+        metavar="SECONDS",
+        help="the skill's execution timeout (0: none)",
+    )
+    parser.add_argument(
+        "--retries", type=int, metavar="N", help="automatic retries on the robot after a failure"
+    )
+
+
+def _add_execution(command: _Command) -> None:
+    sync = command("sync", "upload a robot's blueprint (or a prefix of it) to the robot")
+    sync.add_argument("agent", metavar="ROBOT")
+    sync.add_argument("--upto", metavar="ID", help="upload up to and including this skill")
+    unsync = command("unsync", "pull not-started synchronized skills back to the blueprint")
+    unsync.add_argument("agent", metavar="ROBOT")
+    unsync.add_argument(
+        "--from", dest="from_id", metavar="ID", help="this skill and all after it (default: all)"
+    )
+    for name, summary in (
+        ("start", "start executing synchronized skills on ROBOT (default: every robot)"),
+        ("pause", "pause ROBOT's running skill (default: every robot)"),
+        ("resume", "resume ROBOT's paused skill (default: every robot)"),
+        ("stop", "stop ROBOT's running skill; it stays synchronized (default: every robot)"),
+    ):
+        control = command(name, summary)
+        control.add_argument("agent", nargs="?", metavar="ROBOT")
+    retry = command("retry", "run a failed skill again (a new attempt after it)")
+    retry.add_argument("skill_id", metavar="ID")
+    skip = command("skip", "skip a failed skill; the robot continues after it")
+    skip.add_argument("skill_id", metavar="ID")
+
+
+def _add_markers(command: _Command, common: argparse.ArgumentParser) -> None:
+    command("markers", "list the task markers")
+    marker = command("marker", "add, move, rename or delete a task marker")
+    actions = marker.add_subparsers(dest="marker_command", metavar="ACTION", required=True)
+    where_help = (
+        "x,y[,z,roll,pitch,yaw] or '{x: 1, y: 2}'; an area: 'x,y x,y x,y ...' "
+        "(put -- before a WHERE that starts with '-')"
+    )
+    add = actions.add_parser("add", help="add a task marker", parents=[common])
+    add.add_argument("name", metavar="NAME", help="its name ('' for a generated one)")
+    add.add_argument("type", choices=("position", "pose", "area"), metavar="TYPE",
+                     help="position, pose or area")  # fmt: skip
+    add.add_argument("where", metavar="WHERE", help=where_help)
+    move = actions.add_parser("move", help="move a task marker", parents=[common])
+    move.add_argument("name", metavar="NAME")
+    move.add_argument("where", metavar="WHERE", help=where_help)
+    rename = actions.add_parser("rename", help="rename a task marker", parents=[common])
+    rename.add_argument("name", metavar="NAME")
+    rename.add_argument("new_name", metavar="NEW_NAME")
+    delete = actions.add_parser("delete", help="delete an unused task marker", parents=[common])
+    delete.add_argument("name", metavar="NAME")
+
+
+def _add_files(command: _Command) -> None:
+    new = command("new", "start an empty mission (keeps the task markers)")
+    new.add_argument("--drop-markers", action="store_true", help="delete the task markers too")
+    save = command("save", "save the mission as YAML into a local file")
+    save.add_argument("file", metavar="FILE", help="where to write ('-': standard output)")
+    load = command("load", "replace the mission with one saved before")
+    load.add_argument("file", metavar="FILE", help="a saved mission ('-': standard input)")

@@ -1,0 +1,113 @@
+"""The read side of :class:`~.mission_client.MissionClient` and its revision tracking."""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Mapping
+from typing import Any, Self
+
+from rosmc.msg import ErrorCode
+
+from ...core import Library, MissionState, SkillInstance, SkillSpec
+from ..conversions import mission_from_msg, param_to_msg
+from .connection import ServiceCaller, raise_for
+from .wire import library_from_msg
+
+
+class ClientBase:
+    """Connections, the cached library, mission snapshots and the known revision.
+
+    Thread-safe: one lock covers the known revision across a request and its answer.
+
+    Args:
+        timeout: Seconds to wait for the server to appear (per connection).
+    """
+
+    def __init__(self, timeout: float = 5.0) -> None:
+        self._caller = ServiceCaller(timeout)
+        self.revision: int | None = None
+        self._library: Library | None = None
+        self._kinds: dict[str, tuple[str, str]] = {}
+        self._lock = threading.RLock()
+
+    @property
+    def timeout(self) -> float:
+        """Seconds to wait for the server to answer."""
+        return self._caller.timeout
+
+    def close(self) -> None:
+        """Close the connections to the server (they reopen when needed)."""
+        self._caller.close()
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.close()
+
+    # -- queries -------------------------------------------------------------------
+    def library(self) -> Library:
+        """The skill library (fetched once, then cached)."""
+        with self._lock:
+            if self._library is None:
+                self._library = library_from_msg(self._caller.call("get_library").library)
+            return self._library
+
+    def get_mission(self) -> MissionState:
+        """The current mission; the client now knows its revision."""
+        with self._lock:
+            state = self.fetch_mission()
+            self.revision = state.revision
+            return state
+
+    def fetch_mission(self) -> MissionState:
+        """The current mission, leaving the client's known revision as it was."""
+        content, revision = mission_from_msg(self._caller.call("get_mission").mission)
+        state = MissionState(content, revision)
+        self._kinds.update({s.id: (s.agent, s.skill) for s in state.skills()})
+        return state
+
+    def skill(self, skill_id: str) -> SkillInstance:
+        """The current instance of a skill (NotFound if there is none)."""
+        return self.fetch_mission().skill(skill_id)
+
+    def skill_spec(self, skill_id: str) -> SkillSpec:
+        """The library schema of an existing skill (NotFound if there is no such skill)."""
+        if skill_id not in self._kinds:
+            self.skill(skill_id)
+        agent, skill = self._kinds[skill_id]
+        return self.library().skill(agent, skill)
+
+    # -- internals ---------------------------------------------------------------------
+    def _parameters(
+        self, agent: str, skill: str, params: Mapping[str, object], bindings: Mapping[str, str]
+    ) -> list[Any]:
+        spec = self.library().skill(agent, skill)
+        msgs = [param_to_msg(n, spec.parameter(n).check(raw, skill)) for n, raw in params.items()]
+        msgs += [param_to_msg(n, spec.parameter(n).default, m) for n, m in bindings.items()]
+        return msgs
+
+    def _mutate(
+        self,
+        operation: str,
+        base_revision: int | None = None,
+        retry_on_conflict: bool = False,
+        **fields: Any,
+    ) -> Any:
+        with self._lock:
+            base = self._base(base_revision)
+            response = self._caller.call(operation, base_revision=base, **fields)
+            conflict = response.error_code == ErrorCode.CONFLICT
+            if conflict and retry_on_conflict and base_revision is None:
+                base = self.get_mission().revision
+                response = self._caller.call(operation, base_revision=base, **fields)
+            raise_for(response, base)
+            self.revision = response.revision
+            return response
+
+    def _base(self, base_revision: int | None) -> int:
+        if base_revision is not None:
+            return base_revision
+        if self.revision is None:
+            return self.get_mission().revision
+        return self.revision

@@ -1,0 +1,332 @@
+""":class:`MissionClient`: every operator operation as a typed Python method."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from ...core import (
+    InvalidRequest,
+    Pose,
+    SkillInstance,
+    TaskMarker,
+)
+from ...core.editing import check_retries, check_timeout
+from ..conversions import marker_to_msg, pose_to_msg
+from .base import ClientBase
+from .connection import raise_for
+from .results import (
+    BarrierAdded,
+    ControlCommand,
+    ControlSent,
+    MarkerAdded,
+    MissionSaved,
+    Result,
+    SkillAdded,
+    SkillRetried,
+    Transferred,
+)
+
+
+class MissionClient(ClientBase):
+    """The Python client of the mission server (command line, GUIs, scripted operators).
+
+    Methods take core-level arguments (agent and skill names, parameter values as
+    plain data checked against the library schema, marker bindings) and return a
+    :class:`Result` or raise a core :class:`~rosmc_server.core.RosmcError`:
+    InvalidRequest, NotFound, RuleViolation, Unavailable (robot unreachable),
+    :class:`RevisionConflict` (a StaleRevision) and :class:`ServerUnavailable`.
+
+    ``revision`` is the latest mission revision the client knows (from
+    :meth:`get_mission` and accepted requests). Mutating requests are made against
+    it unless ``base_revision`` is given; so a change by someone else since then is
+    refused as a conflict. ``retry_on_conflict=True`` instead refetches the mission
+    and sends the request once more; use it only where that is safe.
+
+    Args:
+        timeout: Seconds to wait for the server to appear (per connection).
+    """
+
+    # -- blueprint -------------------------------------------------------------------
+    def add_skill(
+        self,
+        agent: str,
+        skill: str,
+        params: Mapping[str, object] | None = None,
+        *,
+        bindings: Mapping[str, str] | None = None,
+        label: str = "",
+        index: int | None = None,
+        timeout: float = 0.0,
+        max_retries: int = 0,
+        base_revision: int | None = None,
+        retry_on_conflict: bool = False,
+    ) -> SkillAdded:
+        """Add a skill to ``agent``'s blueprint (appended, or inserted at task ``index``).
+
+        ``params`` maps parameter names to raw values (``12``, ``{"x": 3, "y": 4}``);
+        ``bindings`` maps parameter names to task marker names. Unnamed parameters
+        take the library default.
+        """
+        parameters = self._parameters(agent, skill, params or {}, bindings or {})
+        response = self._mutate(
+            "add_skill",
+            base_revision,
+            retry_on_conflict,
+            agent=agent,
+            skill=skill,
+            label=label,
+            index=-1 if index is None else index,
+            parameters=parameters,
+            timeout=check_timeout(timeout),
+            max_retries=check_retries(max_retries),
+        )
+        self._kinds[response.skill_id] = (agent, skill)
+        return SkillAdded(response.revision, response.skill_id)
+
+    def edit_skill(
+        self,
+        skill_id: str,
+        params: Mapping[str, object] | None = None,
+        *,
+        bindings: Mapping[str, str | None] | None = None,
+        label: str | None = None,
+        timeout: float | None = None,
+        max_retries: int | None = None,
+        base_revision: int | None = None,
+        retry_on_conflict: bool = False,
+    ) -> Result:
+        """Change a blueprint skill; only what is given changes.
+
+        A parameter given a value loses its marker binding; a binding to ``None``
+        or ``""`` unbinds the parameter and keeps its current value.
+        """
+        bindings = dict(bindings or {})
+        values = dict(params or {})
+        unbind = [name for name, marker in bindings.items() if not marker]
+        current = (
+            self.skill(skill_id) if unbind or (timeout is None) != (max_retries is None) else None
+        )
+        if current is not None:
+            values.update({name: current.params[name] for name in unbind if name in current.params})
+        spec = self.skill_spec(skill_id)
+        agent, _ = self._kinds[skill_id]
+        marked = {name: marker for name, marker in bindings.items() if marker}
+        set_options = timeout is not None or max_retries is not None
+        response = self._mutate(
+            "edit_skill",
+            base_revision,
+            retry_on_conflict,
+            skill_id=skill_id,
+            label=label or "",
+            parameters=self._parameters(agent, spec.name, values, marked),
+            set_options=set_options,
+            timeout=check_timeout(timeout if timeout is not None else _opt(current, "timeout")),
+            max_retries=check_retries(
+                max_retries if max_retries is not None else _opt(current, "max_retries")
+            ),
+        )
+        return Result(response.revision)
+
+    def delete_skills(
+        self,
+        skill_ids: Sequence[str],
+        *,
+        base_revision: int | None = None,
+        retry_on_conflict: bool = False,
+    ) -> Result:
+        """Delete blueprint skills (and their barrier memberships)."""
+        return Result(
+            self._mutate(
+                "delete_skills", base_revision, retry_on_conflict, skill_ids=list(skill_ids)
+            ).revision
+        )
+
+    def reorder(
+        self,
+        agent: str,
+        order: Sequence[str],
+        *,
+        base_revision: int | None = None,
+        retry_on_conflict: bool = False,
+    ) -> Result:
+        """Give ``agent``'s editable blueprint a new order (a permutation of its ids)."""
+        return Result(
+            self._mutate(
+                "reorder_skills", base_revision, retry_on_conflict, agent=agent, order=list(order)
+            ).revision
+        )
+
+    # -- synchronization and execution ---------------------------------------------------
+    def synchronize(
+        self,
+        agent: str,
+        upto_id: str | None = None,
+        *,
+        base_revision: int | None = None,
+        retry_on_conflict: bool = False,
+    ) -> Transferred:
+        """Upload ``agent``'s blueprint up to and including ``upto_id`` (None: all of it)."""
+        response = self._mutate(
+            "synchronize", base_revision, retry_on_conflict, agent=agent, upto_id=upto_id or ""
+        )
+        return Transferred(response.revision, tuple(response.skill_ids))
+
+    def unsynchronize(
+        self,
+        agent: str,
+        from_id: str | None = None,
+        *,
+        base_revision: int | None = None,
+        retry_on_conflict: bool = False,
+    ) -> Transferred:
+        """Pull ``from_id`` and every later not-started synchronized skill back (None: all)."""
+        response = self._mutate(
+            "unsynchronize", base_revision, retry_on_conflict, agent=agent, from_id=from_id or ""
+        )
+        return Transferred(response.revision, tuple(response.skill_ids))
+
+    def control(self, command: ControlCommand, agent: str | None = None) -> ControlSent:
+        """Start, pause, resume or stop one robot, or every robot (``agent`` None)."""
+        response = self._caller.call("control", agent=agent or "", command=int(command))
+        raise_for(response, response.revision)
+        return ControlSent(response.revision, tuple(response.agents))
+
+    def retry(
+        self, skill_id: str, *, base_revision: int | None = None, retry_on_conflict: bool = False
+    ) -> SkillRetried:
+        """Retry a FAILURE: a fresh synchronized instance follows it."""
+        response = self._mutate("retry_skill", base_revision, retry_on_conflict, skill_id=skill_id)
+        return SkillRetried(response.revision, response.new_skill_id)
+
+    def skip(
+        self, skill_id: str, *, base_revision: int | None = None, retry_on_conflict: bool = False
+    ) -> Result:
+        """Skip a FAILURE: the robot continues after it."""
+        return Result(
+            self._mutate("skip_skill", base_revision, retry_on_conflict, skill_id=skill_id).revision
+        )
+
+    # -- barriers and task markers -------------------------------------------------------
+    def add_barrier(
+        self,
+        skill_ids: Sequence[str],
+        *,
+        base_revision: int | None = None,
+        retry_on_conflict: bool = False,
+    ) -> BarrierAdded:
+        """Make skills on distinct agents start together."""
+        response = self._mutate(
+            "add_barrier", base_revision, retry_on_conflict, skill_ids=list(skill_ids)
+        )
+        return BarrierAdded(response.revision, response.barrier_id)
+
+    def delete_barrier(
+        self, barrier_id: str, *, base_revision: int | None = None, retry_on_conflict: bool = False
+    ) -> Result:
+        """Remove a barrier whose skills have not started."""
+        return Result(
+            self._mutate(
+                "delete_barrier", base_revision, retry_on_conflict, barrier_id=barrier_id
+            ).revision
+        )
+
+    def add_marker(
+        self,
+        marker: TaskMarker,
+        *,
+        base_revision: int | None = None,
+        retry_on_conflict: bool = False,
+    ) -> MarkerAdded:
+        """Add a task marker (an empty name gets a generated one)."""
+        response = self._mutate(
+            "add_task_marker", base_revision, retry_on_conflict, marker=marker_to_msg(marker)
+        )
+        return MarkerAdded(response.revision, response.name)
+
+    def move_marker(
+        self,
+        name: str,
+        pose: Pose,
+        vertices: Sequence[Pose] = (),
+        *,
+        base_revision: int | None = None,
+        retry_on_conflict: bool = False,
+    ) -> Result:
+        """Move a task marker (an AREA by its ``vertices``); bound parameters follow."""
+        response = self._mutate(
+            "move_task_marker",
+            base_revision,
+            retry_on_conflict,
+            name=name,
+            pose=pose_to_msg(pose),
+            vertices=[pose_to_msg(v) for v in vertices],
+        )
+        return Result(response.revision)
+
+    def rename_marker(
+        self,
+        name: str,
+        new_name: str,
+        *,
+        base_revision: int | None = None,
+        retry_on_conflict: bool = False,
+    ) -> Result:
+        """Rename a task marker; bindings follow."""
+        response = self._mutate(
+            "rename_task_marker", base_revision, retry_on_conflict, name=name, new_name=new_name
+        )
+        return Result(response.revision)
+
+    def delete_marker(
+        self, name: str, *, base_revision: int | None = None, retry_on_conflict: bool = False
+    ) -> Result:
+        """Delete a task marker that no skill is bound to."""
+        return Result(
+            self._mutate("delete_task_marker", base_revision, retry_on_conflict, name=name).revision
+        )
+
+    # -- whole missions ----------------------------------------------------------------
+    def new_mission(
+        self,
+        keep_markers: bool = True,
+        *,
+        base_revision: int | None = None,
+        retry_on_conflict: bool = False,
+    ) -> Result:
+        """Start an empty mission (refused while robots hold unfinished skills)."""
+        return Result(
+            self._mutate(
+                "new_mission", base_revision, retry_on_conflict, keep_markers=keep_markers
+            ).revision
+        )
+
+    def save_mission(self, path: str = "") -> MissionSaved:
+        """The mission as a YAML document; with ``path``, also written on the server's host."""
+        response = self._caller.call("save_mission", path=path)
+        raise_for(response, response.revision)
+        return MissionSaved(response.revision, response.document, response.path_written)
+
+    def load_mission(
+        self,
+        document: str | None = None,
+        path: str | None = None,
+        *,
+        base_revision: int | None = None,
+        retry_on_conflict: bool = False,
+    ) -> Result:
+        """Replace the mission with a saved ``document``, or a file at ``path`` on the server."""
+        if (document is None) == (path is None):
+            raise InvalidRequest("give exactly one of a document and a path to load")
+        response = self._mutate(
+            "load_mission",
+            base_revision,
+            retry_on_conflict,
+            document=document or "",
+            path=path or "",
+        )
+        return Result(response.revision)
+
+
+def _opt(skill: SkillInstance | None, name: str) -> Any:
+    return getattr(skill, name) if skill is not None else 0
