@@ -327,7 +327,7 @@ class Engine:
             self.agent,
             skill.id,
             skill.params,
-            skill.attempt + active.retries_used,
+            skill.attempt + (1 if active.retries_used else 0),  # one more than the last run
             self.clock,
             lambda text: self._progress(skill.id, text),
         )
