@@ -1,0 +1,155 @@
+"""The science and manipulation skills: identify, pick and deliver stones; carry boxes.
+
+Identification scores depend on who looks: the science rover alone raises a
+region's stones to a fraction of its maximum score, the science and the
+manipulator rover together (their identifications overlapping in time, which
+a skill barrier arranges) to the maximum; an unidentified stone scores the
+minimum. A stone's score counts when it reaches the lander.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+from .sim import LEVEL_COLLABORATIVE, LEVEL_SCIENCE, Robot, Simulation
+from .tasks import Steps, TaskFailed, _drive, _pose, _work
+
+IDENTIFY_SECONDS = {"quick": 10.0, "standard": 20.0, "detailed": 40.0}
+HANDLING_SECONDS = 8.0
+REACH = 1.5  # how close the arm must be to what it handles
+
+
+def identify_stones(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps:
+    """Image the stones of the region at a position (both rovers together: best score)."""
+    if robot.kind == "drone":
+        raise TaskFailed("the drone has no cameras for identification")
+    x, y, _ = _pose(params, "position")
+    reach = float(params.get("radius", 2.0))
+    region = sim.region_at(x, y, margin=reach)
+    if region is None:
+        raise TaskFailed(f"no discovered region at ({x:.1f}, {y:.1f}): explore first")
+    away = robot.distance_to(x, y) - reach - region.spec.radius
+    if away > 0:
+        raise TaskFailed(f"too far from {region.spec.name}: {away:.1f} m away")
+    start = sim.time
+    region.sessions[robot.kind] = (start, None)
+    yield from _work(
+        sim,
+        robot,
+        IDENTIFY_SECONDS[str(params.get("mode", "standard"))],
+        f"identifying stones at {region.spec.name}",
+    )
+    region.sessions[robot.kind] = (start, sim.time)
+    partner = "manipulator_rover" if robot.kind == "science_rover" else "science_rover"
+    other = region.sessions.get(partner)
+    together = (
+        other is not None and (other[1] is None or other[1] >= start) and other[0] <= sim.time
+    )
+    level = (
+        LEVEL_COLLABORATIVE if together else (LEVEL_SCIENCE if robot.kind == "science_rover" else 0)
+    )
+    if level > region.identified:
+        region.identified = level
+        for stone in sim.stones.values():
+            if stone.region == region.spec.name and not stone.delivered and not stone.carried_by:
+                stone.level = max(stone.level, level)
+        how = "together with the other rover" if together else "alone"
+        sim.log(f"{robot.name} identified the stones of {region.spec.name} {how}")
+    if level == 0:
+        return f"looked at {region.spec.name}; the science rover must identify the stones"
+    return f"stones of {region.spec.name} identified ({'collaboratively' if together else 'alone'})"
+
+
+def pick_stone(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps:
+    """Drive to the best stone near a position and pick it up."""
+    _require_arm(robot)
+    if robot.carrying:
+        raise TaskFailed(f"the gripper already holds {robot.carrying}")
+    x, y, _ = _pose(params, "position")
+    reach = float(params.get("radius", 2.0))
+    region = sim.region_at(x, y, margin=reach)
+    if region is None:
+        raise TaskFailed(f"no discovered region at ({x:.1f}, {y:.1f}): explore first")
+    stones = [
+        s
+        for s in sim.stones.values()
+        if s.region == region.spec.name and not s.carried_by and not s.delivered
+    ]
+    if not stones:
+        raise TaskFailed(f"no stone left at {region.spec.name}")
+    stone = max(stones, key=lambda s: (s.level, -math.hypot(s.x - x, s.y - y)))
+    yield from _approach(sim, robot, stone.x, stone.y, f"approaching {stone.name}")
+    yield from _work(sim, robot, HANDLING_SECONDS, f"picking {stone.name}")
+    stone.carried_by = robot.name
+    robot.carrying = stone.name
+    sim.log(f"{robot.name} picked {stone.name}")
+    return f"holding {stone.name}"
+
+
+def deposit_at_lander(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps:
+    """Bring the carried stone to the lander's sample box."""
+    _require_arm(robot)
+    stone = sim.stones.get(robot.carrying)
+    if stone is None:
+        raise TaskFailed("not carrying a stone")
+    yield from _approach(
+        sim, robot, 0.0, 0.0, "driving to the lander", reach=sim.scenario.charge_radius - 0.5
+    )
+    yield from _work(sim, robot, HANDLING_SECONDS, "depositing the stone")
+    value = sim.stone_value(stone)
+    stone.delivered, stone.carried_by, robot.carrying = True, "", ""
+    sim.score += value
+    sim.delivered += 1
+    sim.log(f"{robot.name} delivered {stone.name} worth {value:.2f}; score {sim.score:.2f}")
+    return f"delivered {stone.name} (+{value:.2f})"
+
+
+def pick_box(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps:
+    """Drive to a payload box and pick it up."""
+    _require_arm(robot)
+    box = sim.boxes.get(str(params["box"]))
+    if box is None:
+        raise TaskFailed(f"there is no box {params['box']!r}")
+    if robot.carrying:
+        raise TaskFailed(f"the gripper already holds {robot.carrying}")
+    if box.carried_by:
+        raise TaskFailed(f"{box.spec.name} is carried by {box.carried_by}")
+    yield from _approach(sim, robot, box.x, box.y, f"approaching {box.spec.name}", reach=3.0)
+    yield from _work(sim, robot, HANDLING_SECONDS, f"picking {box.spec.name}")
+    box.carried_by, box.deployed, robot.carrying = robot.name, False, box.spec.name
+    return f"holding {box.spec.name}"
+
+
+def place_box(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps:
+    """Drive to a pose and deploy the carried box there."""
+    _require_arm(robot)
+    box = sim.boxes.get(robot.carrying)
+    if box is None:
+        raise TaskFailed("not carrying a box")
+    x, y, _ = _pose(params, "target")
+    yield from _drive(sim, robot, x, y, robot.spec.speed, f"carrying {box.spec.name}")
+    yield from _work(sim, robot, HANDLING_SECONDS, f"deploying {box.spec.name}")
+    box.carried_by, robot.carrying, box.deployed = "", "", True
+    box.x, box.y, box.z = robot.x + math.cos(robot.yaw), robot.y + math.sin(robot.yaw), 0.25
+    sim.log(f"{robot.name} deployed {box.spec.name} at ({box.x:.1f}, {box.y:.1f})")
+    return f"{box.spec.name} deployed"
+
+
+def _require_arm(robot: Robot) -> None:
+    if robot.kind != "manipulator_rover":
+        raise TaskFailed(f"{robot.name} has no arm")
+
+
+def _approach(
+    sim: Simulation, robot: Robot, x: float, y: float, what: str, reach: float = REACH
+) -> Steps:
+    """Drive until within ``reach`` of (x, y), stopping short of the point itself."""
+    distance = robot.distance_to(x, y)
+    if distance <= reach:
+        return ""
+    angle = math.atan2(robot.y - y, robot.x - x)
+    stop = (x + (reach - 0.3) * math.cos(angle), y + (reach - 0.3) * math.sin(angle))
+    yield from _drive(sim, robot, stop[0], stop[1], robot.spec.speed, what)
+    return ""

@@ -1,0 +1,241 @@
+"""What the simulated robots can do: one task per skill, stepped with the simulation.
+
+Each task is a generator that sets the robot moving or working and yields
+progress text while it waits for the world to catch up; it returns a closing
+text on success and raises :class:`TaskFailed` with the reason on failure.
+:class:`TaskRunner` steps it, pauses it (the robot holds still and resumes
+the same path), cancels it, and fails it when the battery runs empty.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Generator, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from .planner import NoPath
+from .sim import Robot, Simulation
+
+Steps = Generator[str, None, str]
+TaskFunction = Callable[[Simulation, Robot, Mapping[str, Any]], Steps]
+
+
+class TaskFailed(Exception):
+    """A task cannot go on; the message is the reason the operator reads."""
+
+
+@dataclass(frozen=True)
+class TaskResult:
+    """How a task ended."""
+
+    success: bool
+    text: str
+
+
+class TaskRunner:
+    """Runs one task of one robot."""
+
+    def __init__(
+        self,
+        sim: Simulation,
+        robot: Robot,
+        task: TaskFunction,
+        params: Mapping[str, Any],
+        needs_power: bool = True,
+    ) -> None:
+        self._sim = sim
+        self._needs_power = needs_power
+        self._robot = robot
+        self._steps = task(sim, robot, params)
+        self.progress = ""
+        self.paused = False
+        self.result: TaskResult | None = None
+        self._saved: tuple[list[tuple[float, float]], float | None] = ([], None)
+
+    def update(self) -> TaskResult | None:
+        """Advance the task by one simulation step; the result once finished."""
+        if self.result is not None or self.paused:
+            return self.result
+        if self._needs_power and self._robot.battery <= 0.0:
+            return self._end(False, "battery empty")
+        try:
+            self.progress = next(self._steps)
+        except StopIteration as done:
+            return self._end(True, str(done.value or ""))
+        except (TaskFailed, NoPath) as failure:
+            return self._end(False, str(failure))
+        return None
+
+    def pause(self) -> None:
+        """Hold still; the task resumes where it was."""
+        if not self.paused and self.result is None:
+            self.paused = True
+            self._saved = (list(self._robot.path), self._robot.target_z)
+            self._sim.halt(self._robot)
+            self._robot.activity = "idle"
+
+    def resume(self) -> None:
+        """Go on after a pause."""
+        if self.paused:
+            self.paused = False
+            self._robot.path, self._robot.target_z = self._saved
+
+    def cancel(self) -> None:
+        """Stop for good."""
+        if self.result is None:
+            self._steps.close()
+            self._end(False, "cancelled")
+
+    def _end(self, success: bool, text: str) -> TaskResult:
+        self._sim.halt(self._robot)
+        self._robot.activity = "idle"
+        self._robot.charging_to = None
+        self.result = TaskResult(success, text)
+        return self.result
+
+
+# -- building blocks ----------------------------------------------------------------
+def _drive(sim: Simulation, robot: Robot, x: float, y: float, speed: float, what: str) -> Steps:
+    """Move to (x, y) along a planned path, yielding the distance left."""
+    if robot.kind == "drone" and not robot.flying:
+        raise TaskFailed("the drone must take off first")
+    if robot.kind != "drone" and robot.z > 0.05:
+        raise TaskFailed("the rover cannot move from here")
+    sim.go(robot, sim.plan(robot, x, y), speed)
+    while robot.path:
+        left = math.hypot(robot.path[-1][0] - robot.x, robot.path[-1][1] - robot.y)
+        yield f"{what}: {left:.1f} m to go"
+    return ""
+
+
+def _work(sim: Simulation, robot: Robot, seconds: float, what: str) -> Steps:
+    """Stand still and work for ``seconds`` of sim time."""
+    end = sim.time + seconds
+    robot.activity = "work"
+    while sim.time < end:
+        yield f"{what}: {end - sim.time:.0f} s left"
+    robot.activity = "idle"
+    return ""
+
+
+def _climb(sim: Simulation, robot: Robot, altitude: float) -> Steps:
+    robot.target_z = altitude
+    while robot.moving:
+        yield f"altitude {robot.z:.1f} m"
+    return ""
+
+
+def _pose(params: Mapping[str, Any], name: str) -> tuple[float, float, float]:
+    pose = params[name]
+    return float(pose.x), float(pose.y), float(pose.yaw)
+
+
+def _area(params: Mapping[str, Any]) -> list[tuple[float, float]]:
+    corners = [(float(p["x"]), float(p["y"])) for p in params["area"]]
+    if len(corners) < 3:
+        raise TaskFailed("an area needs at least three corners")
+    return corners
+
+
+def _sweep(area: list[tuple[float, float]], spacing: float) -> list[tuple[float, float]]:
+    """Lawnmower waypoints over the area's bounding box."""
+    xs, ys = [c[0] for c in area], [c[1] for c in area]
+    lanes = max(1, math.ceil((max(ys) - min(ys)) / spacing))
+    points = []
+    for lane in range(lanes + 1):
+        y = min(ys) + lane * (max(ys) - min(ys)) / lanes
+        row = [(min(xs), y), (max(xs), y)]
+        points += row if lane % 2 == 0 else row[::-1]
+    return points
+
+
+# -- the skills ----------------------------------------------------------------------
+def navigate_to(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps:
+    """Go to a pose (rovers around obstacles, the drone straight at its altitude)."""
+    x, y, yaw = _pose(params, "target")
+    yield from _drive(sim, robot, x, y, float(params.get("speed", robot.spec.speed)), "driving")
+    while abs((yaw - robot.yaw + math.pi) % (2 * math.pi) - math.pi) > 0.05:
+        turn = (yaw - robot.yaw + math.pi) % (2 * math.pi) - math.pi
+        robot.yaw += max(-0.06, min(0.06, turn))
+        yield "turning to the target heading"
+    return f"arrived at ({x:.1f}, {y:.1f})"
+
+
+def take_off(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps:
+    """Climb to the given altitude."""
+    robot.flying = True
+    yield from _climb(sim, robot, float(params["altitude"]))
+    return f"flying at {robot.z:.1f} m"
+
+
+def land(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps:
+    """Descend and land where the drone is."""
+    yield from _climb(sim, robot, 0.0)
+    robot.flying = False
+    return "landed"
+
+
+def fly_over(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps:
+    """Cover an area in lanes, discovering the regions in it."""
+    area = _area(params)
+    if not robot.flying:
+        raise TaskFailed("the drone must take off first")
+    yield from _climb(sim, robot, float(params.get("altitude", robot.z)))
+    found: list[str] = []
+    lanes = _sweep(area, float(params.get("spacing", 4.0)))
+    for number, (x, y) in enumerate(lanes, 1):
+        sim.go(robot, [(x, y)], robot.spec.speed)
+        while robot.path:
+            found += sim.reveal_around(robot, area)
+            yield f"covering the area: leg {number} of {len(lanes)}"
+    return f"found {', '.join(found)}" if found else "found no region"
+
+
+def explore(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps:
+    """Drive around an area, discovering the regions in it."""
+    area = _area(params)
+    found: list[str] = []
+    for number, (x, y) in enumerate(_sweep(area, 6.0), 1):
+        try:
+            path = sim.plan(robot, x, y)
+        except NoPath:
+            continue  # a corner inside a rock: skip it, the others still cover the area
+        sim.go(robot, path, robot.spec.speed)
+        while robot.path:
+            found += sim.reveal_around(robot, area)
+            yield f"exploring: waypoint {number}"
+    return f"found {', '.join(found)}" if found else "found no region"
+
+
+def return_to_lander(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps:
+    """Go back to the lander (the drone lands on it)."""
+    if robot.kind == "drone":
+        if not robot.flying:
+            raise TaskFailed("the drone must take off first")
+        yield from _drive(sim, robot, 0.0, 0.0, robot.spec.speed, "returning")
+        yield from land(sim, robot, params)
+        return "landed on the lander"
+    angle = math.atan2(robot.y, robot.x)
+    distance = sim.scenario.charge_radius - 0.8
+    yield from _drive(
+        sim,
+        robot,
+        distance * math.cos(angle),
+        distance * math.sin(angle),
+        robot.spec.speed,
+        "returning",
+    )
+    return "at the lander"
+
+
+def recharge(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps:
+    """Charge at the lander up to a battery level."""
+    if not sim.at_lander(robot):
+        raise TaskFailed("not at the lander: return to it first")
+    level = float(params.get("level", 1.0))
+    robot.charging_to = level
+    while robot.battery < level - 1e-6:
+        yield f"charging: {robot.battery * 100:.0f} %"
+    robot.charging_to = None
+    return f"battery at {robot.battery * 100:.0f} %"
