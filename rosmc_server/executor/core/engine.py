@@ -294,9 +294,11 @@ class Engine:
         self._try_release(active)
 
     def _try_release(self, active: _Active) -> None:
+        if self.mode is not Mode.STARTED:
+            return  # paused or stopped: the skill waits for the operator, barrier or not
         barrier = active.barrier
-        if barrier is None or self.mode is not Mode.STARTED:
-            if barrier is None and active.behavior is None:
+        if barrier is None:
+            if active.behavior is None:
                 self._run(active)
             return
         missing = self.board.missing(barrier)
@@ -385,11 +387,12 @@ class Engine:
         if active.paused_from is S.RUNNING and active.behavior is not None:
             active.behavior.resume()
             self._set(active.skill_id, S.RUNNING, text="")
-        elif active.barrier is not None:
-            # Back to waiting at the barrier, not to PAUSED (and not straight to running).
-            self._set(active.skill_id, S.SYNCWAITING, text=self._waiting_text(active.barrier))
-            self._announce(active, SignalKind.READY)
-            self._try_release(active)
+        else:
+            if active.barrier is not None:
+                # Back to waiting at the barrier, not to PAUSED (and not straight to running).
+                self._set(active.skill_id, S.SYNCWAITING, text=self._waiting_text(active.barrier))
+                self._announce(active, SignalKind.READY)
+            self._try_release(active)  # runs it if its barrier went away meanwhile
         active.paused_from = None
 
     def _drop_active(self, active: _Active, why: str) -> None:
