@@ -63,6 +63,7 @@ class _Active:
     barrier: BarrierInfo | None = None
     paused_from: SkillStatus | None = None
     deadline: float = 0.0
+    paused_at: float = 0.0
     retries_used: int = 0
     last_announce: float = 0.0
 
@@ -376,6 +377,7 @@ class Engine:
         status = self._status(active.skill_id)
         if status is S.RUNNING and active.behavior is not None:
             active.behavior.pause()
+            active.paused_at = self.clock()
         elif status is S.SYNCWAITING:
             self._announce(active, SignalKind.WITHDRAWN)
         else:
@@ -386,6 +388,8 @@ class Engine:
     def _resume_active(self, active: _Active) -> None:
         if active.paused_from is S.RUNNING and active.behavior is not None:
             active.behavior.resume()
+            if active.deadline:  # time spent paused does not count against the timeout
+                active.deadline += self.clock() - active.paused_at
             self._set(active.skill_id, S.RUNNING, text="")
         else:
             if active.barrier is not None:
