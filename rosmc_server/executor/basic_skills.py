@@ -82,8 +82,8 @@ class Count(SkillBehavior):
         self._cancelled = True
 
 
-def skill_types() -> list[SkillType]:
-    """The basic skills, for the executor's ``~skills`` parameter."""
+def skill_types(agent: str = "") -> list[SkillType]:
+    """The basic skills, for the executor's ``~skills`` parameter (any agent)."""
     return [
         SkillType("wait", Wait, {"duration": ParamType.FLOAT}, "Wait some seconds."),
         SkillType(

@@ -54,11 +54,11 @@ _log = logging.getLogger(__name__)
 DEFAULT_SKILLS = "rosmc_server.executor.basic_skills:skill_types"
 
 
-def load_skill_types(spec: str) -> dict[str, SkillType]:
-    """Import ``module:function`` and call it for the robot's skill types."""
+def load_skill_types(spec: str, agent: str) -> dict[str, SkillType]:
+    """Import ``module:function`` and call it with the agent name for its skill types."""
     module_name, _, function = spec.partition(":")
     factory = getattr(importlib.import_module(module_name), function or "skill_types")
-    types: Iterable[SkillType] = factory()
+    types: Iterable[SkillType] = factory(agent)
     return {kind.name: kind for kind in types}
 
 
@@ -205,7 +205,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     state = str(rospy.get_param("~state_file", str(default_state_file(agent))))
     try:
-        skill_types = load_skill_types(str(rospy.get_param("~skills", DEFAULT_SKILLS)))
+        skill_types = load_skill_types(str(rospy.get_param("~skills", DEFAULT_SKILLS)), agent)
     except (ImportError, AttributeError, ValueError) as error:
         _log.critical("mission executor %s: cannot load skills: %s", agent, error)
         return 1

@@ -1,0 +1,167 @@
+"""The simulated robots' skills, as the mission executor sees them.
+
+Each skill forwards its execution to the robot's controllers (played by the
+simulator) with the robot-task protocol: START with the typed parameters,
+PAUSE, RESUME and CANCEL on ``/<robot>/sim/task`` (rosmc/RobotTask), progress
+and outcome back on ``/<robot>/sim/task_status`` (rosmc/RobotTaskStatus). A
+real robot would register skills of the same names that call its own stack.
+
+Use one function per robot kind as the executor's ``~skills`` parameter:
+``rosmc_sim.ros.robot_skills:drone_skills`` (or ``science_rover_skills``,
+``manipulator_rover_skills``).
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Mapping
+
+import rosmc.msg as wire
+import rospy
+
+from rosmc_server.core import ParamType, Value
+from rosmc_server.executor.core import Outcome, SkillBehavior, SkillContext, SkillType
+from rosmc_server.ros.conversions import param_to_msg
+
+from .topics import task_status_topic, task_topic
+
+RESEND_AFTER = 1.0  # wall seconds without any status before a START is sent again
+
+P = ParamType
+_PARAMS: Mapping[str, Mapping[str, ParamType]] = {
+    "navigate_to": {"target": P.POSE},
+    "take_off": {"altitude": P.FLOAT},
+    "land": {},
+    "fly_over": {"area": P.LIST},
+    "explore": {"area": P.LIST},
+    "return_to_lander": {},
+    "recharge": {"level": P.FLOAT},
+    "identify_stones": {"position": P.POSE},
+    "pick_stone": {"position": P.POSE},
+    "deposit_at_lander": {},
+    "pick_box": {"box": P.STRING},
+    "place_box": {"target": P.POSE},
+}
+_KINDS: Mapping[str, tuple[str, ...]] = {
+    "drone": ("take_off", "land", "fly_over", "navigate_to", "return_to_lander", "recharge"),
+    "science_rover": ("navigate_to", "explore", "identify_stones", "return_to_lander", "recharge"),
+    "manipulator_rover": (
+        "navigate_to",
+        "identify_stones",
+        "pick_stone",
+        "deposit_at_lander",
+        "pick_box",
+        "place_box",
+        "return_to_lander",
+        "recharge",
+    ),
+}
+
+
+class RobotController:
+    """One robot's task channel to its controllers (shared by all its skills)."""
+
+    def __init__(self, robot: str) -> None:
+        self.robot = robot
+        self._lock = threading.Lock()
+        self._status: dict[str, wire.RobotTaskStatus] = {}
+        self._publisher = rospy.Publisher(task_topic(robot), wire.RobotTask, queue_size=100)
+        self._subscriber = rospy.Subscriber(
+            task_status_topic(robot), wire.RobotTaskStatus, self._on_status, queue_size=100
+        )
+
+    def _on_status(self, msg: wire.RobotTaskStatus) -> None:
+        with self._lock:
+            self._status[msg.task_id] = msg
+
+    def status(self, task_id: str) -> wire.RobotTaskStatus | None:
+        """The latest status heard for a task."""
+        with self._lock:
+            return self._status.get(task_id)
+
+    def send(
+        self, task_id: str, action: int, skill: str = "", params: Mapping[str, Value] | None = None
+    ) -> None:
+        """Publish a task request."""
+        parameters = [param_to_msg(name, value) for name, value in (params or {}).items()]
+        self._publisher.publish(
+            wire.RobotTask(
+                robot=self.robot, task_id=task_id, action=action, skill=skill, parameters=parameters
+            )
+        )
+
+
+class ForwardedSkill(SkillBehavior):
+    """Runs a skill on the robot's controllers and reports what they report."""
+
+    def __init__(self, controller: RobotController, skill: str) -> None:
+        self._controller = controller
+        self._skill = skill
+        self._ctx: SkillContext | None = None
+        self._task_id = ""
+        self._sent = 0.0
+        self._last_text = ""
+
+    def start(self, ctx: SkillContext) -> None:
+        """Ask the controllers to start."""
+        self._ctx = ctx
+        self._task_id = f"{ctx.skill_id}#{ctx.attempt}"
+        self._send_start()
+
+    def _send_start(self) -> None:
+        assert self._ctx is not None
+        self._controller.send(self._task_id, wire.RobotTask.START, self._skill, self._ctx.params)
+        self._sent = time.monotonic()
+
+    def update(self, now: float) -> Outcome | None:
+        """Follow the controllers' status; resend START if nothing was heard yet."""
+        assert self._ctx is not None
+        status = self._controller.status(self._task_id)
+        if status is None:
+            if time.monotonic() - self._sent > RESEND_AFTER:
+                self._send_start()
+            return None
+        if status.state == wire.RobotTaskStatus.SUCCEEDED:
+            return Outcome.ok(status.text)
+        if status.state == wire.RobotTaskStatus.FAILED:
+            return Outcome.failed(status.text or "failed")
+        if status.text and status.text != self._last_text:
+            self._last_text = status.text
+            self._ctx.progress(status.text)
+        return None
+
+    def pause(self) -> None:
+        """Ask the controllers to hold still."""
+        self._controller.send(self._task_id, wire.RobotTask.PAUSE)
+
+    def resume(self) -> None:
+        """Ask the controllers to go on."""
+        self._controller.send(self._task_id, wire.RobotTask.RESUME)
+
+    def cancel(self) -> None:
+        """Ask the controllers to stop."""
+        self._controller.send(self._task_id, wire.RobotTask.CANCEL)
+
+
+def _skills(agent: str, kind: str) -> list[SkillType]:
+    controller = RobotController(agent)
+    return [
+        SkillType(name, lambda name=name: ForwardedSkill(controller, name), _PARAMS[name])
+        for name in _KINDS[kind]
+    ]
+
+
+def drone_skills(agent: str) -> list[SkillType]:
+    """The drone scout's skills."""
+    return _skills(agent, "drone")
+
+
+def science_rover_skills(agent: str) -> list[SkillType]:
+    """The science rover's skills."""
+    return _skills(agent, "science_rover")
+
+
+def manipulator_rover_skills(agent: str) -> list[SkillType]:
+    """The manipulator rover's skills."""
+    return _skills(agent, "manipulator_rover")
