@@ -5,6 +5,11 @@ until released (messages may be lost). It starts as soon as it knows every
 other member is ready, or hears that a member already started (RELEASED),
 which can only happen once everybody was ready. A member that pauses, stops
 or is unsynchronized while waiting sends WITHDRAWN.
+
+Readiness is soft state: a READY counts for :data:`READY_LEASE` seconds (of
+the hearing robot's clock) unless repeated, so a member that crashed or
+restarted while waiting, and could not withdraw, does not stay "ready"
+for ever. It is not persisted either: waiting peers repeat it anyway.
 """
 
 from __future__ import annotations
@@ -13,14 +18,17 @@ from dataclasses import dataclass, field
 
 from .protocol import BarrierInfo, Signal, SignalKind
 
+READY_LEASE = 2.0  # seconds; waiting robots repeat READY every 0.5 s
+
 
 @dataclass
 class BarrierBoard:
     """What one robot knows about its peers' barrier readiness."""
 
     agent: str
+    lease: float = READY_LEASE
     barriers: dict[str, BarrierInfo] = field(default_factory=dict)
-    _ready: dict[str, set[str]] = field(default_factory=dict)
+    _ready: dict[str, dict[str, float]] = field(default_factory=dict)  # barrier: agent: heard
     _released: set[str] = field(default_factory=set)
 
     def replace(self, barriers: tuple[BarrierInfo, ...]) -> None:
@@ -34,36 +42,36 @@ class BarrierBoard:
                 return barrier
         return None
 
-    def hear(self, signal: Signal) -> None:
-        """Record a peer's signal (own signals are ignored)."""
+    def hear(self, signal: Signal, now: float) -> None:
+        """Record a peer's signal heard at ``now`` (own signals are ignored)."""
         if signal.agent == self.agent:
             return
-        ready = self._ready.setdefault(signal.barrier_id, set())
+        ready = self._ready.setdefault(signal.barrier_id, {})
         if signal.kind is SignalKind.WITHDRAWN:
-            ready.discard(signal.agent)
+            ready.pop(signal.agent, None)
         else:
-            ready.add(signal.agent)
+            ready[signal.agent] = now
             if signal.kind is SignalKind.RELEASED:
                 self._released.add(signal.barrier_id)
 
-    def missing(self, barrier: BarrierInfo) -> tuple[str, ...]:
-        """Members not known to be ready (empty once the barrier may release)."""
+    def missing(self, barrier: BarrierInfo, now: float) -> tuple[str, ...]:
+        """Members not known to be ready at ``now`` (empty once the barrier may release)."""
         if barrier.id in self._released:
             return ()
-        ready = self._ready.get(barrier.id, set())
-        return tuple(a for a in barrier.agents_except(self.agent) if a not in ready)
+        ready = self._ready.get(barrier.id, {})
+        return tuple(
+            a
+            for a in barrier.agents_except(self.agent)
+            if a not in ready or now - ready[a] > self.lease
+        )
 
     def to_dict(self) -> dict[str, object]:
-        """Peer readiness, for the executor's persisted state."""
-        return {
-            "ready": {b: sorted(agents) for b, agents in self._ready.items()},
-            "released": sorted(self._released),
-        }
+        """What the executor persists: the barriers known to have released."""
+        return {"released": sorted(self._released)}
 
     def load(self, data: dict[str, object]) -> None:
-        """Restore peer readiness saved by :meth:`to_dict`."""
-        ready = data.get("ready", {})
+        """Restore what :meth:`to_dict` saved (peers' readiness is heard afresh)."""
         released = data.get("released", [])
-        assert isinstance(ready, dict) and isinstance(released, list)
-        self._ready = {str(b): set(agents) for b, agents in ready.items()}
+        assert isinstance(released, list)
+        self._ready = {}
         self._released = {str(b) for b in released}

@@ -223,7 +223,7 @@ class Engine:
     # -- peers and the ground -------------------------------------------------------------
     def hear(self, signal: Signal) -> None:
         """A peer's barrier signal."""
-        self.board.hear(signal)
+        self.board.hear(signal, self.clock())
         active = self._active
         if active is not None and active.barrier is not None and active.behavior is None:
             self._try_release(active)
@@ -302,7 +302,7 @@ class Engine:
             if active.behavior is None:
                 self._run(active)
             return
-        missing = self.board.missing(barrier)
+        missing = self.board.missing(barrier, self.clock())
         if missing:
             self._set(active.skill_id, S.SYNCWAITING, text=self._waiting_text(barrier))
             return
@@ -310,7 +310,7 @@ class Engine:
         self._run(active)
 
     def _waiting_text(self, barrier: BarrierInfo) -> str:
-        missing = self.board.missing(barrier)
+        missing = self.board.missing(barrier, self.clock())
         return f"waiting for {', '.join(missing)}" if missing else ""
 
     def _announce(self, active: _Active, kind: SignalKind) -> None:
@@ -491,6 +491,12 @@ class Engine:
         for skill_id in interrupted:
             self._set(skill_id, S.IDLE_SYNCHRONIZED, text="interrupted by an executor restart",
                       started=0.0)  # fmt: skip
+            barrier = self.board.barrier_of(skill_id)
+            if barrier is not None:  # peers may still count this robot as ready
+                now = self.clock()
+                self.outputs.signal(
+                    Signal(self.agent, barrier.id, skill_id, SignalKind.WITHDRAWN, now)
+                )
         return interrupted
 
     def queue_hash(self) -> str:
@@ -515,7 +521,7 @@ class Engine:
         active = self._active
         waiting = ""
         if active is not None and active.barrier is not None and active.behavior is None:
-            waiting = ", ".join(self.board.missing(active.barrier))
+            waiting = ", ".join(self.board.missing(active.barrier, self.clock()))
         return Snapshot(
             self.clock(),
             self.last_command_seq,
