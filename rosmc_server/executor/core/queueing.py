@@ -107,13 +107,19 @@ def skip(queue: Sequence[SkillInstance], failed_id: str) -> Answer:
 def adopt(
     queue: Sequence[SkillInstance], ground: Sequence[SkillInstance], why_not: Checker
 ) -> Answer:
-    """Make the queue the ground's list, keeping what started here (a repair)."""
+    """Make the queue the ground's list, keeping what started here (a repair).
+
+    A skill the ground logged as finished stays finished: a robot that lost its
+    state must not run again what it has done.
+    """
     mine = {s.id: s for s in queue}
     wanted = {s.id for s in ground}
     out = [s for s in queue if s.id not in wanted and s.status.has_started]
     for skill in ground:
         if skill.id in mine:
             out.append(mine[skill.id])
+        elif skill.status.is_final:
+            out.append(replace(skill, transfer=Transfer.NONE))
         elif not why_not(skill):
             out.append(held(skill))
     return Answer(out, accepted=tuple(s.id for s in out))
