@@ -34,13 +34,17 @@ def identify_stones(sim: Simulation, robot: Robot, params: Mapping[str, Any]) ->
     if away > 0:
         raise TaskFailed(f"too far from {region.spec.name}: {away:.1f} m away")
     start = sim.time
+    seconds = IDENTIFY_SECONDS.get(str(params.get("mode", "standard")))
+    if seconds is None:
+        raise TaskFailed(f"mode must be one of {', '.join(IDENTIFY_SECONDS)}")
     region.sessions[robot.kind] = (start, None)
-    yield from _work(
-        sim,
-        robot,
-        IDENTIFY_SECONDS[str(params.get("mode", "standard"))],
-        f"identifying stones at {region.spec.name}",
-    )
+    try:
+        yield from _work(sim, robot, seconds, f"identifying stones at {region.spec.name}")
+    except GeneratorExit:
+        # Cancelled or failed: an open session would make the partner's later,
+        # separate identification count as collaborative.
+        region.sessions.pop(robot.kind, None)
+        raise
     region.sessions[robot.kind] = (start, sim.time)
     partner = "manipulator_rover" if robot.kind == "science_rover" else "science_rover"
     other = region.sessions.get(partner)

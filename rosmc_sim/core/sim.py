@@ -42,6 +42,7 @@ class Robot:
     target_z: float | None = None
     carrying: str = ""  # a box name or a stone name
     charging_to: float | None = None
+    worked: float = 0.0  # sim seconds spent working (the clock of timed work; stops in pauses)
 
     @property
     def name(self) -> str:
@@ -199,6 +200,8 @@ class Simulation:
         return 1.0
 
     def _drain(self, robot: Robot, dt: float) -> None:
+        if robot.activity == "work":
+            robot.worked += dt
         if robot.charging_to is not None:
             if self.at_lander(robot):
                 robot.battery = min(1.0, robot.battery + dt / CHARGE_TIME[robot.kind])

@@ -51,7 +51,12 @@ class TaskRunner:
         self.progress = ""
         self.paused = False
         self.result: TaskResult | None = None
-        self._saved: tuple[list[tuple[float, float]], float | None] = ([], None)
+        self._saved: tuple[list[tuple[float, float]], float | None, str, float | None] = (
+            [],
+            None,
+            "idle",
+            None,
+        )
 
     def update(self) -> TaskResult | None:
         """Advance the task by one simulation step; the result once finished."""
@@ -65,29 +70,36 @@ class TaskRunner:
             return self._end(True, str(done.value or ""))
         except (TaskFailed, NoPath) as failure:
             return self._end(False, str(failure))
+        except KeyError as missing:
+            return self._end(False, f"missing parameter {missing}")
+        except (TypeError, ValueError, AttributeError) as error:
+            return self._end(False, f"invalid parameters: {error}")
         return None
 
     def pause(self) -> None:
         """Hold still; the task resumes where it was."""
         if not self.paused and self.result is None:
             self.paused = True
-            self._saved = (list(self._robot.path), self._robot.target_z)
-            self._sim.halt(self._robot)
-            self._robot.activity = "idle"
+            robot = self._robot
+            self._saved = (list(robot.path), robot.target_z, robot.activity, robot.charging_to)
+            self._sim.halt(robot)
+            robot.activity = "idle"  # work stops too: its clock (Robot.worked) holds still
+            robot.charging_to = None
 
     def resume(self) -> None:
         """Go on after a pause."""
         if self.paused:
             self.paused = False
-            self._robot.path, self._robot.target_z = self._saved
+            robot = self._robot
+            robot.path, robot.target_z, robot.activity, robot.charging_to = self._saved
 
     def cancel(self) -> None:
         """Stop for good."""
         if self.result is None:
-            self._steps.close()
             self._end(False, "cancelled")
 
     def _end(self, success: bool, text: str) -> TaskResult:
+        self._steps.close()  # an interrupted task cleans up (e.g. an identification session)
         self._sim.halt(self._robot)
         self._robot.activity = "idle"
         self._robot.charging_to = None
@@ -110,11 +122,11 @@ def _drive(sim: Simulation, robot: Robot, x: float, y: float, speed: float, what
 
 
 def _work(sim: Simulation, robot: Robot, seconds: float, what: str) -> Steps:
-    """Stand still and work for ``seconds`` of sim time."""
-    end = sim.time + seconds
+    """Stand still and work for ``seconds`` of sim time (a pause does not count)."""
+    end = robot.worked + seconds
     robot.activity = "work"
-    while sim.time < end:
-        yield f"{what}: {end - sim.time:.0f} s left"
+    while robot.worked < end - 1e-9:
+        yield f"{what}: {end - robot.worked:.0f} s left"
     robot.activity = "idle"
     return ""
 
@@ -233,7 +245,7 @@ def recharge(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps:
     """Charge at the lander up to a battery level."""
     if not sim.at_lander(robot):
         raise TaskFailed("not at the lander: return to it first")
-    level = float(params.get("level", 1.0))
+    level = min(1.0, max(0.0, float(params.get("level", 1.0))))  # above 1 would never end
     robot.charging_to = level
     while robot.battery < level - 1e-6:
         yield f"charging: {robot.battery * 100:.0f} %"

@@ -31,6 +31,10 @@ ROBOT_SIZE = {
 }
 BOX_SIZE = 0.5
 STONE_RADIUS = 0.15
+# Collision groups: Bullet puts static bodies in group 2 (mask: all but 2); obstacles also get
+# their own bit, so a line-of-sight ray sees only them (not a robot or a box in between).
+_STATIC_GROUP = 2
+_OBSTACLE_GROUP = 64
 
 
 @dataclass(frozen=True)
@@ -74,6 +78,13 @@ class World:
                     obstacle.yaw,
                 )
             self._obstacle_ids.add(body)
+            pb.setCollisionFilterGroupMask(
+                body,
+                -1,
+                _STATIC_GROUP | _OBSTACLE_GROUP,
+                -1 ^ _STATIC_GROUP,
+                physicsClientId=self.client,
+            )
         self._add(
             "lander", "lander", pb.GEOM_BOX, (scenario.lander_radius,) * 2 + (0.6,), (0, 0, 0.6)
         )
@@ -156,7 +167,7 @@ class World:
 
     def line_of_sight(self, a: tuple[float, float, float], b: tuple[float, float, float]) -> bool:
         """Whether no obstacle blocks the straight line between two points."""
-        hit = pb.rayTest(a, b, physicsClientId=self.client)[0]
+        hit = pb.rayTest(a, b, collisionFilterMask=_OBSTACLE_GROUP, physicsClientId=self.client)[0]
         return hit[0] not in self._obstacle_ids
 
     def step(self) -> None:
