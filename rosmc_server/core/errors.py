@@ -23,7 +23,7 @@ class RuleViolation(RosmcError):
 
 
 class StaleRevision(RosmcError):
-    """A request was made against an older revision of the mission."""
+    """A request was made against a revision that another operator's change superseded."""
 
     def __init__(self, base_revision: int, current_revision: int) -> None:
         super().__init__(

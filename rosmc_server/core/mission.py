@@ -24,6 +24,16 @@ from .state import MissionContent, MissionState
 
 IdFactory = Callable[[str], str]
 
+# Changes the robots make (answers and reports); every other event is an operator's.
+ROBOT_EVENTS = frozenset(
+    {
+        EventKind.SYNC_CONFIRMED,
+        EventKind.SYNC_DECLINED,
+        EventKind.UNSYNC_CONFIRMED,
+        EventKind.STATUS_CHANGED,
+    }
+)
+
 
 def random_ids(prefix: str) -> str:
     """Short random ids like ``drone-3fa9c1``: easy to type, unique in practice."""
@@ -49,6 +59,7 @@ class Mission:
         self.state = MissionState(content or MissionContent.empty(library), revision)
         self._clock = clock
         self._new_id = new_id
+        self.operator_revision = revision
 
     @property
     def revision(self) -> int:
@@ -313,11 +324,15 @@ class Mission:
             )
         self.state.apply(event.change)
         self.state.revision = event.revision
+        if event.kind not in ROBOT_EVENTS:
+            self.operator_revision = event.revision
 
     # -- internals ---------------------------------------------------------------
     def _commit(self, proposal: Proposal) -> MissionEvent:
         self.state.apply(proposal.change)
         self.state.revision += 1
+        if proposal.kind not in ROBOT_EVENTS:
+            self.operator_revision = self.state.revision
         return MissionEvent(
             self.state.revision,
             proposal.kind,
@@ -328,7 +343,15 @@ class Mission:
         )
 
     def _check_revision(self, base_revision: int | None) -> None:
-        if base_revision is not None and base_revision != self.state.revision:
+        """Refuse a request made before another operator's change (or from the future).
+
+        Robots report progress all the time; that bumps the revision but does not
+        make an operator's view stale, because the mission rules already refuse
+        what progress forbids (editing a skill that has started, say).
+        """
+        if base_revision is None:
+            return
+        if base_revision < self.operator_revision or base_revision > self.state.revision:
             raise StaleRevision(base_revision, self.state.revision)
 
     def _unique_id(self, prefix: str) -> str:

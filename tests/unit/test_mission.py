@@ -231,7 +231,8 @@ def test_every_operation_emits_one_event_and_one_revision(
         args = _resolve(args)
         operation = getattr(mission, name)
         if name not in ROBOT_SIDE:
-            stale = mission.revision - 1
+            # Stale: made before the latest operator change (robot progress alone is not).
+            stale = mission.operator_revision - 1
             error = rejected(
                 mission, StaleRevision, operation, *args, base_revision=stale, **kwargs
             )
@@ -325,3 +326,18 @@ def test_id_factory_that_repeats_itself(library: Any, rejected: Any) -> None:
     mission = Mission(library, new_id=lambda prefix: "same")
     mission.add_skill("alpha", "move")
     rejected(mission, RuleViolation, mission.add_skill, "alpha", "move", match="free id")
+
+
+def test_robot_progress_does_not_make_an_operator_view_stale(mission: Any) -> None:
+    """Reports bump the revision, but an operator request made before them still goes through."""
+    first = mission.add_skill("alpha", "noop").change.put_skills[0].skill.id
+    mission.add_skill("alpha", "noop")
+    mission.synchronize("alpha", first)
+    view = mission.revision
+    mission.confirm_synchronized("alpha", [first])
+    mission.report_status(first, SkillStatus.RUNNING)
+    assert mission.revision == view + 2
+    event = mission.add_skill("alpha", "noop", base_revision=view)
+    assert event.revision == view + 3
+    with pytest.raises(StaleRevision):
+        mission.add_skill("alpha", "noop", base_revision=view)  # another operator's add came since
