@@ -107,7 +107,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         description="Plan, synchronize and adapt the sample-return mission in the mission "
         "core, printing each robot's schedule.",
     )
-    parser.parse_args(argv)
+    parser.parse_args([a for a in (argv if argv is not None else sys.argv[1:]) if ":=" not in a])
     events: list[MissionEvent] = []
     mission = run(events)
     print(f"\n{len(events)} accepted changes; final revision {mission.revision}.")
