@@ -121,11 +121,20 @@ def param_from_msg(msg: wire.ParameterValue) -> tuple[str, object]:
 def params_from_msgs(
     msgs: Iterable[wire.ParameterValue],
 ) -> tuple[dict[str, object], dict[str, str]]:
-    """Split parameter messages into values and marker bindings; names must be unique."""
+    """Split parameter messages into values and marker bindings; names must be unique.
+
+    A bound parameter takes its value from its marker, so only its name and marker
+    are read: the value fields of a binding may be left empty.
+    """
     values: dict[str, object] = {}
     bindings: dict[str, str] = {}
     for msg in msgs:
-        name, value = param_from_msg(msg)
+        if msg.marker:
+            name = msg.name
+            if not name:
+                raise InvalidRequest("a parameter has an empty name")
+        else:
+            name, value = param_from_msg(msg)
         if name in values or name in bindings:
             raise InvalidRequest(f"parameter '{name}' is given twice")
         if msg.marker:
