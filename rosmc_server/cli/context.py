@@ -38,6 +38,16 @@ class Context:
         revision: int | None = self.args.revision
         return revision
 
+    def against(self) -> dict[str, Any]:
+        """How a change names its base revision: ``--revision`` if given, else the current one.
+
+        Without ``--revision`` the command fetched the revision itself a moment before,
+        so a conflict only means someone else was a few milliseconds faster: the change
+        is retried once against the newer mission (the server checks every rule again).
+        With ``--revision``, a conflict is reported (exit code 1).
+        """
+        return {"base_revision": self.revision, "retry_on_conflict": self.revision is None}
+
     def emit(self, text: str, data: Any) -> None:
         """Print ``text``, or ``data`` as JSON with --json."""
         if self.json:

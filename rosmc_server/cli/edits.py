@@ -36,7 +36,7 @@ def add(ctx: Context) -> int:
         index=args.index,
         timeout=args.skill_timeout or 0.0,
         max_retries=args.retries or 0,
-        base_revision=ctx.revision,
+        **ctx.against(),
     )
     return ctx.emit_result(result, result.skill_id)
 
@@ -52,38 +52,38 @@ def edit(ctx: Context) -> int:
         label=args.label,
         timeout=args.skill_timeout,
         max_retries=args.retries,
-        base_revision=ctx.revision,
+        **ctx.against(),
     )
     return ctx.emit_result(result)
 
 
 def delete(ctx: Context) -> int:
     """Delete blueprint skills."""
-    return ctx.emit_result(ctx.client.delete_skills(ctx.args.skill_ids, base_revision=ctx.revision))
+    return ctx.emit_result(ctx.client.delete_skills(ctx.args.skill_ids, **ctx.against()))
 
 
 def reorder(ctx: Context) -> int:
     """Give a robot's blueprint a new order."""
     args = ctx.args
-    return ctx.emit_result(ctx.client.reorder(args.agent, args.order, base_revision=ctx.revision))
+    return ctx.emit_result(ctx.client.reorder(args.agent, args.order, **ctx.against()))
 
 
 def barrier(ctx: Context) -> int:
     """Add a barrier; print its id."""
-    result = ctx.client.add_barrier(ctx.args.skill_ids, base_revision=ctx.revision)
+    result = ctx.client.add_barrier(ctx.args.skill_ids, **ctx.against())
     return ctx.emit_result(result, result.barrier_id)
 
 
 def unbarrier(ctx: Context) -> int:
     """Remove a barrier."""
-    result = ctx.client.delete_barrier(ctx.args.barrier_id, base_revision=ctx.revision)
+    result = ctx.client.delete_barrier(ctx.args.barrier_id, **ctx.against())
     return ctx.emit_result(result)
 
 
 def sync(ctx: Context) -> int:
     """Upload a robot's blueprint (up to --upto)."""
     args = ctx.args
-    result = ctx.client.synchronize(args.agent, args.upto, base_revision=ctx.revision)
+    result = ctx.client.synchronize(args.agent, args.upto, **ctx.against())
     ids = ", ".join(result.skill_ids)
     return ctx.emit_result(result, f"uploading to {args.agent}: {ids} (revision {result.revision})")
 
@@ -91,7 +91,7 @@ def sync(ctx: Context) -> int:
 def unsync(ctx: Context) -> int:
     """Pull synchronized skills back to the blueprint."""
     args = ctx.args
-    result = ctx.client.unsynchronize(args.agent, args.from_id, base_revision=ctx.revision)
+    result = ctx.client.unsynchronize(args.agent, args.from_id, **ctx.against())
     ids = ", ".join(result.skill_ids)
     return ctx.emit_result(
         result, f"removing from {args.agent}: {ids} (revision {result.revision})"
@@ -107,37 +107,37 @@ def control(ctx: Context) -> int:
 
 def retry(ctx: Context) -> int:
     """Retry a failed skill; print the new instance's id."""
-    result = ctx.client.retry(ctx.args.skill_id, base_revision=ctx.revision)
+    result = ctx.client.retry(ctx.args.skill_id, **ctx.against())
     return ctx.emit_result(result, result.new_skill_id)
 
 
 def skip(ctx: Context) -> int:
     """Skip a failed skill."""
-    return ctx.emit_result(ctx.client.skip(ctx.args.skill_id, base_revision=ctx.revision))
+    return ctx.emit_result(ctx.client.skip(ctx.args.skill_id, **ctx.against()))
 
 
 def marker(ctx: Context) -> int:
     """Add, move, rename or delete a task marker."""
-    args, client, base = ctx.args, ctx.client, ctx.revision
+    args, client, base = ctx.args, ctx.client, ctx.against()
     if args.marker_command == "add":
         kind = MarkerType[args.type.upper()]
         pose, vertices = marker_shape(kind, args.where, f"the {args.type} of the marker")
-        added = client.add_marker(TaskMarker(args.name, kind, pose, vertices), base_revision=base)
+        added = client.add_marker(TaskMarker(args.name, kind, pose, vertices), **base)
         return ctx.emit_result(added, added.name)
     if args.marker_command == "move":
         old = next((m for m in client.fetch_mission().markers if m.name == args.name), None)
         kind = old.type if old is not None else MarkerType.POSE  # the server names a missing one
         pose, vertices = marker_shape(kind, args.where, f"the new place of '{args.name}'")
-        return ctx.emit_result(client.move_marker(args.name, pose, vertices, base_revision=base))
+        return ctx.emit_result(client.move_marker(args.name, pose, vertices, **base))
     if args.marker_command == "rename":
-        return ctx.emit_result(client.rename_marker(args.name, args.new_name, base_revision=base))
-    return ctx.emit_result(client.delete_marker(args.name, base_revision=base))
+        return ctx.emit_result(client.rename_marker(args.name, args.new_name, **base))
+    return ctx.emit_result(client.delete_marker(args.name, **base))
 
 
 def new(ctx: Context) -> int:
     """Start an empty mission."""
     keep = not ctx.args.drop_markers
-    return ctx.emit_result(ctx.client.new_mission(keep_markers=keep, base_revision=ctx.revision))
+    return ctx.emit_result(ctx.client.new_mission(keep_markers=keep, **ctx.against()))
 
 
 def save(ctx: Context) -> int:
@@ -167,7 +167,7 @@ def load(ctx: Context) -> int:
         raise MissionFileError(f"{name}: cannot read the mission ({error.strerror})") from error
     except UnicodeDecodeError as error:
         raise MissionFileError(f"{name}: the file is not UTF-8 text") from error
-    return ctx.emit_result(ctx.client.load_mission(document, base_revision=ctx.revision))
+    return ctx.emit_result(ctx.client.load_mission(document, **ctx.against()))
 
 
 COMMANDS: dict[str, Callable[[Context], int]] = {

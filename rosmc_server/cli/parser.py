@@ -58,8 +58,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--revision",
         type=int,
         metavar="N",
-        help="make changes against mission revision N: refused if the mission has changed "
-        "since (default: the current revision)",
+        help="make changes against mission revision N: refused (exit 1) if the mission "
+        "has changed since (default: the current mission)",
     )
     common = argparse.ArgumentParser(add_help=False)
     common.add_argument("--json", action="store_true", default=argparse.SUPPRESS, help="print JSON")

@@ -105,7 +105,7 @@ def _print_event(ctx: Context, event: MissionEvent) -> None:
 
 
 def _print_states(ctx: Context, states: dict[str, AgentStatus]) -> None:
-    for agent, status in sorted(states.items()):
+    for agent, status in states.items():
         if ctx.json:
             line = json.dumps({"agent": agent, "state": agent_status_to_json(status)})
         else:

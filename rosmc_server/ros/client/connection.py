@@ -8,12 +8,15 @@ from __future__ import annotations
 
 import io
 import logging
+import socket
 import threading
+import time
 from collections.abc import Mapping
 from typing import Any
 
 import genpy
 import rosgraph
+import rosgraph.network
 import rosmc.srv as srv
 import rospy
 from rosmc.msg import ErrorCode
@@ -105,24 +108,47 @@ class ServiceCaller:
         if proxy is not None:
             return proxy
         name = interface.service_name(operation)
-        try:
-            rospy.wait_for_service(name, timeout=self.timeout)
-        except rospy.ROSInterruptException:
-            raise
-        except rospy.ROSException as error:
-            raise ServerUnavailable(
-                f"the mission server is not reachable: {name} did not answer within "
-                f"{self.timeout:g} s (ROS master {rosgraph.get_master_uri()})"
-            ) from error
+        deadline = time.monotonic() + self.timeout
+        while not _service_answers(name, max(0.1, deadline - time.monotonic())):
+            if time.monotonic() >= deadline or rospy.is_shutdown():
+                raise ServerUnavailable(self._not_reachable(name))
+            time.sleep(0.1)
         service_class = getattr(srv, interface.SERVICES[operation])
         proxy = rospy.ServiceProxy(name, service_class, persistent=True)
         self._proxies[operation] = proxy
         return proxy
 
+    def _not_reachable(self, name: str) -> str:
+        master = rosgraph.get_master_uri()
+        if not rosgraph.is_master_online(master):
+            return f"the ROS master at {master} is not reachable (is ROS_MASTER_URI right?)"
+        return (
+            f"the mission server is not reachable: {name} did not answer within "
+            f"{self.timeout:g} s (ROS master {master})"
+        )
+
     def _drop(self, operation: str) -> None:
         proxy = self._proxies.pop(operation, None)
         if proxy is not None:
             proxy.close()
+
+
+def _service_answers(name: str, timeout: float) -> bool:
+    """Whether the master knows service ``name`` and its server accepts a connection.
+
+    Like ``rospy.wait_for_service``'s probe, but without rospy's logging, which
+    needs an initialized node (and raises ROSInitException instead of waiting).
+    """
+    try:
+        uri = rosgraph.Master(rospy.names.get_caller_id()).lookupService(name)
+        address = rospy.core.parse_rosrpc_uri(uri)
+        with socket.create_connection(address, timeout=timeout) as connection:
+            caller = rospy.names.get_caller_id()
+            header = {"probe": "1", "md5sum": "*", "callerid": caller, "service": name}
+            rosgraph.network.write_ros_handshake_header(connection, header)
+    except (rosgraph.MasterException, rospy.ROSException, OSError):
+        return False
+    return True
 
 
 def raise_for(response: Any, base_revision: int) -> None:

@@ -1,0 +1,437 @@
+"""The ``rosmc`` command line and MissionClient against a real master and mission server.
+
+One mission server runs for the whole module (tests share it and run in file order:
+the synchronization test comes late because an upload without a robot never ends).
+The CLI runs as subprocesses with the master's environment.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from rosmc_server.core import InvalidRequest, MarkerType, NotFound, Pose, RuleViolation, TaskMarker
+from rosmc_server.ros.client import MissionClient, RevisionConflict, ServerUnavailable
+from rosmc_server.text import mission_to_json
+
+REPO = Path(__file__).resolve().parents[2]
+ROSMC = REPO / "scripts" / "rosmc"
+SERVER = REPO / "scripts" / "mission_server"
+SUBCOMMANDS = [
+    "status",
+    "library",
+    "watch",
+    "add",
+    "edit",
+    "delete",
+    "reorder",
+    "barrier",
+    "unbarrier",
+    "sync",
+    "unsync",
+    "start",
+    "pause",
+    "resume",
+    "stop",
+    "retry",
+    "skip",
+    "markers",
+    "marker",
+    "new",
+    "save",
+    "load",
+]
+
+
+@dataclass
+class Server:
+    """The mission server process of this module (restartable)."""
+
+    env: dict[str, str]
+    journal_dir: Path
+    log_dir: Path
+    process: subprocess.Popen[bytes] | None = None
+    starts: list[Path] = field(default_factory=list)
+
+    def start(self) -> None:
+        """Start the server and wait until it answers."""
+        log = self.log_dir / f"mission_server-{len(self.starts)}.log"
+        self.starts.append(log)
+        with log.open("wb") as out:
+            self.process = subprocess.Popen(
+                [sys.executable, str(SERVER), f"_journal_dir:={self.journal_dir}"],
+                env=self.env,
+                cwd=REPO,
+                stdin=subprocess.DEVNULL,
+                stdout=out,
+                stderr=subprocess.STDOUT,
+                start_new_session=True,
+            )
+        with MissionClient(timeout=30.0) as probe:
+            probe.get_mission()
+
+    def stop(self, sig: int = signal.SIGINT) -> None:
+        """Stop the server (SIGINT lets it unregister; SIGKILL leaves stale registrations)."""
+        if self.process is None:
+            return
+        try:
+            os.killpg(self.process.pid, sig)
+            self.process.wait(10.0)
+        except subprocess.TimeoutExpired:
+            os.killpg(self.process.pid, signal.SIGKILL)
+            self.process.wait(10.0)
+        except ProcessLookupError:
+            pass
+        self.process = None
+
+
+@pytest.fixture(scope="module")
+def server(ros_master: Any, tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
+    """One mission server for the module, journaling into a temporary directory."""
+    base = tmp_path_factory.mktemp("cli")
+    (base / "journal").mkdir()
+    running = Server(dict(ros_master.env), base / "journal", base)
+    running.start()
+    try:
+        yield running
+    finally:
+        running.stop()
+        for log in running.starts:
+            print(f"--- {log.name} ---\n{log.read_text(errors='replace')[-3000:]}")
+
+
+@pytest.fixture(scope="module")
+def client(server: Server) -> Iterator[MissionClient]:
+    """An in-process client of the module's server."""
+    with MissionClient(timeout=10.0) as mission_client:
+        yield mission_client
+
+
+def start_cli(env: dict[str, str], args: Sequence[str]) -> subprocess.Popen[str]:
+    """Start ``rosmc ARGS`` (stdout and stderr piped)."""
+    return subprocess.Popen(
+        [sys.executable, str(ROSMC), *args],
+        env=env,
+        cwd=REPO,
+        stdin=subprocess.DEVNULL,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+
+def run_many(env: dict[str, str], commands: Sequence[Sequence[str]]) -> list[Any]:
+    """Run independent ``rosmc`` commands in parallel; their CompletedProcess results."""
+    started = [(args, start_cli(env, args)) for args in commands]
+    results = []
+    for args, process in started:
+        out, err = process.communicate(timeout=60.0)
+        results.append(subprocess.CompletedProcess(args, process.returncode, out, err))
+    return results
+
+
+def rosmc(server: Server, *args: str, code: int = 0) -> str:
+    """Run ``rosmc ARGS``; it must exit with ``code``; return its stdout."""
+    (result,) = run_many(server.env, [args])
+    assert result.returncode == code, f"rosmc {' '.join(args)}: {result.stderr}{result.stdout}"
+    return str(result.stdout)
+
+
+def status(server: Server) -> dict[str, Any]:
+    """``rosmc status --json`` as data."""
+    data: dict[str, Any] = json.loads(rosmc(server, "status", "--json"))
+    return data
+
+
+def skills_of(data: dict[str, Any], agent: str) -> list[dict[str, Any]]:
+    """The skills of ``agent`` in status JSON."""
+    return next(a["skills"] for a in data["agents"] if a["name"] == agent)
+
+
+def assert_refused(result: Any, needle: str) -> None:
+    """Exit code 1 and one clear ``rosmc: ...`` line on stderr."""
+    assert result.returncode == 1, (result.args, result.stdout, result.stderr)
+    assert result.stderr.startswith("rosmc: "), result.stderr
+    assert result.stderr.count("\n") == 1, result.stderr
+    assert needle in result.stderr, (needle, result.stderr)
+
+
+@pytest.fixture
+def fresh(client: MissionClient) -> MissionClient:
+    """An empty mission without task markers."""
+    client.get_mission()
+    client.new_mission(keep_markers=False)
+    return client
+
+
+def test_help_for_every_subcommand(server: Server) -> None:
+    commands = [["--help"]] + [[name, "--help"] for name in SUBCOMMANDS]
+    commands += [["marker", action, "--help"] for action in ("add", "move", "rename", "delete")]
+    for result in run_many(server.env, commands):
+        assert result.returncode == 0, result
+        assert result.stdout.startswith(f"usage: rosmc {' '.join(result.args[:-1])}".rstrip())
+    usage = run_many(server.env, [["add", "drone"], ["frobnicate"], ["watch", "--count", "0"]])
+    assert [result.returncode for result in usage] == [2, 2, 2]
+
+
+def test_library_as_text_and_json(server: Server) -> None:
+    text, full, only = run_many(
+        server.env, [["library"], ["library", "--json"], ["--json", "library", "lander"]]
+    )
+    assert text.stdout.startswith("library mars_sample_return\n")
+    assert "drone (dynamic, model drone_scout)" in text.stdout
+    assert "    altitude: float = 5 m, range 1..30" in text.stdout
+    data = json.loads(full.stdout)
+    names = [a["name"] for a in data["agents"]]
+    assert names[:3] == ["drone", "science_rover", "manipulator_rover"]
+    take_off = data["agents"][0]["skills"][0]
+    assert take_off["name"] == "take_off"
+    assert take_off["parameters"][0] == {
+        "name": "altitude",
+        "type": "float",
+        "default": 5.0,
+        "min": 1.0,
+        "max": 30.0,
+        "choices": [],
+        "unit": "m",
+        "description": "Height above the ground to climb to.",
+        "marker": None,
+    }
+    assert [a["name"] for a in json.loads(only.stdout)["agents"]] == ["lander"]
+
+
+AREA = "[{x: 0, y: 0}, {x: 6, y: 0}, {x: 6, y: 6}]"
+
+
+def run_pair(server: Server, first: Sequence[str], second: Sequence[str]) -> tuple[str, str]:
+    """Run two changes at once; both must succeed; their stdout.
+
+    Without --revision a change that loses the race to the other retries once
+    against the newer mission, so two concurrent changes both go through.
+    """
+    one, two = run_many(server.env, [first, second])
+    for result in (one, two):
+        assert result.returncode == 0, (result.args, result.stderr)
+    return one.stdout.strip(), two.stdout.strip()
+
+
+def test_compose_edit_reorder_barrier(server: Server, fresh: MissionClient) -> None:
+    marker, climb = run_pair(
+        server,
+        ["marker", "add", "RSS A", "position", "10,6"],
+        ["add", "drone", "take_off", "altitude=12", "--label=lift", "--retries=2"],
+    )
+    assert marker == "RSS A"
+    cover, go = run_pair(
+        server,
+        ["add", "drone", "fly_over", f"area={AREA}", "altitude=10", "--index=0"],
+        ["add", "manipulator_rover", "navigate_to", "target=3,4,0,0,0,1.57"],
+    )
+    sci, man = run_pair(
+        server,
+        ["add", "science_rover", "identify_stones", "position=@RSS A", "mode=detailed"],
+        ["add", "manipulator_rover", "identify_stones", "position={x: 10, y: 6}"],
+    )
+    _, barrier = run_pair(
+        server,
+        ["edit", climb, "altitude=15", "--label", "climb", "--timeout", "45"],
+        ["barrier", sci, man],
+    )
+    rosmc(server, "reorder", "drone", climb, cover)
+    as_json, as_text, markers = run_many(
+        server.env, [["status", "--json"], ["status", "--verbose"], ["markers", "--json"]]
+    )
+    ids = {"climb": climb, "cover": cover, "sci": sci, "man": man, "go": go}
+
+    data = json.loads(as_json.stdout)
+    assert data["revision"] == fresh.fetch_mission().revision
+    assert data["library"] == "mars_sample_return"
+    climb, cover = skills_of(data, "drone")
+    assert (climb["id"], cover["id"]) == (ids["climb"], ids["cover"])
+    assert climb["label"] == "climb" and climb["params"] == {"altitude": 15.0}
+    assert climb["timeout"] == 45.0 and climb["max_retries"] == 2
+    assert cover["params"]["area"] == [{"x": 0, "y": 0}, {"x": 6, "y": 0}, {"x": 6, "y": 6}]
+    (sci,) = skills_of(data, "science_rover")
+    assert sci["bindings"] == {"position": "RSS A"} and sci["params"]["position"]["x"] == 10.0
+    assert sci["params"]["mode"] == "detailed"
+    by_id = {skill["id"]: skill for skill in skills_of(data, "manipulator_rover")}
+    go, man = by_id[ids["go"]], by_id[ids["man"]]  # added concurrently: either order
+    assert go["params"]["target"] == {"x": 3, "y": 4, "z": 0, "roll": 0, "pitch": 0, "yaw": 1.57}
+    assert man["params"]["position"]["y"] == 6.0 and man["bindings"] == {}
+    assert all(s["status"] == "IDLE" and s["transfer"] == "NONE" for s in (climb, sci, go))
+    assert data["barriers"] == [
+        {"id": barrier, "skills": [sci["id"], man["id"]], "agents": [
+            "science_rover", "manipulator_rover"]}
+    ]  # fmt: skip
+    assert all("link" in agent for agent in data["agents"])
+    assert json.loads(markers.stdout) == data["markers"]
+    assert [m["name"] for m in data["markers"]] == ["RSS A"]
+    text = as_text.stdout
+    assert f"barrier {barrier}" in text and "position=@RSS A" in text
+    assert text.splitlines()[2].startswith("    link ")
+
+    run_pair(server, ["marker", "move", "RSS A", "8,5"], ["unbarrier", barrier])
+    assert fresh.skill(ids["sci"]).params["position"].x == 8.0  # the bound skill follows
+    rosmc(server, "edit", ids["sci"], "position=@")  # unbind, keep the value
+    sci_now = fresh.skill(ids["sci"])
+    assert sci_now.bindings == {} and sci_now.params["position"].x == 8.0
+    assert fresh.get_mission().barriers == ()
+
+
+def build_mission(client: MissionClient) -> dict[str, str]:
+    """A small mission made through the client API; the skill ids by role."""
+    client.add_marker(TaskMarker("RSS A", MarkerType.POSITION, Pose(10.0, 6.0)))
+    return {
+        "climb": client.add_skill("drone", "take_off", {"altitude": 12}).skill_id,
+        "cover": client.add_skill("drone", "fly_over", {"altitude": 9.5}).skill_id,
+        "land": client.add_skill("drone", "land").skill_id,
+        "sci": client.add_skill(
+            "science_rover", "identify_stones", bindings={"position": "RSS A"}
+        ).skill_id,
+        "man": client.add_skill("manipulator_rover", "identify_stones").skill_id,
+    }
+
+
+def test_every_error_class_exits_1_with_one_line(server: Server, fresh: MissionClient) -> None:
+    fresh.add_marker(TaskMarker("RSS A", MarkerType.POSITION, Pose(10.0, 6.0)))
+    first = fresh.add_skill("science_rover", "navigate_to").skill_id
+    second = fresh.add_skill("science_rover", "explore").skill_id
+    cases = {
+        ("add", "nobody", "land"): "there is no agent 'nobody'",
+        ("add", "lander", "land"): "static agent",
+        ("add", "drone", "take_off", "altitude=high"): "cannot read 'high' as float",
+        ("add", "drone", "fly_over", "area=@RSS A"): "takes area markers",
+        ("barrier", first, second): "distinct",
+        ("delete", "nope"): "there is no skill 'nope'",
+        ("--revision", "1", "add", "drone", "land"): "changed since revision 1",
+        ("load", "/nonexistent/mission.yaml"): "cannot read the mission",
+    }
+    for result, needle in zip(run_many(server.env, list(cases)), cases.values(), strict=True):
+        assert_refused(result, needle)
+
+
+def test_client_conflicts_and_local_checks(server: Server, fresh: MissionClient) -> None:
+    other = MissionClient(timeout=5.0)
+    other.get_mission()
+    fresh.add_skill("drone", "land")  # `other` has not seen this
+    with pytest.raises(RevisionConflict) as caught:
+        other.add_skill("drone", "take_off", {"altitude": 3})
+    assert caught.value.current_revision == fresh.revision
+    added = other.add_skill("drone", "take_off", {"altitude": 3}, retry_on_conflict=True)
+    assert other.revision == added.revision == fresh.revision + 1
+    assert other.skill(added.skill_id).params == {"altitude": 3.0}
+    with pytest.raises(InvalidRequest):
+        other.add_skill("drone", "take_off", {"altitude": "high"})
+    with pytest.raises(NotFound):
+        other.edit_skill("nope", {"altitude": 3})
+    with pytest.raises(InvalidRequest):
+        other.add_barrier([added.skill_id, added.skill_id])
+    with pytest.raises(RuleViolation):
+        other.add_barrier([added.skill_id, fresh.get_mission().task("drone")[0].id])
+    other.close()
+
+
+def test_save_new_load_restores(server: Server, fresh: MissionClient, tmp_path: Path) -> None:
+    ids = build_mission(fresh)
+    fresh.add_barrier([ids["sci"], ids["man"]])
+    before = mission_to_json(fresh.get_mission())
+    path = tmp_path / "mission.yaml"
+    assert rosmc(server, "save", str(path)) == f"saved revision {before['revision']} to {path}\n"
+    assert path.read_text().startswith("rosmc_mission: 1\n")
+    rosmc(server, "new")
+    emptied = mission_to_json(fresh.get_mission())
+    assert all(agent["skills"] == [] for agent in emptied["agents"])
+    assert emptied["markers"] == before["markers"] and emptied["barriers"] == []
+    broken = tmp_path / "broken.yaml"
+    broken.write_text("rosmc_mission: 99\n")
+    restored, refused = run_many(server.env, [["load", str(path)], ["load", str(broken)]])
+    assert restored.returncode == 0, restored.stderr
+    assert_refused(refused, "is missing")
+    after = mission_to_json(fresh.get_mission())
+    assert after["revision"] == before["revision"] + 2
+    assert {key: after[key] for key in ("agents", "barriers", "markers")} == {
+        key: before[key] for key in ("agents", "barriers", "markers")
+    }
+
+
+def test_watch_sees_concurrent_changes(server: Server, fresh: MissionClient) -> None:
+    watcher = start_cli(server.env, ["watch", "--count", "2"])
+    assert watcher.stderr is not None
+    ready = watcher.stderr.readline()
+    assert ready.startswith("rosmc: watching mission events from revision"), ready
+    added = rosmc(server, "add", "drone", "land").strip()
+    rosmc(server, "marker", "add", "Here", "position", "1,2")
+    out, err = watcher.communicate(timeout=20.0)
+    assert watcher.returncode == 0, err
+    first, second = out.splitlines()
+    assert "SKILL_ADDED" in first and added in first and "drone" in first
+    assert "MARKER_ADDED" in second and "'Here'" in second
+
+
+def test_watch_stops_cleanly_on_ctrl_c(server: Server) -> None:
+    watcher = start_cli(server.env, ["watch", "--json", "--states", "0.5"])
+    assert watcher.stderr is not None and watcher.stdout is not None
+    assert watcher.stderr.readline().startswith("rosmc: watching")
+    state = json.loads(watcher.stdout.readline())  # agent states arrive at 2 Hz
+    assert state["agent"] == "drone" and "state" in state["state"]
+    watcher.send_signal(signal.SIGINT)
+    _, err = watcher.communicate(timeout=10.0)
+    assert watcher.returncode == 0, err
+    assert "Traceback" not in err
+
+
+def test_sync_shows_uploading(server: Server, fresh: MissionClient) -> None:
+    ids = build_mission(fresh)
+    out = rosmc(server, "sync", "drone", "--upto", ids["cover"])
+    assert out.startswith(f"uploading to drone: {ids['climb']}, {ids['cover']} (revision")
+    drone = skills_of(status(server), "drone")
+    assert [s["transfer"] for s in drone] == ["UPLOADING", "UPLOADING", "NONE"]
+    started, refused_new, refused_edit, refused_unsync = run_many(
+        server.env,
+        [["start", "drone"], ["new"], ["edit", ids["climb"], "altitude=3"], ["unsync", "drone"]],
+    )
+    assert started.stdout == "start sent to drone\n", started.stderr
+    assert_refused(refused_new, "cannot start a new mission while drone holds")
+    assert_refused(refused_edit, "being uploaded")
+    assert_refused(refused_unsync, "awaits the robot's answer")
+
+
+def test_unreachable_master_exits_3_quickly(server: Server) -> None:
+    """No master at ROS_MASTER_URI: exit 3 after --timeout, with one clear line."""
+    with socket.socket() as probe:  # a port that nothing listens on
+        probe.bind(("127.0.0.1", 0))
+        uri = f"http://127.0.0.1:{probe.getsockname()[1]}/"
+    began = time.monotonic()
+    (result,) = run_many(dict(server.env, ROS_MASTER_URI=uri), [["--timeout", "1", "status"]])
+    assert time.monotonic() - began < 8.0
+    assert result.returncode == 3, result
+    assert result.stderr == (
+        f"rosmc: the ROS master at {uri} is not reachable (is ROS_MASTER_URI right?)\n"
+    )
+
+
+def test_client_reconnects_after_server_restart(server: Server, client: MissionClient) -> None:
+    client.get_mission()
+    server.stop(signal.SIGKILL)  # connections break, the registrations stay behind
+    began = time.monotonic()
+    with pytest.raises(ServerUnavailable):
+        MissionClient(timeout=1.0).get_mission()
+    assert time.monotonic() - began < 5.0
+    server.start()  # a new mission at revision 0, in a new journal
+    assert client.get_mission().revision == 0  # the broken connection was replaced
+    assert client.add_skill("drone", "land").revision == 1
+    server.stop()  # cleanly: the services are gone, the master stays
+    (result,) = run_many(server.env, [["--timeout", "1", "add", "drone", "land"]])
+    assert result.returncode == 3
+    assert result.stderr.startswith("rosmc: the mission server is not reachable"), result.stderr
