@@ -79,6 +79,13 @@ def _text(value: str, what: str) -> str:
     return value
 
 
+def _host_path(path: str) -> str:
+    # The operating system cannot take a NUL byte in a path; Python raises ValueError.
+    if "\0" in path:
+        raise InvalidRequest("a file path cannot contain a NUL character")
+    return path
+
+
 class OperatorServices:
     """Request handlers of every operator service."""
 
@@ -302,7 +309,7 @@ class OperatorServices:
             revision = self._server.mission.revision
         resp.document = dump_mission(content, revision)
         if req.path:
-            save_mission(req.path, content, revision)
+            save_mission(_host_path(req.path), content, revision)
             resp.path_written = req.path
         resp.revision = revision
         return None
@@ -313,7 +320,7 @@ class OperatorServices:
         if req.path:
             from ..core import load_mission
 
-            content, _ = load_mission(req.path, self._server.library)
+            content, _ = load_mission(_host_path(req.path), self._server.library)
             source = req.path
         else:
             content, _ = parse_mission(req.document, self._server.library, "the document")
