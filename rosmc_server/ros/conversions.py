@@ -35,6 +35,10 @@ from ..core import (
     Value,
 )
 
+# Deeper LIST/DICT values are refused: the core checks them and the YAML mission files
+# write them recursively, which fails a few hundred levels down.
+MAX_JSON_NESTING = 32
+
 
 def time_to_msg(seconds: float) -> genpy.Time:
     """Seconds since the epoch as a ROS time (0 stays 0)."""
@@ -110,12 +114,30 @@ def param_from_msg(msg: wire.ParameterValue) -> tuple[str, object]:
         return name, pose_from_msg(msg.pose_value)
     try:
         data = json.loads(msg.json_value)
-    except ValueError:
+    except (ValueError, RecursionError):
         raise InvalidRequest(f"parameter '{name}' does not hold valid JSON") from None
     expected = list if ptype is ParamType.LIST else dict
     if not isinstance(data, expected):
         raise InvalidRequest(f"parameter '{name}' must hold a JSON {expected.__name__}")
+    if _nesting(data) > MAX_JSON_NESTING:
+        raise InvalidRequest(
+            f"parameter '{name}' nests its JSON deeper than {MAX_JSON_NESTING} levels"
+        )
     return name, data
+
+
+def _nesting(data: object) -> int:
+    """How deep lists and dicts nest in ``data`` (without recursion: the data may be deep)."""
+    deepest = 0
+    stack = [(data, 1)]
+    while stack:
+        item, depth = stack.pop()
+        if isinstance(item, dict):
+            item = list(item.values())
+        if isinstance(item, list):
+            deepest = max(deepest, depth)
+            stack.extend((child, depth + 1) for child in item)
+    return deepest
 
 
 def params_from_msgs(
