@@ -99,11 +99,31 @@ class Engine:
     # -- ground commands -----------------------------------------------------------
     def handle_command(self, cmd: Command) -> Ack | None:
         """Execute the next command once; answer duplicates again; ignore early ones."""
+        return self._numbered(cmd.seq, lambda: self._execute(cmd))
+
+    def refuse_command(self, seq: int, error: str) -> Ack | None:
+        """Answer a command that could not be read: numbered like any other, not executed.
+
+        Refusing it (rather than staying silent) keeps the link going: the ground
+        learns why, and the commands after it are not held up for ever.
+        """
+        return self._numbered(seq, lambda: self._ack(seq, error=error, rejected_ids=("command",)))
+
+    def _numbered(self, seq: int, answer: Callable[[], Ack]) -> Ack | None:
         self.ground_contact()
-        if cmd.seq <= self.last_command_seq:
-            return self.acks.get(cmd.seq) or self._ack(cmd.seq, error="already executed")
-        if cmd.seq != self.last_command_seq + 1:
+        if seq <= self.last_command_seq:
+            return self.acks.get(seq) or self._ack(seq, error="already executed")
+        if seq != self.last_command_seq + 1:
             return None  # an earlier command is missing; the ground resends in order
+        ack = answer()
+        self.last_command_seq = seq
+        self.acks[seq] = ack
+        while len(self.acks) > KEPT_ACKS:
+            self.acks.popitem(last=False)
+        self.outputs.changed()
+        return ack
+
+    def _execute(self, cmd: Command) -> Ack:
         handlers: Mapping[CommandKind, Callable[[Command], Ack]] = {
             CommandKind.UPLOAD: self._upload,
             CommandKind.UNSYNC: self._unsync,
@@ -117,13 +137,7 @@ class Engine:
             CommandKind.SET_OPTIONS: self._set_options,
             CommandKind.SYNC_STATE: self._sync_state,
         }
-        ack = handlers[cmd.kind](cmd)
-        self.last_command_seq = cmd.seq
-        self.acks[cmd.seq] = ack
-        while len(self.acks) > KEPT_ACKS:
-            self.acks.popitem(last=False)
-        self.outputs.changed()
-        return ack
+        return handlers[cmd.kind](cmd)
 
     def _ack(self, seq: int, **fields: object) -> Ack:
         rejected = fields.get("rejected_ids", ())

@@ -39,7 +39,8 @@ import rospy
 from rosmc_server import interface
 from rosmc_server.ros.logging_bridge import bridge_logging_to_rosout
 
-from ..core import Engine, Report, Signal, SkillType
+from ...core import RosmcError
+from ..core import Command, Engine, Report, Signal, SkillType
 from ..core.state_file import load_state, save_state
 from .conversions import (
     ack_to_msg,
@@ -129,13 +130,18 @@ class ExecutorNode:
         if msg.agent != self.agent:
             _log.warning("%s: ignoring a command for %s", self.agent, msg.agent)
             return
+        command: Command | None = None
+        reason = ""
         try:
             command = command_from_msg(msg)
-        except ValueError as error:
+        except (ValueError, RosmcError) as error:  # refused below, so the link goes on
             _log.warning("%s: refusing malformed command %d: %s", self.agent, msg.seq, error)
-            return
+            reason = f"the robot cannot read command {msg.seq}: {error}"
         with self._lock:
-            ack = self.engine.handle_command(command)
+            if command is None:
+                ack = self.engine.refuse_command(msg.seq, reason)
+            else:
+                ack = self.engine.handle_command(command)
             self._persist()  # before answering: an acknowledged command survives a crash
             if ack is not None:
                 self._ack_pub.publish(ack_to_msg(self.agent, ack, rospy.get_time()))
