@@ -96,6 +96,7 @@ class MissionServer:
     def __init__(self, config: ServerConfig, library: Library) -> None:
         self.config = config
         self.library = library
+        self._stopping = False  # first: robot-link callbacks may arrive during construction
         self._lock = threading.RLock()
         self.mission, self._journal = self._open_journal()
         self._events = rospy.Publisher(interface.EVENTS_TOPIC, wire.MissionEvent, queue_size=1000)
@@ -105,7 +106,6 @@ class MissionServer:
         self.link = GroundLink(self, library.dynamic_agents, timeout=config.link_timeout)
         self._agent_states = AgentStatePublisher(self, config.agent_state_rate)
         self._services = OperatorServices(self)
-        self._stopping = False
 
     # -- lifecycle -----------------------------------------------------------------
     def start(self) -> None:
