@@ -21,8 +21,23 @@ from typing import Any
 
 import pytest
 
-from rosmc_server.core import InvalidRequest, MarkerType, NotFound, Pose, RuleViolation, TaskMarker
-from rosmc_server.ros.client import MissionClient, RevisionConflict, ServerUnavailable
+from rosmc_server.cli.values import parse_vertices, typed_values
+from rosmc_server.core import (
+    InvalidRequest,
+    MarkerType,
+    NotFound,
+    Pose,
+    RuleViolation,
+    TaskMarker,
+    load_library,
+)
+from rosmc_server.ros.client import (
+    MissionClient,
+    RevisionConflict,
+    ServerUnavailable,
+    library_from_msg,
+)
+from rosmc_server.ros.conversions import library_to_msg
 from rosmc_server.text import mission_to_json
 
 REPO = Path(__file__).resolve().parents[2]
@@ -173,6 +188,30 @@ def fresh(client: MissionClient) -> MissionClient:
     client.get_mission()
     client.new_mission(keep_markers=False)
     return client
+
+
+def test_library_round_trips_through_the_wire() -> None:
+    """What the server sends (library_to_msg) reads back as the same library."""
+    shipped = load_library(REPO / "rosmc_server" / "config" / "mars_team.yaml")
+    assert library_from_msg(library_to_msg(shipped)) == shipped
+
+
+def test_key_value_words_follow_the_schema() -> None:
+    """Typed values, marker bindings, unbinding and the @@ escape; clear refusals."""
+    library = load_library(REPO / "rosmc_server" / "config" / "mars_team.yaml")
+    spec = library.skill("science_rover", "identify_stones")
+    values, bindings = typed_values(spec, ["radius=3", "mode=@@quick", "position=@RSS A"])
+    assert values == {"radius": 3.0, "mode": "@quick"} and bindings == {"position": "RSS A"}
+    assert typed_values(spec, ["position=@"]) == ({}, {"position": None})
+    assert typed_values(spec, ["position=1,2"])[0] == {"position": {"x": 1.0, "y": 2.0}}
+    with pytest.raises(ValueError, match="expected key=value"):
+        typed_values(spec, ["radius"])
+    with pytest.raises(NotFound, match="has no parameter 'speed'"):
+        typed_values(spec, ["speed=1"])
+    with pytest.raises(InvalidRequest, match="given twice"):
+        typed_values(spec, ["radius=1", "radius=2"])
+    assert parse_vertices("0,0 1,0;0,1", "area")[2] == Pose(0.0, 1.0)
+    assert parse_vertices("[{x: 2, y: 3}]", "area") == (Pose(2.0, 3.0),)
 
 
 def test_help_for_every_subcommand(server: Server) -> None:
