@@ -14,6 +14,7 @@ from __future__ import annotations
 import json
 import logging
 import math
+import re
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
@@ -73,6 +74,15 @@ def error_code(error: RosmcError) -> int:
     return ErrorCode.INVALID
 
 
+# Line breaks and other control characters an error may quote from the request.
+_CONTROL = re.compile(r"[\x00-\x1f\x7f\x85\u2028\u2029]")
+
+
+def one_line(message: str) -> str:
+    """The message with quoted control characters escaped, so it stays one line."""
+    return _CONTROL.sub(lambda match: repr(match.group())[1:-1], message)
+
+
 def _text(value: str, what: str) -> str:
     if not value.strip():
         raise InvalidRequest(f"{what} is empty")
@@ -115,7 +125,7 @@ class OperatorServices:
             try:
                 event = handler(request, response)
             except RosmcError as error:
-                self._fail(response, error_code(error), str(error))
+                self._fail(response, error_code(error), one_line(str(error)))
             except Exception:  # a server fault must not reach the caller as a stack trace
                 _log.exception("service %s failed", name)
                 self._fail(
