@@ -1006,3 +1006,10 @@ def test_skip_a_failed_skill(fresh: Client) -> None:
     do(c, "skip_skill", skill_id=failed)
     assert find(c.mission(), failed).resolution == wire.Skill.RESOLUTION_SKIPPED
     assert_rejected(c, "skip_skill", E.RULE, base_revision=c.revision(), skill_id=failed)
+
+
+def test_errors_quoting_the_request_stay_one_line(scene: Scene) -> None:
+    for text in ("a\nb", "tab\there", "nul\0byte", "ls\u2028sep", "cr\r"):
+        check_rejection(scene, "delete_skills", {"skill_ids": [text]}, E.NOT_FOUND)
+        check_rejection(scene, "delete_task_marker", {"name": text}, E.NOT_FOUND)
+        check_rejection(scene, "add_skill", {"agent": text, "skill": "land"}, E.NOT_FOUND)
