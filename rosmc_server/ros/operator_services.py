@@ -75,12 +75,12 @@ def error_code(error: RosmcError) -> int:
 
 
 # Line breaks and other control characters an error may quote from the request.
-_CONTROL = re.compile(r"[\x00-\x1f\x7f\x85\u2028\u2029]")
+_CONTROL_CHARS = re.compile(r"[\x00-\x1f\x7f\x85\u2028\u2029]")
 
 
 def one_line(message: str) -> str:
     """The message with quoted control characters escaped, so it stays one line."""
-    return _CONTROL.sub(lambda match: repr(match.group())[1:-1], message)
+    return _CONTROL_CHARS.sub(lambda match: repr(match.group())[1:-1], message)
 
 
 def _text(value: str, what: str) -> str:
