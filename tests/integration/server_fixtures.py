@@ -77,6 +77,7 @@ class ServerProcess:
         """
         for other in list(_RUNNING):
             other.stop()
+        forget_server_params()
         self.stopped = False
         _RUNNING.append(self)
         with self.log_path.open("ab") as log:
@@ -151,6 +152,17 @@ class ServerProcess:
         raise AssertionError("no VmHWM in /proc status")
 
 
+def forget_server_params() -> None:
+    """Delete the server's private parameters from the master.
+
+    ``_key:=value`` arguments stay on the parameter server after the node ends, so a
+    server started later without ``_resume:=true`` would still resume (and with the old
+    journal). Every start here gets exactly the parameters it was given.
+    """
+    with contextlib.suppress(KeyError):
+        rospy.delete_param(interface.SERVER_NODE)
+
+
 def _param_text(value: object) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
@@ -180,6 +192,7 @@ def _stop_all(started: list[ServerProcess]) -> None:
         code = server.stop()
         tail = "\n".join(server.log().splitlines()[-25:])
         print(f"--- {server.log_path.name} (exit {code}) ---\n{tail}")
+    forget_server_params()  # leave no parameters behind for other tests' servers
 
 
 @pytest.fixture(scope="session")
