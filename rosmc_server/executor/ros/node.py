@@ -77,6 +77,7 @@ class ExecutorNode:
         self._lock = threading.RLock()
         self._state_file = state_file
         self._dirty = False
+        self._held_reports: list[Report] | None = None  # while a command is being answered
         topics = interface.robot_link(agent) if robot_side else interface.ground_link(agent)
         self._ack_pub = rospy.Publisher(topics.ack, wire.RobotAck, queue_size=100)
         self._report_pub = rospy.Publisher(topics.report, wire.RobotReport, queue_size=1000)
@@ -115,6 +116,9 @@ class ExecutorNode:
     # -- engine outputs (called with the lock held) ------------------------------------
     def report(self, report: Report) -> None:
         """Publish a new report now (it is retransmitted until acknowledged)."""
+        if self._held_reports is not None:
+            self._held_reports.append(report)  # goes out after the command's ack
+            return
         self._report_pub.publish(report_to_msg(self.agent, report))
 
     def signal(self, signal: Signal) -> None:
@@ -138,13 +142,21 @@ class ExecutorNode:
             _log.warning("%s: refusing malformed command %d: %s", self.agent, msg.seq, error)
             reason = f"the robot cannot read command {msg.seq}: {error}"
         with self._lock:
-            if command is None:
-                ack = self.engine.refuse_command(msg.seq, reason)
-            else:
-                ack = self.engine.handle_command(command)
-            self._persist()  # before answering: an acknowledged command survives a crash
-            if ack is not None:
-                self._ack_pub.publish(ack_to_msg(self.agent, ack, rospy.get_time()))
+            # The ground learns from the ack that an uploaded skill is on the robot; a
+            # report about that skill (it may start at once) must not overtake it.
+            self._held_reports = []
+            try:
+                if command is None:
+                    ack = self.engine.refuse_command(msg.seq, reason)
+                else:
+                    ack = self.engine.handle_command(command)
+                self._persist()  # before answering: an acknowledged command survives a crash
+                if ack is not None:
+                    self._ack_pub.publish(ack_to_msg(self.agent, ack, rospy.get_time()))
+            finally:
+                held, self._held_reports = self._held_reports, None
+                for report in held:
+                    self._report_pub.publish(report_to_msg(self.agent, report))
 
     def _on_report_ack(self, msg: wire.ReportAck) -> None:
         if msg.agent == self.agent:
@@ -186,6 +198,7 @@ class ExecutorNode:
         if self._dirty and self._state_file is not None:
             save_state(self.engine, self._state_file)
         self._dirty = False
+        self._held_reports: list[Report] | None = None  # while a command is being answered
 
 
 def default_state_file(agent: str) -> Path:
