@@ -107,14 +107,16 @@ def skip(queue: Sequence[SkillInstance], failed_id: str) -> Answer:
 def adopt(
     queue: Sequence[SkillInstance], ground: Sequence[SkillInstance], why_not: Checker
 ) -> Answer:
-    """Make the queue the ground's list, keeping what started here (a repair).
+    """Make the queue the ground's list, keeping what is under way here (a repair).
 
     A skill the ground logged as finished stays finished: a robot that lost its
-    state must not run again what it has done.
+    state must not run again what it has done. Finished skills the ground no
+    longer lists (it started a new mission) are dropped; their reports are kept
+    apart, until acknowledged.
     """
     mine = {s.id: s for s in queue}
     wanted = {s.id for s in ground}
-    out = [s for s in queue if s.id not in wanted and s.status.has_started]
+    out = [s for s in queue if s.id not in wanted and s.status.is_active]
     for skill in ground:
         if skill.id in mine:
             out.append(mine[skill.id])
