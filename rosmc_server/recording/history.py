@@ -1,0 +1,265 @@
+"""The mission at every revision of a journal, for people reviewing what happened.
+
+:class:`MissionHistory` reads a journal once: it starts from the first snapshot,
+applies every journaled event with :meth:`Mission.replay` and starts over from
+the snapshot that follows a ``MISSION_REPLACED`` event (such an event carries no
+content). It keeps a copy of the content every few hundred revisions, so any
+revision is rebuilt by replaying a short run of events. Times are seconds since
+the recording started (its first record) unless a log time (ns) is asked for.
+
+Typical use::
+
+    history = MissionHistory.from_journal("bags/mission_20260101_120000.mcap")
+    state = history.at_time(42.0)  # a MissionState
+    lanes = history.timeline().lanes
+"""
+
+from __future__ import annotations
+
+import bisect
+from dataclasses import dataclass
+from pathlib import Path
+
+from rosmc_server.core import (
+    AgentKind,
+    AgentSpec,
+    EventKind,
+    InvalidRequest,
+    Library,
+    Mission,
+    MissionContent,
+    MissionEvent,
+    MissionState,
+    NotFound,
+    RosmcError,
+)
+from rosmc_server.recording.errors import JournalError
+from rosmc_server.recording.reader import JournalResult, read_journal
+from rosmc_server.recording.timeline import Timeline, TimelineBuilder
+from rosmc_server.recording.topics import MISSION_EVENTS_TOPIC, MISSION_TOPIC, ROBOT_REPORTS_TOPIC
+from rosmc_server.ros.conversions import event_from_msg, mission_from_msg
+
+CHECKPOINT_EVERY = 256
+"""Revisions between two kept copies of the content (bounds the replay per lookup)."""
+
+
+@dataclass(frozen=True)
+class Revision:
+    """One revision of the mission in a recording.
+
+    Attributes:
+        revision: The mission revision.
+        log_time: When it was journaled (ns since the epoch).
+        kind: The event that produced it; None for a snapshot the history (re)started from.
+        summary: The event's one-sentence summary ("" for a snapshot).
+    """
+
+    revision: int
+    log_time: int
+    kind: EventKind | None
+    summary: str
+
+
+@dataclass
+class _Entry:
+    info: Revision
+    event: MissionEvent | None
+    checkpoint: MissionContent | None
+
+
+class MissionHistory:
+    """Every revision of the mission a journal holds; build it with :meth:`from_journal`."""
+
+    def __init__(self, result: JournalResult) -> None:
+        """Replay ``result`` (a read journal); raises JournalError without a snapshot."""
+        self.path = result.path
+        self.warnings: tuple[str, ...] = result.warnings
+        """What reading the file found wrong (a cut-off tail, undecodable records)."""
+        if not result.records:
+            raise JournalError(f"journal {result.path} holds no records")
+        self.start = min(record.log_time for record in result.records)
+        """Log time (ns) of the first record: time 0 of the recording."""
+        self.end = max(record.log_time for record in result.records)
+        """Log time (ns) of the last record."""
+        self._entries: list[_Entry] = []
+        self._problems: list[str] = []
+        self._timeline = TimelineBuilder(self.start)
+        self._build(result)
+        self.problems = tuple(f"journal {self.path}: {text}" for text in self._problems)
+        """Revisions that could not be rebuilt and why (empty for an intact journal)."""
+        self._revisions = [entry.info.revision for entry in self._entries]
+        self._cache: tuple[int, Mission] | None = None
+
+    @classmethod
+    def from_journal(cls, path: str | Path) -> MissionHistory:
+        """Read and replay the journal at ``path``.
+
+        Raises:
+            JournalError: The file is not a readable journal or holds no snapshot.
+        """
+        return cls(read_journal(path, (MISSION_TOPIC, MISSION_EVENTS_TOPIC, ROBOT_REPORTS_TOPIC)))
+
+    # -- queries ---------------------------------------------------------------------
+    @property
+    def revisions(self) -> tuple[Revision, ...]:
+        """Every revision the history can show, oldest first."""
+        return tuple(entry.info for entry in self._entries)
+
+    @property
+    def duration(self) -> float:
+        """Seconds from the first to the last record."""
+        return self.seconds(self.end)
+
+    def seconds(self, log_time: int) -> float:
+        """A log time (ns) as seconds since the recording started."""
+        return (log_time - self.start) / 1e9
+
+    def at_revision(self, revision: int) -> MissionState:
+        """The mission at ``revision``.
+
+        Raises:
+            NotFound: The recording does not hold that revision.
+        """
+        index = bisect.bisect_left(self._revisions, revision)
+        if index == len(self._revisions) or self._revisions[index] != revision:
+            raise NotFound(
+                f"journal {self.path} holds no revision {revision} (it holds "
+                f"{self._revisions[0]} to {self._revisions[-1]}"
+                + (", with gaps)" if self.problems else ")")
+            )
+        return self._state(index)
+
+    def at_time(self, t: float, *, log_time: bool = False) -> MissionState:
+        """The mission as it was at ``t`` seconds since the start (or at log time ``t`` ns).
+
+        The mission before the first snapshot is that snapshot; after the last
+        record, the last revision.
+
+        Raises:
+            InvalidRequest: ``t`` is negative (or not a number).
+        """
+        if not t >= 0:
+            raise InvalidRequest(f"a time must be 0 or more, got {t}")
+        stamp = int(t) if log_time else self.start + round(t * 1e9)
+        times = [entry.info.log_time for entry in self._entries]
+        index = max(0, bisect.bisect_right(times, stamp) - 1)
+        return self._state(index)
+
+    def revision_at(self, t: float) -> Revision:
+        """The revision current ``t`` seconds after the start."""
+        return self._entries[self._index_at(t)].info
+
+    def timeline(self) -> Timeline:
+        """Every robot's skill executions, barrier waits and barrier releases."""
+        return self._timeline.build(self.seconds(self.end))
+
+    # -- building ----------------------------------------------------------------------
+    def _index_at(self, t: float) -> int:
+        times = [entry.info.log_time for entry in self._entries]
+        return max(0, bisect.bisect_right(times, self.start + round(max(t, 0.0) * 1e9)) - 1)
+
+    def _state(self, index: int) -> MissionState:
+        start = index
+        while self._entries[start].checkpoint is None:
+            start -= 1
+        cached = self._cache
+        if cached is not None and start <= cached[0] <= index:
+            start, mission = cached  # sequential lookups replay only the new events
+        else:
+            mission = _mission(self._entries[start].checkpoint, self._revisions[start])
+        for entry in self._entries[start + 1 : index + 1]:
+            if entry.checkpoint is not None:
+                mission = _mission(entry.checkpoint, entry.info.revision)
+            else:
+                assert entry.event is not None
+                mission.replay(entry.event)
+        self._cache = (index, mission)
+        return MissionState(mission.state.content(), mission.revision)
+
+    def _build(self, result: JournalResult) -> None:
+        mission: Mission | None = None
+        pending: tuple[MissionEvent, int] | None = None  # a replacement awaiting its snapshot
+        broken_at: int | None = None  # first revision that could not be applied
+        since_checkpoint = 0
+        for record in result.records:
+            if record.topic == ROBOT_REPORTS_TOPIC:
+                self._timeline.report(record.message)
+                continue
+            if record.topic == MISSION_TOPIC:
+                revision = int(record.message.revision)
+                current = -1 if mission is None else mission.revision
+                if pending is not None and revision == pending[0].revision:
+                    event, log_time = pending
+                    info = Revision(revision, log_time, event.kind, event.summary)
+                    pending = None
+                elif revision > current:
+                    if mission is not None:
+                        self._gap(current, revision, broken_at)
+                    info = Revision(revision, record.log_time, None, "")
+                else:
+                    continue  # a periodic snapshot of a revision already rebuilt
+                content, _ = mission_from_msg(record.message)
+                mission = _mission(content, revision)
+                self._entries.append(_Entry(info, None, content))
+                self._timeline.reset(mission.state, info.log_time)
+                broken_at, since_checkpoint = None, 0
+                continue
+            if mission is None or record.topic != MISSION_EVENTS_TOPIC:
+                continue
+            revision = int(record.message.revision)
+            if revision <= mission.revision or broken_at is not None:
+                continue  # already in the snapshot, or after a gap: wait for a snapshot
+            if pending is not None:
+                self._problems.append(
+                    f"revision {pending[0].revision} replaced the mission but its snapshot is "
+                    f"missing; revisions from {pending[0].revision} on are left out"
+                )
+                pending, broken_at = None, pending[0].revision
+                continue
+            if revision != mission.revision + 1:
+                broken_at = mission.revision + 1
+                continue
+            try:
+                event = event_from_msg(record.message)
+                if event.kind is EventKind.MISSION_REPLACED:
+                    pending = (event, record.log_time)
+                    continue
+                self._timeline.event(mission.state, event, record.log_time)
+                mission.replay(event)
+            except RosmcError as err:
+                self._problems.append(f"revision {revision} does not apply ({err}); skipped")
+                broken_at = revision
+                continue
+            since_checkpoint += 1
+            checkpoint = None
+            if since_checkpoint >= CHECKPOINT_EVERY:
+                checkpoint, since_checkpoint = mission.state.content(), 0
+            info = Revision(revision, record.log_time, event.kind, event.summary)
+            self._entries.append(_Entry(info, event if checkpoint is None else None, checkpoint))
+        if broken_at is not None:
+            self._problems.append(
+                f"revision {broken_at} is missing; the revisions after it are left out"
+            )
+        if pending is not None:
+            self._problems.append(
+                f"revision {pending[0].revision} replaced the mission, but the journal ends "
+                "before the new mission's snapshot; it is left out"
+            )
+        if not self._entries:
+            raise JournalError(f"journal {self.path} holds no mission snapshot to start from")
+
+    def _gap(self, current: int, revision: int, broken_at: int | None) -> None:
+        first = current + 1 if broken_at is None else broken_at
+        if revision > first:
+            missing = f"{first}" if revision == first + 1 else f"{first} to {revision - 1}"
+            self._problems.append(
+                f"revision {missing} cannot be rebuilt; the history continues from the "
+                f"snapshot of revision {revision}"
+            )
+
+
+def _mission(content: MissionContent | None, revision: int) -> Mission:
+    """A mission to replay events on; replaying needs no skill schemas, only the agents."""
+    assert content is not None
+    agents = tuple(AgentSpec(name, AgentKind.DYNAMIC, "") for name in content.tasks)
+    return Mission(Library(content.library, agents), content, revision)
