@@ -1,0 +1,219 @@
+"""A recording's timeline as a picture: one lane per robot, one bar per skill execution.
+
+The SVG is plain text written here (no plotting library). Bars are coloured by
+what the robot did and how it ended: teal for running and success, red for a
+failure, olive while waiting at a barrier, grey while paused; a stopped or
+unfinished execution has a dashed outline. A barrier release is a vertical line
+joining its members' lanes. PNG goes through ImageMagick's ``convert``.
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+from xml.sax.saxutils import escape
+
+from rosmc_server.core import RosmcError, SkillStatus
+from rosmc_server.recording.timeline import BarrierRelease, Interval, Timeline
+
+TEAL = "#1b9e8f"
+RED = "#d1453b"
+OLIVE = "#8d8d2b"
+GREY = "#9a9a9a"
+INK = "#222222"
+
+LABEL_WIDTH = 170
+PLOT_WIDTH = 1000
+LANE_HEIGHT = 46
+BAR_HEIGHT = 26
+TOP = 48
+PNG_DENSITY = 144  # dpi: twice the SVG's pixel size, sharp on high-resolution screens
+CHAR_WIDTH = 6.2  # of the 11 px sans-serif labels, to decide whether a label fits its bar
+
+
+class TimelineExportError(RosmcError):
+    """The timeline picture cannot be written (format, tool or file)."""
+
+
+def interval_colour(interval: Interval) -> str:
+    """The fill of an interval's bar."""
+    if interval.status is SkillStatus.SYNCWAITING:
+        return OLIVE
+    if interval.status is SkillStatus.PAUSED:
+        return GREY
+    return RED if interval.outcome is SkillStatus.FAILURE else TEAL
+
+
+def render_svg(timeline: Timeline, title: str = "") -> str:
+    """The timeline as an SVG document."""
+    lanes = list(timeline.lanes)
+    span = max(timeline.duration, 1e-3)
+    scale = PLOT_WIDTH / span
+    height = TOP + LANE_HEIGHT * max(len(lanes), 1) + 86
+    width = LABEL_WIDTH + PLOT_WIDTH + 30
+    out = [
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" '
+        f'viewBox="0 0 {width} {height}" font-family="DejaVu Sans, Arial, sans-serif" '
+        'font-size="11" stroke="none">',
+        f'<rect width="{width}" height="{height}" fill="white"/>',
+        f'<text x="10" y="22" font-size="15" font-weight="bold">{escape(title)}</text>',
+    ]
+    for row, agent in enumerate(lanes):
+        y = TOP + row * LANE_HEIGHT
+        shade = "#f4f4f4" if row % 2 == 0 else "#ffffff"
+        out.append(
+            f'<rect x="{LABEL_WIDTH}" y="{y}" width="{PLOT_WIDTH}" height="{LANE_HEIGHT}" '
+            f'fill="{shade}"/>'
+        )
+        out.append(
+            f'<text x="{LABEL_WIDTH - 10}" y="{y + LANE_HEIGHT / 2 + 4}" text-anchor="end" '
+            f'font-size="12" font-weight="bold">{escape(agent)}</text>'
+        )
+        out += [_bar(interval, y, scale) for interval in timeline.lanes[agent]]
+    row_of = {agent: row for row, agent in enumerate(lanes)}
+    out += [_release(release, row_of, scale) for release in timeline.releases]
+    out += _axis(span, scale, TOP + LANE_HEIGHT * len(lanes))
+    out += _legend(height - 16)
+    out.append("</svg>")
+    return "\n".join(out) + "\n"
+
+
+def write_timeline(timeline: Timeline, path: str | Path, title: str = "") -> Path:
+    """Write the timeline to ``path``: ``.svg``, or ``.png`` through ImageMagick.
+
+    Raises:
+        TimelineExportError: Another suffix, PNG without ``convert`` on PATH, or the file
+            cannot be written.
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in (".svg", ".png"):
+        raise TimelineExportError(f"cannot write a timeline as {path.name}: use .svg or .png")
+    svg = render_svg(timeline, title)
+    try:
+        if suffix == ".svg":
+            path.write_text(svg, encoding="utf-8")
+            return path
+        convert = shutil.which("convert")
+        if convert is None:
+            raise TimelineExportError(
+                "PNG needs ImageMagick ('convert' is not on PATH; 'make setup' installs it); "
+                "write an .svg instead"
+            )
+        with tempfile.TemporaryDirectory() as tmp:
+            source = Path(tmp) / "timeline.svg"
+            source.write_text(svg, encoding="utf-8")
+            done = subprocess.run(
+                [convert, "-density", str(PNG_DENSITY), str(source), str(path)],
+                capture_output=True,
+                text=True,
+                check=False,
+            )
+        if done.returncode != 0:
+            reason = done.stderr.strip().splitlines()[-1:] or ["no message"]
+            raise TimelineExportError(f"convert could not write {path}: {reason[0]}")
+    except OSError as err:
+        raise TimelineExportError(f"cannot write {path}: {err.strerror}") from err
+    return path
+
+
+def _x(seconds: float, scale: float) -> float:
+    return round(LABEL_WIDTH + seconds * scale, 2)
+
+
+def _bar(interval: Interval, lane_y: float, scale: float) -> str:
+    x = _x(interval.start, scale)
+    width = max(round((interval.end - interval.start) * scale, 2), 2.0)
+    y = lane_y + (LANE_HEIGHT - BAR_HEIGHT) / 2
+    ended = interval.outcome.name if interval.outcome is not None else "still going"
+    if interval.outcome is SkillStatus.IDLE_SYNCHRONIZED:
+        ended = "stopped"
+    dashed = interval.outcome in (None, SkillStatus.IDLE_SYNCHRONIZED)
+    outline = f'stroke="{INK}" stroke-dasharray="4 2"' if dashed else 'stroke="white"'
+    label = interval.label + (f" #{interval.attempt}" if interval.attempt > 1 else "")
+    tip = (
+        f"{interval.agent} {interval.skill_id} ({interval.skill}) {interval.status.name} "
+        f"{interval.start:.2f}-{interval.end:.2f} s, then {ended}"
+        + (f", barrier {interval.barrier}" if interval.barrier else "")
+    )
+    parts = [
+        f'<g><title>{escape(tip)}</title><rect x="{x}" y="{y}" width="{width}" '
+        f'height="{BAR_HEIGHT}" rx="3" fill="{interval_colour(interval)}" {outline}/>'
+    ]
+    if len(label) * CHAR_WIDTH + 6 <= width:
+        parts.append(
+            f'<text x="{x + 4}" y="{y + BAR_HEIGHT / 2 + 4}" fill="white">{escape(label)}</text>'
+        )
+    parts.append("</g>")
+    return "".join(parts)
+
+
+def _release(release: BarrierRelease, row_of: dict[str, int], scale: float) -> str:
+    rows = sorted(row_of[agent] for agent, _ in release.members if agent in row_of)
+    if not rows:
+        return ""
+    x = _x(release.time, scale)
+    top = TOP + rows[0] * LANE_HEIGHT + 4
+    bottom = TOP + (rows[-1] + 1) * LANE_HEIGHT - 4
+    dots = "".join(
+        f'<circle cx="{x}" cy="{TOP + row * LANE_HEIGHT + LANE_HEIGHT / 2}" r="4" fill="{INK}"/>'
+        for row in rows
+    )
+    tip = f"barrier {release.barrier} released at {release.time:.2f} s"
+    return (
+        f'<g><title>{escape(tip)}</title><line x1="{x}" y1="{top}" x2="{x}" y2="{bottom}" '
+        f'stroke="{INK}" stroke-width="2"/>{dots}</g>'
+    )
+
+
+def _axis(span: float, scale: float, y: float) -> list[str]:
+    step = _tick_step(span)
+    out = [
+        f'<line x1="{LABEL_WIDTH}" y1="{y}" x2="{LABEL_WIDTH + PLOT_WIDTH}" y2="{y}" '
+        f'stroke="{INK}"/>'
+    ]
+    for index in range(int(span / step + 1e-9) + 1):
+        seconds = index * step
+        x = _x(seconds, scale)
+        text = f"{seconds:g}"
+        out.append(f'<line x1="{x}" y1="{y}" x2="{x}" y2="{y + 5}" stroke="{INK}"/>')
+        out.append(f'<text x="{x}" y="{y + 18}" text-anchor="middle">{text}</text>')
+    out.append(
+        f'<text x="{LABEL_WIDTH + PLOT_WIDTH / 2}" y="{y + 34}" text-anchor="middle">'
+        "seconds since the recording started</text>"
+    )
+    return out
+
+
+def _tick_step(span: float) -> float:
+    """A 1-2-5 step that gives about ten ticks over ``span`` seconds."""
+    raw = span / 10
+    magnitude = 10 ** math.floor(math.log10(raw))
+    for factor in (1, 2, 5, 10):
+        if raw <= factor * magnitude:
+            return float(factor * magnitude)
+    return float(10 * magnitude)  # pragma: no cover
+
+
+def _legend(y: float) -> list[str]:
+    items = (
+        (TEAL, "", "running / success"),
+        (RED, "", "failure"),
+        (OLIVE, "", "waiting at a barrier"),
+        (GREY, "", "paused"),
+        ("white", f'stroke="{INK}" stroke-dasharray="4 2"', "stopped / unfinished"),
+    )
+    out = []
+    x = LABEL_WIDTH
+    for colour, stroke, text in items:
+        out.append(f'<rect x="{x}" y="{y - 10}" width="14" height="12" fill="{colour}" {stroke}/>')
+        out.append(f'<text x="{x + 20}" y="{y}">{escape(text)}</text>')
+        x += 40 + len(text) * CHAR_WIDTH
+    out.append(
+        f'<line x1="{x}" y1="{y - 12}" x2="{x}" y2="{y + 2}" stroke="{INK}" stroke-width="2"/>'
+    )
+    out.append(f'<text x="{x + 8}" y="{y}">barrier release</text>')
+    return out
