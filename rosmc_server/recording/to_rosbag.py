@@ -1,0 +1,81 @@
+"""Converting a mission journal (MCAP) to a rosbag1 file for ``rosbag play``.
+
+Every recorded message keeps its topic and log time; the mission snapshots are
+marked latched, as the mission server publishes them, so a late subscriber to
+a ``rosbag play`` gets the last snapshot played.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
+
+import genpy
+import rosbag
+
+from rosmc_server.recording.errors import JournalError
+from rosmc_server.recording.reader import read_journal
+from rosmc_server.recording.topics import MISSION_TOPIC
+
+_log = logging.getLogger(__name__)
+
+CALLER_ID = "/rosmc/mission_server"
+"""The publisher the bag names: the node that published these topics live."""
+
+
+@dataclass(frozen=True)
+class BagSummary:
+    """What a conversion wrote.
+
+    Attributes:
+        path: The bag file.
+        counts: Messages per topic.
+        warnings: What reading the journal found wrong (a cut-off tail, ...).
+    """
+
+    path: Path
+    counts: dict[str, int]
+    warnings: tuple[str, ...]
+
+    @property
+    def total(self) -> int:
+        """Messages written."""
+        return sum(self.counts.values())
+
+
+def journal_to_rosbag(
+    journal: str | Path, bag_path: str | Path, *, overwrite: bool = False
+) -> BagSummary:
+    """Write every intact record of ``journal`` into a new rosbag1 file at ``bag_path``.
+
+    Raises:
+        JournalError: The journal cannot be read, the bag exists (without ``overwrite``)
+            or cannot be written.
+    """
+    bag_path = Path(bag_path)
+    if bag_path.exists() and not overwrite:
+        raise JournalError(f"{bag_path} exists already; remove it or choose another name")
+    result = read_journal(journal)
+    counts: Counter[str] = Counter()
+    try:
+        with rosbag.Bag(str(bag_path), "w") as bag:
+            for record in result.records:
+                message = record.message
+                header = {
+                    "topic": record.topic,
+                    "type": message._type,
+                    "md5sum": message._md5sum,
+                    "message_definition": message._full_text,
+                    "callerid": CALLER_ID,
+                    "latching": "1" if record.topic == MISSION_TOPIC else "0",
+                }
+                stamp = genpy.Time(record.log_time // 10**9, record.log_time % 10**9)
+                bag.write(record.topic, message, stamp, connection_header=header)
+                counts[record.topic] += 1
+    except (OSError, ValueError, rosbag.ROSBagException, genpy.SerializationError) as err:
+        bag_path.unlink(missing_ok=True)
+        raise JournalError(f"cannot write the bag {bag_path}: {err}") from err
+    _log.info("wrote %d messages of %s to %s", sum(counts.values()), result.path, bag_path)
+    return BagSummary(bag_path, dict(counts), result.warnings)
