@@ -198,7 +198,6 @@ class ExecutorNode:
         if self._dirty and self._state_file is not None:
             save_state(self.engine, self._state_file)
         self._dirty = False
-        self._held_reports: list[Report] | None = None  # while a command is being answered
 
 
 def default_state_file(agent: str) -> Path:
