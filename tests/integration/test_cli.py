@@ -225,16 +225,25 @@ def test_help_for_every_subcommand(server: Server) -> None:
 
 
 def test_library_as_text_and_json(server: Server) -> None:
-    text, full, only = run_many(
-        server.env, [["library"], ["library", "--json"], ["--json", "library", "lander"]]
-    )
-    assert text.stdout.startswith("library mars_sample_return\n")
-    assert "drone (dynamic, model drone_scout)" in text.stdout
+    text, data = run_many(server.env, [["library", "drone"], ["--json", "library"]])
+    assert text.stdout.startswith("library mars_sample_return\ndrone (dynamic, model drone_scout)")
     assert "    altitude: float = 5 m, range 1..30" in text.stdout
-    data = json.loads(full.stdout)
-    names = [a["name"] for a in data["agents"]]
-    assert names[:3] == ["drone", "science_rover", "manipulator_rover"]
-    take_off = data["agents"][0]["skills"][0]
+    assert "science_rover" not in text.stdout
+    agents = json.loads(data.stdout)["agents"]
+    assert [a["name"] for a in agents][:4] == [
+        "drone",
+        "science_rover",
+        "manipulator_rover",
+        "lander",
+    ]
+    assert agents[3] == {
+        "name": "lander",
+        "kind": "static",
+        "model": "lander",
+        "description": "The lander at the origin of the map frame.",
+        "skills": [],
+    }
+    take_off = agents[0]["skills"][0]
     assert take_off["name"] == "take_off"
     assert take_off["parameters"][0] == {
         "name": "altitude",
@@ -247,7 +256,6 @@ def test_library_as_text_and_json(server: Server) -> None:
         "description": "Height above the ground to climb to.",
         "marker": None,
     }
-    assert [a["name"] for a in json.loads(only.stdout)["agents"]] == ["lander"]
 
 
 AREA = "[{x: 0, y: 0}, {x: 6, y: 0}, {x: 6, y: 6}]"
@@ -342,13 +350,18 @@ def build_mission(client: MissionClient) -> dict[str, str]:
     }
 
 
-def test_every_error_class_exits_1_with_one_line(server: Server, fresh: MissionClient) -> None:
+def test_every_error_class_exits_1_with_one_line(
+    server: Server, fresh: MissionClient, tmp_path: Path
+) -> None:
+    broken = tmp_path / "broken.yaml"
+    broken.write_text("rosmc_mission: 1\ntasks: []\n")
     fresh.add_marker(TaskMarker("RSS A", MarkerType.POSITION, Pose(10.0, 6.0)))
     first = fresh.add_skill("science_rover", "navigate_to").skill_id
     second = fresh.add_skill("science_rover", "explore").skill_id
     cases = {
         ("add", "nobody", "land"): "there is no agent 'nobody'",
         ("add", "lander", "land"): "static agent",
+        ("load", str(broken)): "is missing",
         ("add", "drone", "take_off", "altitude=high"): "cannot read 'high' as float",
         ("add", "drone", "fly_over", "area=@RSS A"): "takes area markers",
         ("barrier", first, second): "distinct",
@@ -392,11 +405,7 @@ def test_save_new_load_restores(server: Server, fresh: MissionClient, tmp_path: 
     emptied = mission_to_json(fresh.get_mission())
     assert all(agent["skills"] == [] for agent in emptied["agents"])
     assert emptied["markers"] == before["markers"] and emptied["barriers"] == []
-    broken = tmp_path / "broken.yaml"
-    broken.write_text("rosmc_mission: 99\n")
-    restored, refused = run_many(server.env, [["load", str(path)], ["load", str(broken)]])
-    assert restored.returncode == 0, restored.stderr
-    assert_refused(refused, "is missing")
+    rosmc(server, "load", str(path))
     after = mission_to_json(fresh.get_mission())
     assert after["revision"] == before["revision"] + 2
     assert {key: after[key] for key in ("agents", "barriers", "markers")} == {
@@ -410,7 +419,8 @@ def test_watch_sees_concurrent_changes(server: Server, fresh: MissionClient) -> 
     ready = watcher.stderr.readline()
     assert ready.startswith("rosmc: watching mission events from revision"), ready
     added = rosmc(server, "add", "drone", "land").strip()
-    rosmc(server, "marker", "add", "Here", "position", "1,2")
+    fresh.get_mission()
+    fresh.add_marker(TaskMarker("Here", MarkerType.POSITION, Pose(1.0, 2.0)))
     out, err = watcher.communicate(timeout=20.0)
     assert watcher.returncode == 0, err
     first, second = out.splitlines()
@@ -433,15 +443,17 @@ def test_watch_stops_cleanly_on_ctrl_c(server: Server) -> None:
 def test_sync_shows_uploading(server: Server, fresh: MissionClient) -> None:
     ids = build_mission(fresh)
     out = rosmc(server, "sync", "drone", "--upto", ids["cover"])
-    assert out.startswith(f"uploading to drone: {ids['climb']}, {ids['cover']} (revision")
-    drone = skills_of(status(server), "drone")
-    assert [s["transfer"] for s in drone] == ["UPLOADING", "UPLOADING", "NONE"]
-    started, refused_new, refused_edit, refused_unsync = run_many(
-        server.env,
-        [["start", "drone"], ["new"], ["edit", ids["climb"], "altitude=3"], ["unsync", "drone"]],
+    assert out.startswith(f"uploading to drone: {ids['climb']}, {ids['cover']} (revision"), out
+    data = status(server)
+    drone = skills_of(data, "drone")
+    assert [s["transfer"] for s in drone] == ["UPLOADING", "UPLOADING", "NONE"], data
+    started, refused_edit, refused_unsync = run_many(
+        server.env, [["start", "drone"], ["edit", ids["climb"], "altitude=3"], ["unsync", "drone"]]
     )
-    assert started.stdout == "start sent to drone\n", started.stderr
-    assert_refused(refused_new, "cannot start a new mission while drone holds")
+    assert started.stdout == "start sent to drone\n", (started.stdout, started.stderr)
+    fresh.get_mission()
+    with pytest.raises(RuleViolation, match="cannot start a new mission while drone holds"):
+        fresh.new_mission()
     assert_refused(refused_edit, "being uploaded")
     assert_refused(refused_unsync, "awaits the robot's answer")
 
