@@ -390,6 +390,21 @@ def test_progress_is_reported_as_running_text(robot: Robot) -> None:
     ]
 
 
+def test_progress_from_a_skill_thread_waits_for_the_next_tick(robot: Robot) -> None:
+    """A threaded skill must not change the engine's state from its own thread."""
+    robot.upload(make_skill("a", params={"duration": 5.0}))
+    robot.send(K.START)
+    ctx = Timed.instances[0].ctx
+    assert ctx is not None
+    before = list(robot.out.reports)
+    ctx.progress("half way")  # as if from the skill's thread
+    assert robot.out.reports == before
+    assert robot.skill("a").status_text == ""
+    robot.run_for(0.1)
+    assert robot.skill("a").status_text == "half way"
+    assert robot.out.reports[-1].status_text == "half way"
+
+
 def test_pause_and_resume_a_running_skill(robot: Robot) -> None:
     robot.upload(make_skill("a", params={"duration": 1.0}))
     robot.send(K.START)

@@ -6,13 +6,15 @@ duplicates with the stored answer), to peers' barrier signals, and to time
 Every status change becomes a numbered :class:`Report` kept until the ground
 acknowledges it, so an outage delays reports but never loses or reorders them.
 The engine is single-threaded; the ROS adapter serializes calls with a lock.
+Skills may report progress from threads of their own: that is queued and
+applied by the next :meth:`Engine.tick`.
 """
 
 from __future__ import annotations
 
 import enum
 import logging
-from collections import OrderedDict
+from collections import OrderedDict, deque
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 from typing import Protocol
@@ -95,6 +97,8 @@ class Engine:
         self._ground_contact = clock()
         self._policy_triggered = False
         self._contingency: SkillBehavior | None = None
+        # Progress texts from skill threads, applied by tick() (deque appends are atomic).
+        self._progress_box: deque[tuple[str, str]] = deque()
 
     # -- ground commands -----------------------------------------------------------
     def handle_command(self, cmd: Command) -> Ack | None:
@@ -262,6 +266,7 @@ class Engine:
     def tick(self) -> None:
         """Advance the active skill, timeouts, retries, announcements and the link policy."""
         now = self.clock()
+        self._apply_progress()
         self._check_link_policy(now)
         if self._contingency is not None:
             self._run_contingency(now)
@@ -282,6 +287,7 @@ class Engine:
             outcome = active.behavior.update(now)
         except Exception as error:  # a broken skill implementation fails the skill
             outcome = Outcome.failed(f"skill crashed: {type(error).__name__}: {error}")
+        self._apply_progress()  # what the skill said before it finished
         if outcome is None and active.deadline and now >= active.deadline:
             active.behavior.cancel()
             skill = self._find(active.skill_id)
@@ -346,7 +352,7 @@ class Engine:
             skill.params,
             skill.attempt + (1 if active.retries_used else 0),  # one more than the last run
             self.clock,
-            lambda text: self._progress(skill.id, text),
+            lambda text: self._progress_box.append((skill.id, text)),
         )
         active.behavior = behavior
         active.deadline = now + skill.timeout if skill.timeout > 0 else 0.0
@@ -373,6 +379,10 @@ class Engine:
             return
         self._active = None
         self._set(skill.id, S.FAILURE, text=outcome.reason, finished=self.clock())
+
+    def _apply_progress(self) -> None:
+        while self._progress_box:
+            self._progress(*self._progress_box.popleft())
 
     def _progress(self, skill_id: str, text: str) -> None:
         skill = self._find(skill_id)
