@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from collections.abc import Callable
 
+from .replay import add_commands as _add_recording
+
 DEFAULT_TIMEOUT = 5.0
 
 # add_command(name, summary, epilog=None): a new subcommand parser.
@@ -80,6 +82,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_execution(command)
     _add_markers(command, common)
     _add_files(command)
+    _add_recording(command)
     return parser
 
 

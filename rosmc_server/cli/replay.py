@@ -1,0 +1,198 @@
+"""The recording commands: replay, at, timeline and tobag.
+
+All but ``replay`` read the journal file only and work without a ROS master.
+Times are seconds since the recording started, as ``rosmc timeline`` draws them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import sys
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # the commands import ROS late, so that --help stays fast
+    from ..recording.history import MissionHistory
+    from .context import Context
+
+_Command = Callable[..., argparse.ArgumentParser]
+
+AT_HELP = """\
+WHEN is seconds since the recording started (12.5) or a revision (r42).
+The mission shown is the one the mission server held then."""
+
+
+def add_commands(command: _Command) -> None:
+    """Add the recording subcommands through the parser's ``command`` helper."""
+    replay = command(
+        "replay",
+        "republish a recording onto the ROS graph (needs a ROS master)",
+        "rviz, the command GUI and 'rosmc watch' then show the mission evolving. Refuses to "
+        "publish where a live mission server does, unless --prefix moves the replay aside.",
+    )
+    replay.add_argument("file", metavar="FILE", help="a mission journal (.mcap)")
+    replay.add_argument(
+        "--rate", type=_positive, default=1.0, metavar="R", help="speed-up (default 1: as recorded)"
+    )
+    replay.add_argument(
+        "--start", type=_seconds, default=0.0, metavar="S", help="begin S seconds in (default 0)"
+    )
+    replay.add_argument(
+        "--prefix",
+        default="",
+        metavar="P",
+        help="put P before every topic, e.g. /replay (default: the live names)",
+    )
+    at = command("at", "print the mission as it was at a time or revision of a recording", AT_HELP)
+    at.add_argument("file", metavar="FILE", help="a mission journal (.mcap)")
+    at.add_argument("when", metavar="WHEN", help="seconds since the start, or rN for revision N")
+    at.add_argument("-v", "--verbose", action="store_true", help="show parameter values")
+    timeline = command("timeline", "draw every robot's skill executions of a recording")
+    timeline.add_argument("file", metavar="FILE", help="a mission journal (.mcap)")
+    timeline.add_argument(
+        "-o", "--output", required=True, metavar="OUT", help="OUT.svg, or OUT.png (ImageMagick)"
+    )
+    tobag = command("tobag", "convert a recording to a rosbag1 file for 'rosbag play'")
+    tobag.add_argument("file", metavar="FILE", help="a mission journal (.mcap)")
+    tobag.add_argument("bag", metavar="OUT.bag", help="the bag to write")
+    tobag.add_argument("-f", "--force", action="store_true", help="overwrite OUT.bag")
+
+
+def replay(ctx: Context) -> int:
+    """Republish the recording onto the graph, timed by log time over the rate."""
+    import rospy
+
+    from ..core import RosmcError
+    from ..recording import read_journal
+    from ..recording.history import MissionHistory
+    from ..ros.conversions import event_from_msg
+    from ..ros.replayer import RecordingReplayer, ReplayConfig
+    from ..text import format_event
+
+    args = ctx.args
+    result = read_journal(args.file)
+    history = _history(MissionHistory(result))
+    config = ReplayConfig(rate=args.rate, start=args.start, prefix=args.prefix)
+
+    def show(msg: Any, seconds: float) -> None:
+        try:
+            line = format_event(event_from_msg(msg))
+        except RosmcError:
+            line = f"r{msg.revision} (an event that does not decode)"
+        print(f"[{seconds:8.2f} s] {line}", file=ctx.out, flush=True)
+
+    player = RecordingReplayer(history, result.records, config, None if ctx.json else show)
+    player.check_names()  # before init_node, which would wait for a missing master forever
+    rospy.init_node(f"rosmc_replay_{os.getpid()}", disable_signals=True, disable_rosout=True)
+    where = f"under {config.topic('')}" if config.topic("") else "on the live topic names"
+    ctx.emit(
+        f"replaying {history.path} ({history.duration:.1f} s, revisions "
+        f"{history.revisions[0].revision} to {history.revisions[-1].revision}) from "
+        f"{args.start:g} s at {args.rate:g}x {where}",
+        None,
+    )
+    revision = player.run()
+    ctx.emit(f"replay done at revision {revision}", {"revision": revision})
+    return 0
+
+
+def at(ctx: Context) -> int:
+    """Print the mission at a time (seconds since the start) or a revision (rN)."""
+    from ..recording.history import MissionHistory
+    from ..text import format_markers, format_schedule, mission_to_json
+    from .context import UsageError
+
+    history = _history(MissionHistory.from_journal(ctx.args.file))
+    when = ctx.args.when.strip()
+    match = re.fullmatch(r"[rR](\d+)", when)
+    if match:
+        state = history.at_revision(int(match.group(1)))
+    else:
+        try:
+            seconds = float(when)
+        except ValueError:
+            raise UsageError(f"WHEN must be seconds or rN, got {when!r}") from None
+        state = history.at_time(seconds)
+        when = f"{seconds:g} s"
+    info = next(r for r in history.revisions if r.revision == state.revision)
+    changed = history.seconds(info.log_time)
+    last = f"{info.kind.name}: {info.summary}" if info.kind else "the recorded snapshot"
+    title = f"{history.path.name} at {when}"
+    text = format_schedule(state, title, verbose=ctx.args.verbose)
+    text += f"\n  last change at {changed:.2f} s: {last}"
+    if state.markers:
+        markers = format_markers(state.markers).splitlines()
+        text += "\n  task markers\n" + "\n".join(f"    {line}" for line in markers)
+    data = mission_to_json(state)
+    data["recording_time"] = changed
+    data["summary"] = info.summary
+    ctx.emit(text, data)
+    return 0
+
+
+def timeline(ctx: Context) -> int:
+    """Draw the recording's per-robot timeline into an SVG or PNG file."""
+    from ..recording.history import MissionHistory
+    from ..recording.timeline_svg import write_timeline
+
+    history = _history(MissionHistory.from_journal(ctx.args.file))
+    drawn = history.timeline()
+    title = (
+        f"{history.path.name}: {history.duration:.1f} s, revision {history.revisions[-1].revision}"
+    )
+    path = write_timeline(drawn, ctx.args.output, title)
+    runs = len(drawn.intervals)
+    ctx.emit(
+        f"wrote {path}: {len(drawn.lanes)} robots, {runs} bars, "
+        f"{len(drawn.releases)} barrier releases",
+        {"path": str(path), "robots": list(drawn.lanes), "bars": runs},
+    )
+    return 0
+
+
+def tobag(ctx: Context) -> int:
+    """Convert the recording to a rosbag1 file."""
+    from ..recording.to_rosbag import journal_to_rosbag
+
+    summary = journal_to_rosbag(ctx.args.file, ctx.args.bag, overwrite=ctx.args.force)
+    counts = ", ".join(f"{topic} {count}" for topic, count in summary.counts.items())
+    ctx.emit(
+        f"wrote {summary.path}: {summary.total} messages ({counts})",
+        {"path": str(summary.path), "counts": summary.counts},
+    )
+    return 0
+
+
+COMMANDS: dict[str, Callable[[Context], int]] = {
+    "replay": replay,
+    "at": at,
+    "timeline": timeline,
+    "tobag": tobag,
+}
+"""The recording commands by name, for the dispatcher in :mod:`.main`."""
+
+
+def _history(history: MissionHistory) -> MissionHistory:
+    """Warn on stderr about revisions the recording lacks; return the history.
+
+    (What reading the file found wrong is logged by the reader already.)
+    """
+    for line in history.problems:
+        print(f"rosmc: warning: {line}", file=sys.stderr)
+    return history
+
+
+def _positive(text: str) -> float:
+    value = float(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be a positive number, got {text}")
+    return value
+
+
+def _seconds(text: str) -> float:
+    value = float(text)
+    if not value >= 0:
+        raise argparse.ArgumentTypeError(f"must be 0 or more seconds, got {text}")
+    return value
