@@ -73,12 +73,15 @@ class ClientBase:
 
     def skill_spec(self, skill_id: str) -> SkillSpec:
         """The library schema of an existing skill (NotFound if there is no such skill)."""
-        if skill_id not in self._kinds:
-            self.skill(skill_id)
-        agent, skill = self._kinds[skill_id]
-        return self.library().skill(agent, skill)
+        return self.library().skill(*self._kind(skill_id))
 
     # -- internals ---------------------------------------------------------------------
+    def _kind(self, skill_id: str) -> tuple[str, str]:
+        """The agent and skill name of a skill id (they never change, so they are cached)."""
+        if skill_id not in self._kinds:
+            self.skill(skill_id)  # fills the cache, or raises NotFound
+        return self._kinds[skill_id]
+
     def _parameters(
         self, agent: str, skill: str, params: Mapping[str, object], bindings: Mapping[str, str]
     ) -> list[Any]:

@@ -8,7 +8,6 @@ from typing import Any
 from ...core import (
     InvalidRequest,
     Pose,
-    SkillInstance,
     TaskMarker,
 )
 from ...core.editing import check_retries, check_timeout
@@ -41,7 +40,8 @@ class MissionClient(ClientBase):
     :meth:`get_mission` and accepted requests). Mutating requests are made against
     it unless ``base_revision`` is given; so a change by someone else since then is
     refused as a conflict. ``retry_on_conflict=True`` instead refetches the mission
-    and sends the request once more; use it only where that is safe.
+    and sends the request once more; use it only where that is safe. One client may
+    be shared between threads (calls are serialized).
 
     Args:
         timeout: Seconds to wait for the server to appear (per connection).
@@ -96,37 +96,49 @@ class MissionClient(ClientBase):
         base_revision: int | None = None,
         retry_on_conflict: bool = False,
     ) -> Result:
-        """Change a blueprint skill; only what is given changes.
+        """Change a blueprint skill; only what is given changes (``label`` "" or None: kept).
 
         A parameter given a value loses its marker binding; a binding to ``None``
         or ``""`` unbinds the parameter and keeps its current value.
         """
-        bindings = dict(bindings or {})
-        values = dict(params or {})
-        unbind = [name for name, marker in bindings.items() if not marker]
-        current = (
-            self.skill(skill_id) if unbind or (timeout is None) != (max_retries is None) else None
+        fields = self._edit_fields(
+            skill_id, dict(params or {}), dict(bindings or {}), timeout, max_retries
         )
-        if current is not None:
-            values.update({name: current.params[name] for name in unbind if name in current.params})
-        spec = self.skill_spec(skill_id)
-        agent, _ = self._kinds[skill_id]
-        marked = {name: marker for name, marker in bindings.items() if marker}
-        set_options = timeout is not None or max_retries is not None
         response = self._mutate(
             "edit_skill",
             base_revision,
             retry_on_conflict,
             skill_id=skill_id,
             label=label or "",
-            parameters=self._parameters(agent, spec.name, values, marked),
-            set_options=set_options,
-            timeout=check_timeout(timeout if timeout is not None else _opt(current, "timeout")),
-            max_retries=check_retries(
-                max_retries if max_retries is not None else _opt(current, "max_retries")
-            ),
+            **fields,
         )
         return Result(response.revision)
+
+    def _edit_fields(
+        self,
+        skill_id: str,
+        values: dict[str, object],
+        bindings: dict[str, str | None],
+        timeout: float | None,
+        max_retries: int | None,
+    ) -> dict[str, Any]:
+        # The wire unbinds a parameter when it gets a value, and sets both options or
+        # neither, so what stays as it was is sent with its current value.
+        set_options = timeout is not None or max_retries is not None
+        unbind = [name for name, marker in bindings.items() if not marker]
+        if unbind or (timeout is None) != (max_retries is None):
+            current = self.skill(skill_id)
+            values.update({name: current.params[name] for name in unbind if name in current.params})
+            timeout = current.timeout if timeout is None else timeout
+            max_retries = current.max_retries if max_retries is None else max_retries
+        agent, skill = self._kind(skill_id)
+        marked = {name: marker for name, marker in bindings.items() if marker}
+        return {
+            "parameters": self._parameters(agent, skill, values, marked),
+            "set_options": set_options,
+            "timeout": check_timeout(timeout or 0.0),
+            "max_retries": check_retries(max_retries or 0),
+        }
 
     def delete_skills(
         self,
@@ -326,7 +338,3 @@ class MissionClient(ClientBase):
             path=path or "",
         )
         return Result(response.revision)
-
-
-def _opt(skill: SkillInstance | None, name: str) -> Any:
-    return getattr(skill, name) if skill is not None else 0

@@ -1,0 +1,45 @@
+"""Plain-text and JSON views of a mission, its library and its events.
+
+Pure functions over core objects (no rospy): the ``rosmc`` command line, the
+scripted demo and tests share them. :mod:`.plain` renders text for people
+(each robot's schedule, status marks, tags); :mod:`.data` returns plain data
+with stable keys for ``--json`` output.
+"""
+
+from .data import (
+    agent_status_to_json,
+    event_to_json,
+    library_to_json,
+    marker_to_json,
+    mission_to_json,
+    skill_to_json,
+)
+from .plain import (
+    STATUS_MARK,
+    format_agent_status,
+    format_event,
+    format_library,
+    format_markers,
+    format_params,
+    format_schedule,
+    format_value,
+)
+from .status import AgentStatus
+
+__all__ = [
+    "STATUS_MARK",
+    "AgentStatus",
+    "agent_status_to_json",
+    "event_to_json",
+    "format_agent_status",
+    "format_event",
+    "format_library",
+    "format_markers",
+    "format_params",
+    "format_schedule",
+    "format_value",
+    "library_to_json",
+    "marker_to_json",
+    "mission_to_json",
+    "skill_to_json",
+]
