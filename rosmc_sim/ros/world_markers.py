@@ -1,0 +1,178 @@
+"""The site's geometry for rviz: ``/rosmc/sim/world`` (visualization_msgs/MarkerArray, latched).
+
+One array holds everything (after a DELETEALL, so what disappeared goes): the
+ground, obstacles, slopes (flat, translucent), the lander, payload boxes,
+discovered regions (translucent discs with a label), the stones lying in them,
+and the Wi-Fi coverage circles of the lander and of deployed Wi-Fi boxes.
+Robot bodies are left to TF and the interactive markers. Namespaces are per
+kind; ids are stable (the scenario's order). The array is republished when
+what it shows changes (checked every :data:`CHECK_PERIOD` wall seconds, sent
+at most every :data:`MIN_PERIOD`), e.g. a box carried, a region discovered.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Hashable
+
+import rospy
+from geometry_msgs.msg import Point
+from std_msgs.msg import ColorRGBA
+from visualization_msgs.msg import Marker, MarkerArray
+
+from ..core.sim import Simulation
+from ..core.world import BOX_SIZE, STONE_RADIUS
+from .robot_state import MAP_FRAME, yaw_quaternion
+from .timing import Throttle
+from .topics import WORLD_TOPIC
+
+CHECK_PERIOD = 0.1
+MIN_PERIOD = 0.5
+CIRCLE_POINTS = 72
+LANDER_HEIGHT = 1.2
+_COLORS = {
+    "ground": (0.76, 0.45, 0.30, 1.0),
+    "obstacles": (0.45, 0.30, 0.25, 1.0),
+    "slopes": (0.60, 0.35, 0.20, 0.35),
+    "lander": (0.85, 0.85, 0.88, 1.0),
+    "boxes": (0.80, 0.80, 0.80, 1.0),
+    "regions": (0.95, 0.85, 0.20, 0.35),
+    "region_labels": (1.0, 1.0, 1.0, 1.0),
+    "stones": (0.30, 0.30, 0.32, 1.0),
+    "wifi": (0.20, 0.60, 1.00, 0.8),
+}
+_BOX_COLORS = {
+    "wifi": (0.25, 0.55, 0.95, 1.0),
+    "sample": (0.90, 0.90, 0.90, 1.0),
+    "lofar": (0.70, 0.40, 0.80, 1.0),
+    "power": (0.95, 0.60, 0.15, 1.0),
+}
+
+
+def world_signature(sim: Simulation) -> Hashable:
+    """What the markers show, coarsely: the array is republished when this changes."""
+    return (
+        tuple(r.discovered for r in sim.regions.values()),
+        tuple(
+            (round(b.x, 1), round(b.y, 1), round(b.z, 1), b.deployed) for b in sim.boxes.values()
+        ),
+        tuple(bool(s.carried_by) or s.delivered for s in sim.stones.values()),
+    )
+
+
+def world_markers(sim: Simulation) -> MarkerArray:
+    """Every marker of the site, after a DELETEALL."""
+    clear = Marker(action=Marker.DELETEALL)
+    clear.header.frame_id = MAP_FRAME
+    return MarkerArray(
+        markers=[clear, *_static_markers(sim), *_box_markers(sim), *_science_markers(sim)]
+    )
+
+
+def _marker(ns: str, ident: int, kind: int, x: float, y: float, z: float) -> Marker:
+    marker = Marker(ns=ns, id=ident, type=kind, action=Marker.ADD)
+    marker.header.frame_id = MAP_FRAME
+    marker.header.stamp = rospy.Time(0)
+    marker.pose.position = Point(x, y, z)
+    marker.pose.orientation = yaw_quaternion(0.0)
+    marker.color = ColorRGBA(*_COLORS[ns])
+    return marker
+
+
+def _sized(marker: Marker, sx: float, sy: float, sz: float, yaw: float = 0.0) -> Marker:
+    marker.scale.x, marker.scale.y, marker.scale.z = sx, sy, sz
+    marker.pose.orientation = yaw_quaternion(yaw)
+    return marker
+
+
+def _static_markers(sim: Simulation) -> list[Marker]:
+    scenario = sim.scenario
+    x_min, x_max, y_min, y_max = scenario.bounds
+    ground = _marker("ground", 0, Marker.CUBE, (x_min + x_max) / 2, (y_min + y_max) / 2, -0.05)
+    out = [_sized(ground, x_max - x_min, y_max - y_min, 0.1)]
+    for i, o in enumerate(scenario.obstacles):
+        if o.shape == "cylinder":
+            m = _marker("obstacles", i, Marker.CYLINDER, o.x, o.y, o.height / 2)
+            out.append(_sized(m, 2 * o.radius, 2 * o.radius, o.height))
+        else:
+            m = _marker("obstacles", i, Marker.CUBE, o.x, o.y, o.height / 2)
+            out.append(_sized(m, o.size_x, o.size_y, o.height, o.yaw))
+    for i, s in enumerate(scenario.slopes):
+        out.append(
+            _sized(_marker("slopes", i, Marker.CUBE, s.x, s.y, 0.01), s.size_x, s.size_y, 0.02)
+        )
+    side = 2 * scenario.lander_radius
+    lander = _marker("lander", 0, Marker.CUBE, 0.0, 0.0, LANDER_HEIGHT / 2)
+    out.append(_sized(lander, side, side, LANDER_HEIGHT))
+    return out
+
+
+def _box_markers(sim: Simulation) -> list[Marker]:
+    out = []
+    for i, box in enumerate(sim.boxes.values()):
+        m = _sized(_marker("boxes", i, Marker.CUBE, box.x, box.y, box.z), *(BOX_SIZE,) * 3)
+        m.color = ColorRGBA(*_BOX_COLORS.get(box.spec.kind, _COLORS["boxes"]))
+        out.append(m)
+    sources = [(0.0, 0.0, sim.scenario.lander_wifi_radius)]
+    sources += [
+        (b.x, b.y, b.spec.wifi_radius)
+        for b in sim.boxes.values()
+        if b.deployed and b.spec.kind == "wifi"
+    ]
+    for i, (x, y, radius) in enumerate(sources):
+        out.append(_circle("wifi", i, x, y, radius))
+    return out
+
+
+def _circle(ns: str, ident: int, x: float, y: float, radius: float) -> Marker:
+    marker = _marker(ns, ident, Marker.LINE_STRIP, 0.0, 0.0, 0.05)
+    marker.scale.x = 0.1  # line width
+    marker.points = [
+        Point(
+            x + radius * math.cos(2 * math.pi * k / CIRCLE_POINTS),
+            y + radius * math.sin(2 * math.pi * k / CIRCLE_POINTS),
+            0.0,
+        )
+        for k in range(CIRCLE_POINTS + 1)
+    ]
+    return marker
+
+
+def _science_markers(sim: Simulation) -> list[Marker]:
+    out = []
+    for i, region in enumerate(sim.regions.values()):
+        if not region.discovered:
+            continue
+        spec = region.spec
+        disc = _marker("regions", i, Marker.CYLINDER, spec.x, spec.y, 0.02)
+        out.append(_sized(disc, 2 * spec.radius, 2 * spec.radius, 0.04))
+        label = _marker("region_labels", i, Marker.TEXT_VIEW_FACING, spec.x, spec.y, 1.5)
+        label.scale.z = 0.8
+        label.text = f"{spec.name} (max {spec.max_score:g})"
+        out.append(label)
+    discovered = {name for name, r in sim.regions.items() if r.discovered}
+    for i, stone in enumerate(sim.stones.values()):
+        if stone.region in discovered and not stone.carried_by and not stone.delivered:
+            m = _marker("stones", i, Marker.SPHERE, stone.x, stone.y, STONE_RADIUS)
+            out.append(_sized(m, *(2 * STONE_RADIUS,) * 3))
+    return out
+
+
+class WorldPublisher:
+    """Republishes the world markers when what they show changes."""
+
+    def __init__(self, sim: Simulation) -> None:
+        self.sim = sim
+        self._shown: Hashable = None
+        self._check = Throttle(CHECK_PERIOD)
+        self._send = Throttle(MIN_PERIOD)
+        self._publisher = rospy.Publisher(WORLD_TOPIC, MarkerArray, queue_size=2, latch=True)
+
+    def after_step(self, now: float) -> None:
+        """Publish if the world looks different and the last array is old enough."""
+        if not self._check.due(now):
+            return
+        signature = world_signature(self.sim)
+        if signature != self._shown and self._send.due(now):
+            self._shown = signature
+            self._publisher.publish(world_markers(self.sim))
