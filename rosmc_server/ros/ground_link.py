@@ -229,6 +229,8 @@ class GroundLink:
         if link.reports is None:
             return  # wait for the robot's snapshot to learn its numbering
         if link.reports.classify(msg.seq) is Arrival.NEXT:
+            if msg.skill_id in self._uploading(agent):
+                return  # it overtook the upload's ack (another topic); the robot resends it
             link.reports.accept(msg.seq)
             self._host.record_report(msg)
             self._apply_report(msg)
