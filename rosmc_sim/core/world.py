@@ -52,6 +52,11 @@ class World:
 
     def __init__(self, scenario: Scenario, gui: bool = False) -> None:
         self.client = pb.connect(pb.GUI if gui else pb.DIRECT)
+        # The GUI redraws after every body added (seconds each with software GL); draw
+        # once everything is built, i.e. from the first step on.
+        self._render_pending = gui
+        if gui:
+            pb.configureDebugVisualizer(pb.COV_ENABLE_RENDERING, 0, physicsClientId=self.client)
         self._bodies: dict[str, int] = {}
         self._obstacle_ids: set[int] = set()
         x_min, x_max, y_min, y_max = scenario.bounds
@@ -172,6 +177,9 @@ class World:
 
     def step(self) -> None:
         """Advance pybullet (kinematic bodies need no dynamics; keeps the GUI live)."""
+        if self._render_pending:
+            self._render_pending = False
+            pb.configureDebugVisualizer(pb.COV_ENABLE_RENDERING, 1, physicsClientId=self.client)
         pb.stepSimulation(physicsClientId=self.client)
 
     def close(self) -> None:
