@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import signal
 import sys
 import threading
@@ -91,6 +92,9 @@ class SimConfig:
             raise ConfigError("~real_time_factor must be 0 (as fast as possible) or positive")
         if not 0 < config.step <= 1.0:
             raise ConfigError("~step must be above 0 and at most 1 s")
+        if config.gui and not os.environ.get("DISPLAY"):
+            # pybullet would exit the process from C, without a word to rosout.
+            raise ConfigError("~gui needs a display, and DISPLAY is not set")
         return config
 
 
