@@ -193,12 +193,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         description="The pybullet simulation of the Mars site (_scenario:=FILE "
         "_real_time_factor:=X _step:=S _gui:=BOOL _seed:=N).",
     ).parse_args(args[1:])
-    # rospy's own signal handler shuts ROS down on the main thread, which deadlocks when the
-    # signal lands while the sim loop holds a publisher's lock; ours only asks the loop to end.
     rospy.init_node("sim", disable_signals=True)
-    stop = threading.Event()
-    for signum in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(signum, lambda _signum, _frame: stop.set())
+    stop = _stop_on_signals()
     bridge_logging_to_rosout()
     try:
         config = SimConfig.from_params()
@@ -207,16 +203,34 @@ def main(argv: Sequence[str] | None = None) -> int:
         _log.critical("sim: %s", error)
         rospy.signal_shutdown("no scenario")
         return 1
-    node = SimNode(config, scenario)
+    return _run(SimNode(config, scenario), stop)
+
+
+def _stop_on_signals() -> threading.Event:
+    """SIGINT and SIGTERM set the returned event.
+
+    rospy's own handler shuts ROS down on the main thread, which deadlocks when the
+    signal lands while the sim loop holds a publisher's lock; ours only asks the loop
+    to end, and the shutdown follows from ordinary code.
+    """
+    stop = threading.Event()
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, lambda _signum, _frame: stop.set())
+    return stop
+
+
+def _run(node: SimNode, stop: threading.Event) -> int:
     _log.info(
         "sim: %s with %s, real-time factor %g",
-        scenario.name,
+        node.sim.scenario.name,
         ", ".join(node.sim.robots),
-        config.real_time_factor,
+        node.config.real_time_factor,
     )
     try:
         node.run(stop)
-    except Exception:  # the top-level guard: say what broke, with the traceback
+    except Exception as error:  # the top-level guard: say what broke, with the traceback
+        if isinstance(error, rospy.ROSException) and rospy.is_shutdown():
+            return 0  # ROS went away in the middle of a step (rosnode kill, for one)
         _log.exception("sim: stopped by an error")
         return 1
     finally:

@@ -79,7 +79,8 @@ class TaskChannel:
     def close(self) -> None:
         """Cancel the active task and say so."""
         for status in self.desk.close():
-            self._publisher.publish(self._to_msg(status))
+            if not rospy.is_shutdown():
+                self._publisher.publish(self._to_msg(status))
         self._subscriber.unregister()
 
     def _handle(self, msg: wire.RobotTask) -> list[TaskStatus]:
