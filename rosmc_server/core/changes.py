@@ -41,6 +41,7 @@ class EventKind(enum.IntEnum):
     MARKER_RENAMED = 17
     MARKER_DELETED = 18
     MISSION_REPLACED = 19
+    UPLOAD_CANCELLED = 20
 
 
 @dataclass(frozen=True)

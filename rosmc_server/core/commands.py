@@ -73,7 +73,8 @@ def commands_for_event(event: MissionEvent, state: MissionState) -> list[Command
         skills = tuple(placed.skill for placed in change.put_skills)
         barriers = queued_barriers(state, event.agent)
         return [CommandSpec(event.agent, CommandKind.UPLOAD, skills, barriers=barriers)]
-    if kind is EventKind.UNSYNC_REQUESTED:
+    if kind in (EventKind.UNSYNC_REQUESTED, EventKind.UPLOAD_CANCELLED):
+        # A cancelled upload may have reached the robot after all: have it dropped.
         ids = tuple(placed.skill.id for placed in change.put_skills)
         return [CommandSpec(event.agent, CommandKind.UNSYNC, skill_ids=ids)]
     if kind is EventKind.SKILL_RETRIED:

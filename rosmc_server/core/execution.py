@@ -95,6 +95,24 @@ def plan_decline_sync(
     )
 
 
+def plan_cancel_uploads(state: MissionState, agent: str) -> Proposal:
+    """Give up on unanswered uploads: the skills return to the editable blueprint now.
+
+    The robot is told to drop them (see commands), in case it got them after all.
+    """
+    uploading = _pending(state.task(agent), Transfer.UPLOADING)
+    if not uploading:
+        raise RuleViolation(f"no upload to {agent} awaits an answer")
+    text = "upload cancelled by the operator"
+    puts = _placed(state, [replace(s, transfer=Transfer.NONE, status_text=text) for s in uploading])
+    return Proposal(
+        EventKind.UPLOAD_CANCELLED,
+        agent,
+        f"cancelled the upload of {_ids(uploading)} to {agent}",
+        Change(put_skills=puts),
+    )
+
+
 def plan_request_unsync(state: MissionState, agent: str, from_id: str | None) -> Proposal:
     """Ask the robot to give back ``from_id`` and every later synchronized skill."""
     task = state.task(agent)

@@ -52,9 +52,16 @@ class ParameterSpec:
     marker_type: MarkerType | None = None
 
     def check(self, raw: object, skill: str) -> Value:
-        """Check a value for this parameter of ``skill``; return it normalized."""
+        """Check a value for this parameter of ``skill``; return it normalized.
+
+        A parameter an area marker fills must be a polygon: at least three
+        ``{x, y}`` points, since that is what robots receive from a marker.
+        """
         what = f"parameter '{self.name}' of skill '{skill}'"
-        return check_value(self.type, raw, what, self.minimum, self.maximum, self.choices)
+        value = check_value(self.type, raw, what, self.minimum, self.maximum, self.choices)
+        if self.marker_type is MarkerType.AREA:
+            check_polygon(value, what)
+        return value
 
     def accepts_marker(self, marker_type: MarkerType) -> bool:
         """Whether a task marker of ``marker_type`` may fill this parameter."""
@@ -130,6 +137,19 @@ class Library:
             known = ", ".join(sorted(skills)) or "none"
             raise NotFound(f"agent '{agent}' has no skill '{skill}' (it has: {known})")
         return skills[skill]
+
+
+def check_polygon(value: object, what: str) -> None:
+    """Raise InvalidRequest unless ``value`` is a list of at least three {x, y} points."""
+    if not isinstance(value, list) or len(value) < 3:
+        raise InvalidRequest(f"{what} must list at least three corners")
+    for index, point in enumerate(value):
+        ok = isinstance(point, dict) and all(
+            isinstance(point.get(axis), (int, float)) and not isinstance(point.get(axis), bool)
+            for axis in ("x", "y")
+        )
+        if not ok:
+            raise InvalidRequest(f"corner {index} of {what} must be a point with x and y")
 
 
 def load_library(path: str | Path) -> Library:

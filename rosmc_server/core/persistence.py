@@ -107,6 +107,8 @@ def mission_from_dict(
 ) -> tuple[MissionContent, int]:
     """Build and check a mission from plain data."""
     reader = _FileReader(source)
+    if isinstance(data, dict) and "rosmc_mission" in data:
+        _check_version(reader, data["rosmc_mission"])  # before anything a new version may change
     top = reader.fields(
         data,
         "",
@@ -128,6 +130,11 @@ def mission_from_dict(
     tasks = _read_tasks(reader, top["tasks"], library, markers)
     barriers = _read_barriers(reader, top.get("barriers", []), tasks)
     return MissionContent(library.name, tasks, barriers, markers), revision
+
+
+def _check_version(reader: _FileReader, version: object) -> None:
+    if isinstance(version, bool) or version != MISSION_VERSION:
+        reader.fail("rosmc_mission", f"unsupported mission file version {version!r}")
 
 
 def _read_markers(reader: _FileReader, raw: object) -> dict[str, TaskMarker]:

@@ -198,7 +198,8 @@ class GroundLink:
         command = item.payload
         if command.type == CommandKind.UPLOAD:
             self._upload_answered(agent, command, msg)
-        elif command.type == CommandKind.UNSYNC:
+        elif command.type == CommandKind.UNSYNC and self._removing(agent):
+            # (An UNSYNC that only cleans up a cancelled upload needs no answer.)
             removed = [] if msg.result == wire.RobotAck.REJECTED else list(msg.accepted_ids)
             self._apply(lambda m: m.confirm_unsynchronized(agent, removed))
         link.robot_hash = msg.queue_hash
@@ -219,6 +220,9 @@ class GroundLink:
             tail = pending[pending.index(refused[0]) :]
             reason = ack.error or next(iter(ack.rejection_reasons), "refused by the robot")
             self._apply(lambda m: m.decline_synchronize(agent, tail, reason))
+
+    def _removing(self, agent: str) -> bool:
+        return any(s.transfer is Transfer.REMOVING for s in self._mission.state.task(agent))
 
     def _uploading(self, agent: str) -> list[str]:
         return [s.id for s in self._mission.state.task(agent) if s.transfer is Transfer.UPLOADING]

@@ -16,6 +16,7 @@ import logging
 import math
 import re
 from collections.abc import Callable
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import rosmc.srv as srv
@@ -33,6 +34,7 @@ from ..core import (
     RosmcError,
     RuleViolation,
     StaleRevision,
+    Transfer,
     Unavailable,
     dump_mission,
     parse_mission,
@@ -89,11 +91,23 @@ def _text(value: str, what: str) -> str:
     return value
 
 
-def _host_path(path: str) -> str:
+def _host_path(path: str, mission_dir: Path) -> Path:
+    """A mission file path on the server's host, confined to ``mission_dir``.
+
+    Anybody on the ROS graph can call the services, so the server touches files
+    only below one directory; relative paths are taken from there.
+    """
     # The operating system cannot take a NUL byte in a path; Python raises ValueError.
     if "\0" in path:
         raise InvalidRequest("a file path cannot contain a NUL character")
-    return path
+    root = mission_dir.expanduser().resolve()
+    target = (root / Path(path).expanduser()).resolve()
+    if not target.is_relative_to(root):
+        raise InvalidRequest(
+            f"the server reads and writes mission files only under {root}; "
+            "pass the document itself to save or load elsewhere"
+        )
+    return target
 
 
 class OperatorServices:
@@ -212,6 +226,13 @@ class OperatorServices:
 
     def _unsynchronize(self, req: Any, resp: Any) -> MissionEvent:
         with self._server.locked():
+            if self._uploading(req.agent):
+                # An upload still unanswered (the robot may be out of reach) is cancelled:
+                # the operator can always take back what the robot has not confirmed.
+                base = req.base_revision
+                event = self._apply(lambda m: m.cancel_uploads(req.agent, base_revision=base))
+                resp.skill_ids = [placed.skill.id for placed in event.change.put_skills]
+                return event
             self._require_link(req.agent)
             event = self._apply(
                 lambda m: m.unsynchronize(
@@ -220,6 +241,12 @@ class OperatorServices:
             )
         resp.skill_ids = [placed.skill.id for placed in event.change.put_skills]
         return event
+
+    def _uploading(self, agent: str) -> bool:
+        state = self._server.mission.state
+        if agent not in state.agents:
+            return False
+        return any(s.transfer is Transfer.UPLOADING for s in state.task(agent))
 
     def _control(self, req: Any, resp: Any) -> None:
         if req.command not in _CONTROL:
@@ -319,8 +346,11 @@ class OperatorServices:
             revision = self._server.mission.revision
         resp.document = dump_mission(content, revision)
         if req.path:
-            save_mission(_host_path(req.path), content, revision)
-            resp.path_written = req.path
+            target = _host_path(req.path, self._server.config.mission_dir)
+            if target.parent == self._server.config.mission_dir.expanduser().resolve():
+                target.parent.mkdir(parents=True, exist_ok=True)  # the mission folder itself
+            save_mission(target, content, revision)
+            resp.path_written = str(target)
         resp.revision = revision
         return None
 
@@ -330,7 +360,8 @@ class OperatorServices:
         if req.path:
             from ..core import load_mission
 
-            content, _ = load_mission(_host_path(req.path), self._server.library)
+            path = _host_path(req.path, self._server.config.mission_dir)
+            content, _ = load_mission(path, self._server.library)
             source = req.path
         else:
             content, _ = parse_mission(req.document, self._server.library, "the document")

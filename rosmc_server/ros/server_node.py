@@ -23,6 +23,9 @@ Parameters (private):
     ``~link_timeout`` (float, s): silence after which a robot link is DOWN (3.0).
     ``~agent_state_rate`` (float, Hz): rate of ``/rosmc/agent_states`` (2.0).
     ``~fsync`` (bool): fsync the journal on every change (survives power loss).
+    ``~mission_dir`` (str): the only directory (with its subdirectories) where SaveMission
+        and LoadMission read or write files on the server's host (default ``missions/``);
+        elsewhere, clients pass the document itself.
 
 Every accepted change is journaled (and flushed) before its service answers.
 If the journal cannot be written, the change is reported as failed and the
@@ -61,6 +64,7 @@ _log = logging.getLogger(__name__)
 PACKAGE_ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_LIBRARY = PACKAGE_ROOT / "rosmc_server" / "config" / "mars_team.yaml"
 DEFAULT_JOURNAL_DIR = PACKAGE_ROOT / "bags"
+DEFAULT_MISSION_DIR = PACKAGE_ROOT / "missions"
 
 
 @dataclass(frozen=True)
@@ -74,6 +78,7 @@ class ServerConfig:
     link_timeout: float = 3.0
     agent_state_rate: float = 2.0
     fsync: bool = False
+    mission_dir: Path = DEFAULT_MISSION_DIR
 
     @classmethod
     def from_params(cls) -> ServerConfig:
@@ -87,6 +92,7 @@ class ServerConfig:
             link_timeout=float(rospy.get_param("~link_timeout", 3.0)),
             agent_state_rate=float(rospy.get_param("~agent_state_rate", 2.0)),
             fsync=bool(rospy.get_param("~fsync", False)),
+            mission_dir=Path(str(rospy.get_param("~mission_dir", str(DEFAULT_MISSION_DIR)))),
         )
 
 

@@ -180,6 +180,8 @@ def _launcher(env: dict[str, str], base: Path) -> tuple[StartServer, list[Server
             journal_dir = base / f"{name}-{len(started)}-journal"
             journal_dir.mkdir(parents=True, exist_ok=True)
             params.setdefault("journal_dir", journal_dir)
+        # Mission files may live in any of this session's temporary directories.
+        params.setdefault("mission_dir", base.parent)
         server = ServerProcess(env, base / f"{name}-{len(started)}.log", params)
         started.append(server)
         return server.start()

@@ -1013,3 +1013,13 @@ def test_errors_quoting_the_request_stay_one_line(scene: Scene) -> None:
         check_rejection(scene, "delete_skills", {"skill_ids": [text]}, E.NOT_FOUND)
         check_rejection(scene, "delete_task_marker", {"name": text}, E.NOT_FOUND)
         check_rejection(scene, "add_skill", {"agent": text, "skill": "land"}, E.NOT_FOUND)
+
+
+def test_mission_files_stay_inside_the_mission_directory(scene: Scene) -> None:
+    """Anybody on the graph can call the services: no file outside ~mission_dir is touched."""
+    for path in ("/etc/rosmc_escape.yaml", "../../escape.yaml"):
+        response = scene.client.call("save_mission", path=path)
+        assert response.error_code == E.INVALID, (response.error_code, response.error)
+        assert "only under" in response.error
+        check_rejection(scene, "load_mission", {"path": path}, E.INVALID)
+    assert not Path("/etc/rosmc_escape.yaml").exists()
