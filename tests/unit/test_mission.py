@@ -341,3 +341,28 @@ def test_robot_progress_does_not_make_an_operator_view_stale(mission: Any) -> No
     assert event.revision == view + 3
     with pytest.raises(StaleRevision):
         mission.add_skill("alpha", "noop", base_revision=view)  # another operator's add came since
+
+
+def test_cancelling_an_unanswered_upload_returns_the_skills_to_the_blueprint(
+    mission: Any,
+) -> None:
+    first = mission.add_skill("alpha", "noop").change.put_skills[0].skill.id
+    second = mission.add_skill("alpha", "noop").change.put_skills[0].skill.id
+    mission.synchronize("alpha")
+    event = mission.cancel_uploads("alpha", base_revision=mission.revision)
+    assert event.kind is EventKind.UPLOAD_CANCELLED
+    assert [p.skill.id for p in event.change.put_skills] == [first, second]
+    for skill_id in (first, second):
+        skill = mission.state.skill(skill_id)
+        assert skill.is_editable and skill.status_text == "upload cancelled by the operator"
+    with pytest.raises(RuleViolation):
+        mission.cancel_uploads("alpha")  # nothing pending any more
+    mission.edit_skill(first, label="edited after the cancel")
+
+
+def test_area_parameters_must_be_polygons(mission: Any) -> None:
+    from rosmc_server.core import InvalidRequest
+
+    for bad in ([1, 2, 3], [{"x": 0, "y": 0}, {"x": 1, "y": 0}], [{"x": 0}, {"x": 1}, {"y": 2}]):
+        with pytest.raises(InvalidRequest):
+            mission.add_skill("alpha", "scan", {"area": bad})
