@@ -196,6 +196,8 @@ def operator_requests(drv: Any) -> list[tuple[EventKind, str, Any, dict[str, Any
             ("alpha", lambda: drv.ids("alpha")[1:], "no"),
             {},
         ),
+        (EventKind.SYNC_REQUESTED, "synchronize", ("alpha",), {}),
+        (EventKind.UPLOAD_CANCELLED, "cancel_uploads", ("alpha",), {}),
         (EventKind.UNSYNC_REQUESTED, "unsynchronize", ("alpha",), {}),
         (EventKind.UNSYNC_CONFIRMED, "confirm_unsynchronized", ("alpha", []), {}),
         (EventKind.STATUS_CHANGED, "report_status", (a2, S.SYNCWAITING), {}),
