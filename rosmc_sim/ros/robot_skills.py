@@ -24,6 +24,7 @@ from rosmc_server.core import ParamType, Value
 from rosmc_server.executor.core import Outcome, SkillBehavior, SkillContext, SkillType
 from rosmc_server.ros.conversions import param_to_msg
 
+from ..core.skills_registry import TASKS
 from .topics import task_status_topic, task_topic
 
 RESEND_AFTER = 1.0  # wall seconds without any status before a START is sent again
@@ -42,20 +43,6 @@ _PARAMS: Mapping[str, Mapping[str, ParamType]] = {
     "deposit_at_lander": {},
     "pick_box": {"box": P.STRING},
     "place_box": {"target": P.POSE},
-}
-_KINDS: Mapping[str, tuple[str, ...]] = {
-    "drone": ("take_off", "land", "fly_over", "navigate_to", "return_to_lander", "recharge"),
-    "science_rover": ("navigate_to", "explore", "identify_stones", "return_to_lander", "recharge"),
-    "manipulator_rover": (
-        "navigate_to",
-        "identify_stones",
-        "pick_stone",
-        "deposit_at_lander",
-        "pick_box",
-        "place_box",
-        "return_to_lander",
-        "recharge",
-    ),
 }
 
 
@@ -148,7 +135,8 @@ def _skills(agent: str, kind: str) -> list[SkillType]:
     controller = RobotController(agent)
     return [
         SkillType(name, lambda name=name: ForwardedSkill(controller, name), _PARAMS[name])
-        for name in _KINDS[kind]
+        for name, task in TASKS.items()
+        if kind in task.kinds
     ]
 
 
