@@ -53,7 +53,13 @@ from ..core.changes import EventKind
 from ..core.commands import commands_for_event
 from ..recording import JournalOptions, JournalWriter, default_journal_path, latest_state
 from .agent_states import AgentStatePublisher
-from .conversions import event_from_msg, event_to_msg, mission_from_msg, mission_to_msg
+from .conversions import (
+    SnapshotConverter,
+    event_from_msg,
+    event_to_msg,
+    mission_from_msg,
+    mission_to_msg,
+)
 from .ground_link import GroundLink
 from .logging_bridge import bridge_logging_to_rosout
 from .operator_services import OperatorServices
@@ -104,6 +110,7 @@ class MissionServer:
         self.library = library
         self._stopping = False  # first: robot-link callbacks may arrive during construction
         self._lock = threading.RLock()
+        self._converter = SnapshotConverter()
         self.mission, self._journal = self._open_journal()
         self._events = rospy.Publisher(interface.EVENTS_TOPIC, wire.MissionEvent, queue_size=1000)
         self._snapshots = SnapshotPublisher(
@@ -200,7 +207,7 @@ class MissionServer:
         with self._lock:
             content = self.mission.state.content()
             revision = self.mission.revision
-        return mission_to_msg(content, revision, rospy.get_time())
+        return self._converter.mission_to_msg(content, revision, rospy.get_time())
 
     # -- journal -------------------------------------------------------------------
     def _open_journal(self) -> tuple[Mission, JournalWriter]:
