@@ -4,7 +4,10 @@
 ``/rosmc/mission`` (rosmc/Mission). Under a burst of changes it coalesces:
 it waits until changes pause (``quiet``) or a burst has lasted ``max_delay``,
 so a multi-megabyte snapshot is not built per change, yet the latched
-snapshot is always current shortly after a burst ends.
+snapshot is always current shortly after a burst ends. During a long burst it
+publishes at most every ``cost_factor`` times what the last snapshot cost, so
+building and serializing a large mission takes a bounded share of the server's
+time (the service threads share one interpreter with it).
 """
 
 from __future__ import annotations
@@ -29,6 +32,7 @@ class SnapshotPublisher:
         build: Callable[[], wire.Mission],
         quiet: float = 0.05,
         max_delay: float = 0.25,
+        cost_factor: float = 10.0,
         on_published: Callable[[wire.Mission], None] | None = None,
     ) -> None:
         self._publisher = rospy.Publisher(topic, wire.Mission, queue_size=1, latch=True)
@@ -36,6 +40,8 @@ class SnapshotPublisher:
         self._on_published = on_published
         self._quiet = quiet
         self._max_delay = max_delay
+        self._cost_factor = cost_factor
+        self._cost = 0.0  # seconds the last snapshot took to build and publish
         self._changed = threading.Condition()
         self._dirty_since: float | None = None
         self._last_change = 0.0
@@ -73,6 +79,7 @@ class SnapshotPublisher:
                     return
                 self._wait_for_pause()
                 self._dirty_since = None
+            started = time.monotonic()
             try:
                 snapshot = self._build()
                 self._publisher.publish(snapshot)
@@ -80,13 +87,15 @@ class SnapshotPublisher:
                     self._on_published(snapshot)
             except Exception:  # keep publishing later snapshots whatever happened
                 _log.exception("could not publish the mission snapshot")
+            self._cost = time.monotonic() - started
 
     def _wait_for_pause(self) -> None:
         """Wait (lock held) until changes pause or the burst is old enough."""
         assert self._dirty_since is not None
         while not self._stopped:
             now = time.monotonic()
-            deadline = min(self._last_change + self._quiet, self._dirty_since + self._max_delay)
+            longest = max(self._max_delay, self._cost_factor * self._cost)
+            deadline = min(self._last_change + self._quiet, self._dirty_since + longest)
             if now >= deadline:
                 return
             self._changed.wait(deadline - now)
