@@ -824,7 +824,7 @@ def test_released_lets_a_robot_start_that_missed_the_others_ready() -> None:
     robot.upload(make_skill("x3", agent="r3"), barriers=(barrier,))
     robot.send(K.START)
     robot.engine.hear(Signal("r1", "B", "x1", SignalKind.READY, 0.0))
-    assert robot.skill("x3").status_text == "waiting for r2"
+    assert robot.engine.snapshot().waiting_on == "r2"
     # r1 heard r2 (this robot did not) and started: everybody was ready.
     robot.engine.hear(Signal("r1", "B", "x1", SignalKind.RELEASED, 0.0))
     assert robot.status("x3") is S.RUNNING
@@ -838,11 +838,28 @@ def test_three_robots_release_together() -> None:
     team["r1"].send(K.START)
     team["r2"].send(K.START)
     team.deliver()
-    assert team["r1"].skill("x1").status_text == "waiting for r3"
+    assert team["r1"].engine.snapshot().waiting_on == "r3"
     team["r3"].send(K.START)
     team.deliver()
     assert [team[a].status(f"x{a[1]}") for a in ("r1", "r2", "r3")] == [S.RUNNING] * 3
     assert len({team[a].skill(f"x{a[1]}").started for a in ("r1", "r2", "r3")}) == 1
+
+
+def test_peers_arriving_one_by_one_cost_no_reports() -> None:
+    agents = [f"r{i}" for i in range(1, 7)]
+    team = Team(*agents)
+    barrier = barrier_of(*((f"x{a}", a) for a in agents))
+    for agent in agents:
+        team[agent].upload(make_skill(f"x{agent}", agent=agent), barriers=(barrier,))
+    for agent in agents:
+        team[agent].send(K.START)
+        team.deliver()
+    first = team["r1"]
+    assert [(r.status, r.status_text) for r in first.out.reports] == [
+        (S.SYNCWAITING, "waiting for r2, r3, r4, r5, r6"),
+        (S.RUNNING, ""),
+    ]
+    assert all(team[a].status(f"x{a}") is S.RUNNING for a in agents)
 
 
 def test_own_signals_are_ignored(robot: Robot) -> None:

@@ -223,6 +223,8 @@ class Engine:
         active = self._active
         if active is not None and active.behavior is None and active.barrier is not None:
             active.barrier = self.board.barrier_of(active.skill_id)
+            if active.barrier is not None and self._status(active.skill_id) is S.SYNCWAITING:
+                self._set(active.skill_id, S.SYNCWAITING, text=self._waiting_text(active.barrier))
             self._try_release(active)
         return self._ack(cmd.seq)
 
@@ -322,9 +324,9 @@ class Engine:
             if active.behavior is None:
                 self._run(active)
             return
-        missing = self.board.missing(barrier, self.clock())
-        if missing:
-            self._set(active.skill_id, S.SYNCWAITING, text=self._waiting_text(barrier))
+        if self.board.missing(barrier, self.clock()):
+            # Still waiting. Who for is in the snapshot (waiting_on); a report per peer
+            # arrival would cost n^2 reports over the ground link for an n-robot barrier.
             return
         self._announce(active, SignalKind.RELEASED)
         self._run(active)
