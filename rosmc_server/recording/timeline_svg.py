@@ -14,7 +14,7 @@ import shutil
 import subprocess
 import tempfile
 from pathlib import Path
-from xml.sax.saxutils import escape
+from xml.sax.saxutils import escape, quoteattr
 
 from rosmc_server.core import RosmcError, SkillStatus
 from rosmc_server.recording.timeline import BarrierRelease, Interval, Timeline
@@ -64,6 +64,7 @@ def render_svg(timeline: Timeline, title: str = "") -> str:
     for row, agent in enumerate(lanes):
         y = TOP + row * LANE_HEIGHT
         shade = "#f4f4f4" if row % 2 == 0 else "#ffffff"
+        out.append(f'<g class="lane" data-agent={quoteattr(agent)}>')
         out.append(
             f'<rect x="{LABEL_WIDTH}" y="{y}" width="{PLOT_WIDTH}" height="{LANE_HEIGHT}" '
             f'fill="{shade}"/>'
@@ -73,6 +74,7 @@ def render_svg(timeline: Timeline, title: str = "") -> str:
             f'font-size="12" font-weight="bold">{escape(agent)}</text>'
         )
         out += [_bar(interval, y, scale) for interval in timeline.lanes[agent]]
+        out.append("</g>")
     row_of = {agent: row for row, agent in enumerate(lanes)}
     out += [_release(release, row_of, scale) for release in timeline.releases]
     out += _axis(span, scale, TOP + LANE_HEIGHT * len(lanes))
@@ -140,7 +142,7 @@ def _bar(interval: Interval, lane_y: float, scale: float) -> str:
         + (f", barrier {interval.barrier}" if interval.barrier else "")
     )
     parts = [
-        f'<g><title>{escape(tip)}</title><rect x="{x}" y="{y}" width="{width}" '
+        f'<g class="bar"><title>{escape(tip)}</title><rect x="{x}" y="{y}" width="{width}" '
         f'height="{BAR_HEIGHT}" rx="3" fill="{interval_colour(interval)}" {outline}/>'
     ]
     if len(label) * CHAR_WIDTH + 6 <= width:
@@ -164,7 +166,8 @@ def _release(release: BarrierRelease, row_of: dict[str, int], scale: float) -> s
     )
     tip = f"barrier {release.barrier} released at {release.time:.2f} s"
     return (
-        f'<g><title>{escape(tip)}</title><line x1="{x}" y1="{top}" x2="{x}" y2="{bottom}" '
+        f'<g class="release"><title>{escape(tip)}</title>'
+        f'<line x1="{x}" y1="{top}" x2="{x}" y2="{bottom}" '
         f'stroke="{INK}" stroke-width="2"/>{dots}</g>'
     )
 
