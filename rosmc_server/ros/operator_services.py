@@ -364,7 +364,10 @@ class OperatorServices:
             content, _ = load_mission(path, self._server.library)
             source = req.path
         else:
-            content, _ = parse_mission(req.document, self._server.library, "the document")
+            try:
+                content, _ = parse_mission(req.document, self._server.library, "the document")
+            except RecursionError:  # the YAML parser recurses once per nesting level
+                raise InvalidRequest("the document nests its data too deeply to read") from None
             source = "a document"
         return self._apply(lambda m: m.load(content, source, base_revision=req.base_revision))
 
