@@ -1023,3 +1023,8 @@ def test_mission_files_stay_inside_the_mission_directory(scene: Scene) -> None:
         assert "only under" in response.error
         check_rejection(scene, "load_mission", {"path": path}, E.INVALID)
     assert not Path("/etc/rosmc_escape.yaml").exists()
+
+
+def test_a_document_nested_too_deeply_is_invalid(scene: Scene) -> None:
+    nested = "x: " + "[" * 5000 + "]" * 5000 + "\n"
+    check_rejection(scene, "load_mission", {"document": nested}, E.INVALID)
