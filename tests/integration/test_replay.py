@@ -1,0 +1,174 @@
+"""``rosmc replay`` against a real master: it republishes a recording, and stays off live names.
+
+The recording is made with the mission core and JournalWriter (a short planning
+session); the replay runs as a subprocess, this test process subscribes as rviz
+or the command GUI would.
+"""
+
+from __future__ import annotations
+
+import itertools
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+import rosmc.msg as wire
+import rospy
+
+from rosmc_server.core import Mission, Pose, TaskMarker, load_library
+from rosmc_server.core.params import MarkerType
+from rosmc_server.recording import JournalWriter
+from rosmc_server.ros.conversions import event_to_msg, mission_to_msg
+
+REPO = Path(__file__).resolve().parents[2]
+ROSMC = REPO / "scripts" / "rosmc"
+LIBRARY = REPO / "rosmc_server" / "config" / "mars_team.yaml"
+SPACING = 0.05  # seconds between recorded events
+EVENTS = 24
+
+
+@pytest.fixture(scope="module")
+def journal(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A closed journal: a snapshot, then EVENTS planning changes SPACING s apart."""
+    counter = itertools.count(1)
+    clock = itertools.count(100, 5)
+    mission = Mission(
+        load_library(LIBRARY),
+        new_id=lambda prefix: f"{prefix}-{next(counter)}",
+        clock=lambda: float(next(clock)),
+    )
+    path = tmp_path_factory.mktemp("replay") / "mission.mcap"
+    t0 = time.time_ns()
+    snapshot = mission_to_msg(mission.state.content(), 0, 0.0)
+    with JournalWriter.create(path, snapshot, t0) as writer:
+        for index in range(1, EVENTS + 1):
+            if index == 1:
+                event = mission.add_marker(TaskMarker("RSS A", MarkerType.POSITION, Pose(3, 4)))
+            else:
+                event = mission.add_skill("drone", "take_off", {"altitude": float(index)})
+            msg = event_to_msg(event, lambda skill_id: mission.state.locate(skill_id)[0])
+            writer.append_event(msg, t0 + round(index * SPACING * 1e9))
+    return path
+
+
+@pytest.fixture
+def node(ros_master: Any) -> Any:
+    """This process as a rospy node on the session's master."""
+    if not rospy.core.is_initialized():
+        rospy.init_node("replay_tests", anonymous=True, disable_signals=True)
+    return ros_master
+
+
+class Listener:
+    """Subscribes to a replay's mission and events, as a GUI would."""
+
+    def __init__(self, prefix: str = "") -> None:
+        self.snapshots: list[int] = []
+        self.events: list[int] = []
+        self._changed = threading.Condition()
+        self._subscribers = [
+            rospy.Subscriber(f"{prefix}/rosmc/mission", wire.Mission, self._on_mission),
+            rospy.Subscriber(
+                f"{prefix}/rosmc/mission_events", wire.MissionEvent, self._on_event, queue_size=100
+            ),
+        ]
+
+    def _on_mission(self, msg: Any) -> None:
+        with self._changed:
+            self.snapshots.append(int(msg.revision))
+            self._changed.notify_all()
+
+    def _on_event(self, msg: Any) -> None:
+        with self._changed:
+            self.events.append(int(msg.revision))
+            self._changed.notify_all()
+
+    def wait(self, done: Callable[[], bool], timeout: float = 10.0) -> bool:
+        with self._changed:
+            return self._changed.wait_for(done, timeout)
+
+    def close(self) -> None:
+        for subscriber in self._subscribers:
+            subscriber.unregister()
+
+
+@pytest.fixture
+def listen(node: Any) -> Iterator[Callable[[str], Listener]]:
+    listeners: list[Listener] = []
+
+    def make(prefix: str = "") -> Listener:
+        listeners.append(Listener(prefix))
+        return listeners[-1]
+
+    yield make
+    for listener in listeners:
+        listener.close()
+
+
+def replay(env: Any, *args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, str(ROSMC), "replay", *args],
+        env=dict(env),
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+
+
+def publishers(master: Any, topic: str) -> list[str]:
+    _, _, (pubs, _, _) = master.proxy().getSystemState("/replay_tests")
+    return next((nodes for name, nodes in pubs if name == topic), [])
+
+
+def test_replay_republishes_every_event_and_the_final_snapshot(
+    node: Any, journal: Path, listen: Callable[[str], Listener]
+) -> None:
+    listener = listen("")
+    started = time.monotonic()
+    done = replay(node.env, str(journal), "--rate", "10")
+    assert done.returncode == 0, done.stderr
+    assert listener.wait(lambda: EVENTS in listener.snapshots)
+    assert listener.events == list(range(1, EVENTS + 1))
+    assert listener.snapshots[0] == 0 and listener.snapshots[-1] == EVENTS
+    assert "replay done at revision 24" in done.stdout
+    assert time.monotonic() - started < 30
+    assert publishers(node, "/rosmc/mission") == []  # the replay left the graph
+
+
+def test_replay_from_a_start_time_begins_with_the_mission_then(
+    node: Any, journal: Path, listen: Callable[[str], Listener]
+) -> None:
+    listener = listen("")
+    start = 10.5 * SPACING  # revision 10 is the current one then
+    done = replay(node.env, str(journal), "--rate", "10", "--start", str(start))
+    assert done.returncode == 0, done.stderr
+    assert listener.wait(lambda: EVENTS in listener.snapshots)
+    assert listener.snapshots[0] == 10
+    assert listener.events == list(range(11, EVENTS + 1))
+
+
+def test_replay_refuses_live_names_but_plays_under_a_prefix(
+    node: Any, journal: Path, listen: Callable[[str], Listener]
+) -> None:
+    live = rospy.Publisher("/rosmc/mission", wire.Mission, queue_size=1, latch=True)
+    try:
+        deadline = time.monotonic() + 10
+        while not publishers(node, "/rosmc/mission") and time.monotonic() < deadline:
+            time.sleep(0.05)
+        refused = replay(node.env, str(journal), "--rate", "50")
+        assert refused.returncode == 1
+        assert f"/rosmc/mission by {rospy.get_name()}" in refused.stderr
+        assert "--prefix" in refused.stderr
+        listener = listen("/replay")
+        done = replay(node.env, str(journal), "--rate", "50", "--prefix", "/replay")
+        assert done.returncode == 0, done.stderr
+        assert listener.wait(lambda: EVENTS in listener.snapshots)
+        assert listener.events == list(range(1, EVENTS + 1))
+    finally:
+        live.unregister()
