@@ -88,6 +88,7 @@ class MissionHistory:
         self.problems = tuple(f"journal {self.path}: {text}" for text in self._problems)
         """Revisions that could not be rebuilt and why (empty for an intact journal)."""
         self._revisions = [entry.info.revision for entry in self._entries]
+        self._times = [entry.info.log_time for entry in self._entries]
         self._cache: tuple[int, Mission] | None = None
 
     @classmethod
@@ -140,23 +141,23 @@ class MissionHistory:
         """
         if not t >= 0:
             raise InvalidRequest(f"a time must be 0 or more, got {t}")
-        stamp = int(t) if log_time else self.start + round(t * 1e9)
-        times = [entry.info.log_time for entry in self._entries]
-        index = max(0, bisect.bisect_right(times, stamp) - 1)
-        return self._state(index)
+        return self._state(self._index_of(int(t) if log_time else self._log_time(t)))
 
     def revision_at(self, t: float) -> Revision:
         """The revision current ``t`` seconds after the start."""
-        return self._entries[self._index_at(t)].info
+        return self._entries[self._index_of(self._log_time(max(t, 0.0)))].info
 
     def timeline(self) -> Timeline:
         """Every robot's skill executions, barrier waits and barrier releases."""
         return self._timeline.build(self.seconds(self.end))
 
     # -- building ----------------------------------------------------------------------
-    def _index_at(self, t: float) -> int:
-        times = [entry.info.log_time for entry in self._entries]
-        return max(0, bisect.bisect_right(times, self.start + round(max(t, 0.0) * 1e9)) - 1)
+    def _log_time(self, seconds: float) -> int:
+        return self.start + round(seconds * 1e9)
+
+    def _index_of(self, log_time: int) -> int:
+        """The last entry journaled at or before ``log_time`` (the first if none was)."""
+        return max(0, bisect.bisect_right(self._times, log_time) - 1)
 
     def _state(self, index: int) -> MissionState:
         start = index
@@ -214,7 +215,8 @@ class MissionHistory:
                     f"revision {pending[0].revision} replaced the mission but its snapshot is "
                     f"missing; revisions from {pending[0].revision} on are left out"
                 )
-                pending, broken_at = None, pending[0].revision
+                broken_at = pending[0].revision
+                pending = None
                 continue
             if revision != mission.revision + 1:
                 broken_at = mission.revision + 1

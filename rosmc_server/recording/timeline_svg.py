@@ -210,7 +210,7 @@ def _legend(y: float) -> list[str]:
         ("white", f'stroke="{INK}" stroke-dasharray="4 2"', "stopped / unfinished"),
     )
     out = []
-    x = LABEL_WIDTH
+    x = float(LABEL_WIDTH)
     for colour, stroke, text in items:
         out.append(f'<rect x="{x}" y="{y - 10}" width="14" height="12" fill="{colour}" {stroke}/>')
         out.append(f'<text x="{x + 20}" y="{y}">{escape(text)}</text>')
