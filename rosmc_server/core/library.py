@@ -9,14 +9,13 @@ the file, the key and the problem.
 from __future__ import annotations
 
 import enum
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, NoReturn
 
 import yaml
 
+from .documents import DocumentReader
 from .errors import InvalidRequest, LibraryError, NotFound, RuleViolation
 from .params import (
     COMPATIBLE_MARKERS,
@@ -176,7 +175,7 @@ def _yaml_problem(error: yaml.YAMLError) -> str:
 
 def library_from_dict(data: object, source: str = "<library>") -> Library:
     """Build a library from parsed YAML data, checking every key."""
-    reader = _Reader(source)
+    reader = DocumentReader(source, LibraryError)
     top = reader.mapping(
         data, "", required={"rosmc_library", "name", "models", "agents"}, optional=set()
     )
@@ -194,7 +193,7 @@ def library_from_dict(data: object, source: str = "<library>") -> Library:
 
 
 def _read_agents(
-    reader: _Reader, raw: object, models: Mapping[str, Mapping[str, SkillSpec]]
+    reader: DocumentReader, raw: object, models: Mapping[str, Mapping[str, SkillSpec]]
 ) -> tuple[AgentSpec, ...]:
     agents: list[AgentSpec] = []
     for name, entry in reader.mapping(raw, "agents").items():
@@ -213,7 +212,7 @@ def _read_agents(
     return tuple(agents)
 
 
-def _read_model(reader: _Reader, raw: object, key: str) -> dict[str, SkillSpec]:
+def _read_model(reader: DocumentReader, raw: object, key: str) -> dict[str, SkillSpec]:
     body = reader.mapping(raw, key, required={"skills"}, optional={"description"})
     skills: dict[str, SkillSpec] = {}
     for name, entry in reader.mapping(body["skills"], f"{key}.skills").items():
@@ -221,7 +220,7 @@ def _read_model(reader: _Reader, raw: object, key: str) -> dict[str, SkillSpec]:
     return skills
 
 
-def _read_skill(reader: _Reader, name: str, raw: object, key: str) -> SkillSpec:
+def _read_skill(reader: DocumentReader, name: str, raw: object, key: str) -> SkillSpec:
     body = reader.mapping(
         raw, key, optional={"description", "duration", "parameters"}, allow_none=True
     )
@@ -237,7 +236,9 @@ def _read_skill(reader: _Reader, name: str, raw: object, key: str) -> SkillSpec:
     return SkillSpec(name, parameters, description, duration)
 
 
-def _read_parameter(reader: _Reader, skill: str, name: str, raw: object, key: str) -> ParameterSpec:
+def _read_parameter(
+    reader: DocumentReader, skill: str, name: str, raw: object, key: str
+) -> ParameterSpec:
     body = reader.mapping(
         raw,
         key,
@@ -257,7 +258,7 @@ def _read_parameter(reader: _Reader, skill: str, name: str, raw: object, key: st
         ParamType.FLOAT,
     ):
         reader.fail(key, "min and max apply to int and float parameters only")
-    choices = reader.sequence(body.get("choices", []), f"{key}.choices")
+    choices = reader.items(body.get("choices", []), f"{key}.choices")
     try:
         checked_choices = tuple(check_value(ptype, c, f"{key}.choices") for c in choices)
         spec = ParameterSpec(
@@ -278,7 +279,7 @@ def _read_parameter(reader: _Reader, skill: str, name: str, raw: object, key: st
 
 
 def _read_marker_type(
-    reader: _Reader, raw: object, ptype: ParamType, key: str
+    reader: DocumentReader, raw: object, ptype: ParamType, key: str
 ) -> MarkerType | None:
     if raw is None:
         return None
@@ -290,55 +291,3 @@ def _read_marker_type(
         expected = MARKER_PARAM_TYPE[marker].name.lower()
         reader.fail(key, f"a {marker.name.lower()} marker fills {expected} parameters only")
     return marker
-
-
-class _Reader:
-    """Checks pieces of a parsed YAML document and names the key on failure."""
-
-    def __init__(self, source: str) -> None:
-        self.source = source
-
-    def fail(self, key: str, problem: str) -> NoReturn:
-        where = f"{self.source}: {key}" if key else self.source
-        raise LibraryError(f"{where}: {problem}")
-
-    def mapping(
-        self,
-        raw: object,
-        key: str,
-        required: set[str] | frozenset[str] = frozenset(),
-        optional: set[str] | frozenset[str] | None = None,
-        allow_none: bool = False,
-    ) -> dict[str, Any]:
-        if raw is None and allow_none:
-            raw = {}
-        if not isinstance(raw, dict):
-            self.fail(key, f"must be a mapping, got {type(raw).__name__}")
-        for name in raw:
-            if not isinstance(name, str):
-                self.fail(key, f"has a non-text key {name!r}")
-        missing = sorted(required - raw.keys())
-        if missing:
-            self.fail(key, f"is missing {', '.join(missing)}")
-        if optional is not None:
-            unknown = sorted(raw.keys() - required - optional)
-            if unknown:
-                self.fail(key, f"has unknown keys {', '.join(unknown)}")
-        return raw
-
-    def sequence(self, raw: object, key: str) -> list[Any]:
-        if not isinstance(raw, list):
-            self.fail(key, f"must be a list, got {type(raw).__name__}")
-        return raw
-
-    def text(self, raw: object, key: str, empty: bool = False) -> str:
-        if not isinstance(raw, str) or (not empty and not raw.strip()):
-            self.fail(key, f"must be non-empty text, got {raw!r}")
-        return raw
-
-    def number(self, raw: object, key: str) -> float:
-        if isinstance(raw, bool) or not isinstance(raw, (int, float)):
-            self.fail(key, f"must be a number, got {raw!r}")
-        if not math.isfinite(raw):
-            self.fail(key, f"must be a finite number, got {raw!r}")
-        return float(raw)

@@ -8,15 +8,15 @@ nothing is half-loaded. Python object tags are refused, never executed.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import replace
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import Any
 
 import yaml
 
 from .barriers import describe_cycle, find_deadlock
+from .documents import DocumentReader
 from .errors import MissionFileError, RosmcError
 from .library import Library
 from .model import Barrier, Resolution, SkillInstance, SkillStatus, TaskMarker, Transfer
@@ -106,10 +106,10 @@ def mission_from_dict(
     data: object, library: Library, source: str = "<mission>"
 ) -> tuple[MissionContent, int]:
     """Build and check a mission from plain data."""
-    reader = _FileReader(source)
+    reader = DocumentReader(source, MissionFileError)
     if isinstance(data, dict) and "rosmc_mission" in data:
         _check_version(reader, data["rosmc_mission"])  # before anything a new version may change
-    top = reader.fields(
+    top = reader.mapping(
         data,
         "",
         {"rosmc_mission", "library", "revision", "tasks"},
@@ -132,18 +132,18 @@ def mission_from_dict(
     return MissionContent(library.name, tasks, barriers, markers), revision
 
 
-def _check_version(reader: _FileReader, version: object) -> None:
+def _check_version(reader: DocumentReader, version: object) -> None:
     if isinstance(version, bool) or version != MISSION_VERSION:
         reader.fail("rosmc_mission", f"unsupported mission file version {version!r}")
 
 
-def _read_markers(reader: _FileReader, raw: object) -> dict[str, TaskMarker]:
+def _read_markers(reader: DocumentReader, raw: object) -> dict[str, TaskMarker]:
     from .markers import check_marker
 
     markers: dict[str, TaskMarker] = {}
     for i, entry in enumerate(reader.items(raw, "markers")):
         key = f"markers[{i}]"
-        body = reader.fields(entry, key, {"name", "type", "pose"}, {"vertices"})
+        body = reader.mapping(entry, key, {"name", "type", "pose"}, {"vertices"})
         marker_type = reader.enum(MarkerType, body["type"], f"{key}.type")
         vertices = reader.items(body.get("vertices", []), f"{key}.vertices")
         try:
@@ -164,14 +164,14 @@ def _read_markers(reader: _FileReader, raw: object) -> dict[str, TaskMarker]:
 
 
 def _read_tasks(
-    reader: _FileReader,
+    reader: DocumentReader,
     raw: object,
     library: Library,
     markers: Mapping[str, TaskMarker],
 ) -> dict[str, list[SkillInstance]]:
     from .editing import bound_values, check_params
 
-    body = reader.fields(raw, "tasks", set(), None)
+    body = reader.mapping(raw, "tasks", set(), None)
     tasks: dict[str, list[SkillInstance]] = {agent: [] for agent in library.dynamic_agents}
     seen: set[str] = set()
     for agent, entries in body.items():
@@ -203,8 +203,8 @@ def _marker(markers: Mapping[str, TaskMarker], name: str) -> TaskMarker:
     return markers[name]
 
 
-def _read_skill(reader: _FileReader, raw: object, agent: str, key: str) -> SkillInstance:
-    body = reader.fields(
+def _read_skill(reader: DocumentReader, raw: object, agent: str, key: str) -> SkillInstance:
+    body = reader.mapping(
         raw,
         key,
         {"id", "skill", "params"},
@@ -222,8 +222,8 @@ def _read_skill(reader: _FileReader, raw: object, agent: str, key: str) -> Skill
             "finished",
         },
     )
-    params = reader.fields(body["params"], f"{key}.params", set(), None)
-    bindings = reader.fields(body.get("bindings", {}), f"{key}.bindings", set(), None)
+    params = reader.mapping(body["params"], f"{key}.params", set(), None)
+    bindings = reader.mapping(body.get("bindings", {}), f"{key}.bindings", set(), None)
     for name, marker in bindings.items():
         reader.text(marker, f"{key}.bindings.{name}")
     return SkillInstance(
@@ -237,15 +237,15 @@ def _read_skill(reader: _FileReader, raw: object, agent: str, key: str) -> Skill
         transfer=reader.enum(Transfer, body.get("transfer", "NONE"), f"{key}.transfer"),
         resolution=reader.enum(Resolution, body.get("resolution", "NONE"), f"{key}.resolution"),
         attempt=reader.whole(body.get("attempt", 1), f"{key}.attempt", minimum=1),
-        timeout=reader.number(body.get("timeout", 0.0), f"{key}.timeout"),
+        timeout=reader.number(body.get("timeout", 0.0), f"{key}.timeout", minimum=0.0),
         max_retries=reader.whole(body.get("max_retries", 0), f"{key}.max_retries", minimum=0),
         status_text=reader.text(body.get("status_text", ""), f"{key}.status_text", empty=True),
-        started=reader.number(body.get("started", 0.0), f"{key}.started"),
-        finished=reader.number(body.get("finished", 0.0), f"{key}.finished"),
+        started=reader.number(body.get("started", 0.0), f"{key}.started", minimum=0.0),
+        finished=reader.number(body.get("finished", 0.0), f"{key}.finished", minimum=0.0),
     )
 
 
-def _check_sections(reader: _FileReader, task: list[SkillInstance], key: str) -> None:
+def _check_sections(reader: DocumentReader, task: list[SkillInstance], key: str) -> None:
     """Synchronized skills first, then uploading blueprint skills, then the rest.
 
     A robot runs its skills in order, so a skill that has started follows only
@@ -280,14 +280,14 @@ def _check_sections(reader: _FileReader, task: list[SkillInstance], key: str) ->
 
 
 def _read_barriers(
-    reader: _FileReader, raw: object, tasks: Mapping[str, list[SkillInstance]]
+    reader: DocumentReader, raw: object, tasks: Mapping[str, list[SkillInstance]]
 ) -> dict[str, Barrier]:
     agent_of = {skill.id: agent for agent, task in tasks.items() for skill in task}
     barriers: dict[str, Barrier] = {}
     member_of: dict[str, str] = {}
     for i, entry in enumerate(reader.items(raw, "barriers")):
         key = f"barriers[{i}]"
-        body = reader.fields(entry, key, {"id", "skills"}, set())
+        body = reader.mapping(entry, key, {"id", "skills"}, set())
         barrier_id = reader.text(body["id"], f"{key}.id")
         members = tuple(reader.text(s, f"{key}.skills") for s in reader.items(body["skills"], key))
         if barrier_id in barriers or barrier_id in agent_of:
@@ -343,62 +343,3 @@ def _marker_to_dict(marker: TaskMarker) -> dict[str, Any]:
     if marker.vertices:
         data["vertices"] = [v.to_dict() for v in marker.vertices]
     return data
-
-
-class _FileReader:
-    """Checks pieces of a parsed mission document and names the key on failure."""
-
-    def __init__(self, source: str) -> None:
-        self.source = source
-
-    def fail(self, key: str, problem: str) -> NoReturn:
-        raise MissionFileError(
-            f"{self.source}: {key}: {problem}" if key else f"{self.source}: {problem}"
-        )
-
-    def fields(
-        self, raw: object, key: str, required: set[str], optional: set[str] | None
-    ) -> dict[str, Any]:
-        if not isinstance(raw, dict):
-            self.fail(key, f"must be a mapping, got {type(raw).__name__}")
-        if any(not isinstance(name, str) for name in raw):
-            self.fail(key, "has a key that is not text")
-        missing = sorted(required - raw.keys())
-        if missing:
-            self.fail(key, f"is missing {', '.join(missing)}")
-        if optional is not None:
-            unknown = sorted(raw.keys() - required - optional)
-            if unknown:
-                self.fail(key, f"has unknown keys {', '.join(unknown)}")
-        return raw
-
-    def items(self, raw: object, key: str) -> list[Any]:
-        if not isinstance(raw, list):
-            self.fail(key, f"must be a list, got {type(raw).__name__}")
-        return raw
-
-    def text(self, raw: object, key: str, empty: bool = False) -> str:
-        if not isinstance(raw, str) or (not empty and not raw.strip()):
-            self.fail(key, f"must be non-empty text, got {raw!r}")
-        return raw
-
-    def number(self, raw: object, key: str) -> float:
-        if (
-            isinstance(raw, bool)
-            or not isinstance(raw, (int, float))
-            or not math.isfinite(raw)
-            or raw < 0
-        ):
-            self.fail(key, f"must be a non-negative number, got {raw!r}")
-        return float(raw)
-
-    def whole(self, raw: object, key: str, minimum: int) -> int:
-        if isinstance(raw, bool) or not isinstance(raw, int) or raw < minimum:
-            self.fail(key, f"must be a whole number >= {minimum}, got {raw!r}")
-        return raw
-
-    def enum(self, kind: Any, raw: object, key: str) -> Any:
-        names = [member.name for member in kind]
-        if raw not in names:
-            self.fail(key, f"must be one of {', '.join(names)}, got {raw!r}")
-        return kind[raw]

@@ -7,14 +7,13 @@ refused with an error naming the file, the key and the problem.
 
 from __future__ import annotations
 
-import math
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import Any
 
 import yaml
 
+from rosmc_server.core.documents import DocumentReader
 from rosmc_server.core.errors import RosmcError
 
 SCENARIO_VERSION = 1
@@ -130,8 +129,8 @@ def load_scenario(path: str | Path) -> Scenario:
 
 def scenario_from_dict(data: object, source: str = "<scenario>") -> Scenario:
     """Build a scenario from parsed YAML, checking every key."""
-    r = _Reader(source)
-    top = r.fields(
+    r = DocumentReader(source, ScenarioError)
+    top = r.mapping(
         data,
         "",
         {"rosmc_scenario", "name", "site", "lander", "robots"},
@@ -139,13 +138,13 @@ def scenario_from_dict(data: object, source: str = "<scenario>") -> Scenario:
     )
     if top["rosmc_scenario"] != SCENARIO_VERSION:
         r.fail("rosmc_scenario", f"unsupported version {top['rosmc_scenario']!r}")
-    site = r.fields(top["site"], "site", {"x_min", "x_max", "y_min", "y_max"}, set())
+    site = r.mapping(top["site"], "site", {"x_min", "x_max", "y_min", "y_max"}, set())
     bounds = tuple(r.number(site[k], f"site.{k}") for k in ("x_min", "x_max", "y_min", "y_max"))
     if bounds[0] >= bounds[1] or bounds[2] >= bounds[3]:
         r.fail("site", "x_min/y_min must be below x_max/y_max")
-    lander = r.fields(top["lander"], "lander", {"radius", "charge_radius", "wifi_radius"}, set())
-    link = r.fields(top.get("link", {}), "link", set(), {"latency", "drop"})
-    scoring = r.fields(top.get("scoring", {}), "scoring", set(), {"min_score", "science_only"})
+    lander = r.mapping(top["lander"], "lander", {"radius", "charge_radius", "wifi_radius"}, set())
+    link = r.mapping(top.get("link", {}), "link", set(), {"latency", "drop"})
+    scoring = r.mapping(top.get("scoring", {}), "scoring", set(), {"min_score", "science_only"})
     scenario = Scenario(
         name=r.text(top["name"], "name"),
         bounds=(bounds[0], bounds[1], bounds[2], bounds[3]),
@@ -169,7 +168,7 @@ def scenario_from_dict(data: object, source: str = "<scenario>") -> Scenario:
         ),
         robots=tuple(
             _robot(r, name, spec, f"robots.{name}")
-            for name, spec in r.fields(top["robots"], "robots", set(), None).items()
+            for name, spec in r.mapping(top["robots"], "robots", set(), None).items()
         ),
         latency=r.number(link.get("latency", 0.0), "link.latency", minimum=0.0),
         drop=r.number(link.get("drop", 0.0), "link.drop", minimum=0.0, maximum=1.0),
@@ -183,8 +182,8 @@ def scenario_from_dict(data: object, source: str = "<scenario>") -> Scenario:
     return scenario
 
 
-def _obstacle(r: _Reader, raw: object, key: str) -> Obstacle:
-    body = r.fields(
+def _obstacle(r: DocumentReader, raw: object, key: str) -> Obstacle:
+    body = r.mapping(
         raw, key, {"name", "shape", "x", "y", "height"}, {"radius", "size_x", "size_y", "yaw"}
     )
     shape = body["shape"]
@@ -207,8 +206,8 @@ def _obstacle(r: _Reader, raw: object, key: str) -> Obstacle:
     )
 
 
-def _slope(r: _Reader, raw: object, key: str) -> Slope:
-    body = r.fields(raw, key, {"name", "x", "y", "size_x", "size_y", "speed_factor"}, set())
+def _slope(r: DocumentReader, raw: object, key: str) -> Slope:
+    body = r.mapping(raw, key, {"name", "x", "y", "size_x", "size_y", "speed_factor"}, set())
     return Slope(
         r.text(body["name"], f"{key}.name"),
         r.number(body["x"], f"{key}.x"),
@@ -219,8 +218,8 @@ def _slope(r: _Reader, raw: object, key: str) -> Slope:
     )
 
 
-def _region(r: _Reader, raw: object, key: str) -> Region:
-    body = r.fields(raw, key, {"name", "x", "y", "radius", "max_score", "stones"}, set())
+def _region(r: DocumentReader, raw: object, key: str) -> Region:
+    body = r.mapping(raw, key, {"name", "x", "y", "radius", "max_score", "stones"}, set())
     stones = body["stones"]
     if isinstance(stones, bool) or not isinstance(stones, int) or stones < 1:
         r.fail(f"{key}.stones", "must be a whole number of at least 1")
@@ -234,8 +233,8 @@ def _region(r: _Reader, raw: object, key: str) -> Region:
     )
 
 
-def _box(r: _Reader, raw: object, key: str) -> BoxSpec:
-    body = r.fields(raw, key, {"name", "kind", "x", "y"}, {"wifi_radius"})
+def _box(r: DocumentReader, raw: object, key: str) -> BoxSpec:
+    body = r.mapping(raw, key, {"name", "kind", "x", "y"}, {"wifi_radius"})
     if body["kind"] not in BOX_KINDS:
         r.fail(f"{key}.kind", f"must be one of {', '.join(BOX_KINDS)}, got {body['kind']!r}")
     if body["kind"] == "wifi" and "wifi_radius" not in body:
@@ -249,8 +248,8 @@ def _box(r: _Reader, raw: object, key: str) -> BoxSpec:
     )
 
 
-def _robot(r: _Reader, name: str, raw: object, key: str) -> RobotSpec:
-    body = r.fields(raw, key, {"kind", "x", "y", "speed", "endurance"}, {"yaw"})
+def _robot(r: DocumentReader, name: str, raw: object, key: str) -> RobotSpec:
+    body = r.mapping(raw, key, {"kind", "x", "y", "speed", "endurance"}, {"yaw"})
     if body["kind"] not in ROBOT_KINDS:
         r.fail(f"{key}.kind", f"must be one of {', '.join(ROBOT_KINDS)}, got {body['kind']!r}")
     return RobotSpec(
@@ -264,7 +263,7 @@ def _robot(r: _Reader, name: str, raw: object, key: str) -> RobotSpec:
     )
 
 
-def _check_unique(r: _Reader, scenario: Scenario) -> None:
+def _check_unique(r: DocumentReader, scenario: Scenario) -> None:
     names: set[str] = set()
     things: list[Any] = [*scenario.obstacles, *scenario.regions, *scenario.boxes, *scenario.robots]
     for thing in things:
@@ -275,54 +274,3 @@ def _check_unique(r: _Reader, scenario: Scenario) -> None:
     for thing in things:
         if not (x_min <= thing.x <= x_max and y_min <= thing.y <= y_max):
             r.fail("", f"{thing.name!r} lies outside the site")
-
-
-class _Reader:
-    def __init__(self, source: str) -> None:
-        self.source = source
-
-    def fail(self, key: str, problem: str) -> NoReturn:
-        raise ScenarioError(
-            f"{self.source}: {key}: {problem}" if key else f"{self.source}: {problem}"
-        )
-
-    def fields(
-        self, raw: object, key: str, required: set[str], optional: set[str] | None
-    ) -> dict[str, Any]:
-        if not isinstance(raw, Mapping):
-            self.fail(key, f"must be a mapping, got {type(raw).__name__}")
-        missing = sorted(required - set(raw))
-        if missing:
-            self.fail(key, f"is missing {', '.join(missing)}")
-        if optional is not None:
-            unknown = sorted(set(raw) - required - optional)
-            if unknown:
-                self.fail(key, f"has unknown keys {', '.join(map(str, unknown))}")
-        return dict(raw)
-
-    def items(self, raw: object, key: str) -> list[Any]:
-        if not isinstance(raw, list):
-            self.fail(key, f"must be a list, got {type(raw).__name__}")
-        return raw
-
-    def text(self, raw: object, key: str) -> str:
-        if not isinstance(raw, str) or not raw.strip():
-            self.fail(key, f"must be non-empty text, got {raw!r}")
-        return raw
-
-    def number(
-        self, raw: object, key: str, minimum: float | None = None, maximum: float | None = None
-    ) -> float:
-        if isinstance(raw, bool) or not isinstance(raw, (int, float)) or not math.isfinite(raw):
-            self.fail(key, f"must be a finite number, got {raw!r}")
-        if minimum is not None and raw < minimum:
-            self.fail(key, f"must be at least {minimum:g}")
-        if maximum is not None and raw > maximum:
-            self.fail(key, f"must be at most {maximum:g}")
-        return float(raw)
-
-    def positive(self, raw: object, key: str) -> float:
-        value = self.number(raw, key)
-        if value <= 0:
-            self.fail(key, "must be positive")
-        return value

@@ -1,0 +1,99 @@
+"""Reading parsed YAML documents (libraries, mission files, scenarios) with precise errors.
+
+A :class:`DocumentReader` checks one piece of a document at a time and, on a
+problem, raises the caller's error class with one sentence naming the source
+file, the key path and the problem, e.g.
+``library.yaml: models.drone.skills.take_off.duration: must not be negative``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, NoReturn
+
+from .errors import RosmcError
+
+
+class DocumentReader:
+    """Checks the pieces of one parsed document; failures raise ``error``."""
+
+    def __init__(self, source: str, error: type[RosmcError]) -> None:
+        self.source = source
+        self.error = error
+
+    def fail(self, key: str, problem: str) -> NoReturn:
+        """Raise the reader's error about ``key``."""
+        where = f"{self.source}: {key}" if key else self.source
+        raise self.error(f"{where}: {problem}")
+
+    def mapping(
+        self,
+        raw: object,
+        key: str,
+        required: set[str] | frozenset[str] = frozenset(),
+        optional: set[str] | frozenset[str] | None = None,
+        allow_none: bool = False,
+    ) -> dict[str, Any]:
+        """A mapping with text keys, the ``required`` ones, and (unless None) no keys
+        beyond ``optional``."""
+        if raw is None and allow_none:
+            raw = {}
+        if not isinstance(raw, dict):
+            self.fail(key, f"must be a mapping, got {type(raw).__name__}")
+        for name in raw:
+            if not isinstance(name, str):
+                self.fail(key, f"has a non-text key {name!r}")
+        missing = sorted(required - raw.keys())
+        if missing:
+            self.fail(key, f"is missing {', '.join(missing)}")
+        if optional is not None:
+            unknown = sorted(raw.keys() - required - optional)
+            if unknown:
+                self.fail(key, f"has unknown keys {', '.join(unknown)}")
+        return raw
+
+    def items(self, raw: object, key: str) -> list[Any]:
+        """A list."""
+        if not isinstance(raw, list):
+            self.fail(key, f"must be a list, got {type(raw).__name__}")
+        return raw
+
+    def text(self, raw: object, key: str, empty: bool = False) -> str:
+        """Text, non-empty unless ``empty``."""
+        if not isinstance(raw, str) or (not empty and not raw.strip()):
+            self.fail(key, f"must be non-empty text, got {raw!r}")
+        return raw
+
+    def number(
+        self, raw: object, key: str, minimum: float | None = None, maximum: float | None = None
+    ) -> float:
+        """A finite number within the bounds given."""
+        if isinstance(raw, bool) or not isinstance(raw, (int, float)):
+            self.fail(key, f"must be a number, got {raw!r}")
+        if not math.isfinite(raw):
+            self.fail(key, f"must be a finite number, got {raw!r}")
+        if minimum is not None and raw < minimum:
+            self.fail(key, f"must be at least {minimum:g}, got {raw!r}")
+        if maximum is not None and raw > maximum:
+            self.fail(key, f"must be at most {maximum:g}, got {raw!r}")
+        return float(raw)
+
+    def positive(self, raw: object, key: str) -> float:
+        """A finite number above zero."""
+        value = self.number(raw, key)
+        if value <= 0:
+            self.fail(key, f"must be positive, got {raw!r}")
+        return value
+
+    def whole(self, raw: object, key: str, minimum: int) -> int:
+        """A whole number of at least ``minimum``."""
+        if isinstance(raw, bool) or not isinstance(raw, int) or raw < minimum:
+            self.fail(key, f"must be a whole number >= {minimum}, got {raw!r}")
+        return raw
+
+    def enum(self, kind: Any, raw: object, key: str) -> Any:
+        """A member of enum ``kind``, given by name."""
+        names = [member.name for member in kind]
+        if raw not in names:
+            self.fail(key, f"must be one of {', '.join(names)}, got {raw!r}")
+        return kind[raw]
