@@ -9,9 +9,38 @@ file, the key path and the problem, e.g.
 from __future__ import annotations
 
 import math
+import re
 from typing import Any, NoReturn
 
+import yaml
+
 from .errors import RosmcError
+
+# libyaml's C loader and dumper when present: the same safe subset (plain data only,
+# no Python object tags), several times faster on large missions.
+SafeLoader: type[yaml.SafeLoader] = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+SafeDumper: type[yaml.SafeDumper] = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+
+
+MAX_NESTING = 100  # deeper YAML is refused before parsing: libyaml can crash on it
+_BRACKETS = re.compile(r"[\[\]{}]")
+_INDENT = re.compile(r"^( *)", re.MULTILINE)
+
+
+def load_yaml(text: str) -> Any:
+    """Parse YAML text as plain data only (a Python object tag raises ConstructorError).
+
+    A document nested more than MAX_NESTING levels deep raises YAMLError without
+    being parsed: deep enough nesting crashes libyaml (and recursion limits Python's).
+    """
+    depth = deepest = 0
+    for match in _BRACKETS.finditer(text):
+        depth += 1 if match.group() in "[{" else -1
+        deepest = max(deepest, depth)
+    indent = max((len(m.group(1)) for m in _INDENT.finditer(text)), default=0)
+    if deepest > MAX_NESTING or indent > 2 * MAX_NESTING:
+        raise yaml.YAMLError(f"the document is nested more than {MAX_NESTING} levels deep")
+    return yaml.load(text, Loader=SafeLoader)  # nosec: a safe loader
 
 
 class DocumentReader:

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import yaml
 
-from .documents import DocumentReader
+from .documents import DocumentReader, load_yaml
 from .errors import InvalidRequest, LibraryError, NotFound, RuleViolation
 from .params import (
     COMPATIBLE_MARKERS,
@@ -161,7 +161,7 @@ def load_library(path: str | Path) -> Library:
     except UnicodeDecodeError as error:
         raise LibraryError(f"{source}: the file is not UTF-8 text (byte {error.start})") from error
     try:
-        data = yaml.safe_load(text)
+        data = load_yaml(text)
     except yaml.YAMLError as error:
         raise LibraryError(f"{source}: not valid YAML ({_yaml_problem(error)})") from error
     return library_from_dict(data, source)

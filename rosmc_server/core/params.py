@@ -97,23 +97,29 @@ def _finite(raw: object, what: str) -> float:
     return float(raw)
 
 
-def check_json_data(raw: object, what: str) -> Any:
+MAX_DEPTH = 32  # nesting of list/dict parameter values; deeper data is refused
+
+
+def check_json_data(raw: object, what: str, depth: int = 0) -> Any:
     """Return a deep copy of JSON-compatible data, or raise InvalidRequest.
 
-    Allowed: None, bool, int, finite float, str, lists and string-keyed dicts of these.
+    Allowed: None, bool, int, finite float, str, lists and string-keyed dicts of these,
+    nested at most MAX_DEPTH levels.
     """
     if raw is None or isinstance(raw, (bool, int, str)):
         return raw
     if isinstance(raw, float):
         return _finite(raw, what)
+    if depth >= MAX_DEPTH and isinstance(raw, (list, tuple, Mapping)):
+        raise InvalidRequest(f"{what} is nested more than {MAX_DEPTH} levels deep")
     if isinstance(raw, (list, tuple)):
-        return [check_json_data(item, f"{what}[{i}]") for i, item in enumerate(raw)]
+        return [check_json_data(item, f"{what}[{i}]", depth + 1) for i, item in enumerate(raw)]
     if isinstance(raw, Mapping):
         out: dict[str, Any] = {}
         for key, item in raw.items():
             if not isinstance(key, str):
                 raise InvalidRequest(f"{what} has a non-text key {key!r}")
-            out[key] = check_json_data(item, f"{what}.{key}")
+            out[key] = check_json_data(item, f"{what}.{key}", depth + 1)
         return out
     raise InvalidRequest(f"{what} holds a {type(raw).__name__}, which is not list/dict data")
 

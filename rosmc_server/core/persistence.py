@@ -16,7 +16,7 @@ from typing import Any
 import yaml
 
 from .barriers import describe_cycle, find_deadlock
-from .documents import DocumentReader
+from .documents import DocumentReader, SafeDumper, load_yaml
 from .errors import MissionFileError, RosmcError
 from .library import Library
 from .model import Barrier, Resolution, SkillInstance, SkillStatus, TaskMarker, Transfer
@@ -41,7 +41,7 @@ def mission_to_dict(content: MissionContent, revision: int) -> dict[str, Any]:
     }
 
 
-class _PlainDumper(yaml.SafeDumper):
+class _PlainDumper(SafeDumper):  # type: ignore[misc, valid-type]
     """A safe dumper that writes shared values out in full instead of as anchors and aliases.
 
     A retried skill shares its parameter values with the original; aliases would
@@ -85,7 +85,7 @@ def load_mission(path: str | Path, library: Library) -> tuple[MissionContent, in
 def parse_mission(text: str, library: Library, source: str) -> tuple[MissionContent, int]:
     """Parse and check a mission document; return its content and revision."""
     try:
-        data = yaml.safe_load(text)
+        data = load_yaml(text)
     except yaml.constructor.ConstructorError as error:
         raise MissionFileError(
             f"{source}: refused a YAML tag that is not plain data ({error.problem})"

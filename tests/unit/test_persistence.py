@@ -10,7 +10,10 @@ import pytest
 import yaml
 
 from rosmc_server.core import (
+    InvalidRequest,
+    Library,
     MarkerType,
+    Mission,
     MissionContent,
     MissionFileError,
     Pose,
@@ -416,3 +419,19 @@ def test_content_holds_only_what_the_file_says(library: Any) -> None:
         "rosmc_mission: 1\nlibrary: unit_team\nrevision: 0\ntasks: {}\n", library, "x"
     )
     assert content == MissionContent.empty(library)
+
+
+@pytest.mark.parametrize("depth", [150, 100_000])
+def test_deeply_nested_documents_are_refused_before_parsing(library: Library, depth: int) -> None:
+    """libyaml crashes the process on deep enough nesting; such a document never reaches it."""
+    for text in ("x: " + "[" * depth + "]" * depth, "x: " + "{a: " * depth + "}" * depth):
+        with pytest.raises(MissionFileError, match="nested more than"):
+            parse_mission(text, library, "deep.yaml")
+
+
+def test_a_parameter_value_nested_too_deeply_is_refused(mission: Mission) -> None:
+    deep: object = []
+    for _ in range(40):
+        deep = [deep]
+    with pytest.raises(InvalidRequest, match="nested more than"):
+        mission.add_skill("alpha", "wait", {"options": {"deep": deep}})
