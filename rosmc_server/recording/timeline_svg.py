@@ -31,7 +31,7 @@ LANE_HEIGHT = 46
 BAR_HEIGHT = 26
 TOP = 48
 PNG_DENSITY = 144  # dpi: twice the SVG's pixel size, sharp on high-resolution screens
-CHAR_WIDTH = 6.2  # of the 11 px sans-serif labels, to decide whether a label fits its bar
+CHAR_WIDTH = 6.0  # about, in 11 px sans-serif: how much of a label fits its bar
 
 
 class TimelineExportError(RosmcError):
@@ -145,12 +145,21 @@ def _bar(interval: Interval, lane_y: float, scale: float) -> str:
         f'<g class="bar"><title>{escape(tip)}</title><rect x="{x}" y="{y}" width="{width}" '
         f'height="{BAR_HEIGHT}" rx="3" fill="{interval_colour(interval)}" {outline}/>'
     ]
-    if len(label) * CHAR_WIDTH + 6 <= width:
+    fits = _fit(label, width - 8)
+    if fits:
         parts.append(
-            f'<text x="{x + 4}" y="{y + BAR_HEIGHT / 2 + 4}" fill="white">{escape(label)}</text>'
+            f'<text x="{x + 4}" y="{y + BAR_HEIGHT / 2 + 4}" fill="white">{escape(fits)}</text>'
         )
     parts.append("</g>")
     return "".join(parts)
+
+
+def _fit(label: str, room: float) -> str:
+    """``label``, cut short with an ellipsis to fit ``room`` pixels ("" if too little is left)."""
+    chars = int(room / CHAR_WIDTH)
+    if len(label) <= chars:
+        return label
+    return label[: chars - 1] + "…" if chars >= 4 else ""
 
 
 def _release(release: BarrierRelease, row_of: dict[str, int], scale: float) -> str:

@@ -13,6 +13,10 @@ Publishes (each name behind ``prefix``):
     ``/rosmc/mission_events`` (rosmc/MissionEvent): every recorded event after the start.
     ``/rosmc/agent_states`` (rosmc/AgentStates): as recorded (the latest one at once).
     ``/rosmc/robot_reports`` (rosmc/RobotReport): as recorded.
+
+Services (behind ``prefix``):
+    ``/rosmc/get_mission`` (rosmc/GetMission): the mission as replayed so far, so clients that
+    start from it (``rosmc watch``, the GUIs) follow the replay as they follow a live server.
 """
 
 from __future__ import annotations
@@ -26,6 +30,7 @@ from typing import Any
 
 import rosgraph
 import rosmc.msg as wire
+import rosmc.srv as wire_srv
 import rospy
 
 from .. import interface
@@ -45,6 +50,8 @@ WARM_UP = 0.5
 """Seconds for subscribers to connect before the first message."""
 LINGER = 1.0
 """Seconds the last messages get to reach their subscribers before the node leaves."""
+
+GET_MISSION = interface.service_name("get_mission")
 
 TYPES: dict[str, Any] = {
     interface.MISSION_TOPIC: wire.Mission,
@@ -80,22 +87,24 @@ class ReplayConfig:
         return prefix + name
 
 
-def live_publishers(
-    topics: Sequence[str], caller_id: str = "/rosmc_replay"
-) -> dict[str, list[str]]:
-    """The nodes publishing on each of ``topics`` now (topics nobody publishes are left out).
+def taken_names(names: Sequence[str], caller_id: str = "/rosmc_replay") -> dict[str, list[str]]:
+    """The nodes publishing each of the topics, or serving each of the services, in ``names``.
+
+    Names nobody uses are left out.
 
     Raises:
         ServerUnavailable: The ROS master does not answer.
     """
     try:
-        publishers, _, _ = rosgraph.Master(caller_id).getSystemState()
+        publishers, _, services = rosgraph.Master(caller_id).getSystemState()
     except (OSError, rosgraph.MasterException) as err:
         raise ServerUnavailable(
             f"no ROS master answers at {rosgraph.get_master_uri()} ({err}); start roscore first"
         ) from err
-    wanted = set(topics)
-    return {topic: sorted(nodes) for topic, nodes in publishers if topic in wanted and nodes}
+    wanted = set(names)
+    return {
+        name: sorted(nodes) for name, nodes in [*publishers, *services] if name in wanted and nodes
+    }
 
 
 class RecordingReplayer:
@@ -134,21 +143,22 @@ class RecordingReplayer:
         self._latest = -1  # of the last event published
         events = [r.message for r in self._before if r.topic == interface.EVENTS_TOPIC]
         self._stamp = events[-1].stamp.to_sec() if events else 0.0  # mission clock of _latest
+        self._snapshot: Any = None  # the last snapshot published, for get_mission
 
     def check_names(self) -> None:
-        """Refuse to play if any node publishes on the replay's topics.
+        """Refuse to play if any node publishes the replay's topics or serves its service.
 
         Raises:
-            ReplayRefused: A live publisher exists (the message names it).
+            ReplayRefused: Another node uses one of the names (the message names it).
             ServerUnavailable: The ROS master does not answer.
         """
-        names = [self._config.topic(topic) for topic in TYPES]
+        names = [self._config.topic(topic) for topic in (*TYPES, GET_MISSION)]
         caller = rospy.get_name() if rospy.core.is_initialized() else "/rosmc_replay"
-        taken = live_publishers(names, caller)
+        taken = taken_names(names, caller)
         if taken:
-            held = "; ".join(f"{topic} by {', '.join(nodes)}" for topic, nodes in taken.items())
+            held = "; ".join(f"{name} by {', '.join(nodes)}" for name, nodes in taken.items())
             raise ReplayRefused(
-                f"these topics are published already: {held}. Stop the live mission server, or "
+                f"these names are in use already: {held}. Stop the live mission server, or "
                 "replay under a prefix (--prefix /replay)"
             )
 
@@ -165,12 +175,20 @@ class RecordingReplayer:
             self._publishers[topic] = rospy.Publisher(
                 name, msg_type, queue_size=1000, latch=latched
             )
-        rospy.on_shutdown(self._stop.set)
-        initial = self._history.at_time(self._config.start)
-        self._publish_snapshot(initial.revision)
+        self._publish_snapshot(self._history.at_time(self._config.start).revision)
         states = [r for r in self._before if r.topic == AGENT_STATES_TOPIC]
         if states:
             self._publishers[AGENT_STATES_TOPIC].publish(states[-1].message)
+        service = rospy.Service(
+            self._config.topic(GET_MISSION), wire_srv.GetMission, self._on_get_mission
+        )
+        rospy.on_shutdown(self._stop.set)
+        try:
+            return self._play()
+        finally:
+            service.shutdown()
+
+    def _play(self) -> int:
         if self._stop.wait(WARM_UP):
             return self._revision
         began = time.monotonic()
@@ -202,7 +220,7 @@ class RecordingReplayer:
         if record.topic == interface.MISSION_TOPIC:
             if int(msg.revision) > self._revision:  # a revision the history could not rebuild
                 self._publishers[interface.MISSION_TOPIC].publish(msg)
-                self._revision = int(msg.revision)
+                self._revision, self._snapshot = int(msg.revision), msg
             return False
         if record.topic == interface.EVENTS_TOPIC:
             revision = int(msg.revision)
@@ -223,8 +241,11 @@ class RecordingReplayer:
             return  # not rebuilt (a gap in the recording): its recorded snapshot follows
         msg = mission_to_msg(state.content(), revision, self._stamp)
         self._publishers[interface.MISSION_TOPIC].publish(msg)
-        self._revision = revision
+        self._revision, self._snapshot = revision, msg
         _log.debug("replay: snapshot of revision %d", revision)
+
+    def _on_get_mission(self, _request: Any) -> Any:
+        return wire_srv.GetMissionResponse(mission=self._snapshot)
 
 
 def _log_time(record: JournalRecord) -> int:

@@ -172,3 +172,17 @@ def test_replay_refuses_live_names_but_plays_under_a_prefix(
         assert listener.events == list(range(1, EVENTS + 1))
     finally:
         live.unregister()
+
+
+def test_rosmc_watch_follows_a_replay(node: Any, journal: Path, launch_process: Any) -> None:
+    # watch starts from get_mission, which the replay serves, then follows the events.
+    watch = launch_process(
+        [sys.executable, str(ROSMC), "--timeout", "20", "watch", "--count", "3"],
+        env=node.env,
+        name="watch",
+    )
+    done = replay(node.env, str(journal), "--rate", "0.5")
+    assert done.returncode == 0, done.stderr
+    assert watch.wait(timeout=20) == 0, watch.log()
+    events = [line.split()[:2] for line in watch.log().splitlines() if line[1:2].isdigit()]
+    assert len(events) == 3 and events[-1][1] == "SKILL_ADDED", watch.log()
