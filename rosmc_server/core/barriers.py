@@ -33,8 +33,9 @@ def find_deadlock(
     """Return the task-order edges of a cycle through the barrier groups, or None.
 
     ``tasks`` maps each agent to its skill ids in order; ``groups`` are the
-    barriers' member ids. Only agents with barrier members can take part in a
-    cycle, so the others are skipped.
+    barriers' member ids. A skill in no barrier only passes "runs before" on
+    along its task, so each task shrinks to its barrier members in order and
+    the graph has one node per barrier: small, whatever the mission's size.
     """
     point: dict[str, str] = {}
     for number, members in enumerate(groups):
@@ -42,11 +43,10 @@ def find_deadlock(
             point[skill_id] = f"barrier#{number}"
     graph: dict[str, list[tuple[str, OrderEdge]]] = {}
     for agent, ids in tasks.items():
-        if not any(skill_id in point for skill_id in ids):
-            continue
-        for before, after in itertools.pairwise(ids):
-            source, target = point.get(before, before), point.get(after, after)
-            graph.setdefault(source, []).append((target, OrderEdge(agent, before, after)))
+        members = [skill_id for skill_id in ids if skill_id in point]
+        for before, after in itertools.pairwise(members):
+            edge = OrderEdge(agent, before, after)
+            graph.setdefault(point[before], []).append((point[after], edge))
     return _find_cycle(graph)
 
 
@@ -94,15 +94,16 @@ def check_no_deadlock(
 
     ``order`` replaces one agent's editable blueprint order, to check a reorder.
     """
+    groups = [barrier.skill_ids for barrier in state.barriers]
+    if extra_group:
+        groups.append(tuple(extra_group))
+    members = {skill_id for group in groups for skill_id in group}
     tasks: dict[str, list[str]] = {}
     for agent in state.agents:
         ids = [skill.id for skill in state.task(agent)]
         if order is not None and order[0] == agent:
             ids[len(ids) - len(order[1]) :] = order[1]
-        tasks[agent] = ids
-    groups = [barrier.skill_ids for barrier in state.barriers]
-    if extra_group:
-        groups.append(tuple(extra_group))
+        tasks[agent] = [skill_id for skill_id in ids if skill_id in members]
     cycle = find_deadlock(tasks, groups)
     if cycle is not None:
         raise RuleViolation(

@@ -159,8 +159,12 @@ class MissionState:
 
     def bound_to(self, marker_name: str) -> list[SkillInstance]:
         """Skills with a parameter bound to the marker, in task order."""
-        ids = self._bound.get(marker_name, set())
-        return [skill for skill in self.skills() if skill.id in ids]
+        agents = {agent: rank for rank, agent in enumerate(self._content.tasks)}
+        places = sorted(
+            (agents[agent], index)
+            for agent, index in map(self.locate, self._bound.get(marker_name, ()))
+        )
+        return [self._content.tasks[self.agents[rank]][index] for rank, index in places]
 
     # -- the one way to change -------------------------------------------
     def apply(self, change: Change) -> None:
