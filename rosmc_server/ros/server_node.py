@@ -88,13 +88,22 @@ class ServerConfig:
 
     @classmethod
     def from_params(cls) -> ServerConfig:
-        """Read the private parameters (``~name``)."""
+        """Read the private parameters (``~name``).
+
+        ``~journal`` and ``~resume`` are deleted once read: left on the parameter
+        server (as ``rosrun ... _resume:=true`` leaves them), they would make a
+        later, plain start resume an old journal.
+        """
         journal = str(rospy.get_param("~journal", ""))
+        resume = bool(rospy.get_param("~resume", False))
+        for once in ("~journal", "~resume"):
+            if rospy.has_param(once):
+                rospy.delete_param(once)
         return cls(
             library=Path(str(rospy.get_param("~library", str(DEFAULT_LIBRARY)))).expanduser(),
             journal=Path(journal).expanduser() if journal else None,
             journal_dir=Path(str(rospy.get_param("~journal_dir", str(DEFAULT_JOURNAL_DIR)))),
-            resume=bool(rospy.get_param("~resume", False)),
+            resume=resume,
             link_timeout=float(rospy.get_param("~link_timeout", 3.0)),
             agent_state_rate=float(rospy.get_param("~agent_state_rate", 2.0)),
             fsync=bool(rospy.get_param("~fsync", False)),
