@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import json
 import shutil
+import subprocess
+import sys
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -391,3 +393,12 @@ def test_cli_at_timeline_and_tobag_work_without_a_master(
     assert rosmc(["tobag", journal, str(tmp_path / "m.bag")]) == 0
     assert rosmc(["tobag", journal, str(tmp_path / "m.bag")]) == 1  # exists
     assert "messages" in capsys.readouterr().out
+
+
+def test_history_and_pictures_do_not_import_rospy() -> None:
+    program = (
+        "import sys, rosmc_server.recording.history, rosmc_server.recording.timeline_svg; "
+        "sys.exit('rospy' in sys.modules)"
+    )
+    done = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr or "rospy was imported"
