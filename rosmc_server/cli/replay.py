@@ -29,8 +29,9 @@ def add_commands(command: _Command) -> None:
     replay = command(
         "replay",
         "republish a recording onto the ROS graph (needs a ROS master)",
-        "rviz, the command GUI and 'rosmc watch' then show the mission evolving. Refuses to "
-        "publish where a live mission server does, unless --prefix moves the replay aside.",
+        "rviz, the command GUI and 'rosmc watch' then show the mission evolving.\n"
+        "Refuses to publish where a live mission server does, unless --prefix\n"
+        "moves the replay aside.",
     )
     replay.add_argument("file", metavar="FILE", help="a mission journal (.mcap)")
     replay.add_argument(
@@ -43,7 +44,7 @@ def add_commands(command: _Command) -> None:
         "--prefix",
         default="",
         metavar="P",
-        help="put P before every topic, e.g. /replay (default: the live names)",
+        help="put P before every name, e.g. /replay (default: the live names)",
     )
     at = command("at", "print the mission as it was at a time or revision of a recording", AT_HELP)
     at.add_argument("file", metavar="FILE", help="a mission journal (.mcap)")
