@@ -349,3 +349,30 @@ def test_unsync_after_retry_takes_the_new_instance(mission: Any, drv: Any) -> No
     assert drv.ids("alpha") == [failed, fresh, later]
     assert mission.state.skill(fresh).attempt == 2
     assert mission.state.sections("alpha").synced_end == 1
+
+
+# -- cancelling an unanswered upload ---------------------------------------------------
+
+
+def test_cancel_uploads(mission: Any, drv: Any, accepted: Any, uploading: list[str]) -> None:
+    event = accepted(mission, EventKind.UPLOAD_CANCELLED, mission.cancel_uploads, "alpha")
+    assert event.agent == "alpha" and all(i in event.summary for i in uploading)
+    assert transfers(mission, "alpha") == [("IDLE", "NONE")] * 3
+    assert mission.state.sections("alpha").editable_start == 0
+    # Once cancelled, a late answer from the robot is refused.
+    with pytest.raises(RuleViolation):
+        mission.confirm_synchronized("alpha", uploading[:1])
+
+
+def test_cancel_uploads_refusals(mission: Any, drv: Any, rejected: Any) -> None:
+    from rosmc_server.core import StaleRevision
+
+    rejected(mission, RuleViolation, mission.cancel_uploads, "alpha", match="no upload")
+    rejected(mission, NotFound, mission.cancel_uploads, "zulu")
+    drv.adds("alpha", 2)
+    drv.sync("alpha")
+    rejected(mission, RuleViolation, mission.cancel_uploads, "alpha", match="no upload")
+    drv.add("alpha")
+    mission.synchronize("alpha")
+    rejected(mission, StaleRevision, mission.cancel_uploads, "alpha", base_revision=0)
+    mission.cancel_uploads("alpha", base_revision=mission.revision)
