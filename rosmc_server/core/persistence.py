@@ -186,12 +186,12 @@ def _read_tasks(
             try:
                 spec = library.skill(agent, skill.skill)
                 skill = replace(skill, params=check_params(spec, skill.params))
-                missing = sorted({p.name for p in spec.parameters} - set(skill.params))
-                if missing:
-                    reader.fail(f"{key}.params", f"is missing {', '.join(missing)}")
                 bound_values(lambda name: _marker(markers, name), spec, skill.bindings)
             except RosmcError as error:
                 reader.fail(key, str(error))
+            missing = sorted({p.name for p in spec.parameters} - set(skill.params))
+            if missing:
+                reader.fail(f"{key}.params", f"is missing {', '.join(missing)}")
             tasks[agent].append(skill)
         _check_sections(reader, tasks[agent], f"tasks.{agent}")
     return tasks
