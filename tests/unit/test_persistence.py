@@ -435,3 +435,16 @@ def test_a_parameter_value_nested_too_deeply_is_refused(mission: Mission) -> Non
         deep = [deep]
     with pytest.raises(InvalidRequest, match="nested more than"):
         mission.add_skill("alpha", "wait", {"options": {"deep": deep}})
+
+
+def test_each_message_names_the_file_once(document: dict[str, Any], library: Any) -> None:
+    for mutate in (
+        lambda d: _skill(d, "alpha", 0)["params"].pop("speed"),
+        lambda d: _skill(d, "alpha", 0).__setitem__("skill", "fly"),
+        lambda d: d["markers"][0].__setitem__("pose", "here"),
+    ):
+        broken = copy.deepcopy(document)
+        mutate(broken)
+        with pytest.raises(MissionFileError) as caught:
+            parse_mission(yaml.safe_dump(broken), library, "once.yaml")
+        assert str(caught.value).count("once.yaml") == 1, str(caught.value)
