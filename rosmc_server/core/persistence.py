@@ -3,7 +3,8 @@
 A file holds the mission's tasks, barriers, task markers, revision and the
 name of its library. Loading checks everything against the library and the
 mission rules and fails with one sentence naming the file and the problem;
-nothing is half-loaded. Python object tags are refused, never executed.
+nothing is half-loaded. Python object tags are refused, never executed, and
+so are YAML aliases that expand a document beyond reason.
 """
 
 from __future__ import annotations
@@ -92,7 +93,31 @@ def parse_mission(text: str, library: Library, source: str) -> tuple[MissionCont
         ) from error
     except yaml.YAMLError as error:
         raise MissionFileError(f"{source}: not valid YAML ({_yaml_problem(error)})") from error
+    _refuse_alias_bombs(data, len(text), source)
     return mission_from_dict(data, library, source)
+
+
+def _refuse_alias_bombs(data: object, length: int, source: str) -> None:
+    """Refuse a document whose YAML aliases expand it far beyond its own size.
+
+    An alias refers to a value written once, but checking copies it wherever it
+    is used, so a few hundred bytes of nested aliases ("billion laughs") would
+    take hours to load. Ordinary sharing (what yaml.safe_dump writes for repeated
+    values) stays well within the allowance.
+    """
+    allowance = 100_000 + 20 * length
+    pending, count = [data], 0
+    while pending:
+        item = pending.pop()
+        count += 1
+        if count > allowance:
+            raise MissionFileError(
+                f"{source}: its YAML aliases expand it to more than {allowance} values"
+            )
+        if isinstance(item, dict):
+            pending.extend(item.values())
+        elif isinstance(item, list):
+            pending.extend(item)
 
 
 def _yaml_problem(error: yaml.YAMLError) -> str:
