@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import time
 from pathlib import Path
 from typing import Any
 
@@ -448,3 +449,32 @@ def test_each_message_names_the_file_once(document: dict[str, Any], library: Any
         with pytest.raises(MissionFileError) as caught:
             parse_mission(yaml.safe_dump(broken), library, "once.yaml")
         assert str(caught.value).count("once.yaml") == 1, str(caught.value)
+
+
+def test_ordinary_yaml_aliases_load(library: Any) -> None:
+    # yaml.safe_dump writes shared values as anchors and aliases; such files load.
+    text = (
+        "rosmc_mission: 1\nlibrary: unit_team\nrevision: 0\ntasks:\n  alpha:\n"
+        "  - id: a\n    skill: scan\n    params: &params\n"
+        "      area: [{x: 0, y: 0}, {x: 1, y: 0}, {x: 0, y: 1}]\n"
+        "      point: {x: 1.0}\n      mode: slow\n      passes: 2\n"
+        "  - {id: b, skill: scan, params: *params}\n"
+    )
+    content, _ = parse_mission(text, library, "alias.yaml")
+    first, second = content.tasks["alpha"]
+    assert first.params["area"] == second.params["area"]
+
+
+def test_an_alias_bomb_is_refused_at_once(library: Any) -> None:
+    # "Billion laughs": 8 levels of 10 aliases each would expand to 10**9 values.
+    lines = ["        k0: &a0 [1, 1, 1, 1, 1, 1, 1, 1, 1, 1]"]
+    lines += [f"        k{i}: &a{i} [{', '.join([f'*a{i - 1}'] * 10)}]" for i in range(1, 9)]
+    text = (
+        "rosmc_mission: 1\nlibrary: unit_team\nrevision: 0\ntasks:\n  alpha:\n"
+        "  - id: s\n    skill: wait\n    params:\n      options:\n" + "\n".join(lines) + "\n"
+    )
+    started = time.monotonic()
+    with pytest.raises(MissionFileError, match="aliases expand it") as caught:
+        parse_mission(text, library, "bomb.yaml")
+    assert str(caught.value).startswith("bomb.yaml: ")
+    assert time.monotonic() - started < 2.0
