@@ -3,8 +3,9 @@
 :class:`Simulation` advances in fixed steps of sim time. Robots move
 kinematically along paths (rovers around obstacles, the drone straight over
 them at altitude), carried boxes and stones follow their carrier, batteries
-drain with motion and work and recharge at the lander, and Wi-Fi coverage is
-the lander's radius plus every deployed Wi-Fi box's, with line of sight.
+drain with motion and work and recharge at the lander (a drone that runs empty
+in the air comes down where it is), and Wi-Fi coverage is the lander's radius
+plus every deployed Wi-Fi box's, with line of sight.
 """
 
 from __future__ import annotations
@@ -163,6 +164,11 @@ class Simulation:
     def _move(self, robot: Robot, dt: float) -> None:
         if robot.battery <= 0.0:
             self.halt(robot)
+            if robot.z > 0.0:
+                # An empty drone cannot hover: it comes down where it is (an emergency
+                # landing), so over the lander it can still recharge.
+                robot.z = max(0.0, robot.z - CLIMB_RATE * dt)
+                robot.flying = robot.z > 0.0
             return
         if robot.target_z is not None:
             dz = robot.target_z - robot.z
