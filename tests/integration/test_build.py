@@ -61,8 +61,8 @@ def top_level_imports() -> str:
 PRINT_LOOKUPS = f"""
 rospack find rosmc
 rosrun --prefix echo rosmc rosmc_demo
-roslaunch --files rosmc demo.launch
-roslaunch --nodes rosmc demo.launch
+roslaunch --files rosmc mission_server.launch
+roslaunch --nodes rosmc mission_server.launch
 {SYSTEM_PYTHON} -c '{top_level_imports()}'
 """
 
@@ -71,8 +71,8 @@ def check_lookups(lines: list[str], share: Path, script: Path, launch: Path, pyt
     """Check the output of PRINT_LOOKUPS, one line each."""
     assert lines[0] == str(share)
     assert lines[1] == str(script)
-    assert lines[2] == str(launch / "demo.launch")
-    assert lines[3] == "/rosmc_demo"
+    assert lines[2] == str(launch / "mission_server.launch")
+    assert lines[3] == "/rosmc/mission_server"
     assert Path(lines[4]).is_relative_to(python), lines[4]
 
 
