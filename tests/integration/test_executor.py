@@ -1,0 +1,688 @@
+"""The mission executor with a real rosmaster, mission server, executors and link emulator.
+
+Robots run the basic skills (``wait``: timed; ``probe``: fails when asked;
+``count``: steps on the executor's ticks; all honour pause and cancel) from
+``tests/data/test_team.yaml``. The operator is this process, calling the
+server's services; some tests play the ground or a robot on the link topics
+themselves to send what a correct peer never would.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import signal
+import statistics
+import time
+from collections.abc import Callable, Iterator, Sequence
+from pathlib import Path
+
+import pytest
+import rosmc.msg as wire
+import rosmc.srv as srv
+import rospy
+from rosmc.msg import ErrorCode
+
+from rosmc_server import interface
+from rosmc_server.core import Resolution, SkillInstance, SkillStatus, Transfer
+from rosmc_server.core.commands import CommandKind
+from rosmc_server.core.link import queue_hash
+from rosmc_server.ros.conversions import time_to_msg
+from tests.integration.executor_fixtures import (
+    LinkEnd,
+    Operator,
+    OperatorError,
+    RosmcSystem,
+    Transition,
+    command_msg,
+    describe,
+    journal_reports,
+    journal_timelines,
+    running_stamps,
+    wait_for,
+)
+
+pytestmark = pytest.mark.integration
+
+S = SkillStatus
+K = CommandKind
+AGENTS = ("r1", "r2", "r3")
+BARRIER_SKEW = 0.010  # seconds (DESIGN.md §7)
+SKEW_ROUNDS = 12
+
+# Status changes the ground may show for a skill, as (status, transfer) pairs.
+_U = Transfer.UPLOADING
+_N = Transfer.NONE
+_R = Transfer.REMOVING
+LEGAL: dict[tuple[SkillStatus, Transfer], set[tuple[SkillStatus, Transfer]]] = {
+    (S.IDLE, _N): {(S.IDLE, _U)},
+    (S.IDLE, _U): {(S.IDLE_SYNCHRONIZED, _N), (S.IDLE, _N)},
+    (S.IDLE_SYNCHRONIZED, _N): {
+        (S.IDLE_SYNCHRONIZED, _R),
+        (S.SYNCWAITING, _N),
+        (S.RUNNING, _N),
+        (S.FAILURE, _N),
+    },
+    (S.IDLE_SYNCHRONIZED, _R): {(S.IDLE, _N), (S.IDLE_SYNCHRONIZED, _N)},
+    (S.SYNCWAITING, _N): {(S.RUNNING, _N), (S.PAUSED, _N), (S.IDLE_SYNCHRONIZED, _N)},
+    (S.RUNNING, _N): {(S.PAUSED, _N), (S.SUCCESS, _N), (S.FAILURE, _N), (S.IDLE_SYNCHRONIZED, _N)},
+    (S.PAUSED, _N): {(S.RUNNING, _N), (S.SYNCWAITING, _N), (S.IDLE_SYNCHRONIZED, _N)},
+    (S.SUCCESS, _N): set(),
+    (S.FAILURE, _N): set(),
+}
+
+Start = Callable[..., tuple[RosmcSystem, Operator]]
+
+
+@pytest.fixture
+def rosmc(ros_master, tmp_path: Path) -> Iterator[Start]:
+    """``rosmc(agents=AGENTS, emulated=(), server=True, server_params=())``: a running system.
+
+    Starts the mission server (journal in ``tmp_path``), the link emulator for the
+    ``emulated`` agents and one executor per agent, and waits until the server hears
+    every executor. Everything stops when the test ends.
+    """
+    systems: list[RosmcSystem] = []
+    operators: list[Operator] = []
+
+    def start(
+        agents: Sequence[str] = AGENTS,
+        emulated: Sequence[str] = (),
+        server: bool = True,
+        server_params: Sequence[str] = (),
+    ) -> tuple[RosmcSystem, Operator]:
+        system = RosmcSystem(ros_master.env, tmp_path / f"system{len(systems)}")
+        systems.append(system)
+        if server:
+            system.start_server(*server_params)
+        if emulated:
+            system.start_emulator(emulated)
+        for agent in agents:
+            system.start_executor(agent, agent in emulated)
+        operator = Operator()
+        operators.append(operator)
+        if server:
+            operator.wait_links(agents)
+        return system, operator
+
+    yield start
+    for operator in operators:
+        operator.close()
+    for system in systems:
+        system.close()
+        print(system.log_tails())
+
+
+def timeline(lines: dict[str, list[Transition]], skill_id: str) -> list[tuple[SkillStatus, int]]:
+    return [(t.status, t.transfer) for t in lines[skill_id]]
+
+
+def assert_legal(lines: dict[str, list[Transition]], skill_id: str) -> None:
+    """Every step of a skill's journaled history is a legal transition."""
+    steps = timeline(lines, skill_id)
+    assert steps[0] in ((S.IDLE, _N), (S.IDLE_SYNCHRONIZED, _N)), steps  # added, or a retry
+    for before, after in itertools.pairwise(steps):
+        key = (before[0], Transfer(before[1]))
+        assert (after[0], Transfer(after[1])) in LEGAL[key], f"{skill_id}: {before} -> {after}"
+
+
+def happy(barrier: bool) -> list[tuple[SkillStatus, Transfer]]:
+    """IDLE -> uploading -> IDLE_SYNCHRONIZED -> [SYNCWAITING] -> RUNNING -> SUCCESS."""
+    waiting = [(S.SYNCWAITING, _N)] if barrier else []
+    return [(S.IDLE, _N), (S.IDLE, _U), (S.IDLE_SYNCHRONIZED, _N), *waiting,
+            (S.RUNNING, _N), (S.SUCCESS, _N)]  # fmt: skip
+
+
+def skew(stamps: dict[str, float], members: Sequence[str]) -> float:
+    started = [stamps[m] for m in members]
+    return max(started) - min(started)
+
+
+def wait_all_synced(op: Operator, ids: Sequence[str]) -> None:
+    op.wait_status(ids, S.IDLE_SYNCHRONIZED)
+
+
+# -- whole missions -------------------------------------------------------------------
+def test_three_robots_two_barriers_run_to_completion_in_a_legal_order(rosmc: Start) -> None:
+    system, op = rosmc()
+    r1 = [
+        op.add("r1", "wait", {"duration": 0.2}),
+        op.add("r1", "wait", {"duration": 0.1}),
+        op.add("r1", "count", {"steps": 2, "period": 0.05}),
+        op.add("r1", "wait", {"duration": 0.1}),
+    ]
+    r2 = [
+        op.add("r2", "wait", {"duration": 0.4}),
+        op.add("r2", "wait", {"duration": 0.1}),
+        op.add("r2", "probe", {"duration": 0.1, "fail": False}),
+    ]
+    r3 = [
+        op.add("r3", "count", {"steps": 3, "period": 0.1}),
+        op.add("r3", "wait", {"duration": 0.1}),
+    ]
+    barriers = [(r1[1], r2[1]), (r1[3], r3[1])]
+    for members in barriers:
+        op.add_barrier(members)
+    for agent in AGENTS:
+        op.sync(agent)
+    everything = r1 + r2 + r3
+    wait_all_synced(op, everything)
+    op.start()
+    op.wait_status(everything, S.SUCCESS, timeout=20.0)
+
+    assert system.stop("server") == 0  # a clean stop closes the journal
+    lines = journal_timelines(system.journal)
+    in_barrier = {member for members in barriers for member in members}
+    for skill_id in everything:
+        assert timeline(lines, skill_id) == happy(skill_id in in_barrier), skill_id
+    stamps = running_stamps(system.journal)
+    for members in barriers:
+        assert skew(stamps, members) <= BARRIER_SKEW, (members, stamps)
+    # Every robot's reports reached the journal once each, numbered without gaps.
+    for agent in AGENTS:
+        seqs = [r.seq for r in journal_reports(system.journal) if r.agent == agent]
+        assert seqs == list(range(1, len(seqs) + 1)), (agent, seqs)
+
+
+def test_barrier_release_skew_over_repeated_runs(rosmc: Start) -> None:
+    system, op = rosmc()
+    op.start()
+    rounds = []
+    for _ in range(SKEW_ROUNDS):
+        for index, agent in enumerate(AGENTS):  # the robots arrive 0.1 s apart
+            op.add(agent, "wait", {"duration": 0.05 + 0.1 * index})
+        members = [op.add(agent, "wait", {"duration": 0.05}) for agent in AGENTS]
+        op.add_barrier(members)
+        for agent in AGENTS:
+            op.sync(agent)
+        op.wait_status(members, S.SUCCESS)
+        rounds.append(members)
+    system.stop("server")
+    lines = journal_timelines(system.journal)
+    for skill_id in itertools.chain.from_iterable(rounds):  # uploaded to started robots
+        assert timeline(lines, skill_id) == happy(barrier=True), skill_id
+    stamps = running_stamps(system.journal)
+    skews = [skew(stamps, members) for members in rounds]
+    median, worst = statistics.median(skews), max(skews)
+    print(
+        f"barrier release skew, 3 robots, {len(skews)} runs: "
+        f"median {median * 1e3:.2f} ms, max {worst * 1e3:.2f} ms"
+    )
+    assert median <= BARRIER_SKEW
+    assert worst <= 5 * BARRIER_SKEW, skews  # a loaded 2-core machine may stall a process
+
+
+# -- the ground link ---------------------------------------------------------------------
+def test_skills_complete_during_a_blackout_and_report_in_order_after_it(rosmc: Start) -> None:
+    system, op = rosmc(agents=("r1",), emulated=("r1",), server_params=("_link_timeout:=1.0",))
+    ids = [op.add("r1", "wait", {"duration": 0.6}) for _ in range(3)]
+    op.sync("r1")
+    wait_all_synced(op, ids)
+    op.start("r1")
+    op.wait_status(ids[:1], S.RUNNING)
+    op.blackout("r1", True)
+    time.sleep(2.5)  # all three finish 1.8 s after the first started
+    during = op.mission()
+    assert during.skill(ids[2]).status is S.IDLE_SYNCHRONIZED, describe(during)
+    assert op.agent_state("r1").link.state == wire.LinkState.DOWN
+    restored = time.time()
+    op.blackout("r1", False)
+    op.wait_status(ids, S.SUCCESS, timeout=15.0)
+    print(f"reports delivered {time.time() - restored:.2f} s after the link came back")
+
+    system.stop("server")
+    lines = journal_timelines(system.journal)
+    for skill_id in ids:
+        assert timeline(lines, skill_id) == happy(barrier=False)
+    success = [next(t.revision for t in lines[i] if t.status is S.SUCCESS) for i in ids]
+    assert success == sorted(success)
+    finished = {r.skill_id: r.finished for r in journal_reports(system.journal) if r.finished}
+    assert all(finished[i] < restored for i in ids), "the robot finished them during the outage"
+
+
+# -- operator workflows ---------------------------------------------------------------------
+def test_unsync_while_running_keeps_the_running_skill(rosmc: Start) -> None:
+    system, op = rosmc(agents=("r1",))
+    first, *later = [op.add("r1", "wait", {"duration": d}) for d in (1.5, 0.1, 0.1)]
+    op.sync("r1")
+    wait_all_synced(op, [first, *later])
+    op.start("r1")
+    op.wait_status([first], S.RUNNING)
+    assert op.unsync("r1") == later
+    state = op.wait_mission(
+        lambda m: all(m.skill(i).status is S.IDLE and not m.skill(i).transfer for i in later),
+        10.0,
+        "the later skills to return to the blueprint",
+    )
+    assert state.skill(first).status is S.RUNNING
+    op.wait_status([first], S.SUCCESS)
+    time.sleep(0.5)
+    state = op.mission()
+    assert [state.skill(i).status for i in later] == [S.IDLE, S.IDLE]
+    assert all(state.skill(i).started == 0.0 for i in later)
+    link = op.agent_state("r1").link
+    assert link.queue_hash == link.robot_queue_hash == queue_hash([first])
+    system.stop("server")
+    lines = journal_timelines(system.journal)
+    for skill_id in later:
+        assert_legal(lines, skill_id)
+        assert S.RUNNING not in [t.status for t in lines[skill_id]]
+
+
+def test_stop_edit_resync_start(rosmc: Start) -> None:
+    system, op = rosmc(agents=("r1",))
+    long, short = op.add("r1", "wait", {"duration": 30.0}), op.add("r1", "wait", {"duration": 0.1})
+    op.sync("r1")
+    wait_all_synced(op, [long, short])
+    op.start("r1")
+    op.wait_status([long], S.RUNNING)
+    op.control("r1", srv.ControlRequest.STOP)
+    state = op.wait_status([long], S.IDLE_SYNCHRONIZED)
+    assert state.skill(long).status_text == "stopped by the operator"
+    with pytest.raises(OperatorError) as refused:
+        op.edit(long, {"duration": 0.2})  # still on the robot
+    assert refused.value.code == ErrorCode.RULE
+    assert op.unsync("r1") == [long, short]
+    op.wait_status([long, short], S.IDLE)
+    op.edit(long, {"duration": 0.2})
+    op.sync("r1")
+    wait_all_synced(op, [long, short])
+    op.start("r1")
+    state = op.wait_status([long, short], S.SUCCESS)
+    ran = state.skill(long)
+    assert ran.params["duration"] == 0.2
+    assert ran.finished - ran.started < 5.0  # the edited duration ran, not the stopped one
+    system.stop("server")
+    lines = journal_timelines(system.journal)
+    assert_legal(lines, long)
+    assert [t.status for t in lines[long]].count(S.RUNNING) == 2
+
+
+def test_pause_and_resume_at_a_barrier(rosmc: Start) -> None:
+    system, op = rosmc(agents=("r1", "r2"))
+    early = op.add("r1", "wait", {"duration": 0.1})
+    busy = op.add("r2", "wait", {"duration": 4.0})
+    late = op.add("r2", "wait", {"duration": 0.1})
+    op.add_barrier([early, late])
+    op.sync("r1")
+    op.sync("r2")
+    wait_all_synced(op, [early, busy, late])
+    op.start()
+    state = op.wait_status([early], S.SYNCWAITING)
+    assert state.skill(early).status_text == "waiting for r2"
+    op.control("r1", srv.ControlRequest.PAUSE)
+    op.wait_status([early], S.PAUSED)
+    op.control("r1", srv.ControlRequest.RESUME)
+    state = op.wait_mission(lambda m: m.skill(early).status is not S.PAUSED, 10.0, "r1 to resume")
+    assert state.skill(early).status is S.SYNCWAITING, describe(state)
+    assert state.skill(busy).status is S.RUNNING  # the peer has not arrived yet
+    op.wait_status([early, late], S.SUCCESS, timeout=15.0)
+    system.stop("server")
+    lines = journal_timelines(system.journal)
+    assert [t.status for t in lines[early]][2:] == [
+        S.IDLE_SYNCHRONIZED,
+        S.SYNCWAITING,
+        S.PAUSED,
+        S.SYNCWAITING,
+        S.RUNNING,
+        S.SUCCESS,
+    ]
+    assert skew(running_stamps(system.journal), [early, late]) <= BARRIER_SKEW
+
+
+def test_failure_retry_skip_and_a_retry_that_succeeds(rosmc: Start) -> None:
+    system, op = rosmc(agents=("r1", "r2"))
+    # r1: a failure retried as is (fails again), then skipped.
+    probe = op.add("r1", "probe", {"duration": 0.1, "fail": True})
+    after = op.add("r1", "wait", {"duration": 0.1})
+    # r2: a failure retried after the operator fixed the fresh instance's parameters.
+    probe2 = op.add("r2", "probe", {"duration": 0.1, "fail": True})
+    after2 = op.add("r2", "wait", {"duration": 0.1})
+    op.sync("r1")
+    op.sync("r2")
+    wait_all_synced(op, [probe, after, probe2, after2])
+    op.start()
+    state = op.wait_status([probe, probe2], S.FAILURE)
+    assert state.skill(probe).status_text == "the probe failed as its parameters asked"
+    time.sleep(0.5)
+    assert op.mission().skill(after).status is S.IDLE_SYNCHRONIZED  # holding
+    with pytest.raises(OperatorError) as refused:
+        op.edit(probe, {"fail": False})
+    assert refused.value.code == ErrorCode.RULE
+
+    fresh = op.retry(probe)
+    state = op.wait_status([fresh], S.FAILURE)
+    again = state.skill(fresh)
+    assert again.attempt == 2 and again.id != probe
+    assert state.skill(probe).resolution is Resolution.RETRIED
+    assert [s.id for s in state.task("r1")] == [probe, fresh, after]
+    op.skip(fresh)
+    op.wait_status([after], S.SUCCESS)
+
+    op.control("r2", srv.ControlRequest.STOP)  # so the fresh instance waits on the robot
+    fresh2 = op.retry(probe2)
+    op.wait_status([fresh2], S.IDLE_SYNCHRONIZED)
+    assert op.unsync("r2", fresh2) == [fresh2, after2]
+    op.wait_status([fresh2, after2], S.IDLE)
+    op.edit(fresh2, {"fail": False})
+    op.sync("r2")
+    wait_all_synced(op, [fresh2, after2])
+    op.start("r2")
+    state = op.wait_status([fresh2, after2], S.SUCCESS)
+    assert state.skill(fresh2).attempt == 2
+    assert state.skill(fresh2).status_text == "probe done"
+    system.stop("server")
+    lines = journal_timelines(system.journal)
+    for skill_id in (probe, fresh, after, probe2, fresh2, after2):
+        assert_legal(lines, skill_id)
+
+
+def test_executor_restart_mid_mission_keeps_the_queue(rosmc: Start) -> None:
+    system, op = rosmc(agents=("r1",))
+    ids = [op.add("r1", "wait", {"duration": d}) for d in (0.1, 2.0, 0.1)]
+    op.sync("r1")
+    wait_all_synced(op, ids)
+    op.start("r1")
+    op.wait_status(ids[1:2], S.RUNNING)
+    system.stop("r1", signal.SIGKILL)
+    system.start_executor("r1")
+    state = op.wait_status(ids[1:2], S.IDLE_SYNCHRONIZED)
+    assert state.skill(ids[1]).status_text == "interrupted by an executor restart"
+    assert state.skill(ids[0]).status is S.SUCCESS
+    assert state.skill(ids[2]).status is S.IDLE_SYNCHRONIZED
+    op.wait_links(["r1"])
+    restarted = time.time()
+    link = op.agent_state("r1")
+    assert link.link.robot_queue_hash == link.link.queue_hash == queue_hash(ids)
+    assert link.executor_state == "stopped"  # a restarted robot waits for the operator
+    op.start("r1")
+    state = op.wait_status(ids, S.SUCCESS)
+    assert state.skill(ids[1]).started >= restarted  # run again from its beginning
+    system.stop("server")
+    assert "repairing" not in system.log("server").read_text()
+    assert_legal(journal_timelines(system.journal), ids[1])
+
+
+def test_an_executor_that_lost_its_state_does_not_run_finished_skills_again(
+    rosmc: Start,
+) -> None:
+    system, op = rosmc(agents=("r1",))
+    done = [op.add("r1", "wait", {"duration": 0.1}) for _ in range(2)]
+    op.sync("r1")
+    wait_all_synced(op, done)
+    op.start("r1")
+    op.wait_status(done, S.SUCCESS)
+    system.stop("r1", signal.SIGKILL)
+    system.state_file("r1").unlink()  # a new disk
+    system.start_executor("r1")
+    op.wait_links(["r1"])
+    wait_for(
+        lambda: op.agent_state("r1").link.robot_queue_hash == queue_hash(done),
+        15.0,
+        "the ground to repair the robot's queue",
+    )
+    more = op.add("r1", "wait", {"duration": 0.1})
+    op.sync("r1")
+    op.start("r1")
+    state = op.wait_status([more], S.SUCCESS)
+    assert [s.status for s in state.task("r1")] == [S.SUCCESS] * 3
+    system.stop("server")
+    runs = {
+        (r.skill_id, r.started)
+        for r in journal_reports(system.journal)
+        if r.status.value == S.RUNNING
+    }
+    assert sorted(skill_id for skill_id, _ in runs) == sorted([*done, more])  # each ran once
+
+
+def test_a_new_mission_after_a_finished_one(rosmc: Start) -> None:
+    system, op = rosmc(agents=("r1",))
+    done = op.add("r1", "wait", {"duration": 0.1})
+    op.sync("r1")
+    op.start("r1")
+    op.wait_status([done], S.SUCCESS)
+    op.change("new_mission", keep_markers=True)
+    wait_for(
+        lambda: op.agent_state("r1").link.robot_queue_hash == queue_hash([]),
+        10.0,
+        "the robot to drop the old mission",
+    )
+    fresh = op.add("r1", "wait", {"duration": 0.1})
+    op.sync("r1")
+    op.wait_status([fresh], S.SUCCESS)
+    time.sleep(2.5)  # a few snapshots: the hashes agree, no repair goes on
+    link = op.agent_state("r1").link
+    assert (link.robot_queue_hash, link.hash_mismatch) == (queue_hash([fresh]), False)
+    assert link.commands_in_flight == 0
+    system.stop("server")
+    assert system.log("server").read_text().count("repairing") <= 1
+    assert timeline(journal_timelines(system.journal), fresh) == happy(barrier=False)
+
+
+# -- timeouts and automatic retries ---------------------------------------------------------
+def test_timeout_and_automatic_retries(rosmc: Start) -> None:
+    system, op = rosmc(agents=("r1", "r2"))
+    slow = op.add("r1", "wait", {"duration": 30.0}, timeout=0.3)
+    flaky = op.add("r2", "probe", {"duration": 0.1, "fail": True}, max_retries=2)
+    op.sync("r1")
+    op.sync("r2")
+    wait_all_synced(op, [slow, flaky])
+    op.start()
+    state = op.wait_status([slow, flaky], S.FAILURE)
+    assert state.skill(slow).status_text == "timed out after 0.3 s"
+    assert state.skill(slow).finished - state.skill(slow).started < 2.0
+    assert state.skill(flaky).attempt == 3
+    system.stop("server")
+    attempts = [
+        (r.status.value, r.attempt, r.status_text)
+        for r in journal_reports(system.journal)
+        if r.skill_id == flaky
+    ]
+    assert attempts == [
+        (S.RUNNING, 1, ""),
+        (S.RUNNING, 2, "retry 1 of 2"),
+        (S.RUNNING, 3, "retry 2 of 2"),
+        (S.FAILURE, 3, "the probe failed as its parameters asked"),
+    ]
+
+
+# -- bad input -------------------------------------------------------------------------------
+def test_an_upload_with_a_skill_the_robot_lacks_is_refused_with_the_reason(rosmc: Start) -> None:
+    system, op = rosmc(agents=("r1",))
+    ok = op.add("r1", "wait", {"duration": 0.1})
+    lacking = op.add("r1", "teleport")
+    later = op.add("r1", "wait", {"duration": 0.1})
+    op.sync("r1")
+    state = op.wait_mission(
+        lambda m: all(not m.skill(i).transfer for i in (ok, lacking, later)), 10.0, "the answer"
+    )
+    assert state.skill(ok).status is S.IDLE_SYNCHRONIZED
+    for skill_id in (lacking, later):
+        skill = state.skill(skill_id)
+        assert skill.status is S.IDLE  # back in the blueprint
+        assert skill.status_text == "r1 does not implement skill 'teleport'"
+    op.change("delete_skills", skill_ids=[lacking])
+    op.sync("r1")
+    op.start("r1")
+    op.wait_status([ok, later], S.SUCCESS)
+    system.stop("server")
+
+
+def wait_skill(skill_id: str, agent: str = "r1", **params: object) -> SkillInstance:
+    return SkillInstance(skill_id, agent, "wait", "wait", params or {"duration": 0.1})
+
+
+def test_bad_commands_over_the_link_are_refused_clearly(rosmc: Start) -> None:
+    system, _ = rosmc(agents=("r1",), server=False)
+    ground = LinkEnd("r1", "ground")
+    ground.wait_heard("snapshot", lambda m: True, timeout=20.0)  # the executor is up
+    wait_for(ground.connected, 10.0, "the link topics to connect")
+
+    def send(seq: int, kind: CommandKind, **fields: object) -> wire.RobotAck:
+        ground.publish("command", command_msg("r1", seq, kind, **fields))  # type: ignore[arg-type]
+        return ground.wait_heard("ack", lambda a: a.seq == seq and a not in answered)
+
+    answered: list[wire.RobotAck] = []
+    teleport = SkillInstance("t1", "r1", "teleport", "teleport", {})
+    first = send(1, K.UPLOAD, skills=[teleport])
+    answered.append(first)
+    assert first.result == wire.RobotAck.REJECTED
+    assert list(first.rejection_reasons) == ["r1 does not implement skill 'teleport'"]
+
+    typed = send(2, K.UPLOAD, skills=[wait_skill("w1", duration="ten")])
+    answered.append(typed)
+    assert list(typed.rejection_reasons) == ["parameter 'duration' of skill 'wait' must be float"]
+
+    # A duplicate gets the first answer again and is not executed again.
+    duplicate = send(1, K.UPLOAD, skills=[wait_skill("w-dup")])
+    answered.append(duplicate)
+    assert (duplicate.result, list(duplicate.rejection_reasons)) == (
+        first.result,
+        list(first.rejection_reasons),
+    )
+    # An early command waits for the one before it (the ground resends in order).
+    ground.publish("command", command_msg("r1", 4, K.START))
+    time.sleep(0.5)
+    assert not [a for a in ground.received("ack") if a.seq == 4]
+    answered.append(send(3, K.UPLOAD, skills=[wait_skill("w3")]))
+    assert answered[-1].result == wire.RobotAck.ACCEPTED
+    answered.append(send(4, K.START))
+    ground.wait_heard("report", lambda r: r.skill_id == "w3" and r.status.value == S.SUCCESS)
+
+    # Commands the robot cannot read are refused, and the link goes on.
+    bad_type = command_msg("r1", 5, K.START)
+    bad_type.type = 99
+    ground.publish("command", bad_type)
+    unreadable = ground.wait_heard("ack", lambda a: a.seq == 5)
+    assert unreadable.result == wire.RobotAck.REJECTED
+    assert "unknown command type 99" in unreadable.error
+    bad_param = command_msg("r1", 6, K.UPLOAD, skills=[wait_skill("w6")])
+    bad_param.skills[0].parameters[0].type = 42
+    ground.publish("command", bad_param)
+    unreadable = ground.wait_heard("ack", lambda a: a.seq == 6)
+    assert unreadable.result == wire.RobotAck.REJECTED
+    assert "parameter 'duration' has unknown type number 42" in unreadable.error
+    lopsided = wire.Barrier(id="B", skill_ids=["w7", "x"], agents=["r1"])
+    unreadable = send(7, K.BARRIERS, barriers=[lopsided])
+    assert unreadable.result == wire.RobotAck.REJECTED
+    assert "lists 1 agents for 2 skills" in unreadable.error
+
+    # Messages for other robots are none of this robot's business.
+    ground.publish("command", command_msg("r2", 8, K.UPLOAD, skills=[wait_skill("x", "r2")]))
+    ground.publish("report_ack", wire.ReportAck(agent="r2", seq=1000))
+    barriers = rospy.Publisher(interface.BARRIER_TOPIC, wire.BarrierSignal, queue_size=10)
+    wait_for(lambda: barriers.get_num_connections() > 0, 10.0, "the barrier topic")
+    barriers.publish(wire.BarrierSignal(agent="r9", barrier_id="B", skill_id="x", kind=9))
+
+    last = send(8, K.UPLOAD, skills=[wait_skill("w8")])
+    assert last.result == wire.RobotAck.ACCEPTED
+    report = ground.wait_heard("report", lambda r: r.skill_id == "w8" and r.status.value == 5)
+    assert report.seq > 2  # w3's reports were not dropped by the stray report ack
+    snapshot = ground.wait_heard("snapshot", lambda s: s.last_command_seq == 8)
+    assert [s.id for s in snapshot.queue] == ["w3", "w8"]
+    assert system.alive("r1")
+    barriers.unregister()
+    ground.close()
+
+
+def test_lost_link_policy_hold_on_a_silent_link(rosmc: Start) -> None:
+    """The test is the ground: it goes silent (no commands, no report acks)."""
+    system, _ = rosmc(agents=("r1",), server=False)
+    ground = LinkEnd("r1", "ground")
+    ground.wait_heard("snapshot", lambda m: True, timeout=20.0)
+    wait_for(ground.connected, 10.0, "the link topics to connect")
+    options = json.dumps({"lost_link": {"policy": "hold", "after": 1.0}})
+    commands = [
+        command_msg("r1", 1, K.SET_OPTIONS, argument=options),
+        command_msg("r1", 2, K.UPLOAD, skills=[wait_skill("long", duration=30.0)]),
+        command_msg("r1", 3, K.START),
+    ]
+    for command in commands:
+        ground.publish("command", command)
+    ground.wait_heard("ack", lambda a: a.seq == 3)
+    last_contact = time.monotonic()
+    ground.wait_heard("report", lambda r: r.status.value == S.RUNNING)
+    held = ground.wait_heard("report", lambda r: r.status.value == S.PAUSED, timeout=5.0)
+    assert time.monotonic() - last_contact >= 0.9  # the robot heard command 3 a bit earlier
+    assert held.status_text == "held after 1 s without ground contact"
+    snapshot = ground.received("snapshot")[-1]
+    ground.publish("report_ack", wire.ReportAck(agent="r1", seq=held.seq))  # the ground is back
+    snapshot = ground.wait_heard("snapshot", lambda s: "ground contact is back" in s.policy)
+    assert snapshot.state == "paused"
+    assert snapshot.policy.startswith("on link loss: hold after 1 s; held after 1 s")
+    ground.publish("command", command_msg("r1", 4, K.RESUME))
+    resumed = ground.wait_heard("report", lambda r: r.seq > held.seq)
+    assert (resumed.skill_id, resumed.status.value) == ("long", S.RUNNING)
+    assert system.alive("r1")
+    ground.close()
+
+
+def test_the_server_survives_bad_reports(rosmc: Start) -> None:
+    """A fake r3 reports on a skill the server does not know, out of order and twice."""
+    system, op = rosmc(agents=())
+    robot = LinkEnd("r3", "robot")
+    wait_for(robot.connected, 10.0, "the server's link to r3")
+    revision = op.mission().revision
+
+    def snapshot() -> wire.ExecutorSnapshot:
+        return wire.ExecutorSnapshot(agent="r3", queue_hash=queue_hash([]), state="idle")
+
+    def report(seq: int, status: int = S.RUNNING, skill_id: str = "ghost") -> None:
+        robot.publish(
+            "report",
+            wire.RobotReport(
+                agent="r3",
+                seq=seq,
+                stamp=time_to_msg(time.time()),
+                skill_id=skill_id,
+                status=wire.SkillStatus(status),
+                attempt=1,
+            ),
+        )
+
+    def acked() -> list[int]:
+        return [a.seq for a in robot.received("report_ack")]
+
+    robot.publish("snapshot", snapshot())
+    wait_for(lambda: 0 in acked(), 10.0, "the server to learn r3's numbering")
+    report(2)  # early: report 1 is missing
+    report(1)  # a skill the server does not know
+    report(1)  # again
+    report(2, status=42)  # a status that does not exist
+    wait_for(lambda: acked()[-1:] == [2], 10.0, "the server to acknowledge report 2")
+    assert acked().count(1) >= 2  # the duplicate was acknowledged again
+    assert op.mission().revision == revision  # nothing applied
+    assert system.alive("server")
+    assert op.agent_state("r3").link.state == wire.LinkState.UP
+    robot.close()
+    system.stop("server")
+    log = system.log("server").read_text()
+    assert "ghost" in log and "unknown status 42" in log
+    assert "Traceback" not in log
+    journaled = [(r.seq, r.skill_id) for r in journal_reports(system.journal)]
+    assert journaled == [(1, "ghost"), (2, "ghost")]  # the audit trail has both, once
+
+
+def test_lost_link_policy_hold_set_by_the_operator(rosmc: Start) -> None:
+    system, op = rosmc(agents=("r1",), emulated=("r1",))
+    op.call("set_robot_options", agent="r1", lost_link_policy="hold", after=1.0)
+    op.wait_mission(
+        lambda m: "hold after 1 s" in op.agent_state("r1").policy, 10.0, "the policy to be in force"
+    )
+    long = op.add("r1", "wait", {"duration": 30.0})
+    op.sync("r1")
+    wait_all_synced(op, [long])
+    op.start("r1")
+    op.wait_status([long], S.RUNNING)
+    op.blackout("r1", True)
+    time.sleep(2.0)
+    op.blackout("r1", False)
+    state = op.wait_status([long], S.PAUSED)
+    assert state.skill(long).status_text == "held after 1 s without ground contact"
+    wait_for(
+        lambda: "ground contact is back" in op.agent_state("r1").policy, 10.0, "the robot to say so"
+    )
+    assert op.mission().skill(long).status is S.PAUSED  # the operator decides when to go on
+    op.control("r1", srv.ControlRequest.RESUME)
+    op.wait_status([long], S.RUNNING)
+    system.stop("server")
