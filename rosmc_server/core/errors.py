@@ -7,7 +7,20 @@ failed, so adapters can map them to an error code without parsing text.
 
 
 class RosmcError(Exception):
-    """Root of every error ROSMC raises on purpose."""
+    """Root of every error ROSMC raises on purpose.
+
+    A message stays on one line: names quoted from a request (ids, agents,
+    markers) may hold line breaks, which are written as escapes instead.
+    """
+
+    def __init__(self, *args: object) -> None:
+        if len(args) == 1 and isinstance(args[0], str):
+            args = (_one_line(args[0]),)
+        super().__init__(*args)
+
+
+def _one_line(message: str) -> str:
+    return "".join(ch if ch.isprintable() else ascii(ch)[1:-1] for ch in message)
 
 
 class InvalidRequest(RosmcError):
