@@ -180,9 +180,17 @@ def plan_report(
     attempt: int | None = None,
     text: str = "",
     stamp: float = 0.0,
+    started: float = 0.0,
+    finished: float = 0.0,
 ) -> Proposal:
-    """Apply a robot's status report after checking it is legal and in task order."""
+    """Apply a robot's status report after checking it is legal and in task order.
+
+    ``started`` and ``finished`` are the robot's own times for the skill (0 if it
+    gave none); without them the report's ``stamp`` stands in.
+    """
     _check_report_fields(status, attempt, text, stamp)
+    for value in (started, finished):
+        _check_report_fields(status, attempt, text, value)
     stamp = float(stamp)
     skill = state.skill(skill_id)
     agent, index = state.locate(skill_id)
@@ -200,15 +208,15 @@ def plan_report(
         raise RuleViolation(f"the report for skill '{skill_id}' changes nothing")
     if status is not S.IDLE_SYNCHRONIZED:
         _require_turn(state, agent, index, skill_id)
-    started = skill.started or (stamp if status.has_started else 0.0)
+    began = float(started) or skill.started or (stamp if status.has_started else 0.0)
     new = replace(
         skill,
         status=status,
         attempt=new_attempt,
         status_text=text,
         transfer=Transfer.NONE,
-        started=0.0 if status is S.IDLE_SYNCHRONIZED else started,
-        finished=stamp if status.is_final else 0.0,
+        started=0.0 if status is S.IDLE_SYNCHRONIZED else began,
+        finished=(float(finished) or stamp) if status.is_final else 0.0,
     )
     return Proposal(
         EventKind.STATUS_CHANGED,

@@ -187,11 +187,18 @@ class Mission:
         attempt: int | None = None,
         text: str = "",
         stamp: float | None = None,
+        started: float = 0.0,
+        finished: float = 0.0,
     ) -> MissionEvent:
-        """A robot's status report for one of its synchronized skills."""
+        """A robot's status report for one of its synchronized skills.
+
+        ``started``/``finished`` are the robot's own times for the skill, if it gives them.
+        """
         when = self._clock() if stamp is None else stamp
         return self._commit(
-            execution.plan_report(self.state, skill_id, status, attempt, text, when)
+            execution.plan_report(
+                self.state, skill_id, status, attempt, text, when, started, finished
+            )
         )
 
     def stop(self, agent: str, *, base_revision: int | None = None) -> MissionEvent:

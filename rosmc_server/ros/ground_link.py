@@ -67,6 +67,7 @@ class AgentLink:
     robot_hash: str = ""
     mismatch: bool = False
     barriers_sent: tuple[Barrier, ...] = ()
+    newest_stamp: float = 0.0  # robot clock of the newest message heard from it
     last_error: str = ""
     subscribers: list[rospy.Subscriber] = field(default_factory=list)
 
@@ -189,6 +190,7 @@ class GroundLink:
 
     def _on_ack(self, agent: str, msg: wire.RobotAck) -> None:
         link = self._links[agent]
+        link.newest_stamp = max(link.newest_stamp, msg.stamp.to_sec())
         item = link.outbox.acknowledge(msg.seq, self._clock())
         if item is None:
             return  # the answer to a retransmission already processed
@@ -230,6 +232,7 @@ class GroundLink:
     def _on_report(self, agent: str, msg: wire.RobotReport) -> None:
         link = self._links[agent]
         link.outbox.heard(self._clock())
+        link.newest_stamp = max(link.newest_stamp, msg.stamp.to_sec())
         if link.reports is None:
             return  # wait for the robot's snapshot to learn its numbering
         if link.reports.classify(msg.seq) is Arrival.NEXT:
@@ -254,11 +257,20 @@ class GroundLink:
                 attempt=msg.attempt or None,
                 text=msg.status_text,
                 stamp=stamp,
+                started=msg.started,
+                finished=msg.finished,
             )
         )
 
     def _on_snapshot(self, agent: str, msg: wire.ExecutorSnapshot) -> None:
         link = self._links[agent]
+        stamp = msg.stamp.to_sec()
+        if stamp < link.newest_stamp:
+            # Older than something already heard (it queued behind newer reports): its
+            # numbers would look like a robot restart and rewind the report stream.
+            link.outbox.heard(self._clock())
+            return
+        link.newest_stamp = stamp
         if link.outbox.robot_numbering(msg.last_command_seq, self._clock()):
             _log.info("link %s: robot executed commands up to %d", agent, msg.last_command_seq)
         fresh = link.reports is None or msg.last_report_seq < link.reports.last

@@ -48,7 +48,7 @@ import rosmc.msg as wire
 import rospy
 
 from .. import interface
-from ..core import Library, Mission, MissionContent, MissionEvent, load_library
+from ..core import Library, Mission, MissionContent, MissionEvent, Unavailable, load_library
 from ..core.changes import EventKind
 from ..core.commands import commands_for_event
 from ..recording import JournalOptions, JournalWriter, default_journal_path, latest_state
@@ -172,7 +172,7 @@ class MissionServer:
         """
         with self._lock:
             if self._stopping:
-                raise RuntimeError("the mission server is shutting down")
+                raise Unavailable("the mission server is shutting down")
             event = operation(self.mission)
             if event is not None:
                 self._record(event)

@@ -129,8 +129,14 @@ def assert_legal(lines: dict[str, list[Transition]], skill_id: str) -> None:
 def happy(barrier: bool) -> list[tuple[SkillStatus, Transfer]]:
     """IDLE -> uploading -> IDLE_SYNCHRONIZED -> [SYNCWAITING] -> RUNNING -> SUCCESS."""
     waiting = [(S.SYNCWAITING, _N)] if barrier else []
-    return [(S.IDLE, _N), (S.IDLE, _U), (S.IDLE_SYNCHRONIZED, _N), *waiting,
-            (S.RUNNING, _N), (S.SUCCESS, _N)]  # fmt: skip
+    return [
+        (S.IDLE, _N),
+        (S.IDLE, _U),
+        (S.IDLE_SYNCHRONIZED, _N),
+        *waiting,
+        (S.RUNNING, _N),
+        (S.SUCCESS, _N),
+    ]
 
 
 def skew(stamps: dict[str, float], members: Sequence[str]) -> float:
@@ -686,3 +692,56 @@ def test_lost_link_policy_hold_set_by_the_operator(rosmc: Start) -> None:
     op.control("r1", srv.ControlRequest.RESUME)
     op.wait_status([long], S.RUNNING)
     system.stop("server")
+
+
+def test_a_snapshot_overtaken_by_newer_reports_does_not_stall_the_report_stream(
+    rosmc: Start,
+) -> None:
+    """A snapshot processed after a newer report must not look like a robot restart."""
+    _system, op = rosmc(agents=())
+    robot = LinkEnd("r3", "robot")
+    wait_for(robot.connected, 10.0, "the server's link to r3")
+    robot.publish("snapshot", wire.ExecutorSnapshot(agent="r3", queue_hash=queue_hash([])))
+    wait_for(lambda: robot.received("report_ack"), 10.0, "the server to learn r3's numbering")
+    a, b = op.add("r3", "wait", {"duration": 1.0}), op.add("r3", "wait", {"duration": 1.0})
+    op.sync("r3")
+    upload = robot.wait_heard("command", lambda c: c.type == wire.RobotCommand.UPLOAD)
+    robot.publish(
+        "ack",
+        wire.RobotAck(
+            agent="r3", seq=upload.seq, accepted_ids=[a, b], queue_hash=queue_hash([a, b])
+        ),
+    )
+    op.wait_status([a, b], S.IDLE_SYNCHRONIZED)
+    began = time.time()
+
+    def report(seq: int, skill_id: str, status: int, at: float) -> None:
+        robot.publish(
+            "report",
+            wire.RobotReport(
+                agent="r3",
+                seq=seq,
+                stamp=time_to_msg(at),
+                skill_id=skill_id,
+                status=wire.SkillStatus(status),
+                attempt=1,
+                started=at,
+            ),
+        )
+
+    report(1, a, S.RUNNING, began)
+    stale = wire.ExecutorSnapshot(
+        agent="r3",
+        stamp=time_to_msg(began + 0.1),
+        last_command_seq=upload.seq,
+        last_report_seq=1,
+        queue_hash=queue_hash([a, b]),
+        state="running",
+    )
+    report(2, a, S.SUCCESS, began + 0.2)
+    time.sleep(0.3)
+    robot.publish("snapshot", stale)  # taken before report 2, processed after it
+    time.sleep(0.3)
+    report(3, b, S.RUNNING, began + 0.3)
+    wait_for(lambda: op.mission().skill(b).status is S.RUNNING, 10.0, "report 3 to be applied")
+    assert [m.seq for m in robot.received("report_ack")][-1] == 3
