@@ -12,7 +12,6 @@ applied by the next :meth:`Engine.tick`.
 
 from __future__ import annotations
 
-import enum
 import logging
 from collections import OrderedDict, deque
 from collections.abc import Callable, Mapping
@@ -20,27 +19,18 @@ from dataclasses import dataclass, replace
 from typing import Protocol
 
 from rosmc_server.core import SkillInstance, SkillStatus
-from rosmc_server.core.commands import CommandKind
 from rosmc_server.core.link import queue_hash
 
-from . import queueing
+from . import commanding, queueing
 from .barriers import BarrierBoard
 from .policy import LostLinkPolicy
-from .protocol import Ack, AckResult, BarrierInfo, Command, Report, Signal, SignalKind, Snapshot
+from .protocol import Ack, BarrierInfo, Command, Mode, Report, Signal, SignalKind, Snapshot
 from .skills import Outcome, SkillBehavior, SkillContext, SkillType
 
 _log = logging.getLogger(__name__)
 S = SkillStatus
 ANNOUNCE_PERIOD = 0.5  # seconds between READY re-announcements while waiting
 KEPT_ACKS = 256
-
-
-class Mode(enum.Enum):
-    """Whether the operator let the robot execute."""
-
-    STOPPED = "stopped"
-    STARTED = "started"
-    PAUSED = "paused"
 
 
 class EngineOutputs(Protocol):
@@ -128,117 +118,13 @@ class Engine:
         return ack
 
     def _execute(self, cmd: Command) -> Ack:
-        handlers: Mapping[CommandKind, Callable[[Command], Ack]] = {
-            CommandKind.UPLOAD: self._upload,
-            CommandKind.UNSYNC: self._unsync,
-            CommandKind.START: self._start,
-            CommandKind.RESUME: self._start,
-            CommandKind.PAUSE: self._pause_command,
-            CommandKind.STOP: self._stop,
-            CommandKind.RETRY: self._retry,
-            CommandKind.SKIP: self._skip,
-            CommandKind.BARRIERS: self._set_barriers,
-            CommandKind.SET_OPTIONS: self._set_options,
-            CommandKind.SYNC_STATE: self._sync_state,
-        }
-        return handlers[cmd.kind](cmd)
+        return commanding.execute(self, cmd)
 
     def _ack(self, seq: int, **fields: object) -> Ack:
-        rejected = fields.get("rejected_ids", ())
-        accepted = fields.get("accepted_ids", ())
-        result = AckResult.ACCEPTED
-        if rejected:
-            result = AckResult.PARTIAL if accepted else AckResult.REJECTED
-        return Ack(seq, result, queue_hash=self.queue_hash(), **fields)  # type: ignore[arg-type]
-
-    def _upload(self, cmd: Command) -> Ack:
-        answer = queueing.upload(self.queue, cmd.skills, self._why_not)
-        self.queue = answer.queue
-        self.board.replace(cmd.barriers)
-        self._advance()
-        return self._answer(cmd.seq, answer, error=next(iter(answer.reasons), ""))
-
-    def _answer(self, seq: int, answer: queueing.Answer, error: str = "") -> Ack:
-        return self._ack(
-            seq,
-            accepted_ids=answer.accepted,
-            rejected_ids=answer.rejected,
-            rejection_reasons=answer.reasons,
-            error=error,
-        )
+        return commanding.ack(self, seq, **fields)
 
     def _why_not(self, skill: SkillInstance) -> str:
-        if skill.agent != self.agent:
-            return f"skill '{skill.id}' is for {skill.agent}, not {self.agent}"
-        kind = self.skill_types.get(skill.skill)
-        if kind is None:
-            return f"{self.agent} does not implement skill '{skill.skill}'"
-        return kind.check(skill.params)
-
-    def _unsync(self, cmd: Command) -> Ack:
-        active_id = self._active.skill_id if self._active else ""
-        answer = queueing.unsync(self.queue, cmd.skill_ids, active_id)
-        self.queue = answer.queue
-        return self._answer(cmd.seq, answer)
-
-    def _start(self, cmd: Command) -> Ack:
-        self.mode = Mode.STARTED
-        active = self._active
-        if active is not None and self._status(active.skill_id) is S.PAUSED:
-            self._resume_active(active)
-        self._advance()
-        holding = queueing.holding(self.queue)
-        note = f"holding after the failure of '{holding.id}': retry or skip it" if holding else ""
-        return self._ack(cmd.seq, error=note)
-
-    def _pause_command(self, cmd: Command) -> Ack:
-        self.pause("paused by the operator")
-        return self._ack(cmd.seq)
-
-    def _stop(self, cmd: Command) -> Ack:
-        self.mode = Mode.STOPPED
-        active = self._active
-        if active is not None:
-            self._drop_active(active, "stopped by the operator")
-        return self._ack(cmd.seq)
-
-    def _retry(self, cmd: Command) -> Ack:
-        if not cmd.skill_ids or not cmd.skills:
-            return self._ack(cmd.seq, error="a retry names the failed skill and its new instance")
-        answer = queueing.retry(self.queue, cmd.skill_ids[0], cmd.skills[0])
-        return self._queue_changed(cmd.seq, answer)
-
-    def _skip(self, cmd: Command) -> Ack:
-        if not cmd.skill_ids:
-            return self._ack(cmd.seq, error="a skip names the failed skill")
-        return self._queue_changed(cmd.seq, queueing.skip(self.queue, cmd.skill_ids[0]))
-
-    def _queue_changed(self, seq: int, answer: queueing.Answer) -> Ack:
-        self.queue = answer.queue
-        self._advance()
-        return self._answer(seq, answer, error=next(iter(answer.reasons), ""))
-
-    def _set_barriers(self, cmd: Command) -> Ack:
-        self.board.replace(cmd.barriers)
-        active = self._active
-        if active is not None and active.behavior is None and active.barrier is not None:
-            active.barrier = self.board.barrier_of(active.skill_id)
-            if active.barrier is not None and self._status(active.skill_id) is S.SYNCWAITING:
-                self._set(active.skill_id, S.SYNCWAITING, text=self._waiting_text(active.barrier))
-            self._try_release(active)
-        return self._ack(cmd.seq)
-
-    def _set_options(self, cmd: Command) -> Ack:
-        try:
-            self.policy = LostLinkPolicy.from_json(cmd.argument, set(self.skill_types))
-        except ValueError as error:
-            return self._ack(cmd.seq, error=str(error), rejected_ids=("options",))
-        return self._ack(cmd.seq)
-
-    def _sync_state(self, cmd: Command) -> Ack:
-        """Make the queue the ground's list, keeping whatever has started here."""
-        self.board.replace(cmd.barriers)
-        return self._queue_changed(cmd.seq, queueing.adopt(self.queue, cmd.skills, self._why_not))
+        return commanding.why_not(self, skill)
 
     # -- peers and the ground -------------------------------------------------------------
     def hear(self, signal: Signal) -> None:

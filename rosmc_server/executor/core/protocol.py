@@ -104,3 +104,11 @@ class Snapshot:
     active_skill_id: str
     waiting_on: str
     policy: str
+
+
+class Mode(enum.Enum):
+    """Whether the operator let the robot execute."""
+
+    STOPPED = "stopped"
+    STARTED = "started"
+    PAUSED = "paused"

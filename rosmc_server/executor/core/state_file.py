@@ -15,9 +15,9 @@ from typing import Any
 
 from rosmc_server.core import Pose, Resolution, SkillInstance, SkillStatus, Transfer
 
-from .engine import Engine, Mode
+from .engine import Engine
 from .policy import LostLinkPolicy
-from .protocol import Ack, AckResult, BarrierInfo, Report
+from .protocol import Ack, AckResult, BarrierInfo, Mode, Report
 
 STATE_VERSION = 1
 

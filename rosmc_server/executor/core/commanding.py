@@ -1,0 +1,157 @@
+"""What the executor does with each ground command, and its answers.
+
+Every function takes the engine and one command, changes the robot's queue or
+execution accordingly, and returns the :class:`Ack` the ground receives.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable, Mapping
+from typing import TYPE_CHECKING
+
+from rosmc_server.core import SkillInstance, SkillStatus
+from rosmc_server.core.commands import CommandKind
+
+from . import queueing
+from .policy import LostLinkPolicy
+from .protocol import Ack, AckResult, Command, Mode
+
+if TYPE_CHECKING:
+    from .engine import Engine
+
+S = SkillStatus
+
+
+def execute(engine: Engine, cmd: Command) -> Ack:
+    """Run one ground command on the engine and give the robot's answer."""
+    handlers: Mapping[CommandKind, Callable[[Engine, Command], Ack]] = {
+        CommandKind.UPLOAD: _upload,
+        CommandKind.UNSYNC: _unsync,
+        CommandKind.START: _start,
+        CommandKind.RESUME: _start,
+        CommandKind.PAUSE: _pause_command,
+        CommandKind.STOP: _stop,
+        CommandKind.RETRY: _retry,
+        CommandKind.SKIP: _skip,
+        CommandKind.BARRIERS: _set_barriers,
+        CommandKind.SET_OPTIONS: _set_options,
+        CommandKind.SYNC_STATE: _sync_state,
+    }
+    return handlers[cmd.kind](engine, cmd)
+
+
+def ack(engine: Engine, seq: int, **fields: object) -> Ack:
+    rejected = fields.get("rejected_ids", ())
+    accepted = fields.get("accepted_ids", ())
+    result = AckResult.ACCEPTED
+    if rejected:
+        result = AckResult.PARTIAL if accepted else AckResult.REJECTED
+    return Ack(seq, result, queue_hash=engine.queue_hash(), **fields)  # type: ignore[arg-type]
+
+
+def _upload(engine: Engine, cmd: Command) -> Ack:
+    answer = queueing.upload(engine.queue, cmd.skills, functools.partial(why_not, engine))
+    engine.queue = answer.queue
+    engine.board.replace(cmd.barriers)
+    engine._advance()
+    return _answer(engine, cmd.seq, answer, error=next(iter(answer.reasons), ""))
+
+
+def _answer(engine: Engine, seq: int, answer: queueing.Answer, error: str = "") -> Ack:
+    return ack(
+        engine,
+        seq,
+        accepted_ids=answer.accepted,
+        rejected_ids=answer.rejected,
+        rejection_reasons=answer.reasons,
+        error=error,
+    )
+
+
+def why_not(engine: Engine, skill: SkillInstance) -> str:
+    if skill.agent != engine.agent:
+        return f"skill '{skill.id}' is for {skill.agent}, not {engine.agent}"
+    kind = engine.skill_types.get(skill.skill)
+    if kind is None:
+        return f"{engine.agent} does not implement skill '{skill.skill}'"
+    return kind.check(skill.params)
+
+
+def _unsync(engine: Engine, cmd: Command) -> Ack:
+    active_id = engine._active.skill_id if engine._active else ""
+    answer = queueing.unsync(engine.queue, cmd.skill_ids, active_id)
+    engine.queue = answer.queue
+    return _answer(engine, cmd.seq, answer)
+
+
+def _start(engine: Engine, cmd: Command) -> Ack:
+    engine.mode = Mode.STARTED
+    active = engine._active
+    if active is not None and engine._status(active.skill_id) is S.PAUSED:
+        engine._resume_active(active)
+    engine._advance()
+    holding = queueing.holding(engine.queue)
+    note = f"holding after the failure of '{holding.id}': retry or skip it" if holding else ""
+    return ack(engine, cmd.seq, error=note)
+
+
+def _pause_command(engine: Engine, cmd: Command) -> Ack:
+    engine.pause("paused by the operator")
+    return ack(engine, cmd.seq)
+
+
+def _stop(engine: Engine, cmd: Command) -> Ack:
+    engine.mode = Mode.STOPPED
+    active = engine._active
+    if active is not None:
+        engine._drop_active(active, "stopped by the operator")
+    return ack(engine, cmd.seq)
+
+
+def _retry(engine: Engine, cmd: Command) -> Ack:
+    if not cmd.skill_ids or not cmd.skills:
+        return ack(engine, cmd.seq, error="a retry names the failed skill and its new instance")
+    answer = queueing.retry(engine.queue, cmd.skill_ids[0], cmd.skills[0])
+    return _queue_changed(engine, cmd.seq, answer)
+
+
+def _skip(engine: Engine, cmd: Command) -> Ack:
+    if not cmd.skill_ids:
+        return ack(engine, cmd.seq, error="a skip names the failed skill")
+    return _queue_changed(engine, cmd.seq, queueing.skip(engine.queue, cmd.skill_ids[0]))
+
+
+def _queue_changed(engine: Engine, seq: int, answer: queueing.Answer) -> Ack:
+    engine.queue = answer.queue
+    engine._advance()
+    return _answer(engine, seq, answer, error=next(iter(answer.reasons), ""))
+
+
+def _set_barriers(engine: Engine, cmd: Command) -> Ack:
+    engine.board.replace(cmd.barriers)
+    active = engine._active
+    if active is not None and active.behavior is None and active.barrier is not None:
+        active.barrier = engine.board.barrier_of(active.skill_id)
+        if active.barrier is not None and engine._status(active.skill_id) is S.SYNCWAITING:
+            engine._set(active.skill_id, S.SYNCWAITING, text=engine._waiting_text(active.barrier))
+        engine._try_release(active)
+    return ack(engine, cmd.seq)
+
+
+def _set_options(engine: Engine, cmd: Command) -> Ack:
+    try:
+        engine.policy = LostLinkPolicy.from_json(cmd.argument, set(engine.skill_types))
+    except ValueError as error:
+        return ack(engine, cmd.seq, error=str(error), rejected_ids=("options",))
+    return ack(engine, cmd.seq)
+
+
+def _sync_state(engine: Engine, cmd: Command) -> Ack:
+    """Make the queue the ground's list, keeping whatever has started here."""
+    engine.board.replace(cmd.barriers)
+    return _queue_changed(
+        engine,
+        cmd.seq,
+        queueing.adopt(engine.queue, cmd.skills, functools.partial(why_not, engine)),
+    )
