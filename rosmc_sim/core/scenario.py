@@ -13,7 +13,7 @@ from typing import Any
 
 import yaml
 
-from rosmc_server.core.documents import DocumentReader
+from rosmc_server.core.documents import DocumentReader, load_yaml
 from rosmc_server.core.errors import RosmcError
 
 SCENARIO_VERSION = 1
@@ -119,7 +119,7 @@ class Scenario:
 def load_scenario(path: str | Path) -> Scenario:
     """Read and check a scenario file."""
     try:
-        data = yaml.safe_load(Path(path).read_text(encoding="utf-8"))
+        data = load_yaml(Path(path).read_text(encoding="utf-8"))
     except OSError as error:
         raise ScenarioError(f"{path}: cannot read the scenario ({error.strerror})") from error
     except yaml.YAMLError as error:

@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from .sim import LEVEL_COLLABORATIVE, LEVEL_SCIENCE, Robot, Simulation
-from .tasks import Steps, TaskFailed, _drive, _pose, _work
+from .tasks import Steps, TaskFailed, _drive, _pose, _work, free_stop
 
 IDENTIFY_SECONDS = {"quick": 10.0, "standard": 20.0, "detailed": 40.0}
 HANDLING_SECONDS = 8.0
@@ -149,11 +149,14 @@ def _require_arm(robot: Robot) -> None:
 def _approach(
     sim: Simulation, robot: Robot, x: float, y: float, what: str, reach: float = REACH
 ) -> Steps:
-    """Drive until within ``reach`` of (x, y), stopping short of the point itself."""
+    """Drive until within ``reach`` of (x, y), stopping short of the point itself.
+
+    The stop is on the robot's side of the target if that ground is free, else the
+    nearest free side (a box beside the lander is reached from around the lander).
+    """
     distance = robot.distance_to(x, y)
     if distance <= reach:
         return ""
-    angle = math.atan2(robot.y - y, robot.x - x)
-    stop = (x + (reach - 0.3) * math.cos(angle), y + (reach - 0.3) * math.sin(angle))
+    stop = free_stop(sim, robot, x, y, reach - 0.3)
     yield from _drive(sim, robot, stop[0], stop[1], robot.spec.speed, what)
     return ""

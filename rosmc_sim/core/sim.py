@@ -15,7 +15,7 @@ import random
 from dataclasses import dataclass, field
 
 from .planner import Grid, NoPath
-from .scenario import BoxSpec, Region, RobotSpec, Scenario
+from .scenario import BoxSpec, Obstacle, Region, RobotSpec, Scenario
 from .world import ROBOT_SIZE, Placement, World
 
 TURN_RATE = 1.2  # rad/s
@@ -129,7 +129,10 @@ class Simulation:
                 if world is not None:
                     world.add_stone(name, stone.x, stone.y)
         clearance = max(max(ROBOT_SIZE[k][:2]) for k in ROBOT_SIZE) / 2 + 0.4
-        self.grid = Grid.build(scenario.bounds, scenario.obstacles, clearance)
+        # The lander is an obstacle too: rovers drive around it, never across it.
+        side = 2 * scenario.lander_radius
+        lander = Obstacle("lander", "box", 0.0, 0.0, 1.2, size_x=side, size_y=side)
+        self.grid = Grid.build(scenario.bounds, (*scenario.obstacles, lander), clearance)
 
     # -- motion --------------------------------------------------------------------
     def plan(self, robot: Robot, x: float, y: float) -> list[tuple[float, float]]:

@@ -162,6 +162,19 @@ def _sweep(area: list[tuple[float, float]], spacing: float) -> list[tuple[float,
     return points
 
 
+def free_stop(
+    sim: Simulation, robot: Robot, x: float, y: float, radius: float
+) -> tuple[float, float]:
+    """A point ``radius`` from (x, y) that a rover can stand on, closest to its own side."""
+    facing = math.atan2(robot.y - y, robot.x - x)
+    for turn in (0, 1, -1, 2, -2, 3, -3, 4, -4, 5, -5, 6):
+        angle = facing + turn * math.pi / 6
+        stop = (x + radius * math.cos(angle), y + radius * math.sin(angle))
+        if robot.kind == "drone" or sim.grid.free(*sim.grid.cell(stop)):
+            return stop
+    return (x + radius * math.cos(facing), y + radius * math.sin(facing))
+
+
 # -- the skills ----------------------------------------------------------------------
 def navigate_to(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps:
     """Go to a pose (rovers around obstacles, the drone straight at its altitude)."""
@@ -228,13 +241,12 @@ def return_to_lander(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -
         yield from _drive(sim, robot, 0.0, 0.0, robot.spec.speed, "returning")
         yield from land(sim, robot, params)
         return "landed on the lander"
-    angle = math.atan2(robot.y, robot.x)
-    distance = sim.scenario.charge_radius - 0.8
+    x, y = free_stop(sim, robot, 0.0, 0.0, sim.scenario.charge_radius - 0.3)
     yield from _drive(
         sim,
         robot,
-        distance * math.cos(angle),
-        distance * math.sin(angle),
+        x,
+        y,
         robot.spec.speed,
         "returning",
     )
