@@ -14,15 +14,20 @@ import pybullet as pb
 
 from .scenario import Scenario
 
-_COLORS = {
+# One palette for the pybullet bodies and the rviz world markers (RGBA, 0..1).
+COLORS = {
     "ground": (0.76, 0.45, 0.30, 1.0),
-    "obstacle": (0.45, 0.30, 0.25, 1.0),
+    "obstacles": (0.45, 0.30, 0.25, 1.0),
+    "slopes": (0.60, 0.35, 0.20, 0.35),
     "lander": (0.85, 0.85, 0.88, 1.0),
     "drone": (0.20, 0.55, 0.95, 1.0),
     "science_rover": (0.95, 0.75, 0.20, 1.0),
     "manipulator_rover": (0.30, 0.80, 0.40, 1.0),
-    "box": (0.80, 0.80, 0.80, 1.0),
-    "stone": (0.30, 0.30, 0.32, 1.0),
+    "boxes": (0.80, 0.80, 0.80, 1.0),
+    "stones": (0.30, 0.30, 0.32, 1.0),
+    "regions": (0.95, 0.85, 0.20, 0.35),
+    "region_labels": (1.0, 1.0, 1.0, 1.0),
+    "wifi": (0.20, 0.60, 1.00, 0.8),
 }
 ROBOT_SIZE = {
     "drone": (0.7, 0.7, 0.15),
@@ -68,7 +73,7 @@ class World:
             if obstacle.shape == "cylinder":
                 body = self._add(
                     obstacle.name,
-                    "obstacle",
+                    "obstacles",
                     pb.GEOM_CYLINDER,
                     (obstacle.radius, obstacle.height),
                     (obstacle.x, obstacle.y, obstacle.height / 2),
@@ -76,7 +81,7 @@ class World:
             else:
                 body = self._add(
                     obstacle.name,
-                    "obstacle",
+                    "obstacles",
                     pb.GEOM_BOX,
                     (obstacle.size_x / 2, obstacle.size_y / 2, obstacle.height / 2),
                     (obstacle.x, obstacle.y, obstacle.height / 2),
@@ -104,7 +109,7 @@ class World:
                 robot.yaw,
             )
         for box in scenario.boxes:
-            self._add(box.name, "box", pb.GEOM_BOX, (BOX_SIZE / 2,) * 3, (box.x, box.y, 1.45))
+            self._add(box.name, "boxes", pb.GEOM_BOX, (BOX_SIZE / 2,) * 3, (box.x, box.y, 1.45))
 
     def _add(
         self,
@@ -120,7 +125,7 @@ class World:
                 shape, halfExtents=size, physicsClientId=self.client
             )
             visual = pb.createVisualShape(
-                shape, halfExtents=size, rgbaColor=_COLORS[kind], physicsClientId=self.client
+                shape, halfExtents=size, rgbaColor=COLORS[kind], physicsClientId=self.client
             )
         elif shape == pb.GEOM_CYLINDER:
             collision = pb.createCollisionShape(
@@ -130,13 +135,13 @@ class World:
                 shape,
                 radius=size[0],
                 length=size[1],
-                rgbaColor=_COLORS[kind],
+                rgbaColor=COLORS[kind],
                 physicsClientId=self.client,
             )
         else:
             collision = pb.createCollisionShape(shape, radius=size[0], physicsClientId=self.client)
             visual = pb.createVisualShape(
-                shape, radius=size[0], rgbaColor=_COLORS[kind], physicsClientId=self.client
+                shape, radius=size[0], rgbaColor=COLORS[kind], physicsClientId=self.client
             )
         body: int = pb.createMultiBody(
             0,
@@ -151,7 +156,7 @@ class World:
 
     def add_stone(self, name: str, x: float, y: float) -> None:
         """A stone lying on the ground."""
-        self._add(name, "stone", pb.GEOM_SPHERE, (STONE_RADIUS,), (x, y, STONE_RADIUS))
+        self._add(name, "stones", pb.GEOM_SPHERE, (STONE_RADIUS,), (x, y, STONE_RADIUS))
 
     def place(self, name: str, where: Placement) -> None:
         """Move a body (kinematically)."""

@@ -21,7 +21,7 @@ from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
 from ..core.sim import Simulation
-from ..core.world import BOX_SIZE, STONE_RADIUS
+from ..core.world import BOX_SIZE, COLORS, STONE_RADIUS
 from .robot_state import MAP_FRAME, yaw_quaternion
 from .timing import Throttle
 from .topics import WORLD_TOPIC
@@ -30,17 +30,6 @@ CHECK_PERIOD = 0.1
 MIN_PERIOD = 0.5
 CIRCLE_POINTS = 72
 LANDER_HEIGHT = 1.2
-_COLORS = {
-    "ground": (0.76, 0.45, 0.30, 1.0),
-    "obstacles": (0.45, 0.30, 0.25, 1.0),
-    "slopes": (0.60, 0.35, 0.20, 0.35),
-    "lander": (0.85, 0.85, 0.88, 1.0),
-    "boxes": (0.80, 0.80, 0.80, 1.0),
-    "regions": (0.95, 0.85, 0.20, 0.35),
-    "region_labels": (1.0, 1.0, 1.0, 1.0),
-    "stones": (0.30, 0.30, 0.32, 1.0),
-    "wifi": (0.20, 0.60, 1.00, 0.8),
-}
 _BOX_COLORS = {
     "wifi": (0.25, 0.55, 0.95, 1.0),
     "sample": (0.90, 0.90, 0.90, 1.0),
@@ -75,7 +64,7 @@ def _marker(ns: str, ident: int, kind: int, x: float, y: float, z: float) -> Mar
     marker.header.stamp = rospy.Time(0)
     marker.pose.position = Point(x, y, z)
     marker.pose.orientation = yaw_quaternion(0.0)
-    marker.color = ColorRGBA(*_COLORS[ns])
+    marker.color = ColorRGBA(*COLORS[ns])
     return marker
 
 
@@ -111,7 +100,7 @@ def _box_markers(sim: Simulation) -> list[Marker]:
     out = []
     for i, box in enumerate(sim.boxes.values()):
         m = _sized(_marker("boxes", i, Marker.CUBE, box.x, box.y, box.z), *(BOX_SIZE,) * 3)
-        m.color = ColorRGBA(*_BOX_COLORS.get(box.spec.kind, _COLORS["boxes"]))
+        m.color = ColorRGBA(*_BOX_COLORS.get(box.spec.kind, COLORS["boxes"]))
         out.append(m)
     sources = [(0.0, 0.0, sim.scenario.lander_wifi_radius)]
     sources += [
