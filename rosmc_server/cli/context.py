@@ -8,8 +8,8 @@ import sys
 from dataclasses import asdict, dataclass, field
 from typing import Any, TextIO
 
+from ..core import AgentStatus
 from ..ros.client import MissionClient, MissionWatch, Result, init_node
-from ..text import AgentStatus
 
 # How long `rosmc status` waits for the robots' states (the server publishes at 2 Hz).
 STATES_WAIT = 1.5

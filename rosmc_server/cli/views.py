@@ -6,10 +6,9 @@ import json
 import sys
 import time
 
-from ..core import MissionEvent
+from ..core import AgentStatus, MissionEvent
 from ..ros.client import MissionWatch, ServerUnavailable, init_node
 from ..text import (
-    AgentStatus,
     agent_status_to_json,
     event_to_json,
     format_agent_status,

@@ -4,6 +4,7 @@ No rospy, genpy, generated messages, Qt or pybullet are imported here; the
 ROS adapters in :mod:`rosmc_server.ros` translate between this and the wire.
 """
 
+from .agent_status import AgentStatus
 from .changes import Change, EventKind, MissionEvent, PlacedSkill
 from .errors import (
     InvalidRequest,
@@ -38,6 +39,7 @@ from .state import MissionContent, MissionState
 __all__ = [
     "AgentKind",
     "AgentSpec",
+    "AgentStatus",
     "Barrier",
     "Change",
     "EventKind",

@@ -24,11 +24,9 @@ from .plain import (
     format_schedule,
     format_value,
 )
-from .status import AgentStatus
 
 __all__ = [
     "STATUS_MARK",
-    "AgentStatus",
     "agent_status_to_json",
     "event_to_json",
     "format_agent_status",

@@ -15,8 +15,8 @@ from ..core import (
     SkillSpec,
     TaskMarker,
 )
+from ..core.agent_status import AgentStatus
 from ..core.params import value_to_data
-from .status import AgentStatus
 
 
 def mission_to_json(

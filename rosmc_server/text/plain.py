@@ -24,7 +24,7 @@ from ..core import (
     Transfer,
     Value,
 )
-from .status import AgentStatus
+from ..core.agent_status import AgentStatus
 
 STATUS_MARK = {
     SkillStatus.IDLE: "  ",

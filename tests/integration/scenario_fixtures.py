@@ -33,9 +33,8 @@ import rosmc.msg as wire
 import rospy
 from rosgraph_msgs.msg import Clock
 
-from rosmc_server.core import MissionState, RosmcError, SkillStatus, Transfer
+from rosmc_server.core import AgentStatus, MissionState, RosmcError, SkillStatus, Transfer
 from rosmc_server.ros.client import ControlCommand, MissionClient, MissionWatch
-from rosmc_server.text import AgentStatus
 from rosmc_sim.ros.topics import SCIENCE_TOPIC, blackout_topic
 
 REPO = Path(__file__).resolve().parents[2]

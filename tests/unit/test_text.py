@@ -8,6 +8,7 @@ from typing import Any
 import pytest
 
 from rosmc_server.core import (
+    AgentStatus,
     Library,
     MarkerType,
     Mission,
@@ -18,7 +19,6 @@ from rosmc_server.core import (
 )
 from rosmc_server.core.params import parse_text
 from rosmc_server.text import (
-    AgentStatus,
     event_to_json,
     format_agent_status,
     format_event,

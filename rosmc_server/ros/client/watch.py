@@ -17,8 +17,7 @@ import rosmc.msg as wire
 import rospy
 
 from ... import interface
-from ...core import MissionEvent
-from ...text import AgentStatus
+from ...core import AgentStatus, MissionEvent
 from ..conversions import event_from_msg
 from .wire import agent_statuses_from_msg
 

@@ -14,6 +14,7 @@ import yaml
 from ...core import (
     AgentKind,
     AgentSpec,
+    AgentStatus,
     InvalidRequest,
     Library,
     MarkerType,
@@ -23,7 +24,6 @@ from ...core import (
     SkillStatus,
     Value,
 )
-from ...text import AgentStatus
 from ..conversions import param_from_msg, pose_from_msg
 
 _LINK_STATES = {wire.LinkState.UP: "up", wire.LinkState.DOWN: "down"}
@@ -100,6 +100,8 @@ def agent_status_from_msg(msg: wire.AgentState) -> AgentStatus:
         round_trip=msg.link.round_trip,
         commands_in_flight=msg.link.commands_in_flight,
         hash_mismatch=msg.link.hash_mismatch,
+        queue_hash=msg.link.queue_hash,
+        robot_queue_hash=msg.link.robot_queue_hash,
         battery=_finite(telemetry.battery),
         wifi_signal=_finite(telemetry.wifi_signal),
         in_coverage=telemetry.in_coverage,
@@ -108,6 +110,7 @@ def agent_status_from_msg(msg: wire.AgentState) -> AgentStatus:
         current_status=SkillStatus(msg.current_status.value) if current else None,
         executor_state=msg.executor_state,
         waiting_on=msg.waiting_on,
+        policy=msg.policy,
     )
 
 

@@ -1,0 +1,43 @@
+"""What the mission server reports about each robot's live state, as a plain value.
+
+Clients (the CLI, both GUIs, replay) receive it on ``/rosmc/agent_states``; it lives in
+the core so that widgets and marker geometry can use it without importing rospy.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .model import SkillStatus
+from .params import Pose
+
+
+@dataclass(frozen=True)
+class AgentStatus:
+    """What the mission server reports about one agent's robot (``/rosmc/agent_states``).
+
+    ``link`` is ``"up"``, ``"down"`` or ``"unknown"`` (never heard); times are seconds,
+    -1 if unknown. ``battery`` (0..1), ``wifi_signal`` (dBm) and ``pose`` are None without
+    telemetry. ``queue_hash`` is the synchronized queue as the ground sees it and
+    ``robot_queue_hash`` as the robot last reported it (``hash_mismatch``: a repair is under
+    way). ``policy`` is the lost-link policy the robot reports in force (and whether it
+    triggered), as the robot words it; "" if the robot has not said.
+    """
+
+    agent: str
+    link: str = "unknown"
+    last_heard: float = -1.0
+    round_trip: float = -1.0
+    commands_in_flight: int = 0
+    hash_mismatch: bool = False
+    queue_hash: str = ""
+    robot_queue_hash: str = ""
+    battery: float | None = None
+    wifi_signal: float | None = None
+    in_coverage: bool = False
+    pose: Pose | None = None
+    current_skill: str = ""
+    current_status: SkillStatus | None = None
+    executor_state: str = ""
+    waiting_on: str = ""
+    policy: str = ""
