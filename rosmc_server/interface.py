@@ -45,11 +45,28 @@ SERVICES = {
 }
 
 
-def service_name(operation: str) -> str:
-    """Full name of an operator service, e.g. ``/rosmc/add_skill``."""
+def service_name(operation: str, prefix: str = "") -> str:
+    """Full name of an operator service, e.g. ``/rosmc/add_skill`` (``/replay/rosmc/...``)."""
     if operation not in SERVICES:
         raise KeyError(f"unknown operator service {operation!r}")
-    return f"{NAMESPACE}/{operation}"
+    return prefixed(f"{NAMESPACE}/{operation}", prefix)
+
+
+def prefixed(name: str, prefix: str) -> str:
+    """``name`` behind a namespace prefix such as ``/replay`` ("" leaves it as it is).
+
+    A replay (``rosmc replay --prefix /replay``) publishes the live names behind a
+    prefix; clients that follow it put the same prefix before every name they use.
+    """
+    base = prefix.strip().rstrip("/")
+    if base and not base.startswith("/"):
+        base = "/" + base
+    return base + name
+
+
+# Which skills and task markers an operator has selected, shared by the command GUI and
+# rviz so that selecting in one highlights in the other (rosmc/Selection, latched).
+SELECTION_TOPIC = f"{NAMESPACE}/selection"
 
 
 # Robot-to-robot barrier coordination (never through the ground station).

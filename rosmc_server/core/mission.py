@@ -21,6 +21,7 @@ from .model import SkillStatus, TaskMarker, Transfer
 from .params import Pose
 from .reconcile import Reconciliation, RobotSkill, plan_reconcile
 from .state import MissionContent, MissionState
+from .updates import apply_event
 
 IdFactory = Callable[[str], str]
 
@@ -329,13 +330,8 @@ class Mission:
         )
 
     def replay(self, event: MissionEvent) -> None:
-        """Apply a journaled event; it must be the next revision."""
-        if event.revision != self.revision + 1:
-            raise RuleViolation(
-                f"event revision {event.revision} does not follow revision {self.revision}"
-            )
-        self.state.apply(event.change)
-        self.state.revision = event.revision
+        """Apply a journaled event; it must be the next revision (see :func:`apply_event`)."""
+        apply_event(self.state, event)
         if event.kind not in ROBOT_EVENTS:
             self.operator_revision = event.revision
 

@@ -21,18 +21,15 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from rosmc_server.core import (
-    AgentKind,
-    AgentSpec,
     EventKind,
     InvalidRequest,
-    Library,
-    Mission,
     MissionContent,
     MissionEvent,
     MissionState,
     NotFound,
     RosmcError,
 )
+from rosmc_server.core.updates import apply_event
 from rosmc_server.recording.errors import JournalError
 from rosmc_server.recording.reader import JournalResult, read_journal
 from rosmc_server.recording.timeline import Timeline, TimelineBuilder
@@ -89,7 +86,7 @@ class MissionHistory:
         """Revisions that could not be rebuilt and why (empty for an intact journal)."""
         self._revisions = [entry.info.revision for entry in self._entries]
         self._times = [entry.info.log_time for entry in self._entries]
-        self._cache: tuple[int, Mission] | None = None
+        self._cache: tuple[int, MissionState] | None = None
 
     @classmethod
     def from_journal(cls, path: str | Path) -> MissionHistory:
@@ -165,20 +162,20 @@ class MissionHistory:
             start -= 1
         cached = self._cache
         if cached is not None and start <= cached[0] <= index:
-            start, mission = cached  # sequential lookups replay only the new events
+            start, state = cached  # sequential lookups replay only the new events
         else:
-            mission = _mission(self._entries[start].checkpoint, self._revisions[start])
+            state = _state(self._entries[start].checkpoint, self._revisions[start])
         for entry in self._entries[start + 1 : index + 1]:
             if entry.checkpoint is not None:
-                mission = _mission(entry.checkpoint, entry.info.revision)
+                state = _state(entry.checkpoint, entry.info.revision)
             else:
                 assert entry.event is not None
-                mission.replay(entry.event)
-        self._cache = (index, mission)
-        return MissionState(mission.state.content(), mission.revision)
+                apply_event(state, entry.event)
+        self._cache = (index, state)
+        return MissionState(state.content(), state.revision)
 
     def _build(self, result: JournalResult) -> None:
-        mission: Mission | None = None
+        mission: MissionState | None = None
         pending: tuple[MissionEvent, int] | None = None  # a replacement awaiting its snapshot
         broken_at: int | None = None  # first revision that could not be applied
         since_checkpoint = 0
@@ -200,9 +197,9 @@ class MissionHistory:
                 else:
                     continue  # a periodic snapshot of a revision already rebuilt
                 content, _ = mission_from_msg(record.message)
-                mission = _mission(content, revision)
+                mission = _state(content, revision)
                 self._entries.append(_Entry(info, None, content))
-                self._timeline.reset(mission.state, info.log_time)
+                self._timeline.reset(mission, info.log_time)
                 broken_at, since_checkpoint = None, 0
                 continue
             if mission is None or record.topic != MISSION_EVENTS_TOPIC:
@@ -226,8 +223,8 @@ class MissionHistory:
                 if event.kind is EventKind.MISSION_REPLACED:
                     pending = (event, record.log_time)
                     continue
-                self._timeline.event(mission.state, event, record.log_time)
-                mission.replay(event)
+                self._timeline.event(mission, event, record.log_time)
+                apply_event(mission, event)
             except RosmcError as err:
                 self._problems.append(f"revision {revision} does not apply ({err}); skipped")
                 broken_at = revision
@@ -235,7 +232,7 @@ class MissionHistory:
             since_checkpoint += 1
             checkpoint = None
             if since_checkpoint >= CHECKPOINT_EVERY:
-                checkpoint, since_checkpoint = mission.state.content(), 0
+                checkpoint, since_checkpoint = mission.content(), 0
             info = Revision(revision, record.log_time, event.kind, event.summary)
             self._entries.append(_Entry(info, event if checkpoint is None else None, checkpoint))
         if broken_at is not None:
@@ -260,8 +257,7 @@ class MissionHistory:
             )
 
 
-def _mission(content: MissionContent | None, revision: int) -> Mission:
-    """A mission to replay events on; replaying needs no skill schemas, only the agents."""
+def _state(content: MissionContent | None, revision: int) -> MissionState:
+    """A mission state to apply events on (applying needs no library)."""
     assert content is not None
-    agents = tuple(AgentSpec(name, AgentKind.DYNAMIC, "") for name in content.tasks)
-    return Mission(Library(content.library, agents), content, revision)
+    return MissionState(content, revision)

@@ -1,10 +1,13 @@
 """The Python client of the mission server: operator services, events and agent states.
 
-:class:`MissionClient` calls the operator services; :class:`MissionWatch`
-subscribes to the mission events and agent states (after :func:`init_node`).
-Both speak core objects and raise the core error family.
+:class:`MissionClient` calls the operator services; :class:`AsyncMissionClient` runs
+those calls on a worker thread for GUIs. :class:`MissionFollower` keeps a
+:class:`~rosmc_server.core.mirror.MissionMirror` (a live copy of the mission) current from
+the events, agent states and snapshots; :class:`MissionWatch` queues the raw events
+(``rosmc watch``). All speak core objects and raise the core error family.
 """
 
+from .follow import MissionFollower
 from .mission_client import MissionClient
 from .results import (
     BarrierAdded,
@@ -21,15 +24,19 @@ from .results import (
 )
 from .watch import MissionWatch, init_node
 from .wire import agent_status_from_msg, agent_statuses_from_msg, library_from_msg
+from .worker import AsyncMissionClient, Outcome
 
 __all__ = [
+    "AsyncMissionClient",
     "BarrierAdded",
     "ControlCommand",
     "ControlSent",
     "MarkerAdded",
     "MissionClient",
+    "MissionFollower",
     "MissionSaved",
     "MissionWatch",
+    "Outcome",
     "Result",
     "RevisionConflict",
     "ServerUnavailable",

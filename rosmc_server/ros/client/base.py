@@ -21,14 +21,20 @@ class ClientBase:
 
     Args:
         timeout: Seconds to wait for the server to appear (per connection).
+        prefix: Namespace before every service name, e.g. ``/replay`` to read a replay.
     """
 
-    def __init__(self, timeout: float = 5.0) -> None:
-        self._caller = ServiceCaller(timeout)
+    def __init__(self, timeout: float = 5.0, prefix: str = "") -> None:
+        self._caller = ServiceCaller(timeout, prefix)
         self.revision: int | None = None
         self._library: Library | None = None
         self._kinds: dict[str, tuple[str, str]] = {}
         self._lock = threading.RLock()
+
+    @property
+    def prefix(self) -> str:
+        """The namespace before every service name ("" for the live server)."""
+        return self._caller.prefix
 
     @property
     def timeout(self) -> float:

@@ -56,10 +56,11 @@ class ServiceCaller:
     Calls are serialized by one lock, so one client can be shared between threads.
     """
 
-    def __init__(self, timeout: float = 5.0) -> None:
+    def __init__(self, timeout: float = 5.0, prefix: str = "") -> None:
         if timeout <= 0:
             raise ValueError("the timeout must be positive")
         self.timeout = timeout
+        self.prefix = prefix
         self._proxies: dict[str, rospy.ServiceProxy] = {}
         self._lock = threading.RLock()
 
@@ -107,7 +108,7 @@ class ServiceCaller:
         proxy = self._proxies.get(operation)
         if proxy is not None:
             return proxy
-        name = interface.service_name(operation)
+        name = interface.service_name(operation, self.prefix)
         deadline = time.monotonic() + self.timeout
         while not _service_answers(name, max(0.1, deadline - time.monotonic())):
             if time.monotonic() >= deadline or rospy.is_shutdown():

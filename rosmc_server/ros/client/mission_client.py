@@ -45,6 +45,7 @@ class MissionClient(ClientBase):
 
     Args:
         timeout: Seconds to wait for the server to appear (per connection).
+        prefix: Namespace before every service name, e.g. ``/replay`` to read a replay.
     """
 
     # -- blueprint -------------------------------------------------------------------

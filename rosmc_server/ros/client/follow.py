@@ -1,0 +1,169 @@
+"""Keeps a :class:`~rosmc_server.core.mirror.MissionMirror` current from the ROS graph.
+
+Subscribes (each name behind ``prefix``, e.g. ``/replay``):
+    ``/rosmc/mission_events`` (rosmc/MissionEvent): one message per accepted change.
+    ``/rosmc/agent_states`` (rosmc/AgentStates): every robot's link and telemetry.
+
+Calls (on its own worker thread, never the caller's):
+    ``/rosmc/get_mission`` (rosmc/GetMission): the snapshot, at start, after a revision gap,
+    after a replaced mission and after the server restarted.
+
+Watches ``/rosmc/get_mission`` on the master once per ``check_period`` to tell when the
+server went away or came back as a new process (then the mirror starts from its snapshot).
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from collections.abc import Callable
+
+import rosgraph
+import rosmc.msg as wire
+import rospy
+
+from ... import interface
+from ...core import Library, MissionState
+from ...core.mirror import MissionMirror
+from ..conversions import event_from_msg
+from .mission_client import MissionClient
+from .wire import agent_statuses_from_msg
+from .worker import AsyncMissionClient, Outcome
+
+_log = logging.getLogger(__name__)
+
+ConnectionListener = Callable[[bool], None]
+
+
+class MissionFollower:
+    """Feeds a mission mirror from the mission server (or a replay); call :meth:`start`.
+
+    The process must be a ROS node (:func:`~.watch.init_node` or ``rospy.init_node``).
+    Everything that waits on the network runs on worker threads; the mirror's listeners
+    are called on rospy's or the worker's threads (see :class:`MissionMirror`).
+
+    Args:
+        prefix: Namespace before every name ("" for the live server, ``/replay`` for a replay).
+        timeout: Seconds a snapshot fetch waits for the server.
+        retry_period: Seconds between attempts while the server does not answer.
+        check_period: Seconds between checks that the server is still the same process.
+        on_connection: Called with True/False when the server appears or goes away.
+    """
+
+    def __init__(
+        self,
+        prefix: str = "",
+        timeout: float = 5.0,
+        retry_period: float = 2.0,
+        check_period: float = 1.0,
+        on_connection: ConnectionListener | None = None,
+    ) -> None:
+        self.prefix = prefix
+        self.mirror = MissionMirror(self._request_snapshot)
+        self._fetcher = AsyncMissionClient(MissionClient(timeout, prefix), "rosmc-snapshot")
+        self._retry_period = retry_period
+        self._check_period = check_period
+        self._on_connection = on_connection
+        self._server_uri: str | None = None  # who answers now (None: nobody)
+        self._known_uri: str | None = None  # who answered last
+        self._restarted = False
+        self._closed = threading.Event()
+        self._retry: threading.Timer | None = None
+        self._library: Library | None = None
+        self._subscribers = [
+            rospy.Subscriber(
+                interface.prefixed(interface.EVENTS_TOPIC, prefix),
+                wire.MissionEvent,
+                self._on_event,
+                queue_size=10_000,
+            ),
+            rospy.Subscriber(
+                interface.prefixed(interface.AGENT_STATES_TOPIC, prefix),
+                wire.AgentStates,
+                self._on_states,
+                queue_size=1,
+            ),
+        ]
+        self._watcher = threading.Thread(target=self._watch, name="rosmc-follow", daemon=True)
+
+    @property
+    def connected(self) -> bool:
+        """The server answered the last check."""
+        return self._server_uri is not None
+
+    def start(self) -> None:
+        """Ask for the first snapshot and start watching the server."""
+        self.mirror.start()
+        self._watcher.start()
+
+    def library(self, on_done: Callable[[Outcome[Library]], None]) -> None:
+        """Fetch the skill library (once; later calls answer from the cache) without waiting."""
+        self._fetcher.submit(lambda client: client.library(), on_done)
+
+    def refresh(self) -> None:
+        """Fetch a new snapshot now (e.g. after a conflict the operator was told of)."""
+        self._request_snapshot()
+
+    def close(self) -> None:
+        """Unsubscribe and stop the worker threads."""
+        self._closed.set()
+        for subscriber in self._subscribers:
+            subscriber.unregister()
+        if self._retry is not None:
+            self._retry.cancel()
+        self._fetcher.close()
+
+    # -- snapshots -------------------------------------------------------------------------
+    def _request_snapshot(self) -> None:
+        if not self._closed.is_set():
+            self._fetcher.submit(lambda client: client.fetch_mission(), self._on_snapshot)
+
+    def _on_snapshot(self, outcome: Outcome[MissionState]) -> None:
+        if outcome.value is not None:
+            restarted, self._restarted = self._restarted, False
+            self.mirror.on_snapshot(outcome.value, restarted=restarted)
+            return
+        _log.warning("cannot fetch the mission (%s); trying again", outcome.error)
+        if not self._closed.is_set():
+            self._retry = threading.Timer(self._retry_period, self._request_snapshot)
+            self._retry.daemon = True
+            self._retry.start()
+
+    # -- ROS callbacks -----------------------------------------------------------------------
+    def _on_event(self, msg: wire.MissionEvent) -> None:
+        try:
+            event = event_from_msg(msg)
+        except Exception:  # a malformed event must not kill the subscriber thread
+            _log.exception("cannot read mission event at revision %d", msg.revision)
+            return
+        self.mirror.on_event(event)
+
+    def _on_states(self, msg: wire.AgentStates) -> None:
+        try:
+            statuses = agent_statuses_from_msg(msg)
+        except Exception:  # a malformed message must not kill the subscriber thread
+            _log.exception("cannot read agent states")
+            return
+        self.mirror.on_agent_statuses(statuses)
+
+    # -- is the server there, and the same process? ----------------------------------------------
+    def _watch(self) -> None:
+        name = interface.service_name("get_mission", self.prefix)
+        master = rosgraph.Master(rospy.get_name())
+        while not self._closed.wait(self._check_period):
+            try:
+                uri: str | None = master.lookupService(name)
+            except (rosgraph.MasterException, OSError):
+                uri = None
+            if uri == self._server_uri:
+                continue
+            previous, self._server_uri = self._server_uri, uri
+            if uri is not None:
+                # A new process answers at a new address: its revisions may have begun anew.
+                if self._known_uri is not None and uri != self._known_uri:
+                    _log.info("the mission server restarted; fetching its mission")
+                    self._restarted = True
+                    self._request_snapshot()
+                self._known_uri = uri
+            if (previous is None) != (uri is None) and self._on_connection is not None:
+                self._on_connection(uri is not None)
