@@ -1,0 +1,100 @@
+"""Every command of the GUI as a QAction with its text, shortcut and tooltip.
+
+Buttons, context menus and the menu bar share these actions, so one ``setEnabled`` keeps
+them all honest. Shortcuts work anywhere inside the command widget (not elsewhere in
+rqt).
+"""
+
+from __future__ import annotations
+
+from python_qt_binding.QtCore import QObject, Qt
+from python_qt_binding.QtGui import QKeySequence
+from python_qt_binding.QtWidgets import QAction, QWidget
+
+from .legality import Action, RobotAction
+
+# (text, shortcut, tooltip) of each skill action.
+SKILL_ACTIONS: dict[Action, tuple[str, str, str]] = {
+    Action.DELETE: ("Delete", "Delete", "Delete the selected planned skills"),
+    Action.MOVE_UP: ("Move up", "Alt+Up", "Move the selected skills one place earlier"),
+    Action.MOVE_DOWN: ("Move down", "Alt+Down", "Move the selected skills one place later"),
+    Action.SYNC: (
+        "Send to robot",
+        "Ctrl+Return",
+        "Synchronize: send the blueprint up to the selected skill to the robot",
+    ),
+    Action.UNSYNC: (
+        "Take back",
+        "Ctrl+Backspace",
+        "Unsynchronize: take the selected skill and the ones after it back to the blueprint",
+    ),
+    Action.RETRY: ("Retry", "Ctrl+R", "Run the failed skill again"),
+    Action.SKIP: ("Skip", "Ctrl+K", "Leave the failed skill and go on with the next one"),
+    Action.BARRIER: (
+        "Start together",
+        "Ctrl+B",
+        "Barrier: the selected skills (one per robot) start at the same time",
+    ),
+    Action.DELETE_BARRIER: (
+        "Remove barrier",
+        "Ctrl+Shift+B",
+        "The selected skills no longer wait for each other",
+    ),
+}
+# (text, shortcut) of each action on every robot at once.
+ALL_ROBOT_ACTIONS: dict[RobotAction, tuple[str, str]] = {
+    RobotAction.START: ("Start all", "F6"),
+    RobotAction.PAUSE: ("Pause all", "F7"),
+    RobotAction.RESUME: ("Resume all", "F8"),
+    RobotAction.STOP: ("Stop all", "F9"),
+}
+FILE_ACTIONS: dict[str, tuple[str, str, str]] = {
+    "new": ("&New mission", "Ctrl+N", "Start an empty mission"),
+    "open": ("&Open file…", "Ctrl+O", "Load a mission file from this computer"),
+    "open_server": (
+        "Open file on &server…",
+        "Ctrl+Shift+O",
+        "Load a mission file from the mission server's computer",
+    ),
+    "save": ("&Save", "Ctrl+S", "Save the mission where it was last saved"),
+    "save_as": ("Save &as…", "Ctrl+Shift+S", "Save the mission to a file on this computer"),
+    "save_server": (
+        "Save on s&erver as…",
+        "Ctrl+Alt+S",
+        "Save the mission to a file on the mission server's computer",
+    ),
+}
+
+
+class CommandActions(QObject):  # type: ignore[misc]
+    """The actions of one command widget (shortcuts active within ``owner``)."""
+
+    def __init__(self, owner: QWidget) -> None:
+        super().__init__(owner)
+        self.skill: dict[Action, QAction] = {}
+        self.all_robots: dict[RobotAction, QAction] = {}
+        self.file: dict[str, QAction] = {}
+        for action, (text, keys, tip) in SKILL_ACTIONS.items():
+            self.skill[action] = self._make(owner, text, keys, tip, action.value)
+        for robot_action, (text, keys) in ALL_ROBOT_ACTIONS.items():
+            tip = f"{text.split()[0]} every robot"
+            self.all_robots[robot_action] = self._make(
+                owner, text, keys, tip, f"{robot_action.value}_all"
+            )
+        for name, (text, keys, tip) in FILE_ACTIONS.items():
+            self.file[name] = self._make(owner, text, keys, tip, name)
+        self.refresh = self._make(owner, "Refresh", "F5", "Fetch the mission again", "refresh")
+        self.clear_selection = self._make(owner, "Select nothing", "Escape", "", "clear")
+
+    @staticmethod
+    def _make(owner: QWidget, text: str, keys: str, tip: str, name: str) -> QAction:
+        action = QAction(text, owner)
+        action.setObjectName(f"action_{name}")
+        if keys:
+            action.setShortcut(QKeySequence(keys))
+            action.setShortcutContext(Qt.WidgetWithChildrenShortcut)
+            tip = f"{tip} ({keys})" if tip else keys
+        action.setToolTip(tip)
+        action.setStatusTip(tip)
+        owner.addAction(action)
+        return action

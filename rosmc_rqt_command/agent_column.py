@@ -1,0 +1,216 @@
+"""One robot's column of the schedule: header, synchronized section, blueprint, buttons.
+
+The header names the robot and says how it is (link, seconds since heard, battery, Wi-Fi,
+lost-link policy). Above the line: what is on the robot; below: the blueprint, which
+can be reordered by drag and drop. The buttons act on this robot; they are enabled by
+:meth:`AgentColumn.set_legal`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from python_qt_binding.QtCore import QSize, Qt, Signal
+from python_qt_binding.QtWidgets import (
+    QAbstractItemView,
+    QComboBox,
+    QFrame,
+    QHBoxLayout,
+    QHeaderView,
+    QLabel,
+    QMenu,
+    QSizePolicy,
+    QStyle,
+    QTableView,
+    QToolButton,
+    QVBoxLayout,
+    QWidget,
+)
+
+from rosmc_server.core import AgentStatus
+
+from . import presentation
+from .legality import RobotAction
+from .mission_view import MissionView
+from .schedule_model import NUMBER, PARAMS, SKILL, STATUS, TAG, SectionModel
+from .view_state import AgentView
+
+ROW_HEIGHT = 22
+COLUMN_WIDTH = 380
+# Lost-link policies an operator picks from: (label, policy, safe skill or "").
+POLICIES = (
+    ("keep going if the link is lost", "continue", ""),
+    ("hold if the link is lost for 30 s", "hold", ""),
+    ("return to the lander if the link is lost for 30 s", "safe_skill", "return_to_lander"),
+)
+
+
+class SectionTable(QTableView):  # type: ignore[misc]
+    """A table of skills with row selection; a click on empty space clears it."""
+
+    empty_clicked = Signal()
+
+    def __init__(self, model: SectionModel, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.last_modifiers = Qt.NoModifier  # of the last click or key press here
+        self.setModel(model)
+        self.setSelectionBehavior(QAbstractItemView.SelectRows)
+        self.setSelectionMode(QAbstractItemView.ExtendedSelection)
+        self.setContextMenuPolicy(Qt.CustomContextMenu)
+        self.setEditTriggers(QAbstractItemView.NoEditTriggers)
+        self.setWordWrap(False)
+        self.setShowGrid(False)
+        self.setAlternatingRowColors(False)
+        self.setHorizontalScrollBarPolicy(Qt.ScrollBarAlwaysOff)
+        rows = self.verticalHeader()
+        rows.setVisible(False)
+        rows.setSectionResizeMode(QHeaderView.Fixed)
+        rows.setDefaultSectionSize(ROW_HEIGHT)
+        columns = self.horizontalHeader()
+        columns.setHighlightSections(False)
+        for column, width in ((TAG, 34), (NUMBER, 30), (SKILL, 120), (PARAMS, 110)):
+            columns.resizeSection(column, width)
+        columns.setSectionResizeMode(STATUS, QHeaderView.Stretch)
+        if model.blueprint:
+            self.setDragEnabled(True)
+            self.setAcceptDrops(True)
+            self.setDropIndicatorShown(True)
+            self.setDragDropMode(QAbstractItemView.InternalMove)
+            self.setDefaultDropAction(Qt.MoveAction)
+
+    @property
+    def section(self) -> SectionModel:
+        """The model shown."""
+        model: SectionModel = self.model()
+        return model
+
+    def mousePressEvent(self, event: object) -> None:
+        """Clicking below the rows clears the selection (of every column)."""
+        self.last_modifiers = event.modifiers()  # type: ignore[attr-defined]
+        if not self.indexAt(event.pos()).isValid():  # type: ignore[attr-defined]
+            self.empty_clicked.emit()
+            return
+        super().mousePressEvent(event)
+
+    def keyPressEvent(self, event: object) -> None:
+        """Shift+arrows extend the selection across the keyboard too."""
+        self.last_modifiers = event.modifiers()  # type: ignore[attr-defined]
+        super().keyPressEvent(event)
+
+
+class AgentColumn(QFrame):  # type: ignore[misc]
+    """The schedule column of one robot."""
+
+    robot_action = Signal(str, object)  # agent, RobotAction
+    add_requested = Signal(str, str)  # agent, skill name
+    policy_chosen = Signal(str, str, str)  # agent, policy, safe skill
+
+    def __init__(self, agent: str, view: MissionView, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.agent = agent
+        self.setObjectName(f"column_{agent}")
+        self.setFrameShape(QFrame.StyledPanel)
+        self.setFixedWidth(COLUMN_WIDTH)
+        self.synced_model = SectionModel(agent, False, view, self)
+        self.blueprint_model = SectionModel(agent, True, view, self)
+        self.synced_table = SectionTable(self.synced_model, self)
+        self.blueprint_table = SectionTable(self.blueprint_model, self)
+        self.synced_table.setObjectName(f"synced_{agent}")
+        self.blueprint_table.setObjectName(f"blueprint_{agent}")
+
+        self.name_label = QLabel(f"<b style='font-size:13pt'>{agent}</b>")
+        self.status_label = QLabel(presentation.link_summary(None))
+        self.status_label.setWordWrap(True)
+        self.status_label.setObjectName(f"status_{agent}")
+        self.policy_combo = QComboBox()
+        self.policy_combo.setObjectName(f"policy_{agent}")
+        self.policy_combo.setToolTip("What the robot does when it loses contact with the ground")
+        self.policy_combo.setSizePolicy(QSizePolicy.Ignored, QSizePolicy.Fixed)
+        for label, _, _ in POLICIES:
+            self.policy_combo.addItem(label)
+        self.policy_combo.activated.connect(self._on_policy_combo_activated)
+
+        self.add_menu = QMenu(self)
+        self.add_button = self._tool("Add skill", "", f"Add a skill to {agent}'s blueprint")
+        self.add_button.setMenu(self.add_menu)
+        self.add_button.setPopupMode(QToolButton.InstantPopup)
+        self.add_menu.triggered.connect(self._on_add_menu_triggered)
+        self.buttons: dict[RobotAction, QToolButton] = {
+            RobotAction.SYNC_ALL: self._tool("Sync all", "", f"Send {agent}'s whole blueprint"),
+            RobotAction.START: self._tool("", "SP_MediaPlay", f"Start {agent}"),
+            RobotAction.PAUSE: self._tool("", "SP_MediaPause", f"Pause {agent}"),
+            RobotAction.RESUME: self._tool("", "SP_MediaSeekForward", f"Resume {agent}"),
+            RobotAction.STOP: self._tool("", "SP_MediaStop", f"Stop {agent}"),
+        }
+        for action, button in self.buttons.items():
+            button.setObjectName(f"{action.value}_{agent}")
+            button.clicked.connect(lambda _=False, a=action: self.robot_action.emit(self.agent, a))
+
+        header = QVBoxLayout()
+        top = QHBoxLayout()
+        top.addWidget(self.name_label)
+        top.addStretch(1)
+        header.addLayout(top)
+        header.addWidget(self.status_label)
+        header.addWidget(self.policy_combo)
+        bar = QHBoxLayout()
+        bar.addWidget(self.add_button)
+        for button in self.buttons.values():
+            bar.addWidget(button)
+        bar.addStretch(1)
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(4, 4, 4, 4)
+        layout.addLayout(header)
+        layout.addWidget(QLabel("<i>On the robot</i>"))
+        layout.addWidget(self.synced_table, 2)
+        layout.addWidget(QLabel("<i>Blueprint (planned, editable)</i>"))
+        layout.addWidget(self.blueprint_table, 3)
+        layout.addLayout(bar)
+
+    def _tool(self, text: str, icon: str, tip: str) -> QToolButton:
+        button = QToolButton(self)
+        if icon:
+            button.setIcon(self.style().standardIcon(getattr(QStyle, icon)))
+            button.setIconSize(QSize(16, 16))
+        if text:
+            button.setText(text)
+            button.setToolButtonStyle(Qt.ToolButtonTextBesideIcon)
+        button.setToolTip(tip)
+        button.setAutoRaise(False)
+        return button
+
+    @property
+    def tables(self) -> tuple[SectionTable, SectionTable]:
+        """The synchronized table and the blueprint table."""
+        return self.synced_table, self.blueprint_table
+
+    def show_task(self, task: AgentView) -> None:
+        """Show the robot's task (only rows that changed are touched)."""
+        self.synced_model.set_rows(task.synced, 0)
+        self.blueprint_model.set_rows(task.blueprint, task.synced_end)
+
+    def show_status(self, status: AgentStatus | None) -> None:
+        """Show the robot's link and telemetry in the header."""
+        text = presentation.link_summary(status)
+        colour = "#a00000" if status is not None and status.link == "down" else "#333333"
+        self.status_label.setText(f"<span style='color:{colour}'>{text}</span>")
+
+    def set_skills(self, names: Sequence[str]) -> None:
+        """The skills the Add menu offers (the robot's skills)."""
+        self.add_menu.clear()
+        for name in sorted(names):
+            self.add_menu.addAction(name)
+
+    def set_legal(self, legal: set[RobotAction], read_only: bool) -> None:
+        """Enable the buttons whose action can work now."""
+        for action, button in self.buttons.items():
+            button.setEnabled(not read_only and action in legal)
+        self.add_button.setEnabled(not read_only and not self.add_menu.isEmpty())
+        self.policy_combo.setEnabled(not read_only)
+
+    def _on_add_menu_triggered(self, action: object) -> None:
+        self.add_requested.emit(self.agent, action.text())  # type: ignore[attr-defined]
+
+    def _on_policy_combo_activated(self, index: int) -> None:
+        _, policy, safe_skill = POLICIES[index]
+        self.policy_chosen.emit(self.agent, policy, safe_skill)

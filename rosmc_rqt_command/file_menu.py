@@ -1,0 +1,243 @@
+"""New, open and save: mission files on this computer or on the mission server's.
+
+A local file is read here and sent as a document (``load_mission(document=...)``), or
+written here from the server's document (``save_mission()``); a server file is named by
+its path on the server's host. Before New or Open replaces a plan that changed since it
+was last saved or loaded, the operator is asked whether to save it first.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+from python_qt_binding.QtWidgets import QFileDialog, QInputDialog, QMessageBox, QWidget
+
+from .actions import CommandActions
+from .message_area import MessageArea
+from .mission_view import MissionView
+from .requests import Answer, Request
+
+FILTER = "Mission files (*.yaml *.yml);;All files (*)"
+Send = Callable[[Request], None]
+
+
+def plan_fingerprint(view: MissionView) -> tuple[object, ...]:
+    """What a mission file keeps of the plan (ignores statuses and robot progress)."""
+    tasks = tuple(
+        (
+            agent,
+            tuple(
+                (s.skill, s.label, repr(dict(s.params)), repr(dict(s.bindings))) for s in v.skills
+            ),
+        )
+        for agent, v in view.agents.items()
+    )
+    barriers = tuple(sorted(tuple(sorted(b.skill_ids)) for b in view.barriers))
+    markers = tuple(sorted(repr(m) for m in view.markers.values()))
+    return (view.library_name, tasks, barriers, markers)
+
+
+class FileController:
+    """The File menu's actions; keeps where the mission was last saved."""
+
+    def __init__(
+        self,
+        parent: QWidget,
+        actions: CommandActions,
+        view: MissionView,
+        messages: MessageArea,
+        send: Send,
+    ) -> None:
+        self._parent = parent
+        self._view = view
+        self._messages = messages
+        self._send = send
+        self.location: tuple[str, str] | None = None  # ("local" | "server", path)
+        self._saved: tuple[object, ...] | None = None
+        self.ask: Callable[[str], str] = self._ask_save_changes
+        handlers = {
+            "new": self.new_mission,
+            "open": self._on_open_triggered,
+            "open_server": self._on_open_server_triggered,
+            "save": self.save,
+            "save_as": self._on_save_as_triggered,
+            "save_server": self._on_save_server_triggered,
+        }
+        for name, handler in handlers.items():
+            actions.file[name].triggered.connect(lambda _=False, h=handler: h())
+
+    # -- unsaved changes ------------------------------------------------------------------------
+    def mark_saved(self) -> None:
+        """The plan as it is now counts as saved (after a load, save or new mission)."""
+        self._saved = plan_fingerprint(self._view)
+
+    @property
+    def dirty(self) -> bool:
+        """The plan changed since it was last saved, loaded or started anew."""
+        if self._saved is None:
+            return any(view.skills for view in self._view.agents.values())
+        return plan_fingerprint(self._view) != self._saved
+
+    def confirm_discard(self, doing: str) -> bool:
+        """Ask to save unsaved changes before ``doing``; False if the operator cancels."""
+        if not self.dirty:
+            return True
+        answer = self.ask(doing)
+        if answer == "save":
+            self.save()
+            return True
+        return answer == "discard"
+
+    def _ask_save_changes(self, doing: str) -> str:
+        box = QMessageBox(self._parent)
+        box.setIcon(QMessageBox.Question)
+        box.setWindowTitle("Unsaved changes")
+        box.setText(f"The mission has changes that are not saved. Save them before {doing}?")
+        box.setStandardButtons(QMessageBox.Save | QMessageBox.Discard | QMessageBox.Cancel)
+        box.setDefaultButton(QMessageBox.Save)
+        choice = box.exec_()
+        return {QMessageBox.Save: "save", QMessageBox.Discard: "discard"}.get(choice, "cancel")
+
+    # -- operations (what the dialogs lead to; tests call them directly) ---------------------------
+    def new_mission(self) -> None:
+        """Start an empty mission (after asking about unsaved changes)."""
+        if self.confirm_discard("starting a new mission"):
+            self._send(
+                Request(
+                    "new_mission",
+                    what="start a new mission",
+                    base_revision=self._view.revision,
+                    on_answer=self._on_replaced,
+                )
+            )
+
+    def open_local(self, path: str) -> None:
+        """Load a mission file from this computer."""
+        try:
+            document = Path(path).read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as error:
+            self._messages.say(f"Cannot read {path}: {error}.", "error")
+            return
+        self._send(
+            Request(
+                "load_mission",
+                kwargs={"document": document},
+                what=f"open {path}",
+                base_revision=self._view.revision,
+                on_answer=lambda a: self._on_loaded(a, ("local", path)),
+            )
+        )
+
+    def open_server(self, path: str) -> None:
+        """Load a mission file from the server's computer."""
+        self._send(
+            Request(
+                "load_mission",
+                kwargs={"path": path},
+                what=f"open {path} on the server",
+                base_revision=self._view.revision,
+                on_answer=lambda a: self._on_loaded(a, ("server", path)),
+            )
+        )
+
+    def save(self) -> None:
+        """Save where the mission was last saved or opened (else ask where)."""
+        if self.location is None:
+            self._on_save_as_triggered()
+        elif self.location[0] == "local":
+            self.save_local(self.location[1])
+        else:
+            self.save_server(self.location[1])
+
+    def save_local(self, path: str) -> None:
+        """Save the mission to a file on this computer."""
+        fingerprint = plan_fingerprint(self._view)
+        self._send(
+            Request(
+                "save_mission",
+                what=f"save to {path}",
+                on_answer=lambda a: self._on_saved_document(a, path, fingerprint),
+            )
+        )
+
+    def save_server(self, path: str) -> None:
+        """Save the mission to a file on the server's computer."""
+        fingerprint = plan_fingerprint(self._view)
+        self._send(
+            Request(
+                "save_mission",
+                (path,),
+                what=f"save to {path} on the server",
+                on_answer=lambda a: self._on_saved(a, ("server", path), fingerprint),
+            )
+        )
+
+    # -- answers ----------------------------------------------------------------------------
+    def _on_replaced(self, answer: Answer) -> None:
+        if answer.ok:
+            self.location = None
+            self._saved = None
+
+    def _on_loaded(self, answer: Answer, location: tuple[str, str]) -> None:
+        if answer.ok:
+            self.location = location
+            self._saved = None  # taken when the loaded mission arrives (mark_saved_on_next)
+            self.pending_mark = True
+
+    pending_mark = False
+
+    def on_mission_shown(self) -> None:
+        """Called after each update: a freshly loaded mission counts as saved."""
+        if self.pending_mark:
+            self.pending_mark = False
+            self.mark_saved()
+
+    def _on_saved_document(
+        self, answer: Answer, path: str, fingerprint: tuple[object, ...]
+    ) -> None:
+        if not answer.ok:
+            return
+        try:
+            Path(path).write_text(answer.value.document, encoding="utf-8")
+        except OSError as error:
+            self._messages.say(f"Cannot write {path}: {error}.", "error")
+            return
+        self._messages.say(f"Saved the mission to {path}.", "ok")
+        self._on_saved(answer, ("local", path), fingerprint)
+
+    def _on_saved(
+        self, answer: Answer, location: tuple[str, str], fingerprint: tuple[object, ...]
+    ) -> None:
+        if answer.ok:
+            self.location = location
+            self._saved = fingerprint
+
+    # -- dialogs ----------------------------------------------------------------------------
+    def _on_open_triggered(self) -> None:
+        if not self.confirm_discard("opening another mission"):
+            return
+        path, _ = QFileDialog.getOpenFileName(self._parent, "Open mission file", "", FILTER)
+        if path:
+            self.open_local(path)
+
+    def _on_open_server_triggered(self) -> None:
+        if not self.confirm_discard("opening another mission"):
+            return
+        path, ok = QInputDialog.getText(
+            self._parent, "Open file on server", "Path of the mission file on the server:"
+        )
+        if ok and path.strip():
+            self.open_server(path.strip())
+
+    def _on_save_as_triggered(self) -> None:
+        path, _ = QFileDialog.getSaveFileName(self._parent, "Save mission file", "", FILTER)
+        if path:
+            self.save_local(path if Path(path).suffix else f"{path}.yaml")
+
+    def _on_save_server_triggered(self) -> None:
+        path, ok = QInputDialog.getText(
+            self._parent, "Save on server", "Path of the mission file on the server:"
+        )
+        if ok and path.strip():
+            self.save_server(path.strip())

@@ -1,0 +1,118 @@
+"""The GUI thread's picture of the mission: the latest :class:`AgentView` of every robot.
+
+:class:`MissionView` takes :class:`~.view_state.ViewUpdate` values in order and answers the
+read-only questions panels ask (which skill has this id, which barrier holds it, what a
+robot reports). It holds immutable values only, so nothing here needs a lock.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from rosmc_server.core import AgentStatus, Barrier, Library, SkillInstance, TaskMarker
+
+from .view_state import AgentView, ViewUpdate, barrier_tags
+
+
+class MissionView:
+    """The mission as the panels show it (GUI thread only)."""
+
+    def __init__(self) -> None:
+        self.revision = -1
+        self.library: Library | None = None
+        self.library_name = ""
+        self.agents: dict[str, AgentView] = {}
+        self.barriers: tuple[Barrier, ...] = ()
+        self.markers: dict[str, TaskMarker] = {}
+        self.statuses: dict[str, AgentStatus] = {}
+        self._skills: dict[str, SkillInstance] = {}
+        self._tags: dict[str, tuple[int, Barrier]] = {}
+
+    @property
+    def loaded(self) -> bool:
+        """A mission snapshot has arrived."""
+        return self.revision >= 0
+
+    def apply(self, update: ViewUpdate) -> None:
+        """Take one update (in revision order)."""
+        if update.reset:
+            self.agents = {}
+            self._skills = {}
+            self.library_name = update.library
+        for view in update.agents:
+            old = self.agents.get(view.agent)
+            if old is not None:
+                for skill in old.skills:
+                    self._skills.pop(skill.id, None)
+            self.agents[view.agent] = view
+            self._skills.update((skill.id, skill) for skill in view.skills)
+        if update.barriers is not None:
+            self.barriers = update.barriers
+            self._tags = barrier_tags(update.barriers)
+        if update.markers is not None:
+            self.markers = {marker.name: marker for marker in update.markers}
+        for status in update.statuses:
+            self.statuses[status.agent] = status
+        if update.reset:
+            self.revision = update.revision
+        elif self.loaded:
+            self.revision = max(self.revision, update.revision)
+
+    # -- queries ---------------------------------------------------------------------------
+    def skill(self, skill_id: str) -> SkillInstance | None:
+        """The skill with this id, if it exists."""
+        return self._skills.get(skill_id)
+
+    def skills(self, skill_ids: Sequence[str]) -> list[SkillInstance]:
+        """The skills with these ids that exist, in the given order."""
+        return [s for i in skill_ids if (s := self._skills.get(i)) is not None]
+
+    def barrier_of(self, skill_id: str) -> Barrier | None:
+        """The barrier ``skill_id`` belongs to, if any."""
+        tag = self._tags.get(skill_id)
+        return None if tag is None else tag[1]
+
+    def barrier_number(self, skill_id: str) -> int:
+        """The barrier's number as shown ("B1" is 1), 0 if the skill is in none."""
+        tag = self._tags.get(skill_id)
+        return 0 if tag is None else tag[0]
+
+    def view(self, agent: str) -> AgentView:
+        """``agent``'s task (empty if unknown)."""
+        return self.agents.get(agent) or AgentView(agent)
+
+    def position(self, skill: SkillInstance) -> int:
+        """The skill's index in its robot's task (-1 if it is not there)."""
+        for index, other in enumerate(self.view(skill.agent).skills):
+            if other.id == skill.id:
+                return index
+        return -1
+
+    def waiting_on(self, skill: SkillInstance) -> list[str]:
+        """Robots whose barrier partner of ``skill`` has not reached the barrier yet."""
+        barrier = self.barrier_of(skill.id)
+        if barrier is None:
+            return []
+        waiting = []
+        for partner in self.skills(barrier.skill_ids):
+            if partner.id != skill.id and not partner.status.has_started:
+                waiting.append(partner.agent)
+        return waiting
+
+    def bound_markers(self, skills: Sequence[SkillInstance]) -> list[str]:
+        """Names of the task markers bound to any of ``skills`` (each once)."""
+        names: list[str] = []
+        for skill in skills:
+            for name in skill.bindings.values():
+                if name not in names:
+                    names.append(name)
+        return names
+
+    def skills_bound_to(self, marker_name: str) -> list[SkillInstance]:
+        """Skills with a parameter bound to the marker, robot by robot."""
+        return [
+            skill
+            for view in self.agents.values()
+            for skill in view.skills
+            if marker_name in skill.bindings.values()
+        ]

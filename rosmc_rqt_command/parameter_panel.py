@@ -1,0 +1,253 @@
+"""The parameter panel: everything about the selected skill, editable while it is planned.
+
+Shows id, robot, skill, label, status, attempt, status text, timeout and retries, then
+one typed editor per parameter (with its unit and description) and a marker picker for
+parameters a task marker can fill. Each change is checked against the library's spec
+before it is sent; a value that cannot be sent is tinted and explained. Everything is
+read-only unless the skill is in the editable blueprint.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from python_qt_binding.QtCore import Qt, Signal
+from python_qt_binding.QtWidgets import (
+    QDoubleSpinBox,
+    QFormLayout,
+    QGroupBox,
+    QLabel,
+    QLineEdit,
+    QScrollArea,
+    QSpinBox,
+    QVBoxLayout,
+    QWidget,
+)
+
+from rosmc_server.core import InvalidRequest, RosmcError, SkillInstance, SkillSpec
+
+from . import presentation
+from .mission_view import MissionView
+from .param_editors import Editor, MarkerPicker, make_editor
+
+
+class ParameterPanel(QScrollArea):  # type: ignore[misc]
+    """Details and parameters of one skill."""
+
+    edit_requested = Signal(str, dict)  # skill id, edit_skill keyword arguments
+    rename_marker_requested = Signal(str, str)  # old name, new name
+    problem = Signal(str)  # a sentence for the message area
+
+    def __init__(self, view: MissionView, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self._view = view
+        self.skill: SkillInstance | None = None
+        self.editors: dict[str, Editor] = {}
+        self.pickers: dict[str, MarkerPicker] = {}
+        self._spec: SkillSpec | None = None
+        self.setWidgetResizable(True)
+        self.setMinimumWidth(380)
+        body = QWidget()
+        layout = QVBoxLayout(body)
+        self.title = QLabel("<i>Select a skill to see its parameters.</i>")
+        self.title.setWordWrap(True)
+        layout.addWidget(self.title)
+        details = QGroupBox("Skill")
+        form = QFormLayout(details)
+        self.facts: dict[str, QLabel] = {}
+        for name in ("ID", "Robot", "Skill", "Status", "Attempt", "Status text"):
+            label = QLabel("")
+            label.setWordWrap(True)
+            label.setTextInteractionFlags(Qt.TextSelectableByMouse)
+            self.facts[name] = label
+        self.label_edit = QLineEdit()
+        self.label_edit.setObjectName("label_edit")
+        self.timeout_spin = QDoubleSpinBox()
+        self.timeout_spin.setObjectName("timeout_spin")
+        self.timeout_spin.setRange(0.0, 86400.0)
+        self.timeout_spin.setSuffix(" s")
+        self.timeout_spin.setSpecialValueText("no time limit")
+        self.timeout_spin.setKeyboardTracking(False)
+        self.retries_spin = QSpinBox()
+        self.retries_spin.setObjectName("retries_spin")
+        self.retries_spin.setRange(0, 100)
+        self.retries_spin.setKeyboardTracking(False)
+        for name in ("ID", "Robot", "Skill"):
+            form.addRow(name, self.facts[name])
+        form.addRow("Label", self.label_edit)
+        for name in ("Status", "Attempt", "Status text"):
+            form.addRow(name, self.facts[name])
+        form.addRow("Time limit", self.timeout_spin)
+        form.addRow("Retries", self.retries_spin)
+        layout.addWidget(details)
+        self.params_box = QGroupBox("Parameters")
+        self.params_form = QFormLayout(self.params_box)
+        layout.addWidget(self.params_box)
+        layout.addStretch(1)
+        self.setWidget(body)
+        self.label_edit.editingFinished.connect(self._on_label_edit_editing_finished)
+        self.timeout_spin.editingFinished.connect(self._on_options_editing_finished)
+        self.retries_spin.editingFinished.connect(self._on_options_editing_finished)
+        self.show_skill(None)
+
+    # -- showing ------------------------------------------------------------------------------
+    @property
+    def editable(self) -> bool:
+        """The shown skill can be edited."""
+        return self.skill is not None and self.skill.is_editable and not self._read_only
+
+    _read_only = False
+
+    def set_read_only(self, read_only: bool) -> None:
+        """Follow a replay: nothing can be edited."""
+        self._read_only = read_only
+        self.show_skill(self.skill)
+
+    def show_selection(self, skill_ids: list[str]) -> None:
+        """Show the one selected skill (or say how many are selected)."""
+        skills = self._view.skills(skill_ids)
+        self.show_skill(skills[0] if len(skills) == 1 else None, len(skills))
+
+    def show_skill(self, skill: SkillInstance | None, count: int = 1) -> None:
+        """Show ``skill`` (None: nothing); editors are rebuilt only for another skill."""
+        rebuild = skill is None or self.skill is None or skill.id != self.skill.id
+        self.skill = skill
+        if skill is None:
+            self.title.setText(
+                f"<i>{count} skills selected.</i>" if count > 1 else "<i>Select a skill.</i>"
+            )
+            self._clear_editors()
+            for label in self.facts.values():
+                label.setText("")
+            self._enable(False)
+            return
+        self._spec = self._spec_of(skill)
+        where = "planned (editable)" if skill.is_editable else "not editable (on the robot or done)"
+        self.title.setText(f"<b>{skill.label or skill.skill}</b> on {skill.agent} — {where}")
+        facts = {
+            "ID": skill.id,
+            "Robot": skill.agent,
+            "Skill": skill.skill + (f" — {self._spec.description}" if self._spec else ""),
+            "Status": presentation.status_text(skill, self._view.waiting_on(skill)),
+            "Attempt": str(skill.attempt),
+            "Status text": skill.status_text or "—",
+        }
+        for name, text in facts.items():
+            self.facts[name].setText(text)
+        if not self.label_edit.hasFocus():
+            self.label_edit.setText(skill.label)
+        if not self.timeout_spin.hasFocus():
+            self.timeout_spin.setValue(skill.timeout)
+        if not self.retries_spin.hasFocus():
+            self.retries_spin.setValue(skill.max_retries)
+        if rebuild:
+            self._build_editors()
+        self._fill_editors()
+        self._enable(self.editable)
+
+    def refresh(self) -> None:
+        """Show the newest version of the shown skill (after a live update)."""
+        if self.skill is not None:
+            self.show_skill(self._view.skill(self.skill.id))
+
+    def _spec_of(self, skill: SkillInstance) -> SkillSpec | None:
+        library = self._view.library
+        if library is None:
+            return None
+        try:
+            return library.skill(skill.agent, skill.skill)
+        except RosmcError:
+            return None
+
+    def _clear_editors(self) -> None:
+        while self.params_form.rowCount():
+            self.params_form.removeRow(0)
+        self.editors = {}
+        self.pickers = {}
+
+    def _build_editors(self) -> None:
+        self._clear_editors()
+        if self._spec is None:
+            return
+        for spec in self._spec.parameters:
+            editor = make_editor(spec)
+            editor.setObjectName(f"param_{spec.name}")
+            editor.setToolTip(spec.description)
+            editor.committed.connect(lambda n=spec.name: self._on_editor_committed(n))
+            label = QLabel(spec.name + (f" ({spec.unit})" if spec.unit else ""))
+            label.setToolTip(spec.description)
+            self.params_form.addRow(label, editor)
+            self.editors[spec.name] = editor
+            if spec.marker_type is not None:
+                picker = MarkerPicker()
+                picker.setObjectName(f"marker_{spec.name}")
+                picker.bind_requested.connect(lambda m, n=spec.name: self._on_picker_bind(n, m))
+                picker.rename_requested.connect(self.rename_marker_requested)
+                self.params_form.addRow("   marker", picker)
+                self.pickers[spec.name] = picker
+
+    def _fill_editors(self) -> None:
+        skill, spec = self.skill, self._spec
+        if skill is None or spec is None:
+            return
+        for name, editor in self.editors.items():
+            if name in skill.params and not editor.isAncestorOf(editor.focusWidget()):
+                editor.blockSignals(True)
+                editor.set_value(skill.params[name])
+                editor.mark_invalid(False)
+                editor.blockSignals(False)
+        for name, picker in self.pickers.items():
+            param = spec.parameter(name)
+            names = [m.name for m in self._view.markers.values() if param.accepts_marker(m.type)]
+            picker.show_markers(names, skill.bindings.get(name, ""))
+
+    def _enable(self, editable: bool) -> None:
+        for widget in (self.label_edit, self.timeout_spin, self.retries_spin):
+            widget.setEnabled(editable)
+        for editor in self.editors.values():
+            editor.set_read_only(not editable)
+        for picker in self.pickers.values():
+            picker.setEnabled(editable)
+
+    # -- editing ------------------------------------------------------------------------------
+    def _on_editor_committed(self, name: str) -> None:
+        skill, spec = self.skill, self._spec
+        editor = self.editors.get(name)
+        if skill is None or spec is None or editor is None or not self.editable:
+            return
+        try:
+            value = spec.parameter(name).check(editor.value(), skill.skill)
+        except InvalidRequest as error:
+            editor.mark_invalid(True)
+            self.problem.emit(f"Not sent: {error}.")
+            return
+        editor.mark_invalid(False)
+        if skill.params.get(name) != value or name in skill.bindings:
+            self._send({"params": {name: _data(value)}})
+
+    def _on_picker_bind(self, name: str, marker: str) -> None:
+        if self.editable:
+            self._send({"bindings": {name: marker or None}})
+
+    def _on_label_edit_editing_finished(self) -> None:
+        skill = self.skill
+        text = self.label_edit.text().strip()
+        if skill is not None and self.editable and text and text != skill.label:
+            self._send({"label": text})
+
+    def _on_options_editing_finished(self) -> None:
+        skill = self.skill
+        if skill is None or not self.editable:
+            return
+        timeout, retries = self.timeout_spin.value(), self.retries_spin.value()
+        if timeout != skill.timeout or retries != skill.max_retries:
+            self._send({"timeout": float(timeout), "max_retries": int(retries)})
+
+    def _send(self, fields: dict[str, Any]) -> None:
+        assert self.skill is not None
+        self.edit_requested.emit(self.skill.id, fields)
+
+
+def _data(value: object) -> object:
+    to_dict = getattr(value, "to_dict", None)
+    return to_dict() if callable(to_dict) else value

@@ -1,0 +1,136 @@
+"""How skills, robots and parameters read in the GUI: words, short summaries and colours.
+
+Plain Python (colours are ``#rrggbb`` strings), shared by the models and widgets so a
+status looks the same everywhere. Words are for a geologist, not a roboticist.
+"""
+
+from __future__ import annotations
+
+import math
+
+from rosmc_server.core import (
+    AgentStatus,
+    Pose,
+    Resolution,
+    SkillInstance,
+    SkillStatus,
+    Transfer,
+    Value,
+)
+
+# Row background per status: light, distinct, dark text stays readable on all of them.
+STATUS_COLOURS: dict[SkillStatus, str] = {
+    SkillStatus.IDLE: "#ffffff",
+    SkillStatus.IDLE_SYNCHRONIZED: "#d7e6f7",
+    SkillStatus.SYNCWAITING: "#ffe08a",
+    SkillStatus.RUNNING: "#8fd99b",
+    SkillStatus.PAUSED: "#cfcfcf",
+    SkillStatus.SUCCESS: "#cbe6e3",
+    SkillStatus.FAILURE: "#f29a90",
+}
+TRANSFER_COLOUR = "#eef3fb"  # uploading or removing: on its way, not settled
+SETTLED_FAILURE_COLOUR = "#f6d9d5"  # a failure the operator retried or skipped
+TEXT_COLOUR = "#1d1d1d"
+# Barrier tags: saturated colours that stay apart from the status colours.
+BARRIER_COLOURS = (
+    "#7b3fa0",
+    "#d35400",
+    "#1f6fb2",
+    "#b0264a",
+    "#0e8c7a",
+    "#8a6d00",
+    "#5d4037",
+    "#c2185b",
+)
+
+STATUS_WORDS: dict[SkillStatus, str] = {
+    SkillStatus.IDLE: "planned",
+    SkillStatus.IDLE_SYNCHRONIZED: "on robot",
+    SkillStatus.SYNCWAITING: "waiting",
+    SkillStatus.RUNNING: "running",
+    SkillStatus.PAUSED: "paused",
+    SkillStatus.SUCCESS: "done",
+    SkillStatus.FAILURE: "failed",
+}
+
+
+def row_colour(skill: SkillInstance) -> str:
+    """The background of a skill's row."""
+    if skill.transfer is not Transfer.NONE:
+        return TRANSFER_COLOUR
+    if skill.status is SkillStatus.FAILURE and skill.resolution is not Resolution.NONE:
+        return SETTLED_FAILURE_COLOUR
+    return STATUS_COLOURS[skill.status]
+
+
+def barrier_colour(number: int) -> str:
+    """The shared colour of barrier number ``number`` (from 1)."""
+    return BARRIER_COLOURS[(number - 1) % len(BARRIER_COLOURS)]
+
+
+def status_text(skill: SkillInstance, waiting_on: list[str] | None = None) -> str:
+    """The status cell: a word, and what matters about it (pending transfer, wait, reason)."""
+    if skill.transfer is Transfer.UPLOADING:
+        return "uploading…"
+    if skill.transfer is Transfer.REMOVING:
+        return "removing…"
+    word = STATUS_WORDS[skill.status]
+    if skill.status is SkillStatus.SYNCWAITING and waiting_on:
+        word = f"waiting on {', '.join(waiting_on)}"
+    if skill.status is SkillStatus.FAILURE and skill.resolution is not Resolution.NONE:
+        word += f" ({skill.resolution.name.lower()})"
+    if skill.attempt > 1:
+        word += f", try {skill.attempt}"
+    return word
+
+
+def number(value: float) -> str:
+    """A number for display: at most two decimals, no trailing zeros."""
+    if not math.isfinite(value):
+        return str(value)
+    text = f"{value:.2f}".rstrip("0").rstrip(".")
+    return "0" if text == "-0" else text
+
+
+def value_summary(value: Value) -> str:
+    """A parameter value in a few characters."""
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, float):
+        return number(value)
+    if isinstance(value, Pose):
+        return f"({number(value.x)}, {number(value.y)})"
+    if isinstance(value, list):
+        return f"{len(value)} items" if len(value) != 1 else "1 item"
+    if isinstance(value, dict):
+        return f"{len(value)} keys" if len(value) != 1 else "1 key"
+    return str(value)
+
+
+def params_summary(skill: SkillInstance, limit: int = 3) -> str:
+    """The key parameters of a skill: bound markers first, then the first few values."""
+    parts = [f"@{marker}" for marker in skill.bindings.values()]
+    for name, value in skill.params.items():
+        if name not in skill.bindings:
+            parts.append(f"{name} {value_summary(value)}")
+    return ", ".join(parts[:limit]) + (", …" if len(parts) > limit else "")
+
+
+def link_summary(status: AgentStatus | None) -> str:
+    """A robot's header line: link, seconds since heard, battery, Wi-Fi, policy."""
+    if status is None or status.link == "unknown":
+        return "never heard"
+    link = "link up" if status.link == "up" else "LINK DOWN"
+    if status.last_heard >= 0 and (status.link != "up" or status.last_heard >= 2):
+        link += f", heard {status.last_heard:.0f} s ago"
+    parts = [link]
+    if status.battery is not None:
+        parts.append(f"battery {status.battery * 100:.0f}%")
+    if status.wifi_signal is not None:
+        coverage = "" if status.in_coverage else " (out of range)"
+        parts.append(f"Wi-Fi {status.wifi_signal:.0f} dBm{coverage}")
+    if status.executor_state:
+        parts.append(status.executor_state)
+    if status.policy:
+        parts.append(f"if link lost: {status.policy}")
+    return " · ".join(parts)

@@ -1,0 +1,201 @@
+"""The command GUI's only contact with ROS: mirror updates in, service calls out, as Qt signals.
+
+:class:`RosBridge` follows the mission with a
+:class:`~rosmc_server.ros.client.MissionFollower` and runs every request through an
+:class:`~rosmc_server.ros.client.AsyncMissionClient`; nothing here waits on the GUI thread.
+Mirror listeners run on ROS threads with the mirror's lock held: they only copy what
+changed into a :class:`~.view_state.ViewUpdate` and emit a signal, which Qt queues to the
+GUI thread.
+
+ROS interface (each name behind ``prefix``, e.g. ``/replay``):
+    Subscribes ``/rosmc/mission_events`` (rosmc/MissionEvent) and ``/rosmc/agent_states``
+    (rosmc/AgentStates) through the follower, and ``/rosmc/selection`` (rosmc/Selection).
+    Publishes ``/rosmc/selection`` (rosmc/Selection, latched; live server only).
+    Calls the operator services ``/rosmc/<operation>`` (rosmc_server.interface.SERVICES).
+"""
+
+from __future__ import annotations
+
+import logging
+from typing import Any
+
+import rosmc.msg as wire
+import rospy
+from python_qt_binding.QtCore import QObject, Signal
+
+from rosmc_server import interface
+from rosmc_server.core import Library, RosmcError
+from rosmc_server.core.updates import MirrorUpdate
+from rosmc_server.ros.client import (
+    AsyncMissionClient,
+    ControlCommand,
+    MissionClient,
+    MissionFollower,
+    Outcome,
+    RevisionConflict,
+    ServerUnavailable,
+)
+from rosmc_server.ros.client.connection import raise_for
+from rosmc_server.ros.client.results import Result
+
+from .requests import MUTATING, Answer, Request
+from .view_state import view_update
+
+_log = logging.getLogger(__name__)
+
+
+def set_robot_options(client: MissionClient, agent: str, policy: str, safe_skill: str) -> Result:
+    """Set a robot's lost-link policy (``MissionClient.set_robot_options`` once it exists)."""
+    method = getattr(client, "set_robot_options", None)
+    if callable(method):
+        result: Result = method(agent, policy, safe_skill=safe_skill)
+        return result
+    after = 0.0 if policy == "continue" else 30.0
+    # Private until the client has the method (another change adds it).
+    response = client._caller.call(
+        "set_robot_options",
+        agent=agent,
+        lost_link_policy=policy,
+        after=after,
+        safe_skill=safe_skill,
+        safe_skill_parameters=[],
+    )
+    raise_for(response, response.revision)
+    return Result(response.revision)
+
+
+def run_request(client: MissionClient, request: Request) -> Any:
+    """Call the client method ``request`` names (on the worker thread)."""
+    kwargs = dict(request.kwargs)
+    if request.operation in MUTATING:
+        known = [r for r in (request.base_revision, client.revision) if r is not None and r >= 0]
+        if known:
+            kwargs["base_revision"] = max(known)
+    if request.operation == "control":
+        command, agent = request.args
+        return client.control(ControlCommand[command], agent)
+    if request.operation == "set_robot_options":
+        return set_robot_options(client, *request.args)
+    return getattr(client, request.operation)(*request.args, **kwargs)
+
+
+class RosBridge(QObject):  # type: ignore[misc]
+    """Feeds a command widget from ROS and runs its requests; create it on the GUI thread.
+
+    The process must be a ROS node already (``rosmc_server.ros.client.init_node``).
+
+    Args:
+        prefix: Namespace before every name ("" for the live server; a replay's prefix
+            makes the bridge read-only).
+        timeout: Seconds a service call waits for the server.
+    """
+
+    updated = Signal(object)  # ViewUpdate
+    library_ready = Signal(object)  # Library
+    answered = Signal(object)  # Answer
+    connection_changed = Signal(bool)
+    selection_received = Signal(list, list)  # skill ids, marker names
+
+    def __init__(self, prefix: str = "", timeout: float = 5.0) -> None:
+        super().__init__()
+        self.prefix = prefix
+        self.read_only = bool(prefix.strip().strip("/"))
+        self._follower = MissionFollower(prefix, timeout=timeout, on_connection=self._on_connection)
+        self._have_library = False
+        self._client = AsyncMissionClient(MissionClient(timeout, prefix), "rosmc-command")
+        self._unsubscribe = self._follower.mirror.subscribe(self._on_mirror_update)
+        self._name = rospy.get_name()
+        topic = interface.prefixed(interface.SELECTION_TOPIC, prefix)
+        self._selection_pub = (
+            None
+            if self.read_only
+            else rospy.Publisher(topic, wire.Selection, queue_size=1, latch=True)
+        )
+        self._selection_sub = rospy.Subscriber(topic, wire.Selection, self._on_selection)
+
+    @property
+    def mirror_revision(self) -> int | None:
+        """The mirror's revision (for tests and benchmarks)."""
+        return self._follower.mirror.revision
+
+    def start(self) -> None:
+        """Fetch the mission and the library; follow events from now on."""
+        self._follower.start()
+        self._follower.library(self._on_library)
+
+    def close(self) -> None:
+        """Stop following and calling (pending calls are dropped)."""
+        self._unsubscribe()
+        self._selection_sub.unregister()
+        if self._selection_pub is not None:
+            self._selection_pub.unregister()
+        self._follower.close()
+        self._client.close()
+
+    # -- Backend ------------------------------------------------------------------------------
+    def request(self, request: Request) -> None:
+        """Run ``request`` on the worker; :attr:`answered` carries the outcome."""
+        self._client.submit(
+            lambda client: run_request(client, request),
+            lambda outcome: self._on_outcome(request, outcome),
+        )
+
+    def refresh(self) -> None:
+        """Fetch a new snapshot."""
+        self._follower.refresh()
+
+    def publish_selection(self, skill_ids: list[str], marker_names: list[str]) -> None:
+        """Publish what is selected here, for rviz."""
+        if self._selection_pub is None:
+            return
+        self._selection_pub.publish(
+            wire.Selection(
+                source=self._name,
+                stamp=rospy.Time.now(),
+                skill_ids=list(skill_ids),
+                marker_names=list(marker_names),
+            )
+        )
+
+    # -- callbacks (ROS and worker threads: only emit) ---------------------------------------------
+    def _on_mirror_update(self, update: MirrorUpdate) -> None:
+        self.updated.emit(view_update(update, self._follower.mirror.state))
+
+    def _on_library(self, outcome: Outcome[Library]) -> None:
+        if outcome.value is not None:
+            self._have_library = True
+            self.library_ready.emit(outcome.value)
+        else:
+            # The server may not be up yet: _on_connection asks again when it appears.
+            _log.info("cannot fetch the skill library yet (%s)", outcome.error)
+
+    def _on_connection(self, connected: bool) -> None:
+        if connected and not self._have_library:
+            self._follower.library(self._on_library)
+        self.connection_changed.emit(connected)
+
+    def _on_outcome(self, request: Request, outcome: Outcome[Any]) -> None:
+        error = outcome.error
+        if error is None:
+            self.answered.emit(Answer(request, value=outcome.value))
+            return
+        conflict = isinstance(error, RevisionConflict)
+        if conflict:
+            self._follower.refresh()
+        self.answered.emit(
+            Answer(
+                request,
+                error=_sentence(error),
+                conflict=conflict,
+                unreachable=isinstance(error, ServerUnavailable),
+            )
+        )
+
+    def _on_selection(self, msg: wire.Selection) -> None:
+        if msg.source != self._name:
+            self.selection_received.emit(list(msg.skill_ids), list(msg.marker_names))
+
+
+def _sentence(error: RosmcError) -> str:
+    text = str(error).strip().rstrip(".")
+    return text or type(error).__name__

@@ -1,0 +1,195 @@
+"""The schedule panel: one :class:`AgentColumn` per robot, side by side, scrolling sideways.
+
+Owns the selection across columns: a plain click selects in one table only; Ctrl or
+Shift keep what other columns have selected (a barrier spans robots). The selection is
+a list of skill ids that survives live updates: after rows change, the same skills are
+selected again wherever they are now (a skill moves from the blueprint to the
+synchronized table when it is uploaded).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+
+from python_qt_binding.QtCore import QItemSelection, QItemSelectionModel, QPoint, Qt, Signal
+from python_qt_binding.QtWidgets import QApplication, QHBoxLayout, QScrollArea, QWidget
+
+from rosmc_server.core import Library
+
+from .agent_column import AgentColumn, SectionTable
+from .mission_view import MissionView
+from .view_state import ViewUpdate
+
+
+class ScheduleWidget(QScrollArea):  # type: ignore[misc]
+    """Every robot's schedule; emits the selection and the operator's requests."""
+
+    selection_changed = Signal(list)  # selected skill ids
+    context_menu_requested = Signal(object, QPoint)  # table, global position
+    robot_action = Signal(str, object)  # agent, RobotAction
+    add_requested = Signal(str, str)  # agent, skill
+    policy_chosen = Signal(str, str, str)  # agent, policy, safe skill
+    reorder_requested = Signal(str, list)  # agent, new blueprint order
+
+    def __init__(self, view: MissionView, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self._view = view
+        self.columns: dict[str, AgentColumn] = {}
+        self._selected: list[str] = []
+        self._syncing = False
+        self._library: Library | None = None
+        self._inner = QWidget()
+        self._row = QHBoxLayout(self._inner)
+        self._row.setContentsMargins(2, 2, 2, 2)
+        self._row.addStretch(1)
+        self.setWidget(self._inner)
+        self.setWidgetResizable(True)
+        self.setHorizontalScrollBarPolicy(Qt.ScrollBarAsNeeded)
+
+    # -- content --------------------------------------------------------------------------
+    @property
+    def selected_ids(self) -> list[str]:
+        """The selected skills, robot by robot, top to bottom."""
+        return list(self._selected)
+
+    def set_library(self, library: Library) -> None:
+        """Offer each robot's skills in its Add menu."""
+        self._library = library
+        for agent, column in self.columns.items():
+            self._offer_skills(agent, column)
+
+    def apply(self, update: ViewUpdate) -> None:
+        """Show what ``update`` changed (the view has taken it already)."""
+        if update.reset:
+            self._ensure_columns([view.agent for view in update.agents])
+        touched: list[AgentColumn] = []
+        for task in update.agents:
+            column = self.columns.get(task.agent)
+            if column is not None:
+                column.show_task(task)
+                touched.append(column)
+        if update.barriers is not None or update.reset:
+            touched = list(self.columns.values())
+            for column in touched:
+                column.synced_model.refresh()
+                column.blueprint_model.refresh()
+        for status in update.statuses:
+            column = self.columns.get(status.agent)
+            if column is not None:
+                column.show_status(status)
+        if update.agents and self._view.barriers:
+            # Barrier partners' statuses show as "waiting on <robot>" in other columns.
+            for column in self.columns.values():
+                if column not in touched:
+                    column.synced_model.refresh()
+        self._restore(touched)
+
+    def select_ids(self, skill_ids: Sequence[str]) -> None:
+        """Select these skills (e.g. chosen in rviz) and scroll to the first."""
+        self._selected = [i for i in skill_ids if self._view.skill(i) is not None]
+        self._restore(list(self.columns.values()))
+        for table in self.tables():
+            row = table.section.row_of(self._selected[0]) if self._selected else -1
+            if row >= 0:
+                self.ensureWidgetVisible(table.parentWidget())
+                table.scrollTo(table.section.index(row, 0))
+                break
+        self.selection_changed.emit(self.selected_ids)
+
+    def clear_selection(self) -> None:
+        """Select nothing."""
+        self.select_ids([])
+
+    def tables(self) -> Iterable[SectionTable]:
+        """Every table, robot by robot, synchronized first."""
+        for column in self.columns.values():
+            yield from column.tables
+
+    def table_of(self, skill_id: str) -> SectionTable | None:
+        """The table that shows ``skill_id``."""
+        for table in self.tables():
+            if table.section.row_of(skill_id) >= 0:
+                return table
+        return None
+
+    # -- columns --------------------------------------------------------------------------
+    def _ensure_columns(self, agents: list[str]) -> None:
+        if list(self.columns) == agents:
+            return
+        for column in self.columns.values():
+            self._row.removeWidget(column)
+            column.deleteLater()
+        self.columns = {}
+        for position, agent in enumerate(agents):
+            column = AgentColumn(agent, self._view, self._inner)
+            self._row.insertWidget(position, column)
+            self.columns[agent] = column
+            column.robot_action.connect(self.robot_action)
+            column.add_requested.connect(self.add_requested)
+            column.policy_chosen.connect(self.policy_chosen)
+            column.blueprint_model.reorder_requested.connect(self.reorder_requested)
+            column.show_status(self._view.statuses.get(agent))
+            self._offer_skills(agent, column)
+            for table in column.tables:
+                table.selectionModel().selectionChanged.connect(
+                    lambda *_args, t=table: self._on_table_selection_changed(t)
+                )
+                table.empty_clicked.connect(self.clear_selection)
+                table.customContextMenuRequested.connect(
+                    lambda pos, t=table: self._on_table_context_menu(t, pos)
+                )
+
+    def _offer_skills(self, agent: str, column: AgentColumn) -> None:
+        if self._library is not None and agent in self._library.dynamic_agents:
+            column.set_skills(list(self._library.skills_of(agent)))
+
+    # -- selection ------------------------------------------------------------------------
+    def _on_table_selection_changed(self, table: SectionTable) -> None:
+        if self._syncing:
+            return
+        modifiers = QApplication.keyboardModifiers() | table.last_modifiers
+        keep_others = bool(modifiers & (Qt.ControlModifier | Qt.ShiftModifier))
+        if not keep_others and table.selectionModel().hasSelection():
+            self._syncing = True
+            try:
+                for other in self.tables():
+                    if other is not table:
+                        other.clearSelection()
+            finally:
+                self._syncing = False
+        self._selected = [
+            skill.id
+            for other in self.tables()
+            for row in sorted(i.row() for i in other.selectionModel().selectedRows())
+            if (skill := other.section.skill_at(row)) is not None
+        ]
+        self.selection_changed.emit(self.selected_ids)
+
+    def _on_table_context_menu(self, table: SectionTable, pos: QPoint) -> None:
+        index = table.indexAt(pos)
+        if index.isValid() and not table.selectionModel().isRowSelected(
+            index.row(), index.parent()
+        ):
+            table.selectRow(index.row())
+        self.context_menu_requested.emit(table, table.viewport().mapToGlobal(pos))
+
+    def _restore(self, tables_of: Iterable[AgentColumn]) -> None:
+        """Select the remembered skills again in the given columns' tables."""
+        wanted = set(self._selected)
+        self._syncing = True
+        try:
+            for column in tables_of:
+                for table in column.tables:
+                    model = table.section
+                    selection = QItemSelection()
+                    for row, skill in enumerate(model.rows):
+                        if skill.id in wanted:
+                            selection.select(model.index(row, 0), model.index(row, 4))
+                    current = {i.row() for i in table.selectionModel().selectedRows()}
+                    rows = {r for r, s in enumerate(model.rows) if s.id in wanted}
+                    if current != rows:
+                        table.selectionModel().select(
+                            selection, QItemSelectionModel.ClearAndSelect | QItemSelectionModel.Rows
+                        )
+        finally:
+            self._syncing = False

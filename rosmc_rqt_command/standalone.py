@@ -1,0 +1,84 @@
+"""The command GUI in its own window: ``rosmc_command [--ns /replay]``.
+
+Makes the process a ROS node, wires a :class:`~.ros_bridge.RosBridge` to a
+:class:`~.command_widget.CommandWidget` and shows it in a main window.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import signal
+import sys
+from collections.abc import Sequence
+
+import rospy
+from python_qt_binding.QtCore import QTimer
+from python_qt_binding.QtWidgets import QApplication, QMainWindow, QWidget
+
+from rosmc_server.ros.client import init_node
+
+from .command_widget import CommandWidget
+from .ros_bridge import RosBridge
+
+
+def connect(widget: CommandWidget, bridge: RosBridge) -> None:
+    """Route the bridge's signals to the widget's slots (queued across threads)."""
+    bridge.updated.connect(widget.on_update)
+    bridge.library_ready.connect(widget.on_library)
+    bridge.answered.connect(widget.on_answer)
+    bridge.connection_changed.connect(widget.on_connection)
+    bridge.selection_received.connect(widget.on_remote_selection)
+
+
+class CommandWindow(QMainWindow):  # type: ignore[misc]
+    """The standalone main window; asks about unsaved changes before it closes."""
+
+    def __init__(self, widget: CommandWidget, title: str) -> None:
+        super().__init__()
+        self.widget = widget
+        self.setWindowTitle(title)
+        self.setCentralWidget(widget)
+        self.resize(1500, 900)
+
+    def closeEvent(self, event: object) -> None:
+        """Offer to save first; Cancel keeps the window open."""
+        if self.widget.backend.read_only or self.widget.files.confirm_discard("closing"):
+            event.accept()  # type: ignore[attr-defined]
+        else:
+            event.ignore()  # type: ignore[attr-defined]
+
+
+def build(prefix: str = "", parent: QWidget | None = None) -> tuple[CommandWidget, RosBridge]:
+    """A command widget fed by a started bridge (the process must be a ROS node)."""
+    bridge = RosBridge(prefix)
+    widget = CommandWidget(bridge, parent)
+    connect(widget, bridge)
+    bridge.start()
+    return widget, bridge
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Open the command window; returns the exit code."""
+    args = rospy.myargv(list(sys.argv if argv is None else argv))[1:]
+    parser = argparse.ArgumentParser(prog="rosmc_command", description=__doc__)
+    parser.add_argument(
+        "--ns", default="", help="follow a replay served under this prefix, read-only (/replay)"
+    )
+    options = parser.parse_args(args)
+    app = QApplication.instance() or QApplication([sys.argv[0]])
+    init_node(f"rosmc_command_{os.getpid()}")
+    widget, bridge = build(options.ns)
+    title = "ROSMC command" + (f" — following {options.ns} (read-only)" if bridge.read_only else "")
+    window = CommandWindow(widget, title)
+    window.show()
+    # Ctrl-C in the terminal closes the window (Qt otherwise never lets Python see it).
+    signal.signal(signal.SIGINT, lambda *_: window.close())
+    timer = QTimer()
+    timer.timeout.connect(lambda: None)
+    timer.start(200)
+    try:
+        return int(app.exec_())
+    finally:
+        bridge.close()
+        rospy.signal_shutdown("command window closed")
