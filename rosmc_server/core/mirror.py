@@ -125,7 +125,8 @@ class MissionMirror:
         with self.lock:
             if restarted:
                 self._pending.clear()
-            elif self._state is not None and state.revision < self._state.revision:
+            stale = self._state is not None and state.revision < self._state.revision
+            if stale and not restarted:
                 # An answer to a fetch overtaken by events; the mirror is ahead of it.
                 self._awaiting_snapshot = False
                 need = self._apply_pending()
