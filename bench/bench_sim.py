@@ -43,8 +43,8 @@ import rosmc.msg as wire
 import rospy
 from rosgraph_msgs.msg import Clock
 
+from rosmc_server.conversions import param_to_msg
 from rosmc_server.core import Pose
-from rosmc_server.ros.conversions import param_to_msg
 from rosmc_sim.core.scenario import Scenario, load_scenario
 from rosmc_sim.ros.topics import task_status_topic, task_topic
 

@@ -7,11 +7,10 @@ Times are seconds since the recording started, as ``rosmc timeline`` draws them.
 from __future__ import annotations
 
 import argparse
-import os
 import re
 import sys
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # the commands import ROS late, so that --help stays fast
     from ..recording.history import MissionHistory
@@ -63,12 +62,9 @@ def add_commands(command: _Command) -> None:
 
 def replay(ctx: Context) -> int:
     """Republish the recording onto the graph, timed by log time over the rate."""
-    import rospy
-
-    from ..core import RosmcError
+    from ..core import MissionEvent
     from ..recording import read_journal
     from ..recording.history import MissionHistory
-    from ..ros.conversions import event_from_msg
     from ..ros.replayer import RecordingReplayer, ReplayConfig
     from ..text import format_event
 
@@ -77,16 +73,12 @@ def replay(ctx: Context) -> int:
     history = _history(MissionHistory(result))
     config = ReplayConfig(rate=args.rate, start=args.start, prefix=args.prefix)
 
-    def show(msg: Any, seconds: float) -> None:
-        try:
-            line = format_event(event_from_msg(msg))
-        except RosmcError:
-            line = f"r{msg.revision} (an event that does not decode)"
+    def show(revision: int, event: MissionEvent | None, seconds: float) -> None:
+        line = format_event(event) if event else f"r{revision} (an event that does not decode)"
         print(f"[{seconds:8.2f} s] {line}", file=ctx.out, flush=True)
 
     player = RecordingReplayer(history, result.records, config, None if ctx.json else show)
-    player.check_names()  # before init_node, which would wait for a missing master forever
-    rospy.init_node(f"rosmc_replay_{os.getpid()}", disable_signals=True, disable_rosout=True)
+    player.check_names()  # refuse before saying anything
     where = f"under {config.topic('')}" if config.topic("") else "on the live topic names"
     ctx.emit(
         f"replaying {history.path} ({history.duration:.1f} s, revisions "

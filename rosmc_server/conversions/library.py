@@ -1,32 +1,67 @@
-"""Messages the client receives, as core objects: the library and agent states.
+"""The skill library <-> messages (the server sends it; clients read it back).
 
-Complements :mod:`rosmc_server.ros.conversions` (which only needs the library's
-way *to* the wire on the server side) with the way back for clients.
+Part of :mod:`rosmc_server.conversions`, the one boundary between the ``rosmc``
+messages and the core.
 """
 
 from __future__ import annotations
 
-import math
-
 import rosmc.msg as wire
 import yaml
 
-from ...core import (
+from ..core import (
     AgentKind,
     AgentSpec,
-    AgentStatus,
     InvalidRequest,
     Library,
     MarkerType,
     ParameterSpec,
     ParamType,
     SkillSpec,
-    SkillStatus,
     Value,
 )
-from ..conversions import param_from_msg, pose_from_msg
+from .values import param_from_msg, param_to_msg
 
-_LINK_STATES = {wire.LinkState.UP: "up", wire.LinkState.DOWN: "down"}
+
+def parameter_spec_to_msg(spec: ParameterSpec) -> wire.ParameterSpec:
+    """A parameter schema as ``rosmc/ParameterSpec``."""
+    return wire.ParameterSpec(
+        name=spec.name,
+        type=int(spec.type),
+        default_value=param_to_msg(spec.name, spec.default),
+        has_min=spec.minimum is not None,
+        min=spec.minimum if spec.minimum is not None else 0.0,
+        has_max=spec.maximum is not None,
+        max=spec.maximum if spec.maximum is not None else 0.0,
+        choices=[str(choice) for choice in spec.choices],
+        unit=spec.unit,
+        description=spec.description,
+        marker_type=spec.marker_type.name if spec.marker_type is not None else "",
+    )
+
+
+def library_to_msg(library: Library) -> wire.Library:
+    """The library as ``rosmc/Library``."""
+    return wire.Library(
+        name=library.name,
+        agents=[
+            wire.AgentSpec(name=a.name, kind=int(a.kind), model=a.model, description=a.description)
+            for a in library.agents
+        ],
+        skill_sets=[
+            wire.SkillSet(model=model, skills=[_skill_spec_to_msg(s) for s in skills.values()])
+            for model, skills in library.models.items()
+        ],
+    )
+
+
+def _skill_spec_to_msg(spec: SkillSpec) -> wire.SkillSpec:
+    return wire.SkillSpec(
+        name=spec.name,
+        description=spec.description,
+        parameters=[parameter_spec_to_msg(p) for p in spec.parameters],
+        estimated_duration=spec.estimated_duration,
+    )
 
 
 def library_from_msg(msg: wire.Library) -> Library:
@@ -81,38 +116,3 @@ def _choice(ptype: ParamType, text: str) -> Value:
         return text.strip().lower() == "true"
     loaded: Value = yaml.safe_load(text)
     return loaded
-
-
-def agent_statuses_from_msg(msg: wire.AgentStates) -> dict[str, AgentStatus]:
-    """``rosmc/AgentStates`` as one :class:`AgentStatus` per agent."""
-    return {state.agent: agent_status_from_msg(state) for state in msg.agents}
-
-
-def agent_status_from_msg(msg: wire.AgentState) -> AgentStatus:
-    """``rosmc/AgentState`` as an :class:`AgentStatus`."""
-    telemetry = msg.telemetry
-    has_telemetry = bool(telemetry.frame_id) or not telemetry.stamp.is_zero()
-    current = msg.current_skill_id
-    return AgentStatus(
-        agent=msg.agent,
-        link=_LINK_STATES.get(msg.link.state, "unknown"),
-        last_heard=msg.link.last_heard,
-        round_trip=msg.link.round_trip,
-        commands_in_flight=msg.link.commands_in_flight,
-        hash_mismatch=msg.link.hash_mismatch,
-        queue_hash=msg.link.queue_hash,
-        robot_queue_hash=msg.link.robot_queue_hash,
-        battery=_finite(telemetry.battery),
-        wifi_signal=_finite(telemetry.wifi_signal),
-        in_coverage=telemetry.in_coverage,
-        pose=pose_from_msg(telemetry.pose) if has_telemetry else None,
-        current_skill=current,
-        current_status=SkillStatus(msg.current_status.value) if current else None,
-        executor_state=msg.executor_state,
-        waiting_on=msg.waiting_on,
-        policy=msg.policy,
-    )
-
-
-def _finite(number: float) -> float | None:
-    return float(number) if math.isfinite(number) else None

@@ -1,13 +1,18 @@
-"""Executor protocol objects <-> robot-link messages."""
+"""The executor's protocol objects <-> robot-link and barrier messages.
+
+Part of :mod:`rosmc_server.conversions`, the one boundary between the ``rosmc``
+messages and the core (here the executor core's protocol, which the on-robot
+executor speaks).
+"""
 
 from __future__ import annotations
 
 import rosmc.msg as wire
 
-from rosmc_server.core.commands import CommandKind
-from rosmc_server.ros.conversions import skill_from_msg, skill_to_msg, time_to_msg
-
-from ..core import Ack, BarrierInfo, Command, Report, Signal, SignalKind, Snapshot
+from ..core.commands import CommandKind
+from ..executor.core import Ack, BarrierInfo, Command, Report, Signal, SignalKind, Snapshot
+from .mission import skill_from_msg, skill_to_msg
+from .values import time_to_msg
 
 
 def command_from_msg(msg: wire.RobotCommand) -> Command:

@@ -20,6 +20,7 @@ import bisect
 from dataclasses import dataclass
 from pathlib import Path
 
+from rosmc_server.conversions import event_from_msg, mission_from_msg
 from rosmc_server.core import (
     EventKind,
     InvalidRequest,
@@ -34,7 +35,6 @@ from rosmc_server.recording.errors import JournalError
 from rosmc_server.recording.reader import JournalResult, read_journal
 from rosmc_server.recording.timeline import Timeline, TimelineBuilder
 from rosmc_server.recording.topics import MISSION_EVENTS_TOPIC, MISSION_TOPIC, ROBOT_REPORTS_TOPIC
-from rosmc_server.ros.conversions import event_from_msg, mission_from_msg
 
 CHECKPOINT_EVERY = 256
 """Revisions between two kept copies of the content (bounds the replay per lookup)."""

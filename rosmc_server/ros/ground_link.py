@@ -26,12 +26,12 @@ from typing import Protocol
 import rosmc.msg as wire
 import rospy
 
+from ..conversions import barrier_to_msg, skill_to_msg, time_to_msg
 from ..core import Barrier, Mission, MissionEvent, RosmcError, SkillStatus, Transfer
 from ..core.commands import CommandKind, CommandSpec, queued_barriers, repair_command, synced_ids
 from ..core.link import Arrival, InboundSequence, LinkReport, LinkStatus, Outbox, queue_hash
 from ..core.reconcile import RobotSkill
 from ..interface import ground_link
-from .conversions import barrier_to_msg, skill_to_msg, time_to_msg
 
 _log = logging.getLogger(__name__)
 

@@ -24,6 +24,7 @@ import rospy
 from rosmc.msg import ErrorCode
 
 from .. import interface
+from ..conversions import library_to_msg, marker_from_msg, params_from_msgs, pose_from_msg
 from ..core import (
     InvalidRequest,
     LibraryError,
@@ -43,7 +44,6 @@ from ..core import (
 from ..core.commands import CommandKind, CommandSpec
 from ..core.link import LinkStatus
 from ..core.params import value_to_data
-from .conversions import library_to_msg, marker_from_msg, params_from_msgs, pose_from_msg
 
 if TYPE_CHECKING:
     from .server_node import MissionServer

@@ -17,11 +17,17 @@ Publishes (each name behind ``prefix``):
 Services (behind ``prefix``):
     ``/rosmc/get_mission`` (rosmc/GetMission): the mission as replayed so far, so clients that
     start from it (``rosmc watch``, the GUIs) follow the replay as they follow a live server.
+
+The replayer serves clients and is driven by ``rosmc replay``; it ranks with the client
+(``rosmc_server.ros.client``) in the layers, above the server's adapters. Its callers need
+no rospy: :meth:`RecordingReplayer.run` makes the process a node itself and hands each
+event over as a core :class:`~rosmc_server.core.MissionEvent`.
 """
 
 from __future__ import annotations
 
 import logging
+import os
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -34,11 +40,11 @@ import rosmc.srv as wire_srv
 import rospy
 
 from .. import interface
-from ..core import EventKind, InvalidRequest, NotFound, RosmcError
+from ..conversions import event_from_msg, mission_to_msg
+from ..core import EventKind, InvalidRequest, MissionEvent, NotFound, RosmcError
 from ..recording import AGENT_STATES_TOPIC, ROBOT_REPORTS_TOPIC, JournalRecord
 from ..recording.history import MissionHistory
-from .client.results import ServerUnavailable
-from .conversions import mission_to_msg
+from .client import ServerUnavailable, init_node
 
 _log = logging.getLogger(__name__)
 
@@ -59,6 +65,11 @@ TYPES: dict[str, Any] = {
     AGENT_STATES_TOPIC: wire.AgentStates,
     ROBOT_REPORTS_TOPIC: wire.RobotReport,
 }
+
+
+EventCallback = Callable[[int, MissionEvent | None, float], None]
+"""Called with each replayed event: its revision, the event (None if it does not decode)
+and its time in the recording (s)."""
 
 
 class ReplayRefused(RosmcError):
@@ -108,13 +119,13 @@ def taken_names(names: Sequence[str], caller_id: str = "/rosmc_replay") -> dict[
 
 
 class RecordingReplayer:
-    """Plays one recording onto the graph; call :meth:`run` in a node (rospy initialised).
+    """Plays one recording onto the graph with :meth:`run`.
 
     Args:
         history: The recording's history (rebuilds the snapshots).
         records: The recording's records (:attr:`JournalResult.records`).
         config: Rate, start time and topic prefix.
-        on_event: Called with each event message and its time in the recording (s).
+        on_event: Called with each event as it is published (see :data:`EventCallback`).
     """
 
     def __init__(
@@ -122,7 +133,7 @@ class RecordingReplayer:
         history: MissionHistory,
         records: Sequence[JournalRecord],
         config: ReplayConfig,
-        on_event: Callable[[Any, float], None] | None = None,
+        on_event: EventCallback | None = None,
     ) -> None:
         if not config.rate > 0:
             raise InvalidRequest(f"the rate must be a positive number, got {config.rate}")
@@ -167,8 +178,13 @@ class RecordingReplayer:
         self._stop.set()
 
     def run(self) -> int:
-        """Check the names, publish everything on time and return the last revision shown."""
+        """Check the names, publish everything on time and return the last revision shown.
+
+        Makes the process a ROS node first unless it is one already (the names are
+        checked before that: joining the graph waits for a missing master forever).
+        """
         self.check_names()
+        init_node(f"rosmc_replay_{os.getpid()}")
         for topic, msg_type in TYPES.items():
             name = self._config.topic(topic)
             latched = topic == interface.MISSION_TOPIC
@@ -229,7 +245,7 @@ class RecordingReplayer:
             self._publishers[interface.EVENTS_TOPIC].publish(msg)
             self._latest, self._stamp = max(self._latest, revision), msg.stamp.to_sec()
             if self._on_event is not None:
-                self._on_event(msg, self._offset(record))
+                self._on_event(revision, _decoded(msg), self._offset(record))
             return bool(msg.kind == EventKind.MISSION_REPLACED)
         self._publishers[record.topic].publish(msg)
         return False
@@ -246,6 +262,13 @@ class RecordingReplayer:
 
     def _on_get_mission(self, _request: Any) -> Any:
         return wire_srv.GetMissionResponse(mission=self._snapshot)
+
+
+def _decoded(msg: Any) -> MissionEvent | None:
+    try:
+        return event_from_msg(msg)
+    except RosmcError:
+        return None
 
 
 def _log_time(record: JournalRecord) -> int:

@@ -48,18 +48,18 @@ import rosmc.msg as wire
 import rospy
 
 from .. import interface
-from ..core import Library, Mission, MissionContent, MissionEvent, Unavailable, load_library
-from ..core.changes import EventKind
-from ..core.commands import commands_for_event
-from ..recording import JournalOptions, JournalWriter, default_journal_path, latest_state
-from .agent_states import AgentStatePublisher
-from .conversions import (
+from ..conversions import (
     SnapshotConverter,
     event_from_msg,
     event_to_msg,
     mission_from_msg,
     mission_to_msg,
 )
+from ..core import Library, Mission, MissionContent, MissionEvent, Unavailable, load_library
+from ..core.changes import EventKind
+from ..core.commands import commands_for_event
+from ..recording import JournalOptions, JournalWriter, default_journal_path, latest_state
+from .agent_states import AgentStatePublisher
 from .ground_link import GroundLink
 from .logging_bridge import bridge_logging_to_rosout
 from .operator_services import OperatorServices

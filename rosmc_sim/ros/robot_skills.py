@@ -20,9 +20,9 @@ from collections.abc import Mapping
 import rosmc.msg as wire
 import rospy
 
+from rosmc_server.conversions import param_to_msg
 from rosmc_server.core import ParamType, Value
 from rosmc_server.executor.core import Outcome, SkillBehavior, SkillContext, SkillType
-from rosmc_server.ros.conversions import param_to_msg
 
 from ..core.skills_registry import TASKS
 from .topics import task_status_topic, task_topic

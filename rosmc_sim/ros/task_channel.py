@@ -20,8 +20,8 @@ import logging
 import rosmc.msg as wire
 import rospy
 
+from rosmc_server.conversions import param_from_msg
 from rosmc_server.core import RosmcError
-from rosmc_server.ros.conversions import param_from_msg
 
 from .task_desk import TaskDesk, TaskStatus
 from .timing import Throttle

@@ -33,10 +33,10 @@ from rosmc.msg import ErrorCode
 from std_msgs.msg import Bool
 
 from rosmc_server import interface
+from rosmc_server.conversions import mission_from_msg, param_to_msg, skill_to_msg
 from rosmc_server.core import MissionState, SkillInstance, SkillStatus
 from rosmc_server.core.commands import CommandKind
 from rosmc_server.recording import MISSION_EVENTS_TOPIC, ROBOT_REPORTS_TOPIC, read_journal
-from rosmc_server.ros.conversions import mission_from_msg, param_to_msg, skill_to_msg
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 TEST_LIBRARY = REPO_ROOT / "tests" / "data" / "test_team.yaml"

@@ -24,6 +24,7 @@ import pytest
 
 from rosmc_server.cli.parser import build_parser
 from rosmc_server.cli.values import parse_vertices, typed_values
+from rosmc_server.conversions import library_to_msg
 from rosmc_server.core import (
     InvalidRequest,
     MarkerType,
@@ -39,7 +40,6 @@ from rosmc_server.ros.client import (
     ServerUnavailable,
     library_from_msg,
 )
-from rosmc_server.ros.conversions import library_to_msg
 from rosmc_server.text import mission_to_json
 
 REPO = Path(__file__).resolve().parents[2]

@@ -24,10 +24,10 @@ import rospy
 from rosmc.msg import ErrorCode
 
 from rosmc_server import interface
+from rosmc_server.conversions import time_to_msg
 from rosmc_server.core import Resolution, SkillInstance, SkillStatus, Transfer
 from rosmc_server.core.commands import CommandKind
 from rosmc_server.core.link import queue_hash
-from rosmc_server.ros.conversions import time_to_msg
 from tests.integration.executor_fixtures import (
     LinkEnd,
     Operator,

@@ -20,10 +20,10 @@ import pytest
 import rosmc.msg as wire
 import rospy
 
+from rosmc_server.conversions import event_to_msg, mission_to_msg
 from rosmc_server.core import Mission, Pose, TaskMarker, load_library
 from rosmc_server.core.params import MarkerType
 from rosmc_server.recording import JournalWriter
-from rosmc_server.ros.conversions import event_to_msg, mission_to_msg
 
 REPO = Path(__file__).resolve().parents[2]
 ROSMC = REPO / "scripts" / "rosmc"

@@ -26,14 +26,14 @@ import rospy
 
 pytest.register_assert_rewrite("tests.integration.server_fixtures")
 
-from rosmc_server.core import Mission, RosmcError, load_library, parse_mission  # noqa: E402
-from rosmc_server.ros.conversions import (  # noqa: E402
+from rosmc_server.conversions import (  # noqa: E402
     marker_from_msg,
     mission_from_msg,
     mission_to_msg,
     params_from_msgs,
     pose_from_msg,
 )
+from rosmc_server.core import Mission, RosmcError, load_library, parse_mission  # noqa: E402
 from tests.integration.server_fixtures import REPO, Client, ServerProcess, mission_key  # noqa: E402
 
 pytest_plugins = ["tests.integration.server_fixtures"]

@@ -32,8 +32,8 @@ from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Bool
 from visualization_msgs.msg import MarkerArray
 
+from rosmc_server.conversions import param_to_msg
 from rosmc_server.core import Pose
-from rosmc_server.ros.conversions import param_to_msg
 from rosmc_sim.ros.topics import (
     SCIENCE_TOPIC,
     WORLD_TOPIC,

@@ -26,6 +26,7 @@ import rosbag  # noqa: E402
 
 from rosmc_server import demo  # noqa: E402
 from rosmc_server.cli import main as rosmc  # noqa: E402
+from rosmc_server.conversions import event_to_msg, mission_to_msg  # noqa: E402
 from rosmc_server.core import (  # noqa: E402
     EventKind,
     InvalidRequest,
@@ -52,7 +53,6 @@ from rosmc_server.recording.timeline_svg import (  # noqa: E402
     write_timeline,
 )
 from rosmc_server.recording.to_rosbag import journal_to_rosbag  # noqa: E402
-from rosmc_server.ros.conversions import event_to_msg, mission_to_msg  # noqa: E402
 
 T0 = 1_700_000_000_000_000_000
 SVG = "{http://www.w3.org/2000/svg}"

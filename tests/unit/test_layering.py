@@ -1,11 +1,46 @@
-"""Layering: no ``core`` package imports ROS, generated messages, Qt or (outside the sim) pybullet.
+"""Layering: who may import what, checked on every module of the ``rosmc_*`` packages.
 
-DESIGN §2: ``core/`` never imports rospy, genpy, generated messages, Qt or
-pybullet (the simulation core may use pybullet); ``ros/`` is the only place
-that imports rospy. The scanner reads every module with :mod:`ast`, so a
-forbidden import is found even where it would never run (inside a function or
-an ``if``). A second test imports every core package with the forbidden
-modules blocked, which also catches imports that happen indirectly.
+DESIGN §2 and the issue that split the conversions out: the packages form one
+order of layers, and a module imports only from its own layer or below::
+
+    core < conversions < recording < ros < client < app
+    (0)(1)(2)(3)(4)(5)
+
+* **core**: every ``core/`` package (``rosmc_server/core``, ``rosmc_server/executor/core``,
+  ``rosmc_sim/core``, ``rosmc_rviz_markers/core``), ``rosmc_server/interface.py`` (graph
+  names) and the executor's plain skills. Pure Python.
+* **conversions**: ``rosmc_server/conversions`` (the only msg <-> core boundary; generated
+  messages and genpy, no rospy) and ``rosmc_server/text`` (plain-text rendering).
+* **recording**: ``rosmc_server/recording`` (the MCAP journal, history, timelines).
+* **ros**: the ROS adapters of the server, the executor and the simulator
+  (``rosmc_server/ros``, ``rosmc_server/executor/ros``, ``rosmc_sim/ros``).
+* **client**: ``rosmc_server/ros/client`` and ``rosmc_server/ros/replayer.py`` (it plays a
+  recording for clients, driven by ``rosmc replay``).
+* **app**: the CLI (``rosmc_server/cli``), the GUIs (everything of ``rosmc_rviz_markers``
+  and ``rosmc_rqt_command`` outside their ``core/``), the demos and the scripted demo
+  operator (``rosmc_sim/ros/demo_operator.py``).
+
+Besides the order, by what a module imports from outside:
+
+* **ROS runtime** (rospy, rosgraph, interactive_markers, tf2_ros, ...) only in a *ROS
+  adapter module*: one inside a ``ros/`` package, or named ``ros_*.py`` or ``node.py``.
+  So the command GUI's Qt models and widgets never import rospy; its one adapter is
+  ``rosmc_rqt_command/ros_bridge.py``, and the marker servers' rospy lives in
+  ``rosmc_rviz_markers/ros/``.
+* **Messages** (genpy, ``rosmc.msg``/``rosmc.srv``, std/geometry/visualization messages,
+  rosbag) only in conversions, recording and ROS adapter modules: never in a core, the
+  text rendering, the CLI or a GUI model/widget (they get core objects from the client).
+* **Qt** only in the GUI packages outside their ``core/``.
+* **pybullet** only in ``rosmc_sim/core``.
+* **The server's insides**: apps reach the graph through the client. They import nothing
+  of ``rosmc_server.ros`` but the client, the replayer and the logging bridge; a GUI
+  module that is not a ROS adapter imports nothing of ``rosmc_server.ros`` at all (the
+  rqt Plugin ``rosmc_rqt_command/plugin.py`` builds the bridge through ``ros_bridge``).
+
+The scanner reads every module with :mod:`ast`, so a forbidden import is found even where
+it would never run (inside a function, an ``if`` or ``TYPE_CHECKING``). A second test
+imports every core package with the forbidden modules blocked, which also catches imports
+that happen indirectly.
 """
 
 from __future__ import annotations
@@ -20,25 +55,94 @@ from pathlib import Path
 import pytest
 
 REPO = Path(__file__).resolve().parents[2]
+PACKAGES = ("rosmc_server", "rosmc_sim", "rosmc_rviz_markers", "rosmc_rqt_command")
 
-# Top-level modules a core package must not import.
-FORBIDDEN = {
-    "rospy": "rospy",
-    "genpy": "generated-message runtime",
-    "roslib": "roslib",
-    "rosmc": "generated messages (rosmc.msg / rosmc.srv)",
-    "PyQt5": "Qt",
-    "PyQt6": "Qt",
-    "PySide2": "Qt",
-    "PySide6": "Qt",
-    "python_qt_binding": "Qt",
-    "Qt": "Qt",
-    "pybullet": "pybullet",
-    "pybullet_data": "pybullet",
+LAYERS = ("core", "conversions", "recording", "ros", "client", "app")
+RANK = {name: rank for rank, name in enumerate(LAYERS)}
+
+# Path (a folder ending in "/" or one file) -> layer; the longest matching entry wins. A new
+# folder or top-level module needs an entry (test_every_module_has_a_layer says so).
+LAYER_OF_PATH = {
+    "rosmc_server/__init__.py": "core",
+    "rosmc_server/core/": "core",
+    "rosmc_server/interface.py": "core",
+    "rosmc_server/executor/__init__.py": "core",
+    "rosmc_server/executor/core/": "core",
+    "rosmc_server/executor/basic_skills.py": "core",
+    "rosmc_server/conversions/": "conversions",
+    "rosmc_server/text/": "conversions",
+    "rosmc_server/recording/": "recording",
+    "rosmc_server/ros/": "ros",
+    "rosmc_server/executor/ros/": "ros",
+    "rosmc_server/ros/client/": "client",
+    "rosmc_server/ros/replayer.py": "client",
+    "rosmc_server/cli/": "app",
+    "rosmc_server/demo.py": "app",
+    "rosmc_sim/__init__.py": "core",
+    "rosmc_sim/core/": "core",
+    "rosmc_sim/ros/": "ros",
+    "rosmc_sim/ros/demo_operator.py": "app",
+    "rosmc_sim/demo.py": "app",
+    "rosmc_rviz_markers/": "app",
+    "rosmc_rviz_markers/core/": "core",
+    "rosmc_rqt_command/": "app",
+    "rosmc_rqt_command/core/": "core",
 }
-# Only the simulation core may use pybullet.
-PYBULLET_ALLOWED = ("rosmc_sim/core/",)
+
+ROS_RUNTIME = {
+    "rospy",
+    "rosgraph",
+    "roslaunch",
+    "rosnode",
+    "rosservice",
+    "rostopic",
+    "rosparam",
+    "interactive_markers",
+    "tf2_ros",
+    "tf",
+    "actionlib",
+}
+MESSAGES = {
+    "genpy",
+    "roslib",
+    "rosbag",
+    "rosmc",
+    "std_msgs",
+    "std_srvs",
+    "geometry_msgs",
+    "visualization_msgs",
+    "nav_msgs",
+    "sensor_msgs",
+    "tf2_msgs",
+}
+QT = {
+    "PyQt5",
+    "PyQt6",
+    "PySide2",
+    "PySide6",
+    "python_qt_binding",
+    "Qt",
+    "qt_gui",
+    "rqt_gui",
+    "rqt_gui_py",
+}
 PYBULLET = {"pybullet", "pybullet_data"}
+WHY = {
+    **dict.fromkeys(ROS_RUNTIME, "the ROS runtime: only ROS adapter modules"),
+    **dict.fromkeys(MESSAGES, "messages: only conversions, recording and ROS adapters"),
+    **dict.fromkeys(QT, "Qt: only the GUI packages outside core/"),
+    **dict.fromkeys(PYBULLET, "pybullet: only rosmc_sim/core"),
+}
+GUI_PACKAGES = ("rosmc_rviz_markers/", "rosmc_rqt_command/")
+TEXT = "rosmc_server/text/"  # with the conversions in the order, but speaks no messages
+PYBULLET_ALLOWED = ("rosmc_sim/core/",)
+# What the apps may use of rosmc_server.ros: the client and what serves clients.
+FOR_APPS = (
+    "rosmc_server.ros.client",
+    "rosmc_server.ros.replayer",
+    "rosmc_server.ros.logging_bridge",
+)
+CONVERSIONS = "rosmc_server.conversions"
 # Dynamic imports with a literal module name are checked too.
 IMPORT_FUNCTIONS = {"import_module", "__import__"}
 
@@ -56,11 +160,37 @@ class Violation:
         return f"{self.path}:{self.line} imports {self.module} ({self.why})"
 
 
+def package_modules(root: Path = REPO) -> list[Path]:
+    """Every module of the repository's rosmc_* packages."""
+    return sorted(
+        path
+        for package in PACKAGES
+        for path in (root / package).glob("**/*.py")
+        if "__pycache__" not in path.parts
+    )
+
+
 def core_modules(root: Path = REPO) -> list[Path]:
     """Every module of every ``core`` package of the repository's rosmc_* packages."""
     return sorted(
         path for path in root.glob("rosmc_*/**/core/**/*.py") if "__pycache__" not in path.parts
     )
+
+
+def layer_of(relative: str) -> str | None:
+    """The layer of a module given by its path below the repository (None: no entry)."""
+    matches = [
+        key
+        for key in LAYER_OF_PATH
+        if key == relative or (key.endswith("/") and relative.startswith(key))
+    ]
+    return LAYER_OF_PATH[max(matches, key=len)] if matches else None
+
+
+def is_ros_adapter(relative: str) -> bool:
+    """A module that may use the ROS runtime: in a ``ros/`` package, ``ros_*.py`` or ``node.py``."""
+    *folders, name = relative.split("/")
+    return "ros" in folders[1:] or name.startswith("ros_") or name == "node.py"
 
 
 def _module_name(path: Path, root: Path) -> list[str]:
@@ -99,20 +229,67 @@ def _imported(tree: ast.AST, path: Path, root: Path) -> list[tuple[int, str]]:
     return found
 
 
+def _module_path(module: str, root: Path) -> str:
+    """The path of the file an imported ``rosmc_*`` name lives in (its longest module part)."""
+    parts = module.split(".")
+    for end in range(len(parts), 0, -1):
+        stem = "/".join(parts[:end])
+        if (root / f"{stem}.py").is_file():
+            return f"{stem}.py"
+        if (root / stem / "__init__.py").is_file():
+            return f"{stem}/__init__.py"
+    return "/".join(parts) + ".py"
+
+
+def _outside_rule(relative: str, top: str) -> bool:
+    """Whether ``relative`` may import the third-party module ``top``."""
+    layer = layer_of(relative)
+    gui = relative.startswith(GUI_PACKAGES)
+    if top in ROS_RUNTIME:
+        return is_ros_adapter(relative)
+    if top in MESSAGES:
+        if is_ros_adapter(relative):
+            return True
+        return layer in ("conversions", "recording") and not relative.startswith(TEXT)
+    if top in QT:
+        return gui and layer != "core"
+    if top in PYBULLET:
+        return relative.startswith(PYBULLET_ALLOWED)
+    return True
+
+
+def _inside_rule(relative: str, module: str, root: Path) -> str | None:
+    """Why ``relative`` may not import the rosmc_* name ``module`` (None: it may)."""
+    layer = layer_of(relative)
+    target = _module_path(module, root)
+    target_layer = layer_of(target)
+    if layer is None or target_layer is None:
+        return None  # reported by the test that every module has a layer
+    if RANK[target_layer] > RANK[layer]:
+        return f"the {target_layer} layer, above this {layer} module"
+    if layer == "app" and module.startswith(CONVERSIONS) and not is_ros_adapter(relative):
+        return "message conversions: apps get core objects from the client"
+    if layer == "app" and module.startswith("rosmc_server.ros"):
+        if relative.startswith(GUI_PACKAGES) and not is_ros_adapter(relative):
+            return "rosmc_server.ros: a GUI model or widget gets it from the GUI's ROS adapter"
+        if module != "rosmc_server.ros" and not module.startswith(FOR_APPS):
+            return "the server's ROS adapters: apps go through the client"
+    return None
+
+
 def scan(path: Path, root: Path = REPO) -> list[Violation]:
-    """The forbidden imports of one core module."""
+    """The forbidden imports of one module of the rosmc_* packages."""
     relative = path.relative_to(root).as_posix()
     tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
     violations = []
     for line, module in _imported(tree, path, root):
-        parts = module.split(".")
-        top = parts[0]
-        if top in FORBIDDEN:
-            if top in PYBULLET and relative.startswith(PYBULLET_ALLOWED):
-                continue
-            violations.append(Violation(relative, line, module, FORBIDDEN[top]))
-        elif top.startswith("rosmc_") and "ros" in parts[1:]:
-            violations.append(Violation(relative, line, module, "the ROS adapter layer"))
+        top = module.split(".")[0]
+        if top.startswith("rosmc_"):
+            why = _inside_rule(relative, module, root)
+        else:
+            why = None if _outside_rule(relative, top) else WHY[top]
+        if why is not None:
+            violations.append(Violation(relative, line, module, why))
     return violations
 
 
@@ -141,19 +318,44 @@ def test_there_are_core_modules_to_scan() -> None:
     assert expected <= modules
 
 
-def test_no_core_module_imports_ros_qt_or_pybullet() -> None:
-    violations = [str(v) for path in core_modules() for v in scan(path)]
+def test_every_module_has_a_layer() -> None:
+    missing = [
+        p.relative_to(REPO).as_posix()
+        for p in package_modules()
+        if layer_of(p.relative_to(REPO).as_posix()) is None
+    ]
+    assert missing == [], "add these to LAYER_OF_PATH"
+
+
+@pytest.mark.parametrize(
+    ("relative", "layer"),
+    [
+        ("rosmc_server/core/mission.py", "core"),
+        ("rosmc_server/executor/core/engine.py", "core"),
+        ("rosmc_server/interface.py", "core"),
+        ("rosmc_server/conversions/mission.py", "conversions"),
+        ("rosmc_server/recording/history.py", "recording"),
+        ("rosmc_server/ros/server_node.py", "ros"),
+        ("rosmc_server/executor/ros/node.py", "ros"),
+        ("rosmc_server/ros/client/mission_client.py", "client"),
+        ("rosmc_server/ros/replayer.py", "client"),
+        ("rosmc_server/cli/replay.py", "app"),
+        ("rosmc_rviz_markers/core/geometry.py", "core"),
+        ("rosmc_rviz_markers/ros/node.py", "app"),
+        ("rosmc_rqt_command/ros_bridge.py", "app"),
+        ("rosmc_rqt_command/models/schedule.py", "app"),
+    ],
+)
+def test_layer_table(relative: str, layer: str) -> None:
+    assert layer_of(relative) == layer
+
+
+def test_no_module_breaks_the_layers() -> None:
+    violations = [str(v) for path in package_modules() for v in scan(path)]
     assert violations == []
 
 
 def test_core_packages_import_with_the_forbidden_modules_blocked() -> None:
-    packages = sorted(
-        {
-            ".".join(_module_name(path.parent / "__init__.py", REPO))
-            for path in core_modules()
-            if (path.parent / "__init__.py").exists()
-        }
-    )
     modules = sorted(
         {
             ".".join(_module_name(path, REPO))
@@ -162,7 +364,7 @@ def test_core_packages_import_with_the_forbidden_modules_blocked() -> None:
             and not path.relative_to(REPO).as_posix().startswith(PYBULLET_ALLOWED)
         }
     )
-    blocked = sorted(FORBIDDEN)
+    blocked = sorted(ROS_RUNTIME | MESSAGES | QT | PYBULLET)
     program = textwrap.dedent(
         f"""
         import importlib, sys
@@ -172,7 +374,28 @@ def test_core_packages_import_with_the_forbidden_modules_blocked() -> None:
             importlib.import_module(module)
         """
     )
-    assert packages, "no core packages found"
+    assert modules, "no core packages found"
+    result = subprocess.run(
+        [sys.executable, "-c", program],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert result.returncode == 0, result.stderr[-2000:]
+
+
+def test_the_cli_and_recording_tools_load_without_rospy() -> None:
+    """What runs without a ROS graph does not load rospy (the client loads it when used)."""
+    program = textwrap.dedent(
+        """
+        import sys
+        import rosmc_server.cli.parser, rosmc_server.conversions, rosmc_server.recording.history
+        import rosmc_server.text
+        assert "rospy" not in sys.modules, "rospy was imported"
+        """
+    )
     result = subprocess.run(
         [sys.executable, "-c", program],
         cwd=REPO,
@@ -189,9 +412,22 @@ def test_core_packages_import_with_the_forbidden_modules_blocked() -> None:
 
 @pytest.fixture
 def fake_repo(tmp_path: Path) -> Path:
-    for package in ("rosmc_server/core", "rosmc_sim/core", "rosmc_server/ros"):
+    for package in (
+        "rosmc_server/core",
+        "rosmc_sim/core",
+        "rosmc_server/ros",
+        "rosmc_server/ros/client",
+        "rosmc_server/conversions",
+        "rosmc_server/recording",
+        "rosmc_server/cli",
+        "rosmc_rqt_command",
+        "rosmc_rviz_markers/core",
+        "rosmc_rviz_markers/ros",
+    ):
         (tmp_path / package).mkdir(parents=True)
         (tmp_path / package / "__init__.py").write_text("", encoding="utf-8")
+    (tmp_path / "rosmc_server/ros/replayer.py").write_text("", encoding="utf-8")
+    (tmp_path / "rosmc_server/ros/server_node.py").write_text("", encoding="utf-8")
     return tmp_path
 
 
@@ -212,6 +448,8 @@ BAD = [
     "from ..ros import node",
     "from rosmc_server.ros.node import main",
     "from rosmc_server import ros",
+    "from rosmc_server.conversions import skill_to_msg",
+    "from ..recording import history",
     "importlib.import_module('rospy')",
     "__import__('PyQt5')",
     "def later():\n    import rospy",
@@ -235,7 +473,8 @@ def test_scanner_self_test_import_rospy(fake_repo: Path) -> None:
     module = fake_repo / "rosmc_server" / "core" / "uses_ros.py"
     module.write_text('"""A core module that went wrong."""\n\nimport rospy\n', encoding="utf-8")
     (violation,) = scan(module, fake_repo)
-    assert (violation.line, violation.module, violation.why) == (3, "rospy", "rospy")
+    assert (violation.line, violation.module) == (3, "rospy")
+    assert "ROS adapter" in violation.why
 
 
 GOOD = [
@@ -246,7 +485,6 @@ GOOD = [
     "from ..core import errors",
     "from rosmc_server.core.errors import RosmcError",
     "import rosmc_server.core",
-    "from rosmc_server.recording import topics",  # not the ros layer
     "import rospkg_like_name",
     "x = 'import rospy'",
     "# import rospy",
@@ -269,7 +507,7 @@ def test_pybullet_only_in_the_sim_core(fake_repo: Path) -> None:
     assert [v.module for v in scan(sim, fake_repo)] == ["rospy"]
 
 
-def test_only_core_packages_are_scanned(fake_repo: Path) -> None:
+def test_core_packages_are_found_at_any_depth(fake_repo: Path) -> None:
     (fake_repo / "rosmc_server" / "ros" / "node.py").write_text("import rospy\n", encoding="utf-8")
     nested = fake_repo / "rosmc_server" / "executor" / "core"
     nested.mkdir(parents=True)
@@ -277,3 +515,100 @@ def test_only_core_packages_are_scanned(fake_repo: Path) -> None:
     found = [p.relative_to(fake_repo).as_posix() for p in core_modules(fake_repo)]
     assert "rosmc_server/ros/node.py" not in found
     assert "rosmc_server/executor/core/runner.py" in found
+    assert [v.module for v in scan(nested / "runner.py", fake_repo)] == ["rospy"]
+    assert scan(fake_repo / "rosmc_server" / "ros" / "node.py", fake_repo) == []
+
+
+# -- the order of the layers above the core -------------------------------------------------
+
+
+def _scan_source(root: Path, relative: str, source: str) -> list[str]:
+    module = root / relative
+    module.parent.mkdir(parents=True, exist_ok=True)
+    module.write_text(source + "\n", encoding="utf-8")
+    return [v.why for v in scan(module, root)]
+
+
+@pytest.mark.parametrize(
+    ("relative", "source"),
+    [
+        # the conversions: messages yes, the ROS runtime and anything above no
+        ("rosmc_server/conversions/x.py", "import rospy"),
+        ("rosmc_server/conversions/x.py", "from rosmc_server.recording import history"),
+        ("rosmc_server/conversions/x.py", "from ..ros import server_node"),
+        # the recording: below the ROS adapters
+        ("rosmc_server/recording/x.py", "from rosmc_server.ros.server_node import main"),
+        ("rosmc_server/recording/x.py", "import rospy"),
+        # the server's adapters do not use the client
+        ("rosmc_server/ros/x.py", "from .client import MissionClient"),
+        # the client is below the apps
+        ("rosmc_server/ros/client/x.py", "from rosmc_server.cli import main"),
+        # the CLI: no rospy, no messages, no server adapters
+        ("rosmc_server/cli/x.py", "import rospy"),
+        ("rosmc_server/cli/x.py", "from rosmc.msg import Mission"),
+        ("rosmc_server/cli/x.py", "from ..conversions import event_from_msg"),
+        ("rosmc_server/cli/x.py", "from ..ros.server_node import ServerNode"),
+        # GUI models and widgets: no rospy, no messages, not even the client
+        ("rosmc_rqt_command/schedule_model.py", "import rospy"),
+        ("rosmc_rqt_command/schedule_model.py", "from rosmc.msg import Selection"),
+        ("rosmc_rqt_command/schedule_model.py", "from rosmc_server.ros.client import X"),
+        ("rosmc_rqt_command/plugin.py", "import rospy"),
+        ("rosmc_rqt_command/widgets/panel.py", "import rospy"),
+        ("rosmc_rviz_markers/core/geometry.py", "import rospy"),
+        ("rosmc_rviz_markers/core/geometry.py", "from visualization_msgs.msg import Marker"),
+        ("rosmc_rviz_markers/core/geometry.py", "from python_qt_binding import QtCore"),
+        ("rosmc_rviz_markers/core/geometry.py", "from rosmc_server.ros.client import X"),
+        # GUI adapters use the client, not the server's insides
+        ("rosmc_rqt_command/ros_bridge.py", "from rosmc_server.ros.operator_services import X"),
+        ("rosmc_rviz_markers/ros/markers.py", "from rosmc_server.ros import ground_link"),
+        # Qt only in the GUIs
+        ("rosmc_server/cli/x.py", "from python_qt_binding import QtWidgets"),
+    ],
+)
+def test_scanner_catches_a_layer_break(fake_repo: Path, relative: str, source: str) -> None:
+    assert _scan_source(fake_repo, relative, source) != [], (relative, source)
+
+
+@pytest.mark.parametrize(
+    ("relative", "source"),
+    [
+        ("rosmc_server/conversions/x.py", "import genpy\nimport rosmc.msg as wire"),
+        ("rosmc_server/conversions/x.py", "from ..core import Mission"),
+        ("rosmc_server/recording/x.py", "from rosmc_server.conversions import event_from_msg"),
+        ("rosmc_server/recording/x.py", "import genpy\nimport rosbag"),
+        ("rosmc_server/ros/x.py", "import rospy\nfrom ..recording import JournalWriter"),
+        ("rosmc_server/ros/client/x.py", "import rospy\nfrom ...conversions import skill_to_msg"),
+        ("rosmc_server/ros/replayer.py", "from .client import ServerUnavailable"),
+        ("rosmc_server/cli/x.py", "from ..ros.client import MissionClient"),
+        ("rosmc_server/cli/x.py", "from ..ros.replayer import RecordingReplayer"),
+        ("rosmc_server/cli/x.py", "from ..recording.history import MissionHistory"),
+        ("rosmc_rqt_command/ros_bridge.py", "import rospy\nfrom rosmc_server.ros.client import X"),
+        ("rosmc_rqt_command/ros_bridge.py", "from python_qt_binding.QtCore import Signal"),
+        (
+            "rosmc_rqt_command/plugin.py",
+            "from qt_gui.plugin import Plugin\nfrom . import ros_bridge",
+        ),
+        ("rosmc_rqt_command/schedule_model.py", "from python_qt_binding import QtCore"),
+        ("rosmc_rqt_command/schedule_model.py", "from rosmc_server.core import MissionState"),
+        ("rosmc_rviz_markers/ros/node.py", "import rospy\nfrom interactive_markers import x"),
+        ("rosmc_rviz_markers/ros/node.py", "from visualization_msgs.msg import Marker"),
+        ("rosmc_rviz_markers/ros/node.py", "from rosmc_server.ros.client import MissionFollower"),
+        ("rosmc_rviz_markers/ros/node.py", "from rosmc_server.ros.logging_bridge import x"),
+        ("rosmc_rviz_markers/ros/node.py", "from ..core import geometry"),
+        ("rosmc_rviz_markers/core/geometry.py", "from rosmc_server.core.frames import yaw_of"),
+        ("rosmc_rviz_markers/core/geometry.py", "from rosmc_server.interface import MAP_FRAME"),
+    ],
+)
+def test_scanner_allows_the_layers(fake_repo: Path, relative: str, source: str) -> None:
+    assert _scan_source(fake_repo, relative, source) == []
+
+
+def test_ros_adapter_naming() -> None:
+    assert is_ros_adapter("rosmc_server/ros/server_node.py")
+    assert is_ros_adapter("rosmc_rviz_markers/ros/agents.py")
+    assert is_ros_adapter("rosmc_rqt_command/ros_bridge.py")
+    assert is_ros_adapter("rosmc_rqt_command/node.py")
+    assert not is_ros_adapter("rosmc_rqt_command/plugin.py")
+    assert not is_ros_adapter("rosmc_rqt_command/widgets/schedule.py")
+    assert not is_ros_adapter("rosmc_rviz_markers/core/geometry.py")
+    assert not is_ros_adapter("rosmc_server/core/mission.py")

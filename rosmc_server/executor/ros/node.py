@@ -39,10 +39,7 @@ import rospy
 from rosmc_server import interface
 from rosmc_server.ros.logging_bridge import bridge_logging_to_rosout
 
-from ...core import RosmcError
-from ..core import Command, Engine, Report, Signal, SkillType
-from ..core.state_file import load_state, save_state
-from .conversions import (
+from ...conversions.robot_link import (
     ack_to_msg,
     command_from_msg,
     report_to_msg,
@@ -50,6 +47,9 @@ from .conversions import (
     signal_to_msg,
     snapshot_to_msg,
 )
+from ...core import RosmcError
+from ..core import Command, Engine, Report, Signal, SkillType
+from ..core.state_file import load_state, save_state
 
 _log = logging.getLogger(__name__)
 DEFAULT_SKILLS = "rosmc_server.executor.basic_skills:skill_types"

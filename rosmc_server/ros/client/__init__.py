@@ -7,6 +7,7 @@ the events, agent states and snapshots; :class:`MissionWatch` queues the raw eve
 (``rosmc watch``). All speak core objects and raise the core error family.
 """
 
+from ...conversions import agent_status_from_msg, agent_statuses_from_msg, library_from_msg
 from .follow import MissionFollower
 from .mission_client import MissionClient
 from .results import (
@@ -23,7 +24,6 @@ from .results import (
     Transferred,
 )
 from .watch import MissionWatch, init_node
-from .wire import agent_status_from_msg, agent_statuses_from_msg, library_from_msg
 from .worker import AsyncMissionClient, Outcome
 
 __all__ = [

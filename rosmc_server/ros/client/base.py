@@ -8,10 +8,9 @@ from typing import Any, Self
 
 from rosmc.msg import ErrorCode
 
+from ...conversions import library_from_msg, mission_from_msg, param_to_msg
 from ...core import Library, MissionState, SkillInstance, SkillSpec
-from ..conversions import mission_from_msg, param_to_msg
 from .connection import ServiceCaller, raise_for
-from .wire import library_from_msg
 
 
 class ClientBase:

@@ -23,11 +23,10 @@ import rosmc.msg as wire
 import rospy
 
 from ... import interface
+from ...conversions import agent_statuses_from_msg, event_from_msg
 from ...core import Library, MissionState
 from ...core.mirror import MissionMirror
-from ..conversions import event_from_msg
 from .mission_client import MissionClient
-from .wire import agent_statuses_from_msg
 from .worker import AsyncMissionClient, Outcome
 
 _log = logging.getLogger(__name__)

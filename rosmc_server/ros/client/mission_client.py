@@ -5,13 +5,13 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from ...conversions import marker_to_msg, pose_to_msg
 from ...core import (
     InvalidRequest,
     Pose,
     TaskMarker,
 )
 from ...core.editing import check_retries, check_timeout
-from ..conversions import marker_to_msg, pose_to_msg
 from .base import ClientBase
 from .connection import raise_for
 from .results import (

@@ -17,9 +17,8 @@ import rosmc.msg as wire
 import rospy
 
 from ... import interface
+from ...conversions import agent_statuses_from_msg, event_from_msg
 from ...core import AgentStatus, MissionEvent
-from ..conversions import event_from_msg
-from .wire import agent_statuses_from_msg
 
 _log = logging.getLogger(__name__)
 

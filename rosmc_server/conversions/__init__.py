@@ -1,0 +1,77 @@
+"""The one boundary between the ``rosmc`` messages and the core objects.
+
+Nothing else converts: the server, the client, the recording, the executor
+adapter and the simulator all go through these functions. They need the
+generated messages and genpy only, never rospy, so the journal reader and
+replay tools use them without a ROS graph.
+
+Layers: :mod:`rosmc_server.core` < this package < :mod:`rosmc_server.recording`
+and the ROS adapters (``rosmc_server.ros``, ``rosmc_server.executor.ros``) <
+the client (``rosmc_server.ros.client``) < the CLI and GUIs.
+
+Modules:
+
+* :mod:`.values`: times, poses and named parameter values;
+* :mod:`.mission`: skills, barriers, task markers, mission snapshots and events;
+* :mod:`.library`: the skill library, both ways;
+* :mod:`.agents`: agent states (``rosmc/AgentStates``) as core ``AgentStatus``;
+* :mod:`.robot_link`: the executor's protocol (commands, acks, reports, barrier
+  signals, snapshots); import it from the module (it needs the executor core).
+
+``x_to_msg`` builds a message from a core object and ``x_from_msg`` the object
+back; malformed input raises :class:`~rosmc_server.core.InvalidRequest` (or
+ValueError in :mod:`.robot_link`, for the executor). Round trips are exact.
+"""
+
+from .agents import agent_status_from_msg, agent_statuses_from_msg
+from .library import library_from_msg, library_to_msg, parameter_spec_to_msg
+from .mission import (
+    SnapshotConverter,
+    barrier_from_msg,
+    barrier_to_msg,
+    event_from_msg,
+    event_to_msg,
+    marker_from_msg,
+    marker_to_msg,
+    mission_from_msg,
+    mission_to_msg,
+    skill_from_msg,
+    skill_to_msg,
+)
+from .values import (
+    MAX_JSON_NESTING,
+    param_from_msg,
+    param_to_msg,
+    params_from_msgs,
+    pose_from_msg,
+    pose_to_msg,
+    time_to_msg,
+    value_type,
+)
+
+__all__ = [
+    "MAX_JSON_NESTING",
+    "SnapshotConverter",
+    "agent_status_from_msg",
+    "agent_statuses_from_msg",
+    "barrier_from_msg",
+    "barrier_to_msg",
+    "event_from_msg",
+    "event_to_msg",
+    "library_from_msg",
+    "library_to_msg",
+    "marker_from_msg",
+    "marker_to_msg",
+    "mission_from_msg",
+    "mission_to_msg",
+    "param_from_msg",
+    "param_to_msg",
+    "parameter_spec_to_msg",
+    "params_from_msgs",
+    "pose_from_msg",
+    "pose_to_msg",
+    "skill_from_msg",
+    "skill_to_msg",
+    "time_to_msg",
+    "value_type",
+]

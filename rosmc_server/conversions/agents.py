@@ -1,0 +1,51 @@
+"""Agent states (link, telemetry, executor) from messages, as core :class:`AgentStatus`.
+
+Part of :mod:`rosmc_server.conversions`, the one boundary between the ``rosmc``
+messages and the core.
+"""
+
+from __future__ import annotations
+
+import math
+
+import rosmc.msg as wire
+
+from ..core import AgentStatus, SkillStatus
+from .values import pose_from_msg
+
+_LINK_STATES = {wire.LinkState.UP: "up", wire.LinkState.DOWN: "down"}
+
+
+def agent_statuses_from_msg(msg: wire.AgentStates) -> dict[str, AgentStatus]:
+    """``rosmc/AgentStates`` as one :class:`AgentStatus` per agent."""
+    return {state.agent: agent_status_from_msg(state) for state in msg.agents}
+
+
+def agent_status_from_msg(msg: wire.AgentState) -> AgentStatus:
+    """``rosmc/AgentState`` as an :class:`AgentStatus`."""
+    telemetry = msg.telemetry
+    has_telemetry = bool(telemetry.frame_id) or not telemetry.stamp.is_zero()
+    current = msg.current_skill_id
+    return AgentStatus(
+        agent=msg.agent,
+        link=_LINK_STATES.get(msg.link.state, "unknown"),
+        last_heard=msg.link.last_heard,
+        round_trip=msg.link.round_trip,
+        commands_in_flight=msg.link.commands_in_flight,
+        hash_mismatch=msg.link.hash_mismatch,
+        queue_hash=msg.link.queue_hash,
+        robot_queue_hash=msg.link.robot_queue_hash,
+        battery=_finite(telemetry.battery),
+        wifi_signal=_finite(telemetry.wifi_signal),
+        in_coverage=telemetry.in_coverage,
+        pose=pose_from_msg(telemetry.pose) if has_telemetry else None,
+        current_skill=current,
+        current_status=SkillStatus(msg.current_status.value) if current else None,
+        executor_state=msg.executor_state,
+        waiting_on=msg.waiting_on,
+        policy=msg.policy,
+    )
+
+
+def _finite(number: float) -> float | None:
+    return float(number) if math.isfinite(number) else None
