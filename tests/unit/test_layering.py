@@ -23,8 +23,10 @@ order of layers, and a module imports only from its own layer or below::
 Besides the order, by what a module imports from outside:
 
 * **ROS runtime** (rospy, rosgraph, interactive_markers, tf2_ros, ...) only in a *ROS
-  adapter module*: one inside a ``ros/`` package, or named ``ros_*.py`` or ``node.py``.
-  So the command GUI's Qt models and widgets never import rospy; its one adapter is
+  adapter module*: one inside a ``ros/`` package, or named ``ros_*.py`` or ``node.py``;
+  and in a GUI's *entry modules* (``plugin.py``, the rqt Plugin, and ``standalone.py``,
+  the window's ``main``: they make the node and build the bridge and the widgets). So the
+  command GUI's Qt models and widgets never import rospy; its one adapter is
   ``rosmc_rqt_command/ros_bridge.py``, and the marker servers' rospy lives in
   ``rosmc_rviz_markers/ros/``.
 * **Messages** (genpy, ``rosmc.msg``/``rosmc.srv``, std/geometry/visualization messages,
@@ -34,8 +36,8 @@ Besides the order, by what a module imports from outside:
 * **pybullet** only in ``rosmc_sim/core``.
 * **The server's insides**: apps reach the graph through the client. They import nothing
   of ``rosmc_server.ros`` but the client, the replayer and the logging bridge; a GUI
-  module that is not a ROS adapter imports nothing of ``rosmc_server.ros`` at all (the
-  rqt Plugin ``rosmc_rqt_command/plugin.py`` builds the bridge through ``ros_bridge``).
+  model or widget (neither a ROS adapter nor an entry module) imports nothing of
+  ``rosmc_server.ros`` at all: the bridge hands it core objects.
 
 The scanner reads every module with :mod:`ast`, so a forbidden import is found even where
 it would never run (inside a function, an ``if`` or ``TYPE_CHECKING``). A second test
@@ -187,6 +189,12 @@ def layer_of(relative: str) -> str | None:
     return LAYER_OF_PATH[max(matches, key=len)] if matches else None
 
 
+def is_gui_entry(relative: str) -> bool:
+    """A GUI package's ``plugin.py`` or ``standalone.py`` (they start the GUI)."""
+    package, *rest = relative.split("/")
+    return f"{package}/" in GUI_PACKAGES and rest in (["plugin.py"], ["standalone.py"])
+
+
 def is_ros_adapter(relative: str) -> bool:
     """A module that may use the ROS runtime: in a ``ros/`` package, ``ros_*.py`` or ``node.py``."""
     *folders, name = relative.split("/")
@@ -246,7 +254,7 @@ def _outside_rule(relative: str, top: str) -> bool:
     layer = layer_of(relative)
     gui = relative.startswith(GUI_PACKAGES)
     if top in ROS_RUNTIME:
-        return is_ros_adapter(relative)
+        return is_ros_adapter(relative) or is_gui_entry(relative)
     if top in MESSAGES:
         if is_ros_adapter(relative):
             return True
@@ -270,7 +278,8 @@ def _inside_rule(relative: str, module: str, root: Path) -> str | None:
     if layer == "app" and module.startswith(CONVERSIONS) and not is_ros_adapter(relative):
         return "message conversions: apps get core objects from the client"
     if layer == "app" and module.startswith("rosmc_server.ros"):
-        if relative.startswith(GUI_PACKAGES) and not is_ros_adapter(relative):
+        gui_model = not (is_ros_adapter(relative) or is_gui_entry(relative))
+        if relative.startswith(GUI_PACKAGES) and gui_model:
             return "rosmc_server.ros: a GUI model or widget gets it from the GUI's ROS adapter"
         if module != "rosmc_server.ros" and not module.startswith(FOR_APPS):
             return "the server's ROS adapters: apps go through the client"
@@ -552,7 +561,9 @@ def _scan_source(root: Path, relative: str, source: str) -> list[str]:
         ("rosmc_rqt_command/schedule_model.py", "import rospy"),
         ("rosmc_rqt_command/schedule_model.py", "from rosmc.msg import Selection"),
         ("rosmc_rqt_command/schedule_model.py", "from rosmc_server.ros.client import X"),
-        ("rosmc_rqt_command/plugin.py", "import rospy"),
+        ("rosmc_rqt_command/plugin.py", "from rosmc.msg import Selection"),
+        ("rosmc_rqt_command/standalone.py", "from rosmc_server.ros import operator_services"),
+        ("rosmc_rqt_command/widgets/plugin.py", "import rospy"),
         ("rosmc_rqt_command/widgets/panel.py", "import rospy"),
         ("rosmc_rviz_markers/core/geometry.py", "import rospy"),
         ("rosmc_rviz_markers/core/geometry.py", "from visualization_msgs.msg import Marker"),
@@ -588,6 +599,8 @@ def test_scanner_catches_a_layer_break(fake_repo: Path, relative: str, source: s
             "rosmc_rqt_command/plugin.py",
             "from qt_gui.plugin import Plugin\nfrom . import ros_bridge",
         ),
+        ("rosmc_rqt_command/plugin.py", "from rosmc_server.ros.client import init_node"),
+        ("rosmc_rqt_command/standalone.py", "import rospy\nfrom rosmc_server.ros.client import X"),
         ("rosmc_rqt_command/schedule_model.py", "from python_qt_binding import QtCore"),
         ("rosmc_rqt_command/schedule_model.py", "from rosmc_server.core import MissionState"),
         ("rosmc_rviz_markers/ros/node.py", "import rospy\nfrom interactive_markers import x"),
@@ -601,6 +614,13 @@ def test_scanner_catches_a_layer_break(fake_repo: Path, relative: str, source: s
 )
 def test_scanner_allows_the_layers(fake_repo: Path, relative: str, source: str) -> None:
     assert _scan_source(fake_repo, relative, source) == []
+
+
+def test_gui_entry_naming() -> None:
+    assert is_gui_entry("rosmc_rqt_command/plugin.py")
+    assert is_gui_entry("rosmc_rqt_command/standalone.py")
+    assert not is_gui_entry("rosmc_rqt_command/widgets/plugin.py")
+    assert not is_gui_entry("rosmc_server/cli/standalone.py")
 
 
 def test_ros_adapter_naming() -> None:
