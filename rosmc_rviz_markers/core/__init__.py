@@ -1,0 +1,1 @@
+"""Pure marker logic: geometry, styling, menus, icons and requests (no rospy, no messages)."""

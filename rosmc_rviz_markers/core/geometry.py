@@ -1,0 +1,305 @@
+"""Shapes as plain values: what rviz draws, described like ``visualization_msgs/Marker``.
+
+A :class:`Primitive` is one shape (cube, sphere, cylinder, arrow, lines, triangles,
+camera-facing text) relative to its interactive marker's pose. The ROS layer turns each
+into a ``visualization_msgs/Marker`` field by field; nothing here knows rospy.
+Robot bodies are recognisable at the default zoom: a drone with four rotors, rovers with
+six wheels and a camera mast, the manipulator with its arm.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+Point = tuple[float, float, float]
+Quaternion = tuple[float, float, float, float]  # x, y, z, w
+IDENTITY: Quaternion = (0.0, 0.0, 0.0, 1.0)
+
+MAP_FRAME = "map"
+
+
+def base_link(agent: str) -> str:
+    """The body frame of an agent, as the simulator and robots publish it on TF."""
+    return f"{agent}/base_link"
+
+
+@dataclass(frozen=True)
+class Color:
+    """An RGBA colour, each channel 0..1."""
+
+    r: float
+    g: float
+    b: float
+    a: float = 1.0
+
+    def with_alpha(self, alpha: float) -> Color:
+        """The same colour with another opacity."""
+        return Color(self.r, self.g, self.b, alpha)
+
+    def lighter(self, amount: float = 0.35) -> Color:
+        """The colour mixed with white by ``amount`` (0..1)."""
+
+        def mix(c: float) -> float:
+            return c + (1.0 - c) * amount
+
+        return Color(mix(self.r), mix(self.g), mix(self.b), self.a)
+
+
+class Shape(enum.IntEnum):
+    """Marker shapes (numbers match ``visualization_msgs/Marker`` types)."""
+
+    ARROW = 0
+    CUBE = 1
+    SPHERE = 2
+    CYLINDER = 3
+    LINE_STRIP = 4
+    LINE_LIST = 5
+    TEXT = 9
+    TRIANGLE_LIST = 11
+
+
+@dataclass(frozen=True)
+class Primitive:
+    """One shape relative to its marker's pose (see ``visualization_msgs/Marker``)."""
+
+    shape: Shape
+    color: Color
+    position: Point = (0.0, 0.0, 0.0)
+    scale: Point = (1.0, 1.0, 1.0)
+    orientation: Quaternion = IDENTITY
+    points: tuple[Point, ...] = ()
+    text: str = ""
+
+
+def quaternion(roll: float = 0.0, pitch: float = 0.0, yaw: float = 0.0) -> Quaternion:
+    """The quaternion of roll, pitch and yaw (radians, applied z-y-x)."""
+    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
+    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
+    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
+    return (
+        sr * cp * cy - cr * sp * sy,
+        cr * sp * cy + sr * cp * sy,
+        cr * cp * sy - sr * sp * cy,
+        cr * cp * cy + sr * sp * sy,
+    )
+
+
+def yaw_of(q: Quaternion) -> float:
+    """The heading (rotation about z) of a quaternion."""
+    x, y, z, w = q
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def is_finite(*values: float) -> bool:
+    """Every value is a finite number."""
+    return all(math.isfinite(v) for v in values)
+
+
+class BodyKind(enum.Enum):
+    """How an agent looks in rviz, chosen from its library model name."""
+
+    DRONE = "drone"
+    SCIENCE_ROVER = "science_rover"
+    MANIPULATOR_ROVER = "manipulator_rover"
+    ROVER = "rover"
+    LANDER = "lander"
+    PAYLOAD_BOX = "payload_box"
+    GENERIC = "generic"
+
+
+def body_kind(model: str) -> BodyKind:
+    """The body an agent of library model ``model`` gets (by the words in its name)."""
+    name = model.lower()
+    if "drone" in name or "uav" in name or "copter" in name:
+        return BodyKind.DRONE
+    if "manipulator" in name or "arm" in name:
+        return BodyKind.MANIPULATOR_ROVER
+    if "science" in name:
+        return BodyKind.SCIENCE_ROVER
+    if "rover" in name:
+        return BodyKind.ROVER
+    if "lander" in name:
+        return BodyKind.LANDER
+    if "box" in name or "payload" in name:
+        return BodyKind.PAYLOAD_BOX
+    return BodyKind.GENERIC
+
+
+# Body colours per kind (the simulator's palette, so rviz and pybullet agree).
+BODY_COLORS = {
+    BodyKind.DRONE: Color(0.20, 0.55, 0.95),
+    BodyKind.SCIENCE_ROVER: Color(0.95, 0.75, 0.20),
+    BodyKind.MANIPULATOR_ROVER: Color(0.30, 0.80, 0.40),
+    BodyKind.ROVER: Color(0.85, 0.55, 0.25),
+    BodyKind.LANDER: Color(0.85, 0.85, 0.88),
+    BodyKind.PAYLOAD_BOX: Color(0.80, 0.80, 0.80),
+    BodyKind.GENERIC: Color(0.7, 0.7, 0.7),
+}
+DARK = Color(0.12, 0.12, 0.14)
+METAL = Color(0.55, 0.57, 0.60)
+WHEEL_ROLL = quaternion(roll=math.pi / 2)
+
+
+def _box(color: Color, x: float, y: float, z: float, sx: float, sy: float, sz: float) -> Primitive:
+    return Primitive(Shape.CUBE, color, (x, y, z), (sx, sy, sz))
+
+
+def _wheels(xs: Sequence[float], half_track: float, radius: float) -> list[Primitive]:
+    return [
+        Primitive(
+            Shape.CYLINDER,
+            DARK,
+            (x, side * half_track, radius),
+            (2 * radius,) * 2 + (0.14,),
+            WHEEL_ROLL,
+        )
+        for x in xs
+        for side in (-1.0, 1.0)
+    ]
+
+
+def drone_body(color: Color) -> tuple[Primitive, ...]:
+    """A quadcopter: body, two crossed arms, four rotor discs, skids (frame at the bottom)."""
+    parts = [
+        _box(color, 0.0, 0.0, 0.12, 0.32, 0.32, 0.12),
+        Primitive(
+            Shape.CUBE, METAL, (0.0, 0.0, 0.14), (0.95, 0.05, 0.04), quaternion(yaw=math.pi / 4)
+        ),
+        Primitive(
+            Shape.CUBE, METAL, (0.0, 0.0, 0.14), (0.95, 0.05, 0.04), quaternion(yaw=-math.pi / 4)
+        ),
+        _box(DARK, 0.0, -0.12, 0.02, 0.45, 0.03, 0.03),
+        _box(DARK, 0.0, 0.12, 0.02, 0.45, 0.03, 0.03),
+        _box(Color(1.0, 1.0, 1.0), 0.17, 0.0, 0.12, 0.04, 0.12, 0.06),  # front light
+    ]
+    arm = 0.95 / 2 * math.cos(math.pi / 4)
+    for sx in (-1.0, 1.0):
+        for sy in (-1.0, 1.0):
+            parts.append(
+                Primitive(
+                    Shape.CYLINDER,
+                    color.lighter(0.5).with_alpha(0.8),
+                    (sx * arm, sy * arm, 0.18),
+                    (0.36, 0.36, 0.02),
+                )
+            )
+    return tuple(parts)
+
+
+def rover_body(color: Color, science: bool = False) -> tuple[Primitive, ...]:
+    """A six-wheeled rover; the science rover carries a camera mast."""
+    parts = [
+        _box(color, 0.0, 0.0, 0.38, 1.3, 0.75, 0.26),
+        _box(color.lighter(0.3), -0.2, 0.0, 0.55, 0.6, 0.55, 0.08),  # solar deck
+        *_wheels((-0.45, 0.0, 0.45), 0.47, 0.2),
+    ]
+    if science:
+        parts += [
+            Primitive(Shape.CYLINDER, METAL, (0.45, 0.0, 0.75), (0.08, 0.08, 0.5)),
+            _box(DARK, 0.47, 0.0, 1.02, 0.14, 0.32, 0.12),  # camera head
+            Primitive(Shape.SPHERE, Color(0.3, 0.8, 1.0), (0.55, 0.09, 1.02), (0.07, 0.07, 0.07)),
+            Primitive(Shape.SPHERE, Color(0.3, 0.8, 1.0), (0.55, -0.09, 1.02), (0.07, 0.07, 0.07)),
+        ]
+    return tuple(parts)
+
+
+def manipulator_body(color: Color) -> tuple[Primitive, ...]:
+    """A rover with a two-link arm and a gripper reaching forward."""
+    shoulder = (0.35, 0.0, 0.62)
+    return (
+        _box(color, 0.0, 0.0, 0.38, 1.4, 0.8, 0.26),
+        *_wheels((-0.45, 0.0, 0.45), 0.5, 0.2),
+        Primitive(Shape.CYLINDER, METAL, shoulder, (0.2, 0.2, 0.22)),
+        # upper arm tilted up and back, forearm reaching forward and down
+        Primitive(Shape.CUBE, METAL, (0.25, 0.0, 0.95), (0.08, 0.08, 0.6), quaternion(pitch=-0.5)),
+        Primitive(Shape.CUBE, METAL, (0.55, 0.0, 1.1), (0.6, 0.07, 0.07), quaternion(pitch=0.45)),
+        _box(DARK, 0.86, 0.05, 0.92, 0.12, 0.03, 0.14),
+        _box(DARK, 0.86, -0.05, 0.92, 0.12, 0.03, 0.14),
+    )
+
+
+def generic_body(color: Color) -> tuple[Primitive, ...]:
+    """A plain box with a nose, for agent models without a known body."""
+    return (
+        _box(color, 0.0, 0.0, 0.3, 0.8, 0.6, 0.6),
+        Primitive(Shape.ARROW, DARK, (0.4, 0.0, 0.3), (0.3, 0.08, 0.08)),
+    )
+
+
+def static_shell(kind: BodyKind) -> tuple[Primitive, ...]:
+    """A translucent clickable shell around a static agent (the world draws the object)."""
+    color = BODY_COLORS[kind].with_alpha(0.3)
+    if kind is BodyKind.LANDER:
+        return (Primitive(Shape.CYLINDER, color, (0.0, 0.0, 0.65), (4.3, 4.3, 1.3)),)
+    return (_box(color, 0.0, 0.0, 0.27, 0.62, 0.62, 0.62),)
+
+
+def agent_body(kind: BodyKind) -> tuple[Primitive, ...]:
+    """The body of a robot or static agent of ``kind`` (frame at the bottom, x forward)."""
+    color = BODY_COLORS[kind]
+    if kind is BodyKind.DRONE:
+        return drone_body(color)
+    if kind is BodyKind.SCIENCE_ROVER:
+        return rover_body(color, science=True)
+    if kind is BodyKind.ROVER:
+        return rover_body(color)
+    if kind is BodyKind.MANIPULATOR_ROVER:
+        return manipulator_body(color)
+    if kind in (BodyKind.LANDER, BodyKind.PAYLOAD_BOX):
+        return static_shell(kind)
+    return generic_body(color)
+
+
+# -- task markers ------------------------------------------------------------------------------
+FLAG_HEIGHT = 1.6
+
+
+def flag(color: Color) -> tuple[Primitive, ...]:
+    """A flag: pole, triangular cloth and a ground disc (its foot is at the marker's origin)."""
+    cloth = (
+        (0.0, 0.0, FLAG_HEIGHT),
+        (0.0, 0.0, FLAG_HEIGHT - 0.5),
+        (0.7, 0.0, FLAG_HEIGHT - 0.25),
+    )
+    return (
+        Primitive(Shape.CYLINDER, DARK, (0.0, 0.0, FLAG_HEIGHT / 2), (0.06, 0.06, FLAG_HEIGHT)),
+        Primitive(Shape.TRIANGLE_LIST, color.with_alpha(1.0), points=cloth + cloth[::-1]),
+        Primitive(Shape.CYLINDER, color, (0.0, 0.0, 0.02), (0.9, 0.9, 0.04)),
+    )
+
+
+def heading_arrow(color: Color) -> Primitive:
+    """An arrow along the marker's x axis (its heading), lying on the ground."""
+    return Primitive(Shape.ARROW, color.with_alpha(1.0), (0.0, 0.0, 0.08), (1.6, 0.18, 0.18))
+
+
+def ring(color: Color, radius: float, z: float = 0.05, width: float = 0.12) -> Primitive:
+    """A closed circle on the ground (selection highlight)."""
+    steps = 36
+    points = tuple(
+        (radius * math.cos(2 * math.pi * i / steps), radius * math.sin(2 * math.pi * i / steps), z)
+        for i in range(steps + 1)
+    )
+    return Primitive(Shape.LINE_STRIP, color, scale=(width, 0.0, 0.0), points=points)
+
+
+def polygon(
+    vertices: Sequence[tuple[float, float]], color: Color, z: float = 0.04
+) -> tuple[Primitive, ...]:
+    """A filled polygon with a bold outline; ``vertices`` relative to the marker origin."""
+    from .areas import triangulate  # areas imports nothing from here at module level
+
+    outline = tuple((x, y, z + 0.01) for x, y in (*vertices, vertices[0]))
+    triangles = tuple((x, y, z) for tri in triangulate(vertices) for x, y in tri)
+    return (
+        Primitive(Shape.TRIANGLE_LIST, color, points=triangles),
+        Primitive(Shape.LINE_STRIP, color.with_alpha(1.0), scale=(0.12, 0.0, 0.0), points=outline),
+    )
+
+
+def handle(color: Color, size: float = 0.45) -> Primitive:
+    """A small sphere to grab (area centre and vertices)."""
+    return Primitive(Shape.SPHERE, color.with_alpha(1.0), (0.0, 0.0, size / 2), (size,) * 3)

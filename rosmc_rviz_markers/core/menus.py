@@ -1,0 +1,209 @@
+"""The click menus of robots, static agents and task markers, computed from library and mission.
+
+* Robot: ``Add skill ▸ <skill>`` (exactly that robot's skills). Pose parameters default to
+  the robot's pose; a parameter that takes a task marker gets a new marker in front of the
+  robot, already bound.
+* Static agent (lander, payload box): ``Add skill ▸ <robot> ▸ <skill>`` for the skills that
+  take that object: a text parameter whose choices name it (``pick_box box=wifi_box``), or a
+  skill whose name or description mentions it (``return_to_lander``, ``recharge``: "at the
+  lander").
+* Task marker: ``Add skill ▸ <robot> ▸ <skill>`` for skills with a parameter that accepts the
+  marker's kind (the new skill is bound to the marker), ``Rename ▸ <suggestion>`` and
+  ``Delete`` (only when no skill uses it; rename only while it is not locked).
+
+Entries are numbered depth first from 1, as ``visualization_msgs/MenuEntry`` wants.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+from rosmc_server.core.library import AgentKind, Library, SkillSpec
+from rosmc_server.core.markers import generated_name
+from rosmc_server.core.model import SkillInstance, TaskMarker
+from rosmc_server.core.params import MarkerType, ParamType, Value
+from rosmc_server.core.state import MissionState
+
+
+@dataclass(frozen=True)
+class AddSkill:
+    """Add ``skill`` to ``agent``'s blueprint.
+
+    ``bind``: the parameter the clicked task marker fills (None: none). ``values``: fixed
+    parameter values (a static agent's name). ``from_robot``: the robot's menu, so pose
+    parameters take its pose and marker parameters get new markers in front of it.
+    """
+
+    agent: str
+    skill: str
+    bind: str | None = None
+    values: tuple[tuple[str, Value], ...] = ()
+    from_robot: bool = False
+
+
+@dataclass(frozen=True)
+class RenameMarker:
+    """Rename the clicked task marker to ``new_name``."""
+
+    new_name: str
+
+
+@dataclass(frozen=True)
+class DeleteMarker:
+    """Delete the clicked task marker."""
+
+
+MenuAction = AddSkill | RenameMarker | DeleteMarker
+
+
+@dataclass(frozen=True)
+class Menu:
+    """One menu entry: an action, or a submenu of ``children``."""
+
+    title: str
+    action: MenuAction | None = None
+    children: tuple[Menu, ...] = ()
+
+
+@dataclass(frozen=True)
+class FlatEntry:
+    """A numbered entry as rviz wants it (``parent`` 0: top level)."""
+
+    id: int
+    parent: int
+    title: str
+    action: MenuAction | None = None
+
+
+@dataclass(frozen=True)
+class FlatMenu:
+    """A menu numbered for ``visualization_msgs/MenuEntry``, with its actions by id."""
+
+    entries: tuple[FlatEntry, ...] = ()
+    actions: Mapping[int, MenuAction] = field(default_factory=dict)
+
+
+def flatten(menus: Sequence[Menu]) -> FlatMenu:
+    """Number ``menus`` depth first from 1."""
+    entries: list[FlatEntry] = []
+
+    def visit(menu: Menu, parent: int) -> None:
+        entry = FlatEntry(len(entries) + 1, parent, menu.title, menu.action)
+        entries.append(entry)
+        for child in menu.children:
+            visit(child, entry.id)
+
+    for menu in menus:
+        visit(menu, 0)
+    return FlatMenu(tuple(entries), {e.id: e.action for e in entries if e.action is not None})
+
+
+def _skill_title(skill: str, param: str, several: bool) -> str:
+    return f"{skill} ({param})" if several else skill
+
+
+def robot_menu(library: Library, agent: str) -> tuple[Menu, ...]:
+    """``Add skill ▸ <skill>`` for every skill of ``agent``, alphabetical."""
+    skills = sorted(library.skills_of(agent))
+    if not skills:
+        return ()
+    children = tuple(Menu(s, AddSkill(agent, s, from_robot=True)) for s in skills)
+    return (Menu("Add skill", children=children),)
+
+
+def _mentions(spec: SkillSpec, name: str) -> bool:
+    words = name.replace("_", " ").lower()
+    text = f"{spec.name.replace('_', ' ')} {spec.description}".lower()
+    return re.search(rf"\b{re.escape(words)}\b", text) is not None
+
+
+def object_skills(library: Library, obj: str) -> list[AddSkill]:
+    """The skills any robot can do with static agent ``obj``."""
+    found: list[AddSkill] = []
+    for robot in library.dynamic_agents:
+        for name, spec in sorted(library.skills_of(robot).items()):
+            chosen = [
+                p.name for p in spec.parameters if p.type is ParamType.STRING and obj in p.choices
+            ]
+            if chosen:
+                found.append(AddSkill(robot, name, values=((chosen[0], obj),)))
+            elif _mentions(spec, obj):
+                found.append(AddSkill(robot, name))
+    return found
+
+
+def _by_robot(actions: Sequence[AddSkill], titles: Sequence[str]) -> tuple[Menu, ...]:
+    robots: dict[str, list[Menu]] = {}
+    for action, title in zip(actions, titles, strict=True):
+        robots.setdefault(action.agent, []).append(Menu(title, action))
+    if not robots:
+        return ()
+    return (
+        Menu(
+            "Add skill",
+            children=tuple(Menu(robot, children=tuple(items)) for robot, items in robots.items()),
+        ),
+    )
+
+
+def static_agent_menu(library: Library, obj: str) -> tuple[Menu, ...]:
+    """``Add skill ▸ <robot> ▸ <skill>`` for the skills that take static agent ``obj``."""
+    actions = object_skills(library, obj)
+    return _by_robot(actions, [a.skill for a in actions])
+
+
+def marker_skills(library: Library, marker_type: MarkerType) -> list[tuple[AddSkill, str]]:
+    """Every (robot, skill, parameter) a marker of ``marker_type`` can fill, with a title."""
+    found: list[tuple[AddSkill, str]] = []
+    for robot in library.dynamic_agents:
+        for name, spec in sorted(library.skills_of(robot).items()):
+            params = [p.name for p in spec.parameters if p.accepts_marker(marker_type)]
+            for param in params:
+                found.append(
+                    (AddSkill(robot, name, bind=param), _skill_title(name, param, len(params) > 1))
+                )
+    return found
+
+
+def rename_suggestions(
+    state: MissionState, marker: TaskMarker, bound: Sequence[SkillInstance]
+) -> list[str]:
+    """Names to offer for a marker: after its first skill, its place, the next free number."""
+    kind = marker.type.name.capitalize()
+    candidates = []
+    if bound:
+        candidates.append(f"{bound[0].agent} {bound[0].skill}")
+    candidates.append(f"{kind} at ({marker.pose.x:.0f}, {marker.pose.y:.0f})")
+    candidates.append(generated_name(state, marker.type))
+    taken = {m.name for m in state.markers}
+    out: list[str] = []
+    for name in candidates:
+        if name not in taken and name not in out:
+            out.append(name)
+    return out
+
+
+def task_marker_menu(
+    library: Library,
+    state: MissionState,
+    marker: TaskMarker,
+    bound: Sequence[SkillInstance],
+    locked: bool,
+) -> tuple[Menu, ...]:
+    """The menu of a task marker (see the module docstring)."""
+    pairs = marker_skills(library, marker.type)
+    menus = list(_by_robot([a for a, _ in pairs], [t for _, t in pairs]))
+    if not locked:
+        names = rename_suggestions(state, marker, bound)
+        if names:
+            menus.append(Menu("Rename", children=tuple(Menu(n, RenameMarker(n)) for n in names)))
+    if not bound:
+        menus.append(Menu("Delete", DeleteMarker()))
+    return tuple(menus)
+
+
+def is_robot(library: Library, agent: str) -> bool:
+    """Whether ``agent`` executes skills (a dynamic agent)."""
+    return library.agent(agent).kind is AgentKind.DYNAMIC

@@ -1,0 +1,180 @@
+"""The whole picture: which interactive markers a mission shows, and which an update touches.
+
+:class:`Scene` answers two questions for the node: *what does marker X look like now*
+(:meth:`Scene.specs_for`) and *which markers does this mirror update touch*
+(:meth:`Scene.touched`). The node republishes only the touched ones whose spec changed,
+so an event costs what it changes, not the size of the mission.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+from rosmc_server.core.agent_status import AgentStatus
+from rosmc_server.core.library import AgentKind, Library
+from rosmc_server.core.model import SkillInstance
+from rosmc_server.core.state import MissionState
+from rosmc_server.core.updates import (
+    AgentStatusChanged,
+    MarkerPut,
+    MarkerRemoved,
+    MirrorUpdate,
+    MissionReset,
+    SkillAdded,
+    SkillChanged,
+    SkillRemoved,
+)
+
+from . import geometry as geo
+from .menus import flatten, robot_menu, static_agent_menu, task_marker_menu
+from .specs import MarkerSpec, agent_spec, task_specs
+from .styling import is_locked, marker_use
+
+
+@dataclass(frozen=True)
+class Selection:
+    """What an operator selected (``rosmc/Selection``): skills and task markers."""
+
+    skill_ids: frozenset[str] = frozenset()
+    marker_names: frozenset[str] = frozenset()
+
+
+@dataclass
+class Touched:
+    """What an update touched: task marker names, agents (bodies) and agents (icons)."""
+
+    everything: bool = False
+    markers: set[str] = field(default_factory=set)
+    agents: set[str] = field(default_factory=set)
+    icons: set[str] = field(default_factory=set)
+
+    def __bool__(self) -> bool:
+        return self.everything or bool(self.markers or self.agents or self.icons)
+
+
+class Scene:
+    """Computes marker specs from the library, the mission, robot statuses and the selection.
+
+    Args:
+        library: The mission's skill library.
+        read_only: A replay view: no menus, nothing draggable.
+        follow_tf: Agents follow their TF frames (live); otherwise they are placed in the
+            map frame at the pose their status reports (a replay has no TF).
+    """
+
+    def __init__(self, library: Library, *, read_only: bool = False, follow_tf: bool = True):
+        self.library = library
+        self.read_only = read_only
+        self.follow_tf = follow_tf
+        self.selection = Selection()
+
+    # -- which markers an update touches -------------------------------------------------------
+    def touched(self, update: MirrorUpdate) -> Touched:
+        """The markers and icons ``update`` may have changed."""
+        out = Touched()
+        for change in update.changes:
+            if isinstance(change, MissionReset):
+                out.everything = True
+            elif isinstance(change, (SkillAdded, SkillRemoved)):
+                out.markers.update(change.skill.bindings.values())
+                out.icons.add(change.skill.agent)
+            elif isinstance(change, SkillChanged):
+                old, new = change.old, change.new
+                if (old.status, old.transfer, old.bindings) != (
+                    new.status,
+                    new.transfer,
+                    new.bindings,
+                ):
+                    out.markers.update(old.bindings.values())
+                    out.markers.update(new.bindings.values())
+                if old.label != new.label:
+                    out.icons.add(new.agent)
+            elif isinstance(change, MarkerPut):
+                out.markers.add(change.new.name)
+                if change.old is not None:
+                    out.markers.add(change.old.name)
+            elif isinstance(change, MarkerRemoved):
+                out.markers.add(change.marker.name)
+            elif isinstance(change, AgentStatusChanged):
+                out.icons.add(change.new.agent)
+                if not self.follow_tf:
+                    out.agents.add(change.new.agent)
+        return out
+
+    def select(self, selection: Selection, state: MissionState | None) -> Touched:
+        """Take a new selection; returns the markers whose highlight changes."""
+        old, self.selection = self.selection, selection
+        out = Touched()
+        for sel in (old, selection):
+            out.markers.update(sel.marker_names)
+            if state is None:
+                continue
+            for skill_id in sel.skill_ids:
+                if state.has_skill(skill_id):
+                    skill = state.skill(skill_id)
+                    out.markers.update(skill.bindings.values())
+                    out.agents.add(skill.agent)
+        return out
+
+    # -- what a marker looks like -------------------------------------------------------------
+    def agents(self) -> list[str]:
+        """Every agent of the library (robots and static agents)."""
+        return [a.name for a in self.library.agents]
+
+    def agent_spec(
+        self, agent: str, state: MissionState | None, status: AgentStatus | None
+    ) -> MarkerSpec:
+        """The marker of robot or static agent ``agent``."""
+        spec = self.library.agent(agent)
+        robot = spec.kind is AgentKind.DYNAMIC
+        if self.read_only:
+            menu = flatten(())
+        elif robot:
+            menu = flatten(robot_menu(self.library, agent))
+        else:
+            menu = flatten(static_agent_menu(self.library, agent))
+        highlighted = state is not None and any(
+            state.has_skill(s) and state.skill(s).agent == agent for s in self.selection.skill_ids
+        )
+        frame, position, yaw = None, (0.0, 0.0, 0.0), 0.0
+        if not self.follow_tf:
+            frame = geo.MAP_FRAME
+            if status is not None and status.pose is not None:
+                position = (status.pose.x, status.pose.y, status.pose.z)
+                yaw = status.pose.yaw
+        return agent_spec(
+            agent,
+            geo.body_kind(spec.model),
+            menu,
+            robot=robot,
+            highlighted=highlighted,
+            frame=frame,
+            position=position,
+            yaw=yaw,
+        )
+
+    def marker_specs(self, state: MissionState, name: str) -> list[MarkerSpec]:
+        """The interactive markers of task marker ``name`` (none if it does not exist)."""
+        if not state.has_marker(name):
+            return []
+        marker = state.marker(name)
+        bound = state.bound_to(name)
+        locked = is_locked(bound)
+        menu = flatten(
+            () if self.read_only else task_marker_menu(self.library, state, marker, bound, locked)
+        )
+        return task_specs(
+            marker,
+            bound,
+            marker_use(bound),
+            menu,
+            locked=locked,
+            read_only=self.read_only,
+            highlighted=self._highlighted(name, bound),
+        )
+
+    def _highlighted(self, name: str, bound: Iterable[SkillInstance]) -> bool:
+        if name in self.selection.marker_names:
+            return True
+        return any(skill.id in self.selection.skill_ids for skill in bound)

@@ -1,0 +1,1 @@
+"""The rospy side of the marker node: interactive-marker server adapter, conversions, node."""

@@ -1,0 +1,275 @@
+"""The marker node ``/rosmc/markers``: the mission in rviz, kept current event by event.
+
+Follows the mission with a :class:`~rosmc_server.ros.client.MissionFollower` and shows it
+with one ``interactive_markers`` server; every mirror update touches only the markers it
+changed (one staged batch, one ``applyChanges()``). Clicks, drags and the stock rviz tools
+become mission server calls (see :mod:`.interaction`).
+
+ROS interface (every name behind ``~ns``):
+    Publishes ``/rosmc/markers/update`` (visualization_msgs/InteractiveMarkerUpdate),
+    ``/rosmc/markers/update_full`` (InteractiveMarkerInit, latched),
+    ``/rosmc/markers/icons`` (visualization_msgs/MarkerArray, latched: status icons),
+    ``/rosmc/selection`` (rosmc/Selection, latched: what the operator clicked).
+    Subscribes ``/rosmc/markers/feedback`` (InteractiveMarkerFeedback), ``/rosmc/selection``,
+    ``/rosmc/markers/new_position`` (geometry_msgs/PointStamped, Publish Point tool),
+    ``/rosmc/markers/new_pose`` (PoseStamped, 2D Nav Goal tool),
+    ``/rosmc/markers/new_area`` (PoseWithCovarianceStamped, 2D Pose Estimate tool),
+    and, through the follower, ``/rosmc/mission_events`` and ``/rosmc/agent_states``.
+    Calls the operator services ``/rosmc/*`` (``get_library``, ``get_mission``, mutations).
+    Parameters: ``~ns`` (""; ``/replay`` follows a replay), ``~read_only`` (default: ns set),
+    ``~follow_tf`` (default: ns empty), ``~library`` (library file when the followed
+    server serves none, as a replay), ``~commit_delay`` (0.5 s).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import sys
+import threading
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import rospy
+from visualization_msgs.msg import Marker, MarkerArray
+
+from rosmc_server.core import AgentStatus, Library, MissionState, load_library
+from rosmc_server.core.mirror import MissionMirror
+from rosmc_server.core.updates import MirrorUpdate
+from rosmc_server.ros.client import MissionFollower, Outcome
+from rosmc_server.ros.logging_bridge import bridge_logging_to_rosout
+
+from .. import topics
+from ..core import geometry as geo
+from ..core.icons import status_rows
+from ..core.scene import Scene, Touched
+from ..core.specs import MarkerSpec
+from .adapter import MarkerServer
+from .convert import icon_markers, interactive_marker_msg, pose_msg
+from .interaction import Interaction
+
+_log = logging.getLogger(__name__)
+DEFAULT_LIBRARY = os.path.join(
+    os.path.dirname(__file__), "..", "..", "rosmc_server", "config", "mars_team.yaml"
+)
+
+
+@dataclass(frozen=True)
+class MarkerNodeConfig:
+    """The node's settings (private parameters, read once)."""
+
+    ns: str = ""
+    read_only: bool = False
+    follow_tf: bool = True
+    library: str = ""
+    commit_delay: float = 0.5
+
+    @classmethod
+    def from_params(cls) -> MarkerNodeConfig:
+        """Read ``~ns``, ``~read_only``, ``~follow_tf``, ``~library``, ``~commit_delay``."""
+        ns = str(rospy.get_param("~" + topics.PARAM_NS, "")).strip()
+        return cls(
+            ns=ns,
+            read_only=bool(rospy.get_param("~" + topics.PARAM_READ_ONLY, bool(ns))),
+            follow_tf=bool(rospy.get_param("~" + topics.PARAM_FOLLOW_TF, not ns)),
+            library=str(rospy.get_param("~" + topics.PARAM_LIBRARY, "")),
+            commit_delay=float(rospy.get_param("~" + topics.PARAM_COMMIT_DELAY, 0.5)),
+        )
+
+
+class MarkerNode:
+    """Interactive markers for the followed mission (see the module docstring)."""
+
+    def __init__(self, config: MarkerNodeConfig) -> None:
+        self.config = config
+        self.follower = MissionFollower(prefix=config.ns)
+        self._lock = threading.Lock()  # published specs, groups and the server
+        self._published: dict[str, MarkerSpec] = {}
+        self._groups: dict[str, set[str]] = {}  # task marker -> its interactive markers
+        self._scene: Scene | None = None
+        self._pending = Touched()
+        self._wake = threading.Condition()
+        self._closed = False
+        self._unsubscribe: list[object] = []
+        self.server = MarkerServer(topics.topic(topics.MARKERS_NS, config.ns), self._on_feedback)
+        self._icons = rospy.Publisher(
+            topics.topic(topics.ICONS_TOPIC, config.ns), MarkerArray, queue_size=10, latch=True
+        )
+        self.interaction = Interaction(self, config)
+        self._worker = threading.Thread(target=self._run, name="rosmc-markers", daemon=True)
+
+    # -- what the interaction layer reads ---------------------------------------------------------
+    @property
+    def mirror(self) -> MissionMirror:
+        """The live mission copy."""
+        return self.follower.mirror
+
+    @property
+    def scene(self) -> Scene | None:
+        """The scene (None until the library arrived)."""
+        return self._scene
+
+    def published(self, name: str) -> MarkerSpec | None:
+        """The spec last published under interactive marker ``name``."""
+        with self._lock:
+            return self._published.get(name)
+
+    def snap_back(self, name: str) -> None:
+        """Publish marker ``name`` again as the mission has it (undo what rviz shows)."""
+        with self._lock:
+            spec = self._published.get(name)
+            if spec is not None:
+                self.server.insert(interactive_marker_msg(spec))
+                self.server.apply()
+
+    def mark(self, touched: Touched) -> None:
+        """Queue markers to refresh (any thread; the worker publishes them)."""
+        with self._wake:
+            self._pending.everything |= touched.everything
+            self._pending.markers |= touched.markers
+            self._pending.agents |= touched.agents
+            self._pending.icons |= touched.icons
+            self._wake.notify()
+
+    # -- lifecycle --------------------------------------------------------------------------------
+    def start(self) -> None:
+        """Fetch the library, follow the mission and start publishing."""
+        self._worker.start()
+        self.follower.start()
+        if self.config.library or self.config.read_only:
+            self._take_library(load_library(self.config.library or DEFAULT_LIBRARY))
+        else:
+            self.follower.library(self._on_library)
+
+    def close(self) -> None:
+        """Stop following and publishing."""
+        with self._wake:
+            self._closed = True
+            self._wake.notify()
+        self.interaction.close()
+        self.follower.close()
+
+    def _on_library(self, outcome: Outcome[Library]) -> None:
+        if outcome.value is None:
+            _log.warning("cannot fetch the skill library (%s); trying again", outcome.error)
+            timer = threading.Timer(2.0, lambda: self.follower.library(self._on_library))
+            timer.daemon = True
+            timer.start()
+            return
+        self._take_library(outcome.value)
+
+    def _take_library(self, library: Library) -> None:
+        self._scene = Scene(
+            library, read_only=self.config.read_only, follow_tf=self.config.follow_tf
+        )
+        self._unsubscribe.append(self.mirror.subscribe(self._on_update))
+        _log.info("markers for library '%s' (%d agents)", library.name, len(library.agents))
+
+    def _on_update(self, update: MirrorUpdate) -> None:
+        # Called with the mirror lock held: only note what changed; the worker does the rest.
+        scene = self._scene
+        if scene is not None:
+            touched = scene.touched(update)
+            if touched:
+                self.mark(touched)
+
+    # -- the worker: specs, staging, one applyChanges per batch -----------------------------------
+    def _run(self) -> None:
+        while True:
+            with self._wake:
+                while not self._pending and not self._closed:
+                    self._wake.wait()
+                if self._closed:
+                    return
+                touched, self._pending = self._pending, Touched()
+            try:
+                self._refresh(touched)
+            except Exception:  # one bad update must not stop the markers for good
+                _log.exception("cannot refresh the markers")
+
+    def _refresh(self, touched: Touched) -> None:
+        scene = self._scene
+        if scene is None:
+            return
+        with self.mirror.lock:
+            state = self.mirror.state
+            if state is None:
+                return
+            statuses = self.mirror.agent_statuses
+            names = set(touched.markers)
+            agents = set(touched.agents)
+            if touched.everything:
+                names |= {m.name for m in state.markers}
+                with self._lock:
+                    names |= set(self._groups)
+                agents = set(scene.agents())
+            specs = {name: scene.marker_specs(state, name) for name in names}
+            agent_specs = [scene.agent_spec(a, state, statuses.get(a)) for a in agents]
+            icons: list[Marker] | None = None
+            if touched.everything or touched.icons:
+                icons = self._icon_markers(scene, statuses, state)
+        with self._lock:
+            for spec in agent_specs:
+                self._stage(spec)
+            for name, group in specs.items():
+                new_names = {spec.name for spec in group}
+                for gone in self._groups.get(name, set()) - new_names:
+                    self.server.erase(gone)
+                    self._published.pop(gone, None)
+                for spec in group:
+                    self._stage(spec)
+                if new_names:
+                    self._groups[name] = new_names
+                else:
+                    self._groups.pop(name, None)
+            self.server.apply()
+        if icons is not None:
+            self._icons.publish(MarkerArray(markers=icons))
+
+    def _stage(self, spec: MarkerSpec) -> None:
+        old = self._published.get(spec.name)
+        if old == spec:
+            return
+        if old is not None and old.same_but_pose(spec):
+            self.server.set_pose(spec.name, pose_msg(spec.position, spec.yaw), spec.frame)
+        else:
+            self.server.insert(interactive_marker_msg(spec))
+        self._published[spec.name] = spec
+
+    def _icon_markers(
+        self, scene: Scene, statuses: Mapping[str, AgentStatus], state: MissionState
+    ) -> list[Marker]:
+        out: list[Marker] = []
+        for index, agent in enumerate(scene.library.dynamic_agents):
+            status = statuses.get(agent)
+            label = ""
+            if (
+                status is not None
+                and status.current_skill
+                and state.has_skill(status.current_skill)
+            ):
+                label = state.skill(status.current_skill).label
+            frame, position = geo.base_link(agent), (0.0, 0.0, 0.0)
+            if not self.config.follow_tf:
+                frame = geo.MAP_FRAME
+                if status is not None and status.pose is not None:
+                    position = (status.pose.x, status.pose.y, status.pose.z)
+            out += icon_markers(agent, status_rows(status, label), frame, position, index * 10)
+        return out
+
+    # -- feedback ---------------------------------------------------------------------------------
+    def _on_feedback(self, feedback: object) -> None:
+        self.interaction.on_feedback(feedback)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``markers_node``."""
+    rospy.myargv(argv if argv is not None else sys.argv)
+    rospy.init_node("markers", anonymous=False)
+    bridge_logging_to_rosout()
+    node = MarkerNode(MarkerNodeConfig.from_params())
+    node.start()
+    _log.info("marker node ready")
+    rospy.spin()
+    node.close()
+    return 0
