@@ -61,7 +61,9 @@ class MissionMirror:
         self._awaiting_snapshot = False
         self._statuses: dict[str, AgentStatus] = {}
         self._listeners: list[Listener] = []
+        self._held_at_request = -1
         self.snapshots_requested = 0
+        self.ignored_events = 0
 
     # -- reading ---------------------------------------------------------------------------
     @property
@@ -126,15 +128,13 @@ class MissionMirror:
             if restarted:
                 self._pending.clear()
             stale = self._state is not None and state.revision < self._state.revision
-            if stale and not restarted:
-                # An answer to a fetch overtaken by events; the mirror is ahead of it.
-                self._awaiting_snapshot = False
-                need = self._apply_pending()
-            else:
+            if not stale or restarted:
                 self._state = state
-                self._awaiting_snapshot = False
                 self._notify(MirrorUpdate(state.revision, (MissionReset(state),)))
-                need = self._apply_pending()
+            # else: an answer to a fetch overtaken by events; the mirror is ahead of it.
+            self._awaiting_snapshot = False
+            self._drop_phantoms(max(state.revision, self.revision or 0))
+            need = self._apply_pending()
         if need:
             self._ask_snapshot()
 
@@ -184,7 +184,30 @@ class MissionMirror:
             return False
         self._awaiting_snapshot = True
         self.snapshots_requested += 1
+        self._held_at_request = max((e.revision for e in self._pending), default=-1)
         return True
+
+    def _drop_phantoms(self, revision: int) -> None:
+        """Drop held events the server had not reached when it answered (lock held).
+
+        The server publishes an event after committing it, so a snapshot asked for after
+        an event arrived is at least that event's revision. Events held since before the
+        request and still ahead of the answer came from elsewhere (a stray publisher, a
+        server that has gone); waiting for them would ask for snapshots for ever.
+        """
+        phantoms = [e for e in self._pending if revision < e.revision <= self._held_at_request]
+        if not phantoms:
+            return
+        self.ignored_events += len(phantoms)
+        _log.warning(
+            "ignored %d mission event(s) ahead of the server's mission (revision %d): "
+            "another node publishes on the mission events topic?",
+            len(phantoms),
+            revision,
+        )
+        kept = [e for e in self._pending if e not in phantoms]
+        self._pending.clear()
+        self._pending.extend(kept)
 
     def _ask_snapshot(self) -> None:
         if self._request_snapshot is not None:

@@ -13,7 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from .agent_status import AgentStatus
-from .changes import EventKind, MissionEvent
+from .changes import Change, EventKind, MissionEvent
 from .errors import NotFound, RosmcError, RuleViolation
 from .model import Barrier, SkillInstance, TaskMarker
 from .state import MissionState
@@ -35,7 +35,7 @@ def apply_event(state: MissionState, event: MissionEvent) -> None:
         raise RuleViolation(
             f"event revision {event.revision} does not follow revision {state.revision}"
         )
-    if event.kind is EventKind.MISSION_REPLACED and event.change.replacement is None:
+    if _needs_snapshot(event):
         raise SnapshotNeeded(f"revision {event.revision} replaced the mission; fetch it")
     state.apply(event.change)
     state.revision = event.revision
@@ -152,55 +152,55 @@ Listener = Callable[[MirrorUpdate], None]
 def apply_and_describe(state: MissionState, event: MissionEvent) -> tuple[MirrorChange, ...]:
     """Apply ``event`` to ``state`` (as :func:`apply_event`) and say what it changed.
 
-    Removals come first, then skills put (added or changed in place, with their index
-    after the event), a new order, then barriers and markers put: the order in which
-    :meth:`MissionState.apply` applies them.
+    The changes come in the order :meth:`MissionState.apply` makes them (removals, skills
+    put, a new order, barriers and markers put), each index as it is at that moment: a
+    view that applies them one after the other ends equal to ``state``. Only what the
+    event touches is looked at, so the cost is the change's, not the mission's.
     """
+    if event.revision != state.revision + 1 or _needs_snapshot(event):
+        apply_event(state, event)  # raises the error that says why
     change = event.change
-    # Only what the event touches is looked up: the cost is the change's, not the mission's.
-    touched_barriers = {*change.removed_barrier_ids, *(b.id for b in change.put_barriers)}
-    old_barriers = {b: _barrier_or_none(state, b) for b in touched_barriers}
-    touched_markers = {*change.removed_marker_names, *(m.name for m in change.put_markers)}
-    old_markers = {m: state.marker(m) for m in touched_markers if state.has_marker(m)}
-    removed: list[MirrorChange] = [
-        BarrierRemoved(barrier)
-        for barrier_id in change.removed_barrier_ids
-        if (barrier := old_barriers[barrier_id]) is not None
-    ]
+    if change.replacement is not None:
+        apply_event(state, event)
+        return (MissionReset(state),)
+    changes: list[MirrorChange] = []
+    for barrier_id in change.removed_barrier_ids:
+        barrier = _barrier_or_none(state, barrier_id)
+        if barrier is not None:
+            changes.append(BarrierRemoved(barrier))
+            state.apply(Change(removed_barrier_ids=(barrier_id,)))
     for skill_id in change.removed_skill_ids:
         agent, index = state.locate(skill_id)
-        removed.append(SkillRemoved(state.task(agent)[index], index))
-    removed += [MarkerRemoved(state.marker(name)) for name in change.removed_marker_names]
-    removed_ids = set(change.removed_skill_ids)
-    old_skills = {
-        placed.skill.id: state.skill(placed.skill.id)
-        for placed in change.put_skills
-        if placed.skill.id not in removed_ids and state.has_skill(placed.skill.id)
-    }
-    apply_event(state, event)
-    put: list[MirrorChange] = []
+        changes.append(SkillRemoved(state.task(agent)[index], index))
+        state.apply(Change(removed_skill_ids=(skill_id,)))
+    for name in change.removed_marker_names:
+        changes.append(MarkerRemoved(state.marker(name)))
+        state.apply(Change(removed_marker_names=(name,)))
     for placed in change.put_skills:
+        old = state.skill(placed.skill.id) if state.has_skill(placed.skill.id) else None
+        state.apply(Change(put_skills=(placed,)))
         _, index = state.locate(placed.skill.id)
-        old = old_skills.get(placed.skill.id)
-        put.append(
-            SkillAdded(placed.skill, index)
-            if old is None
-            else SkillChanged(old, placed.skill, index)
-        )
+        if old is None:
+            changes.append(SkillAdded(placed.skill, index))
+        else:
+            changes.append(SkillChanged(old, placed.skill, index))
     if change.order_agent:
+        state.apply(Change(order_agent=change.order_agent, blueprint_order=change.blueprint_order))
         order = tuple(skill.id for skill in state.task(change.order_agent))
-        put.append(SkillsMoved(change.order_agent, order))
-    removed_barriers = set(change.removed_barrier_ids)
-    put += [
-        BarrierPut(None if b.id in removed_barriers else old_barriers.get(b.id), b)
-        for b in change.put_barriers
-    ]
-    removed_markers = set(change.removed_marker_names)
-    put += [
-        MarkerPut(None if m.name in removed_markers else old_markers.get(m.name), m)
-        for m in change.put_markers
-    ]
-    return (*removed, *put)
+        changes.append(SkillsMoved(change.order_agent, order))
+    for barrier in change.put_barriers:
+        changes.append(BarrierPut(_barrier_or_none(state, barrier.id), barrier))
+        state.apply(Change(put_barriers=(barrier,)))
+    for marker in change.put_markers:
+        old_marker = state.marker(marker.name) if state.has_marker(marker.name) else None
+        changes.append(MarkerPut(old_marker, marker))
+        state.apply(Change(put_markers=(marker,)))
+    state.revision = event.revision
+    return tuple(changes)
+
+
+def _needs_snapshot(event: MissionEvent) -> bool:
+    return event.kind is EventKind.MISSION_REPLACED and event.change.replacement is None
 
 
 def _barrier_or_none(state: MissionState, barrier_id: str) -> Barrier | None:

@@ -1,0 +1,175 @@
+"""A client's live mission against a real server: MissionFollower and AsyncMissionClient.
+
+The session's real master and a real ``mission_server`` process; this process is the
+client node. Changes made through the operator services reach the mirror through the real
+``/rosmc/mission_events`` stream; a forged event with a revision gap makes it fetch a
+snapshot; a restarted server (a new process whose revisions begin again) is followed; and
+calls on the non-blocking client answer by callback, also when the server is gone.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable, Iterator
+from typing import Any
+
+import pytest
+import rosmc.msg as wire
+import rospy
+
+from rosmc_server import interface
+from rosmc_server.core import MarkerType, NotFound, Pose, TaskMarker
+from rosmc_server.core.updates import MirrorUpdate, MissionReset, SkillAdded
+from rosmc_server.ros.client import (
+    AsyncMissionClient,
+    MissionClient,
+    MissionFollower,
+    Outcome,
+    ServerUnavailable,
+)
+from tests.integration.server_fixtures import ServerProcess, StartServer
+
+pytest_plugins = ["tests.integration.server_fixtures"]
+pytestmark = pytest.mark.integration
+
+
+def wait_for(condition: Callable[[], bool], timeout: float, what: str) -> None:
+    deadline = time.monotonic() + timeout
+    while not condition():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+        time.sleep(0.01)
+
+
+@pytest.fixture
+def server(start_server: StartServer) -> ServerProcess:
+    return start_server("follow")
+
+
+@pytest.fixture
+def follower(server: ServerProcess) -> Iterator[MissionFollower]:
+    follower = MissionFollower(check_period=0.2, retry_period=0.2)
+    follower.start()
+    yield follower
+    follower.close()
+
+
+def mirrored(follower: MissionFollower, client: MissionClient) -> bool:
+    """The mirror is at the server's revision and holds the same mission."""
+    state = follower.mirror.state
+    if state is None:
+        return False
+    current = client.fetch_mission()
+    return state.revision == current.revision and state.content() == current.content()
+
+
+def test_the_mirror_follows_changes_made_through_the_services(
+    follower: MissionFollower,
+) -> None:
+    updates: list[MirrorUpdate] = []
+    follower.mirror.subscribe(updates.append)
+    with MissionClient(timeout=10.0) as client:
+        wait_for(lambda: follower.mirror.state is not None, 10.0, "the first snapshot")
+        client.add_marker(TaskMarker("rss", MarkerType.POSE, Pose(4.0, 2.0)))
+        first = client.add_skill("drone", "take_off", {"altitude": 6.0}).skill_id
+        second = client.add_skill("drone", "navigate_to", bindings={"target": "rss"}).skill_id
+        client.reorder("drone", [second, first])
+        client.move_marker("rss", Pose(7.0, 1.0))
+        client.edit_skill(first, {"altitude": 9.0}, label="higher")
+        wait_for(lambda: mirrored(follower, client), 10.0, "the mirror to catch up")
+    assert follower.mirror.snapshots_requested == 1
+    assert isinstance(updates[0].changes[0], MissionReset)
+    added = [c.skill.id for u in updates for c in u.changes if isinstance(c, SkillAdded)]
+    assert added == [first, second]
+    revisions = [u.revision for u in updates if u.event is not None]
+    assert revisions == sorted(revisions) and len(revisions) == len(set(revisions))
+
+
+def test_a_revision_gap_fetches_one_snapshot(follower: MissionFollower) -> None:
+    with MissionClient(timeout=10.0) as client:
+        wait_for(lambda: follower.mirror.state is not None, 10.0, "the first snapshot")
+        client.add_skill("drone", "land")
+        wait_for(lambda: mirrored(follower, client), 10.0, "the mirror to catch up")
+        # Another publisher on the events topic: an event three revisions ahead.
+        forger = rospy.Publisher(interface.EVENTS_TOPIC, wire.MissionEvent, queue_size=1)
+        try:
+            wait_for(lambda: forger.get_num_connections() > 0, 10.0, "the follower")
+            # An event far ahead: the server never reached it; waiting for it would make
+            # the mirror ask for snapshots for ever.
+            ahead = client.fetch_mission().revision + 1000
+            forger.publish(wire.MissionEvent(revision=ahead, kind=wire.MissionEvent.SKILL_ADDED))
+            wait_for(lambda: follower.mirror.ignored_events == 1, 10.0, "the phantom dropped")
+            for _ in range(3):
+                client.add_skill("drone", "take_off")
+            wait_for(lambda: mirrored(follower, client), 10.0, "the mirror to go on")
+            assert follower.mirror.snapshots_requested == 2, "one refetch for the gap"
+        finally:
+            forger.unregister()
+
+
+def test_a_restarted_server_is_followed_from_its_new_mission(
+    start_server: StartServer, server: ServerProcess
+) -> None:
+    connection: list[bool] = []
+    follower = MissionFollower(check_period=0.2, retry_period=0.2, on_connection=connection.append)
+    follower.start()
+    try:
+        with MissionClient(timeout=10.0) as client:
+            for _ in range(4):
+                client.add_skill("drone", "land")
+            wait_for(lambda: mirrored(follower, client), 10.0, "the mirror to catch up")
+            server.stop()
+            wait_for(lambda: connection[-1:] == [False], 10.0, "the server to be missed")
+            fresh = start_server("follow-again")  # a new journal: revisions begin again
+            assert fresh.alive
+            client.close()
+            client.get_mission()  # this client's known revision is the old server's
+            client.add_skill("science_rover", "explore")
+            wait_for(lambda: mirrored(follower, client), 15.0, "the mirror of the new server")
+        assert follower.mirror.revision == 1
+        assert connection == [True, False, True]
+    finally:
+        follower.close()
+
+
+def test_async_calls_answer_by_callback_with_one_sentence(server: ServerProcess) -> None:
+    outcomes: list[Outcome[Any]] = []
+    done = threading.Event()
+
+    def record(outcome: Outcome[Any]) -> None:
+        outcomes.append(outcome)
+        if len(outcomes) == 2:
+            done.set()
+
+    client = AsyncMissionClient(MissionClient(timeout=10.0))
+    try:
+        added = client.submit(lambda c: c.add_skill("drone", "land"), record)
+        client.submit(lambda c: c.edit_skill("no-such-skill", label="x"), record)
+        assert done.wait(15.0)
+        assert added.result().skill_id.startswith("drone")
+        assert outcomes[0].ok and outcomes[0].value == added.result()
+        error = outcomes[1].error
+        assert isinstance(error, NotFound) and "no-such-skill" in str(error)
+        assert "\n" not in str(error) and client.pending == 0
+    finally:
+        client.close()
+
+
+def test_async_calls_to_a_missing_server_fail_without_blocking_the_caller(
+    server: ServerProcess,
+) -> None:
+    server.stop()
+    outcomes: list[Outcome[Any]] = []
+    arrived = threading.Event()
+    client = AsyncMissionClient(MissionClient(timeout=0.5))
+    try:
+        future = client.submit(
+            lambda c: c.add_skill("drone", "land"), lambda o: (outcomes.append(o), arrived.set())
+        )
+        assert not future.done(), "the call waits for the server on the worker, not here"
+        assert arrived.wait(10.0)
+        assert isinstance(outcomes[0].error, ServerUnavailable)
+        assert "mission server is not reachable" in str(outcomes[0].error)
+    finally:
+        client.close()
