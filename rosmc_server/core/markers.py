@@ -1,8 +1,10 @@
 """Task markers: points and regions of interest that skill parameters follow.
 
-A marker bound to a skill that has left the editable blueprint is locked: it
-can neither move nor be renamed, because the robot already holds the values
-(and finished skills are an immutable log). A marker in use cannot be deleted.
+A marker bound to an unfinished skill that has left the editable blueprint is
+locked: it can neither move nor be renamed, because the robot already holds the
+values. Once those skills are finished (SUCCESS or FAILURE) the marker is free to
+move again; the finished skills keep the values they ran with (an immutable log).
+A marker in use cannot be deleted.
 """
 
 from __future__ import annotations
@@ -92,6 +94,8 @@ def plan_move_marker(
 
     puts = []
     for skill in bound:
+        if skill.status.is_final:
+            continue  # a finished skill's parameters are the log of what it did
         spec = library.skill(skill.agent, skill.skill)
         names = {param: marker for param, marker in skill.bindings.items() if marker == name}
         values = dict(skill.params)
@@ -155,7 +159,7 @@ def plan_delete_marker(state: MissionState, name: str) -> Proposal:
 
 def _require_unlocked(bound: Sequence[SkillInstance], name: str, verb: str) -> None:
     for skill in bound:
-        if not skill.is_editable:
+        if not skill.is_editable and not skill.status.is_final:
             raise RuleViolation(
                 f"marker '{name}' is bound to '{skill.id}', which has been synchronized, "
                 f"so it cannot {verb}"

@@ -161,7 +161,11 @@ def test_move_refused_when_bound_to_a_synchronized_skill(
     mission.confirm_synchronized("alpha", [bound["move"]])
     rejected(mission, RuleViolation, mission.move_marker, "goal", Pose(3.0), match="synchronized")
     drv.finish(bound["move"])
-    rejected(mission, RuleViolation, mission.move_marker, "goal", Pose(3.0), match="synchronized")
+    # Finished, the skill no longer locks the marker (issue 9); it keeps what it ran with.
+    ran_with = mission.state.skill(bound["move"]).params["target"]
+    mission.move_marker("goal", Pose(3.0))
+    assert mission.state.skill(bound["move"]).params["target"] == ran_with
+    assert mission.state.skill(bound["move2"]).params["target"] == Pose(3.0)
     # The other markers are only bound to blueprint skills and still move.
     mission.move_marker("spot", Pose(3.0))
 
