@@ -49,6 +49,7 @@ class SectionTable(QTableView):  # type: ignore[misc]
     """A table of skills with row selection; a click on empty space clears it."""
 
     empty_clicked = Signal()
+    plain_clicked = Signal()  # a row clicked without Ctrl or Shift
 
     def __init__(self, model: SectionModel, parent: QWidget | None = None) -> None:
         super().__init__(parent)
@@ -90,6 +91,8 @@ class SectionTable(QTableView):  # type: ignore[misc]
         if not self.indexAt(event.pos()).isValid():  # type: ignore[attr-defined]
             self.empty_clicked.emit()
             return
+        if not self.last_modifiers & (Qt.ControlModifier | Qt.ShiftModifier):
+            self.plain_clicked.emit()
         super().mousePressEvent(event)
 
     def keyPressEvent(self, event: object) -> None:

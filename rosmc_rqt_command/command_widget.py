@@ -138,7 +138,8 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         first = not self.view.loaded and update.reset
         self.view.apply(update)
         self.schedule.apply(update)
-        self.parameters.refresh()
+        if update.agents or update.markers is not None or update.barriers is not None:
+            self.parameters.refresh(force=update.markers is not None or update.reset)
         if self._select_when_seen and all(self.view.skill(i) for i in self._select_when_seen):
             self.schedule.select_ids(self._select_when_seen)
             self._select_when_seen = []
@@ -155,7 +156,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         """The skill library arrived: offer each robot's skills."""
         self.view.library = library
         self.schedule.set_library(library)
-        self.parameters.refresh()
+        self.parameters.refresh(force=True)
         self._update_legal()
 
     def on_connection(self, connected: bool) -> None:

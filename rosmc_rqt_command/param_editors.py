@@ -71,6 +71,7 @@ class BoolEditor(Editor):
         layout = QHBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
         layout.addWidget(self.box)
+        layout.addStretch(1)
         self.box.clicked.connect(self._on_box_clicked)
 
     def value(self) -> object:
@@ -300,6 +301,9 @@ class MarkerPicker(QComboBox):  # type: ignore[misc]
 
     def show_markers(self, names: Sequence[str], bound: str) -> None:
         """Offer ``names``; ``bound`` is the marker bound now ("" if none)."""
+        offered = [self.itemText(i) for i in range(1, self.count())]
+        if offered == list(names) and bound == self._bound and self.count():
+            return  # unchanged: leave what the operator may be typing alone
         self._bound = bound
         self.blockSignals(True)
         self.clear()
@@ -315,8 +319,10 @@ class MarkerPicker(QComboBox):  # type: ignore[misc]
 
     def _on_picker_return_pressed(self) -> None:
         text = self.currentText().strip()
-        if text and self.findText(text) < 0 and self._bound:
-            self.rename_requested.emit(self._bound, text)
+        old = self._bound
+        if text and old and text != old and self.findText(text) < 0:
+            self._bound = text  # asked once, even if Enter reaches here twice
+            self.rename_requested.emit(old, text)
 
 
 def make_editor(spec: ParameterSpec) -> Editor:

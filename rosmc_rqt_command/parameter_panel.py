@@ -145,10 +145,12 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
         self._fill_editors()
         self._enable(self.editable)
 
-    def refresh(self) -> None:
+    def refresh(self, force: bool = False) -> None:
         """Show the newest version of the shown skill (after a live update)."""
         if self.skill is not None:
-            self.show_skill(self._view.skill(self.skill.id))
+            newest = self._view.skill(self.skill.id)
+            if force or newest is not self.skill:
+                self.show_skill(newest)
 
     def _spec_of(self, skill: SkillInstance) -> SkillSpec | None:
         library = self._view.library

@@ -60,6 +60,13 @@ class ScheduleWidget(QScrollArea):  # type: ignore[misc]
 
     def apply(self, update: ViewUpdate) -> None:
         """Show what ``update`` changed (the view has taken it already)."""
+        self._syncing = True  # rows come and go: the selection is restored afterwards
+        try:
+            self._apply(update)
+        finally:
+            self._syncing = False
+
+    def _apply(self, update: ViewUpdate) -> None:
         if update.reset:
             self._ensure_columns([view.agent for view in update.agents])
         touched: list[AgentColumn] = []
@@ -135,6 +142,7 @@ class ScheduleWidget(QScrollArea):  # type: ignore[misc]
                     lambda *_args, t=table: self._on_table_selection_changed(t)
                 )
                 table.empty_clicked.connect(self.clear_selection)
+                table.plain_clicked.connect(lambda t=table: self._on_table_plain_clicked(t))
                 table.customContextMenuRequested.connect(
                     lambda pos, t=table: self._on_table_context_menu(t, pos)
                 )
@@ -144,19 +152,31 @@ class ScheduleWidget(QScrollArea):  # type: ignore[misc]
             column.set_skills(list(self._library.skills_of(agent)))
 
     # -- selection ------------------------------------------------------------------------
+    def _on_table_plain_clicked(self, table: SectionTable) -> None:
+        """A plain click selects in one table only: the others let go first."""
+        if any(o.selectionModel().hasSelection() for o in self.tables() if o is not table):
+            self._clear_others(table)
+            self._collect()
+
+    def _clear_others(self, table: SectionTable) -> None:
+        self._syncing = True
+        try:
+            for other in self.tables():
+                if other is not table:
+                    other.clearSelection()
+        finally:
+            self._syncing = False
+
     def _on_table_selection_changed(self, table: SectionTable) -> None:
         if self._syncing:
             return
         modifiers = QApplication.keyboardModifiers() | table.last_modifiers
         keep_others = bool(modifiers & (Qt.ControlModifier | Qt.ShiftModifier))
         if not keep_others and table.selectionModel().hasSelection():
-            self._syncing = True
-            try:
-                for other in self.tables():
-                    if other is not table:
-                        other.clearSelection()
-            finally:
-                self._syncing = False
+            self._clear_others(table)
+        self._collect()
+
+    def _collect(self) -> None:
         self._selected = [
             skill.id
             for other in self.tables()
@@ -176,7 +196,7 @@ class ScheduleWidget(QScrollArea):  # type: ignore[misc]
     def _restore(self, tables_of: Iterable[AgentColumn]) -> None:
         """Select the remembered skills again in the given columns' tables."""
         wanted = set(self._selected)
-        self._syncing = True
+        syncing, self._syncing = self._syncing, True
         try:
             for column in tables_of:
                 for table in column.tables:
@@ -192,4 +212,4 @@ class ScheduleWidget(QScrollArea):  # type: ignore[misc]
                             selection, QItemSelectionModel.ClearAndSelect | QItemSelectionModel.Rows
                         )
         finally:
-            self._syncing = False
+            self._syncing = syncing

@@ -49,9 +49,11 @@ class CommandWindow(QMainWindow):  # type: ignore[misc]
             event.ignore()  # type: ignore[attr-defined]
 
 
-def build(prefix: str = "", parent: QWidget | None = None) -> tuple[CommandWidget, RosBridge]:
+def build(
+    prefix: str = "", parent: QWidget | None = None, timeout: float = 5.0
+) -> tuple[CommandWidget, RosBridge]:
     """A command widget fed by a started bridge (the process must be a ROS node)."""
-    bridge = RosBridge(prefix)
+    bridge = RosBridge(prefix, timeout)
     widget = CommandWidget(bridge, parent)
     connect(widget, bridge)
     bridge.start()
