@@ -36,7 +36,7 @@ from .schedule_model import NUMBER, PARAMS, SKILL, STATUS, TAG, SectionModel
 from .view_state import AgentView
 
 ROW_HEIGHT = 22
-COLUMN_WIDTH = 380
+COLUMN_WIDTH = 350
 # Lost-link policies an operator picks from: (label, policy, safe skill or "").
 POLICIES = (
     ("keep going if the link is lost", "continue", ""),
@@ -69,7 +69,7 @@ class SectionTable(QTableView):  # type: ignore[misc]
         rows.setDefaultSectionSize(ROW_HEIGHT)
         columns = self.horizontalHeader()
         columns.setHighlightSections(False)
-        for column, width in ((TAG, 34), (NUMBER, 30), (SKILL, 120), (PARAMS, 110)):
+        for column, width in ((TAG, 30), (NUMBER, 26), (SKILL, 112), (PARAMS, 104)):
             columns.resizeSection(column, width)
         columns.setSectionResizeMode(STATUS, QHeaderView.Stretch)
         if model.blueprint:

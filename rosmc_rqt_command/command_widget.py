@@ -107,8 +107,8 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.splitter.addWidget(right)
         self.splitter.setStretchFactor(0, 1)
         self.splitter.setStretchFactor(1, 0)
-        self.splitter.setSizes([1000, 460])
-        right.setMaximumWidth(560)
+        self.splitter.setSizes([1100, 420])
+        right.setMaximumWidth(480)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(2, 2, 2, 2)
         layout.setMenuBar(self.menu_bar)
@@ -150,7 +150,8 @@ class CommandWidget(QWidget):  # type: ignore[misc]
             self.messages.say(f"Mission shown (revision {update.revision}).", "ok")
         if update.reset:
             self.banner.hide()
-        self._warn_timer.start()
+        if not self._warn_timer.isActive():
+            self._warn_timer.start()
 
     def on_library(self, library: Library) -> None:
         """The skill library arrived: offer each robot's skills."""

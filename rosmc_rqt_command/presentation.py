@@ -132,5 +132,5 @@ def link_summary(status: AgentStatus | None) -> str:
     if status.executor_state:
         parts.append(status.executor_state)
     if status.policy:
-        parts.append(f"if link lost: {status.policy}")
+        parts.append(status.policy)
     return " · ".join(parts)

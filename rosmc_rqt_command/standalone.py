@@ -39,7 +39,7 @@ class CommandWindow(QMainWindow):  # type: ignore[misc]
         self.widget = widget
         self.setWindowTitle(title)
         self.setCentralWidget(widget)
-        self.resize(1500, 900)
+        self.resize(1560, 920)
 
     def closeEvent(self, event: object) -> None:
         """Offer to save first; Cancel keeps the window open."""
