@@ -7,7 +7,15 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-from ..core import InvalidRequest, MarkerType, MissionFileError, SkillSpec, TaskMarker
+from ..core import (
+    InvalidRequest,
+    LostLinkKind,
+    LostLinkPolicy,
+    MarkerType,
+    MissionFileError,
+    SkillSpec,
+    TaskMarker,
+)
 from ..ros.client import ControlCommand
 from .context import Context, UsageError
 from .values import marker_shape, typed_values
@@ -74,7 +82,7 @@ def barrier(ctx: Context) -> int:
     return ctx.emit_result(result, result.barrier_id)
 
 
-def unbarrier(ctx: Context) -> int:
+def delete_barrier(ctx: Context) -> int:
     """Remove a barrier."""
     result = ctx.client.delete_barrier(ctx.args.barrier_id, **ctx.against())
     return ctx.emit_result(result)
@@ -103,6 +111,24 @@ def control(ctx: Context) -> int:
     command = ControlCommand[ctx.args.command.upper()]
     result = ctx.client.control(command, ctx.args.agent)
     return ctx.emit_result(result, f"{ctx.args.command} sent to {', '.join(result.agents)}")
+
+
+def policy(ctx: Context) -> int:
+    """Set a robot's lost-link policy."""
+    args = ctx.args
+    kind = LostLinkKind(args.kind)
+    if (kind is LostLinkKind.SAFE_SKILL) != bool(args.skill):
+        raise UsageError("--skill names the safe skill, and goes with safe_skill only")
+    values: dict[str, object] = {}
+    if args.params:
+        if not args.skill:
+            raise UsageError("--param goes with safe_skill and its --skill only")
+        values, bindings = _values(ctx.client.library().skill(args.agent, args.skill), args.params)
+        if bindings:
+            raise InvalidRequest("safe-skill parameters cannot be bound to task markers")
+    chosen = LostLinkPolicy(kind, args.after, args.skill, values)
+    result = ctx.client.set_robot_options(args.agent, chosen)
+    return ctx.emit_result(result, f"{args.agent}: {chosen.describe()} (sent to the robot)")
 
 
 def retry(ctx: Context) -> int:
@@ -176,13 +202,15 @@ COMMANDS: dict[str, Callable[[Context], int]] = {
     "delete": delete,
     "reorder": reorder,
     "barrier": barrier,
-    "unbarrier": unbarrier,
+    "delete-barrier": delete_barrier,
+    "unbarrier": delete_barrier,
     "sync": sync,
     "unsync": unsync,
     "start": control,
     "pause": control,
     "resume": control,
     "stop": control,
+    "policy": policy,
     "retry": retry,
     "skip": skip,
     "marker": marker,

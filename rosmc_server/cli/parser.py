@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import argparse
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
+from ..core.policy import DEFAULT_AFTER, LostLinkKind
 from .replay import add_commands as _add_recording
 
 DEFAULT_TIMEOUT = 5.0
@@ -25,6 +26,13 @@ target=3,4,0,0,0,1.57 (x,y[,z,roll,pitch,yaw]) or target='{x: 3, y: 4}',
 area='[{x: 0, y: 0}, {x: 5, y: 0}, {x: 5, y: 5}]', mode=quick, flag=true.
 key=@MARKER binds the parameter to a task marker (key=@ unbinds it in edit);
 key=@@text is the text '@text'. See 'rosmc library' for every schema."""
+
+
+POLICY_HELP = """\
+continue (the default) keeps executing; hold pauses the robot after SECONDS
+without the ground; safe_skill pauses it and runs --skill with each
+--param KEY=VALUE (read as in 'rosmc add'), then holds. The robot reports
+the policy in force ('rosmc status --json', "policy")."""
 
 
 def _positive(text: str) -> float:
@@ -67,9 +75,12 @@ def build_parser() -> argparse.ArgumentParser:
     common.add_argument("--json", action="store_true", default=argparse.SUPPRESS, help="print JSON")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
 
-    def command(name: str, summary: str, epilog: str | None = None) -> argparse.ArgumentParser:
+    def command(
+        name: str, summary: str, epilog: str | None = None, aliases: Sequence[str] = ()
+    ) -> argparse.ArgumentParser:
         return sub.add_parser(
             name,
+            aliases=list(aliases),
             help=summary,
             description=summary,
             epilog=epilog,
@@ -128,8 +139,10 @@ def _add_editing(command: _Command) -> None:
     reorder.add_argument("order", nargs="+", metavar="ID", help="every blueprint skill, in order")
     barrier = command("barrier", "make skills on different robots start together")
     barrier.add_argument("skill_ids", nargs="+", metavar="ID")
-    unbarrier = command("unbarrier", "remove a barrier whose skills have not started")
-    unbarrier.add_argument("barrier_id", metavar="BARRIER_ID")
+    delete_barrier = command(
+        "delete-barrier", "remove a barrier whose skills have not started", aliases=["unbarrier"]
+    )
+    delete_barrier.add_argument("barrier_id", metavar="BARRIER_ID")
 
 
 def _add_options(parser: argparse.ArgumentParser) -> None:
@@ -162,6 +175,28 @@ def _add_execution(command: _Command) -> None:
     ):
         control = command(name, summary)
         control.add_argument("agent", nargs="?", metavar="ROBOT")
+    policy = command(
+        "policy", "set what a robot does when it stops hearing the ground station", POLICY_HELP
+    )
+    policy.add_argument("agent", metavar="ROBOT")
+    policy.add_argument("kind", choices=[kind.value for kind in LostLinkKind], metavar="POLICY",
+                        help="continue, hold or safe_skill")  # fmt: skip
+    policy.add_argument(
+        "--param",
+        dest="params",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="a parameter value of the safe skill (repeatable)",
+    )
+    policy.add_argument(
+        "--after",
+        type=_positive,
+        default=DEFAULT_AFTER,
+        metavar="SECONDS",
+        help=f"silence before the policy acts (default {DEFAULT_AFTER:g})",
+    )
+    policy.add_argument("--skill", default="", metavar="SKILL", help="the safe skill (safe_skill)")
     retry = command("retry", "run a failed skill again (a new attempt after it)")
     retry.add_argument("skill_id", metavar="ID")
     skip = command("skip", "skip a failed skill; the robot continues after it")

@@ -15,6 +15,7 @@ Modules:
 * :mod:`.mission`: skills, barriers, task markers, mission snapshots and events;
 * :mod:`.library`: the skill library, both ways;
 * :mod:`.agents`: agent states (``rosmc/AgentStates``) as core ``AgentStatus``;
+* :mod:`.policy`: the lost-link policy <-> ``rosmc/SetRobotOptions`` request fields;
 * :mod:`.robot_link`: the executor's protocol (commands, acks, reports, barrier
   signals, snapshots); import it from the module (it needs the executor core).
 
@@ -38,6 +39,7 @@ from .mission import (
     skill_from_msg,
     skill_to_msg,
 )
+from .policy import policy_from_request, policy_to_request
 from .values import (
     MAX_JSON_NESTING,
     param_from_msg,
@@ -68,6 +70,8 @@ __all__ = [
     "param_to_msg",
     "parameter_spec_to_msg",
     "params_from_msgs",
+    "policy_from_request",
+    "policy_to_request",
     "pose_from_msg",
     "pose_to_msg",
     "skill_from_msg",

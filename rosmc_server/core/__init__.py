@@ -34,6 +34,7 @@ from .persistence import (
     parse_mission,
     save_mission,
 )
+from .policy import LostLinkKind, LostLinkPolicy
 from .state import MissionContent, MissionState
 
 __all__ = [
@@ -46,6 +47,8 @@ __all__ = [
     "InvalidRequest",
     "Library",
     "LibraryError",
+    "LostLinkKind",
+    "LostLinkPolicy",
     "MarkerType",
     "Mission",
     "MissionContent",

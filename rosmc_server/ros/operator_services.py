@@ -11,9 +11,7 @@ Services never wait for robots.
 
 from __future__ import annotations
 
-import json
 import logging
-import math
 import re
 from collections.abc import Callable
 from pathlib import Path
@@ -24,7 +22,13 @@ import rospy
 from rosmc.msg import ErrorCode
 
 from .. import interface
-from ..conversions import library_to_msg, marker_from_msg, params_from_msgs, pose_from_msg
+from ..conversions import (
+    library_to_msg,
+    marker_from_msg,
+    params_from_msgs,
+    policy_from_request,
+    pose_from_msg,
+)
 from ..core import (
     InvalidRequest,
     LibraryError,
@@ -43,7 +47,7 @@ from ..core import (
 )
 from ..core.commands import CommandKind, CommandSpec
 from ..core.link import LinkStatus
-from ..core.params import value_to_data
+from ..core.policy import options_argument
 
 if TYPE_CHECKING:
     from .server_node import MissionServer
@@ -262,27 +266,10 @@ class OperatorServices:
 
     def _set_robot_options(self, req: Any, resp: Any) -> None:
         agent = _text(req.agent, "the agent name")
-        policy = req.lost_link_policy or "continue"
-        if policy not in ("continue", "hold", "safe_skill"):
-            raise InvalidRequest(
-                f"the lost-link policy must be continue, hold or safe_skill, not {policy!r}"
-            )
-        if not (math.isfinite(req.after) and req.after > 0):
-            raise InvalidRequest("the lost-link delay must be a positive number of seconds")
-        values, bindings = params_from_msgs(req.safe_skill_parameters)
-        if bindings:
-            raise InvalidRequest("safe-skill parameters cannot be bound to task markers")
-        options: dict[str, Any] = {"policy": policy, "after": req.after}
-        if policy == "safe_skill":
-            spec = self._server.library.skill(agent, _text(req.safe_skill, "the safe skill"))
-            params = spec.defaults()
-            params.update(
-                {name: spec.parameter(name).check(raw, spec.name) for name, raw in values.items()}
-            )
-            options.update(skill=spec.name, params={k: value_to_data(v) for k, v in params.items()})
+        policy = policy_from_request(req).checked(self._server.library, agent)
         with self._server.locked():
             self._require_link(agent)
-            argument = json.dumps({"lost_link": options})
+            argument = options_argument(policy)
             self._server.link.send(CommandSpec(agent, CommandKind.SET_OPTIONS, argument=argument))
         return None
 

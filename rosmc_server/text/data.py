@@ -101,6 +101,7 @@ def agent_status_to_json(status: AgentStatus) -> dict[str, Any]:
         "current_status": status.current_status.name if status.current_status else None,
         "executor_state": status.executor_state,
         "waiting_on": status.waiting_on,
+        "policy": status.policy,
     }
 
 

@@ -193,10 +193,10 @@ def test_key_value_words_follow_the_schema() -> None:
 
 
 def subcommands() -> list[str]:
-    """Every subcommand the parser knows."""
+    """Every subcommand the parser knows (by its own name, not its aliases)."""
     parser = build_parser()
     (action,) = (a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
-    return list(action.choices)
+    return [name for name, sub in action.choices.items() if sub.prog.endswith(f" {name}")]
 
 
 def test_help_for_every_subcommand(server: Server) -> None:
@@ -314,7 +314,7 @@ def test_compose_edit_reorder_barrier(server: Server, fresh: MissionClient) -> N
     assert f"barrier {barrier}" in text and "position=@RSS A" in text
     assert text.splitlines()[2].startswith("    link ")
 
-    run_pair(server, ["marker", "move", "RSS A", "8,5"], ["unbarrier", barrier])
+    run_pair(server, ["marker", "move", "RSS A", "8,5"], ["delete-barrier", barrier])
     assert fresh.skill(ids["sci"]).params["position"].x == 8.0  # the bound skill follows
     rosmc(server, "edit", ids["sci"], "position=@")  # unbind, keep the value
     sci_now = fresh.skill(ids["sci"])
@@ -424,6 +424,49 @@ def test_watch_stops_cleanly_on_ctrl_c(server: Server) -> None:
     _, err = watcher.communicate(timeout=10.0)
     assert watcher.returncode == 0, err
     assert "Traceback" not in err
+
+
+def test_unbarrier_is_delete_barrier(server: Server, fresh: MissionClient) -> None:
+    first = fresh.add_skill("science_rover", "explore").skill_id
+    second = fresh.add_skill("manipulator_rover", "identify_stones").skill_id
+    barrier = fresh.add_barrier([first, second]).barrier_id
+    rosmc(server, "unbarrier", barrier)
+    assert fresh.get_mission().barriers == ()
+
+
+def test_policy_is_checked_and_sent(server: Server) -> None:
+    """The robots never answer here: the server sends the policy (exit 0) or refuses it."""
+    sent = run_many(
+        server.env,
+        [
+            ["policy", "manipulator_rover", "hold", "--after", "5"],
+            ["policy", "science_rover", "safe_skill", "--skill", "navigate_to", "--param",
+             "speed=0.2", "--after", "30"],
+            ["--json", "policy", "science_rover", "continue"],
+        ],
+    )  # fmt: skip
+    assert [result.returncode for result in sent] == [0, 0, 0], [r.stderr for r in sent]
+    assert sent[0].stdout == "manipulator_rover: on link loss: hold after 5 s (sent to the robot)\n"
+    assert "run navigate_to after 30 s, then hold" in sent[1].stdout
+    assert set(json.loads(sent[2].stdout)) == {"revision"}
+    refused = {
+        ("policy", "lander", "hold"): "static agent",
+        ("policy", "drone", "safe_skill", "--skill", "teleport"): "no skill 'teleport'",
+        ("policy", "drone", "safe_skill", "--skill", "navigate_to", "--param=speed=99"): "speed",
+    }
+    for result, needle in zip(run_many(server.env, list(refused)), refused.values(), strict=True):
+        assert_refused(result, needle)
+    usage = run_many(
+        server.env,
+        [
+            ["policy", "drone", "hold", "--skill", "land"],
+            ["policy", "drone", "safe_skill"],
+            ["policy", "drone", "hold", "--param", "speed=1"],
+            ["policy", "drone", "panic"],
+            ["policy", "drone", "hold", "--after", "0"],
+        ],
+    )
+    assert [result.returncode for result in usage] == [2] * 5, [r.stderr for r in usage]
 
 
 def test_sync_shows_uploading(server: Server, fresh: MissionClient) -> None:

@@ -25,9 +25,17 @@ from rosmc.msg import ErrorCode
 
 from rosmc_server import interface
 from rosmc_server.conversions import time_to_msg
-from rosmc_server.core import Resolution, SkillInstance, SkillStatus, Transfer
+from rosmc_server.core import (
+    LostLinkKind,
+    LostLinkPolicy,
+    Resolution,
+    SkillInstance,
+    SkillStatus,
+    Transfer,
+)
 from rosmc_server.core.commands import CommandKind
 from rosmc_server.core.link import queue_hash
+from rosmc_server.ros.client import MissionClient
 from tests.integration.executor_fixtures import (
     LinkEnd,
     Operator,
@@ -671,7 +679,8 @@ def test_the_server_survives_bad_reports(rosmc: Start) -> None:
 
 def test_lost_link_policy_hold_set_by_the_operator(rosmc: Start) -> None:
     system, op = rosmc(agents=("r1",), emulated=("r1",))
-    op.call("set_robot_options", agent="r1", lost_link_policy="hold", after=1.0)
+    with MissionClient(timeout=20.0) as client:
+        client.set_robot_options("r1", LostLinkPolicy(LostLinkKind.HOLD, after=1.0))
     op.wait_mission(
         lambda m: "hold after 1 s" in op.agent_state("r1").policy, 10.0, "the policy to be in force"
     )

@@ -15,7 +15,15 @@ from typing import Any, ClassVar
 
 import pytest
 
-from rosmc_server.core import ParamType, Pose, Resolution, SkillInstance, SkillStatus, Transfer
+from rosmc_server.core import (
+    LostLinkKind,
+    ParamType,
+    Pose,
+    Resolution,
+    SkillInstance,
+    SkillStatus,
+    Transfer,
+)
 from rosmc_server.core.commands import CommandKind
 from rosmc_server.core.link import queue_hash
 from rosmc_server.executor.basic_skills import Count
@@ -674,7 +682,7 @@ def test_deleting_the_barrier_of_a_skill_paused_at_it_does_not_run_it(robot: Rob
 def test_set_options_refuses_bad_options(robot: Robot, argument: str, error: str) -> None:
     ack = robot.send(K.SET_OPTIONS, argument=argument)
     assert ack.result is AckResult.REJECTED and error in ack.error
-    assert robot.engine.policy.kind == "continue"
+    assert robot.engine.lost_link.policy.kind is LostLinkKind.CONTINUE
 
 
 def test_set_options_sets_the_policy(robot: Robot) -> None:
@@ -1022,7 +1030,7 @@ def test_safe_skill_runs_then_holds(robot: Robot) -> None:
     assert home.ctx is not None and home.ctx.skill_id == ""
     robot.run_for(1.0)  # "home" takes its default second
     assert robot.engine.state_name() == "paused"
-    assert robot.engine.policy_note.endswith("(done); holding")
+    assert robot.engine.lost_link.note.endswith("(done); holding")
     assert robot.status("a") is S.PAUSED and robot.status("b") is S.IDLE_SYNCHRONIZED
     robot.send(K.RESUME)
     assert robot.status("a") is S.RUNNING
@@ -1034,7 +1042,7 @@ def test_safe_skill_is_not_run_with_nothing_to_do(robot: Robot) -> None:
     robot.send(K.START)
     robot.run_for(1.5)
     assert robot.engine.state_name() == "paused"
-    assert robot.engine.policy_note == "held after 1 s without ground contact"
+    assert robot.engine.lost_link.note == "held after 1 s without ground contact"
     assert Timed.instances == []
 
 
@@ -1072,7 +1080,7 @@ def test_state_round_trip_keeps_queue_reports_answers_barriers_and_policy(
     assert engine.queue[1].params["target"] == Pose(1.0, 2.0, 0.5, yaw=1.5)
     assert engine.queue[1].timeout == 9.0 and engine.queue[2].max_retries == 3
     assert engine.queue[2] == robot.engine.queue[2]
-    assert engine.policy == robot.engine.policy
+    assert engine.lost_link.policy == robot.engine.lost_link.policy
     assert engine.board.barriers == robot.engine.board.barriers
     assert engine.board.missing(barrier_of(("c", "r1"), ("y", "r2")), 0.0) == ()  # RELEASED kept
     assert engine.last_command_seq == robot.engine.last_command_seq

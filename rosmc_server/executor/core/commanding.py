@@ -1,7 +1,8 @@
 """What the executor does with each ground command, and its answers.
 
-Every function takes the engine and one command, changes the robot's queue or
-execution accordingly, and returns the :class:`Ack` the ground receives.
+Every handler takes the engine and one command, changes the robot's queue or
+execution through the engine's public surface, and returns the :class:`Ack` the
+ground receives.
 """
 
 from __future__ import annotations
@@ -10,17 +11,15 @@ import functools
 from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING
 
-from rosmc_server.core import SkillInstance, SkillStatus
+from rosmc_server.core import InvalidRequest, LostLinkKind, SkillInstance
 from rosmc_server.core.commands import CommandKind
+from rosmc_server.core.policy import policy_from_argument
 
 from . import queueing
-from .policy import LostLinkPolicy
-from .protocol import Ack, AckResult, Command, Mode
+from .protocol import Ack, AckResult, Command
 
 if TYPE_CHECKING:
     from .engine import Engine
-
-S = SkillStatus
 
 
 def execute(engine: Engine, cmd: Command) -> Ack:
@@ -42,6 +41,7 @@ def execute(engine: Engine, cmd: Command) -> Ack:
 
 
 def ack(engine: Engine, seq: int, **fields: object) -> Ack:
+    """The answer to command ``seq``: accepted, partly or wholly rejected per ``fields``."""
     rejected = fields.get("rejected_ids", ())
     accepted = fields.get("accepted_ids", ())
     result = AckResult.ACCEPTED
@@ -54,7 +54,7 @@ def _upload(engine: Engine, cmd: Command) -> Ack:
     answer = queueing.upload(engine.queue, cmd.skills, functools.partial(why_not, engine))
     engine.queue = answer.queue
     engine.board.replace(cmd.barriers)
-    engine._advance()
+    engine.advance()
     return _answer(engine, cmd.seq, answer, error=next(iter(answer.reasons), ""))
 
 
@@ -70,6 +70,7 @@ def _answer(engine: Engine, seq: int, answer: queueing.Answer, error: str = "") 
 
 
 def why_not(engine: Engine, skill: SkillInstance) -> str:
+    """Why the robot cannot take ``skill`` ("" if it can)."""
     if skill.agent != engine.agent:
         return f"skill '{skill.id}' is for {skill.agent}, not {engine.agent}"
     kind = engine.skill_types.get(skill.skill)
@@ -79,18 +80,13 @@ def why_not(engine: Engine, skill: SkillInstance) -> str:
 
 
 def _unsync(engine: Engine, cmd: Command) -> Ack:
-    active_id = engine._active.skill_id if engine._active else ""
-    answer = queueing.unsync(engine.queue, cmd.skill_ids, active_id)
+    answer = queueing.unsync(engine.queue, cmd.skill_ids, engine.active_skill_id)
     engine.queue = answer.queue
     return _answer(engine, cmd.seq, answer)
 
 
 def _start(engine: Engine, cmd: Command) -> Ack:
-    engine.mode = Mode.STARTED
-    active = engine._active
-    if active is not None and engine._status(active.skill_id) is S.PAUSED:
-        engine._resume_active(active)
-    engine._advance()
+    engine.start()
     holding = queueing.holding(engine.queue)
     note = f"holding after the failure of '{holding.id}': retry or skip it" if holding else ""
     return ack(engine, cmd.seq, error=note)
@@ -102,10 +98,7 @@ def _pause_command(engine: Engine, cmd: Command) -> Ack:
 
 
 def _stop(engine: Engine, cmd: Command) -> Ack:
-    engine.mode = Mode.STOPPED
-    active = engine._active
-    if active is not None:
-        engine._drop_active(active, "stopped by the operator")
+    engine.stop("stopped by the operator")
     return ack(engine, cmd.seq)
 
 
@@ -124,26 +117,25 @@ def _skip(engine: Engine, cmd: Command) -> Ack:
 
 def _queue_changed(engine: Engine, seq: int, answer: queueing.Answer) -> Ack:
     engine.queue = answer.queue
-    engine._advance()
+    engine.advance()
     return _answer(engine, seq, answer, error=next(iter(answer.reasons), ""))
 
 
 def _set_barriers(engine: Engine, cmd: Command) -> Ack:
-    engine.board.replace(cmd.barriers)
-    active = engine._active
-    if active is not None and active.behavior is None and active.barrier is not None:
-        active.barrier = engine.board.barrier_of(active.skill_id)
-        if active.barrier is not None and engine._status(active.skill_id) is S.SYNCWAITING:
-            engine._set(active.skill_id, S.SYNCWAITING, text=engine._waiting_text(active.barrier))
-        engine._try_release(active)
+    engine.set_barriers(cmd.barriers)
     return ack(engine, cmd.seq)
 
 
 def _set_options(engine: Engine, cmd: Command) -> Ack:
     try:
-        engine.policy = LostLinkPolicy.from_json(cmd.argument, set(engine.skill_types))
-    except ValueError as error:
+        policy = policy_from_argument(cmd.argument)
+        if policy.kind is LostLinkKind.SAFE_SKILL and policy.skill not in engine.skill_types:
+            raise InvalidRequest(
+                f"the safe skill {policy.skill!r} is not implemented on this robot"
+            )
+    except InvalidRequest as error:
         return ack(engine, cmd.seq, error=str(error), rejected_ids=("options",))
+    engine.lost_link.policy = policy
     return ack(engine, cmd.seq)
 
 

@@ -23,7 +23,7 @@ from rosmc_server.core.link import queue_hash
 
 from . import commanding, queueing
 from .barriers import BarrierBoard
-from .policy import LostLinkPolicy
+from .lost_link import LostLinkGuard
 from .protocol import Ack, BarrierInfo, Command, Mode, Report, Signal, SignalKind, Snapshot
 from .skills import Outcome, SkillBehavior, SkillContext, SkillType
 
@@ -61,7 +61,12 @@ class _Active:
 
 
 class Engine:
-    """One robot's mission executor."""
+    """One robot's mission executor.
+
+    The ground commands (:mod:`.commanding`) work through its public surface: the
+    ``queue``, the barrier ``board``, :meth:`advance`, :meth:`start`, :meth:`pause`,
+    :meth:`stop`, :meth:`set_barriers`, :attr:`active_skill_id` and ``lost_link.policy``.
+    """
 
     def __init__(
         self,
@@ -81,12 +86,8 @@ class Engine:
         self.unacked: list[Report] = []
         self.acks: OrderedDict[int, Ack] = OrderedDict()
         self.board = BarrierBoard(agent)
-        self.policy = LostLinkPolicy()
-        self.policy_note = ""
+        self.lost_link = LostLinkGuard(agent, clock, self.skill_types)
         self._active: _Active | None = None
-        self._ground_contact = clock()
-        self._policy_triggered = False
-        self._contingency: SkillBehavior | None = None
         # Progress texts from skill threads, applied by tick() (deque appends are atomic).
         self._progress_box: deque[tuple[str, str]] = deque()
 
@@ -123,9 +124,6 @@ class Engine:
     def _ack(self, seq: int, **fields: object) -> Ack:
         return commanding.ack(self, seq, **fields)
 
-    def _why_not(self, skill: SkillInstance) -> str:
-        return commanding.why_not(self, skill)
-
     # -- peers and the ground -------------------------------------------------------------
     def hear(self, signal: Signal) -> None:
         """A peer's barrier signal."""
@@ -144,10 +142,7 @@ class Engine:
 
     def ground_contact(self) -> None:
         """Something arrived from the ground station."""
-        self._ground_contact = self.clock()
-        if self._policy_triggered:
-            self._policy_triggered = False
-            self.policy_note += "; ground contact is back"
+        if self.lost_link.contact():
             self.outputs.changed()
 
     # -- time ---------------------------------------------------------------------
@@ -155,9 +150,12 @@ class Engine:
         """Advance the active skill, timeouts, retries, announcements and the link policy."""
         now = self.clock()
         self._apply_progress()
-        self._check_link_policy(now)
-        if self._contingency is not None:
-            self._run_contingency(now)
+        if self.lost_link.due(now):
+            idle = self._active is None and not queueing.upcoming(self.queue)
+            self.lost_link.trigger(now, idle, self.pause)
+            self.outputs.changed()
+        if self.lost_link.step(now):
+            self.outputs.changed()
         active = self._active
         if active is None:
             return
@@ -186,9 +184,39 @@ class Engine:
             self._finish(active, outcome)
 
     # -- execution -------------------------------------------------------------------
-    def _advance(self) -> None:
+    @property
+    def active_skill_id(self) -> str:
+        """The skill being worked on (at its barrier, running or paused); "" if none."""
+        return self._active.skill_id if self._active is not None else ""
+
+    def start(self) -> None:
+        """Execute: a paused skill resumes (or waits at its barrier again), else the next starts."""
+        self.mode = Mode.STARTED
+        active = self._active
+        if active is not None and self._status(active.skill_id) is S.PAUSED:
+            self._resume_active(active)
+        self.advance()
+
+    def stop(self, why: str) -> None:
+        """Stop: the active skill is cancelled and goes back to IDLE_SYNCHRONIZED."""
+        self.mode = Mode.STOPPED
+        if self._active is not None:
+            self._drop_active(self._active, why)
+
+    def set_barriers(self, barriers: tuple[BarrierInfo, ...]) -> None:
+        """Replace the barriers the robot knows; a skill waiting at one checks again."""
+        self.board.replace(barriers)
+        active = self._active
+        if active is None or active.behavior is not None or active.barrier is None:
+            return
+        active.barrier = self.board.barrier_of(active.skill_id)
+        if active.barrier is not None and self._status(active.skill_id) is S.SYNCWAITING:
+            self._set(active.skill_id, S.SYNCWAITING, text=self._waiting_text(active.barrier))
+        self._try_release(active)
+
+    def advance(self) -> None:
         """Start the next skill if the robot may execute and nothing is active."""
-        if self.mode is not Mode.STARTED or self._active is not None or self._contingency:
+        if self.mode is not Mode.STARTED or self._active is not None or self.lost_link.contingency:
             return
         upcoming = queueing.upcoming(self.queue)
         if upcoming is None or upcoming.status is S.FAILURE:
@@ -258,7 +286,7 @@ class Engine:
         if outcome.success:
             self._active = None
             self._set(skill.id, S.SUCCESS, text=outcome.reason, finished=self.clock())
-            self._advance()
+            self.advance()
             return
         if active.retries_used < skill.max_retries:
             active.retries_used += 1
@@ -318,35 +346,6 @@ class Engine:
             self._announce(active, SignalKind.WITHDRAWN)
         self._active = None
         self._set(active.skill_id, S.IDLE_SYNCHRONIZED, text=why, started=0.0)
-
-    # -- lost-link policy --------------------------------------------------------------
-    def _check_link_policy(self, now: float) -> None:
-        policy = self.policy
-        silent = now - self._ground_contact
-        if policy.kind == "continue" or self._policy_triggered or silent < policy.after:
-            return
-        self._policy_triggered = True
-        if policy.kind == "hold" or (self._active is None and not queueing.upcoming(self.queue)):
-            self.policy_note = f"held after {silent:.0f} s without ground contact"
-            self.pause(self.policy_note)
-        else:
-            self.policy_note = f"ran '{policy.skill}' after {silent:.0f} s without ground contact"
-            self.pause(self.policy_note)
-            kind = self.skill_types[policy.skill]
-            self._contingency = kind.create()
-            ctx = SkillContext(self.agent, "", kind.coerce(policy.params), 1, self.clock)
-            self._contingency.start(ctx)
-        _log.warning("%s: %s", self.agent, self.policy_note)
-        self.outputs.changed()
-
-    def _run_contingency(self, now: float) -> None:
-        assert self._contingency is not None
-        outcome = self._contingency.update(now)
-        if outcome is not None:
-            done = "done" if outcome.success else f"failed: {outcome.reason}"
-            self.policy_note += f" ({done}); holding"
-            self._contingency = None
-            self.outputs.changed()
 
     # -- state helpers -----------------------------------------------------------------
     def _find(self, skill_id: str) -> SkillInstance | None:
@@ -417,7 +416,7 @@ class Engine:
 
     def state_name(self) -> str:
         """A one-word state for operators."""
-        if self._contingency is not None:
+        if self.lost_link.contingency is not None:
             return "contingency"
         if self.mode is not Mode.STARTED:
             return str(self.mode.value)
@@ -443,5 +442,5 @@ class Engine:
             self.state_name(),
             active.skill_id if active else "",
             waiting,
-            self.policy.describe() + (f"; {self.policy_note}" if self.policy_note else ""),
+            self.lost_link.describe(),
         )

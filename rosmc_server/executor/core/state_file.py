@@ -13,10 +13,17 @@ import os
 from pathlib import Path
 from typing import Any
 
-from rosmc_server.core import Pose, Resolution, SkillInstance, SkillStatus, Transfer
+from rosmc_server.core import (
+    LostLinkPolicy,
+    Pose,
+    Resolution,
+    RosmcError,
+    SkillInstance,
+    SkillStatus,
+    Transfer,
+)
 
 from .engine import Engine
-from .policy import LostLinkPolicy
 from .protocol import Ack, AckResult, BarrierInfo, Mode, Report
 
 STATE_VERSION = 1
@@ -38,13 +45,8 @@ def save_state(engine: Engine, path: Path) -> None:
             for b in engine.board.barriers.values()
         ],
         "board": engine.board.to_dict(),
-        "policy": {
-            "kind": engine.policy.kind,
-            "after": engine.policy.after,
-            "skill": engine.policy.skill,
-            "params": engine.policy.params,
-        },
-        "policy_note": engine.policy_note,
+        "policy": engine.lost_link.policy.to_dict(),
+        "policy_note": engine.lost_link.note,
     }
     path.parent.mkdir(parents=True, exist_ok=True)
     temporary = path.with_name(f".{path.name}.tmp")
@@ -78,11 +80,14 @@ def load_state(engine: Engine, path: Path) -> list[str]:
         )
     )
     engine.board.load(data["board"])
-    policy = data["policy"]
-    engine.policy = LostLinkPolicy(
-        policy["kind"], float(policy["after"]), policy["skill"], policy["params"]
-    )
-    engine.policy_note = str(data.get("policy_note", ""))
+    policy = dict(data["policy"])
+    if "kind" in policy:  # written before the policy moved into the core
+        policy["policy"] = policy.pop("kind")
+    try:
+        engine.lost_link.policy = LostLinkPolicy.from_dict(policy)
+    except RosmcError as error:
+        raise ValueError(f"{path}: {error}") from error
+    engine.lost_link.note = str(data.get("policy_note", ""))
     mode = Mode(data["mode"])
     engine.mode = Mode.STOPPED if mode is Mode.STARTED else mode
     return engine.interrupted_by_restart()

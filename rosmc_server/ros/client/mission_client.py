@@ -5,9 +5,10 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from ...conversions import marker_to_msg, pose_to_msg
+from ...conversions import marker_to_msg, policy_to_request, pose_to_msg
 from ...core import (
     InvalidRequest,
+    LostLinkPolicy,
     Pose,
     TaskMarker,
 )
@@ -204,6 +205,23 @@ class MissionClient(ClientBase):
         response = self._caller.call("control", agent=agent or "", command=int(command))
         raise_for(response, response.revision)
         return ControlSent(response.revision, tuple(response.agents))
+
+    def set_robot_options(self, agent: str, policy: LostLinkPolicy) -> Result:
+        """Set ``agent``'s lost-link policy (what it does when it stops hearing the ground).
+
+        The safe skill's parameters are checked against the library here and on the
+        server (those not given take the default). The robot reports the policy in
+        force in its agent state (:attr:`AgentStatus.policy`). Refused (Unavailable)
+        while the robot cannot be reached.
+        """
+        parameters = (
+            self._parameters(agent, policy.skill, policy.params, {}) if policy.skill else []
+        )
+        response = self._caller.call(
+            "set_robot_options", agent=agent, **policy_to_request(policy, parameters)
+        )
+        raise_for(response, response.revision)
+        return Result(response.revision)
 
     def retry(
         self, skill_id: str, *, base_revision: int | None = None, retry_on_conflict: bool = False

@@ -1,0 +1,62 @@
+"""The lost-link policy through ``rosmc/SetRobotOptions`` requests and back (no master)."""
+
+from __future__ import annotations
+
+from io import BytesIO
+
+import pytest
+import rosmc.srv as srv
+
+from rosmc_server.conversions import param_to_msg, policy_from_request, policy_to_request
+from rosmc_server.core import InvalidRequest, LostLinkKind, LostLinkPolicy, Pose
+
+POLICIES = [
+    LostLinkPolicy(),
+    LostLinkPolicy(LostLinkKind.HOLD, 2.5),
+    LostLinkPolicy(LostLinkKind.SAFE_SKILL, 30.0, "navigate_to", {"speed": 2.0}),
+    LostLinkPolicy(LostLinkKind.SAFE_SKILL, 9.0, "navigate_to", {"target": Pose(1, 2, yaw=0.5)}),
+]
+
+
+def _over_the_wire(request: srv.SetRobotOptionsRequest) -> srv.SetRobotOptionsRequest:
+    buffer = BytesIO()
+    request.serialize(buffer)
+    back = srv.SetRobotOptionsRequest()
+    back.deserialize(buffer.getvalue())
+    return back
+
+
+@pytest.mark.parametrize("policy", POLICIES)
+def test_every_field_survives(policy: LostLinkPolicy) -> None:
+    typed = {n: Pose.from_any(v, n) if isinstance(v, dict) else v for n, v in policy.params.items()}
+    parameters = [param_to_msg(name, value) for name, value in typed.items()]
+    request = srv.SetRobotOptionsRequest(agent="r1", **policy_to_request(policy, parameters))
+    assert policy_from_request(_over_the_wire(request)) == policy
+
+
+def test_an_empty_kind_is_continue() -> None:
+    request = srv.SetRobotOptionsRequest(agent="r1", after=5.0)
+    assert policy_from_request(request) == LostLinkPolicy(after=5.0)
+
+
+@pytest.mark.parametrize(
+    ("fields", "needle"),
+    [
+        ({"lost_link_policy": "panic", "after": 5.0}, "must be one of"),
+        ({"lost_link_policy": "hold"}, "'after' must be a positive"),
+        ({"lost_link_policy": "hold", "after": 1.0, "safe_skill": "x"}, "runs no safe skill"),
+        (
+            {
+                "lost_link_policy": "safe_skill",
+                "after": 1.0,
+                "safe_skill": "navigate_to",
+                "safe_skill_parameters": [param_to_msg("target", 0.0, "RSS A")],
+            },
+            "cannot be bound to task markers",
+        ),
+    ],
+)
+def test_a_bad_request_is_refused(fields: dict[str, object], needle: str) -> None:
+    with pytest.raises(InvalidRequest) as caught:
+        policy_from_request(srv.SetRobotOptionsRequest(agent="r1", **fields))
+    assert needle in str(caught.value)

@@ -1,0 +1,120 @@
+"""The lost-link policy (core/policy.py): checks, plain data, the robot command's argument."""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+import pytest
+
+from rosmc_server.core import InvalidRequest, Library, LostLinkKind, LostLinkPolicy, NotFound, Pose
+from rosmc_server.core.policy import DEFAULT_AFTER, options_argument, policy_from_argument
+
+HOME = LostLinkPolicy(LostLinkKind.SAFE_SKILL, 30.0, "navigate_to", {"speed": 2.0})
+
+
+def test_the_default_policy_continues() -> None:
+    policy = LostLinkPolicy()
+    assert (policy.kind, policy.after, policy.skill, policy.params) == (
+        LostLinkKind.CONTINUE,
+        DEFAULT_AFTER,
+        "",
+        {},
+    )
+    assert policy.describe() == "on link loss: continue"
+
+
+def test_descriptions() -> None:
+    assert LostLinkPolicy(LostLinkKind.HOLD, 30).describe() == "on link loss: hold after 30 s"
+    assert HOME.describe() == "on link loss: run navigate_to after 30 s, then hold"
+
+
+def test_a_kind_given_by_name_is_read() -> None:
+    assert LostLinkPolicy("hold", 5.0).kind is LostLinkKind.HOLD  # type: ignore[arg-type]
+    assert LostLinkKind.parse("safe_skill") is LostLinkKind.SAFE_SKILL
+
+
+@pytest.mark.parametrize(
+    ("fields", "needle"),
+    [
+        ({"kind": "panic"}, "must be one of continue, hold, safe_skill, got 'panic'"),
+        ({"after": 0.0}, "'after' must be a positive number"),
+        ({"after": -1.0}, "'after' must be a positive number"),
+        ({"after": float("nan")}, "'after' must be a positive number"),
+        ({"after": float("inf")}, "'after' must be a positive number"),
+        ({"after": True}, "'after' must be a positive number"),
+        ({"after": "5"}, "'after' must be a positive number"),
+        ({"kind": LostLinkKind.SAFE_SKILL}, "names its safe skill"),
+        ({"kind": LostLinkKind.HOLD, "skill": "home"}, "runs no safe skill"),
+        ({"kind": LostLinkKind.CONTINUE, "params": {"a": 1}}, "runs no safe skill"),
+        ({"kind": LostLinkKind.SAFE_SKILL, "skill": "home", "params": 3}, "'params'"),
+        ({"kind": LostLinkKind.SAFE_SKILL, "skill": "home", "params": {"a": object()}}, "data"),
+        ({"kind": LostLinkKind.SAFE_SKILL, "skill": 7}, "skill name"),
+    ],
+)
+def test_a_malformed_policy_is_refused(fields: dict[str, Any], needle: str) -> None:
+    with pytest.raises(InvalidRequest) as caught:
+        LostLinkPolicy(**fields)
+    assert needle in str(caught.value)
+
+
+def test_params_are_a_copy_and_poses_become_mappings() -> None:
+    params: dict[str, Any] = {"target": Pose(1.0, 2.0), "route": [1, 2]}
+    policy = LostLinkPolicy(LostLinkKind.SAFE_SKILL, 5, "navigate_to", params)
+    params["route"].append(3)
+    assert policy.params == {"target": Pose(1.0, 2.0).to_dict(), "route": [1, 2]}
+    assert isinstance(policy.after, float)
+
+
+@pytest.mark.parametrize(
+    "policy", [LostLinkPolicy(), LostLinkPolicy(LostLinkKind.HOLD, 12.5), HOME]
+)
+def test_plain_data_and_the_command_argument_round_trip(policy: LostLinkPolicy) -> None:
+    assert LostLinkPolicy.from_dict(json.loads(json.dumps(policy.to_dict()))) == policy
+    assert policy_from_argument(options_argument(policy)) == policy
+
+
+def test_the_command_argument_keeps_its_wire_form() -> None:
+    """Executors of any version read it: {"lost_link": {"policy", "after", "skill", "params"}}."""
+    assert json.loads(options_argument(HOME)) == {
+        "lost_link": {
+            "policy": "safe_skill",
+            "after": 30.0,
+            "skill": "navigate_to",
+            "params": {"speed": 2.0},
+        }
+    }
+    assert policy_from_argument("") == LostLinkPolicy()
+    assert policy_from_argument('{"lost_link": {"policy": "hold"}}').after == DEFAULT_AFTER
+
+
+@pytest.mark.parametrize(
+    ("argument", "needle"),
+    [
+        ("{", "not valid JSON"),
+        ("[1]", "must be an object with a 'lost_link' object"),
+        ('{"lost_link": 3}', "must be an object with a 'lost_link' object"),
+        ('{"lost_link": {"policy": 3}}', "given by name"),
+        ('{"lost_link": {"policy": "hold", "when": 3}}', "no field 'when'"),
+        ("[" * 100_000, "not valid JSON"),
+    ],
+)
+def test_a_malformed_argument_is_refused(argument: str, needle: str) -> None:
+    with pytest.raises(InvalidRequest) as caught:
+        policy_from_argument(argument)
+    assert needle in str(caught.value)
+
+
+def test_checked_fills_defaults_and_checks_against_the_library(shipped_library: Library) -> None:
+    checked = HOME.checked(shipped_library, "drone")
+    assert checked.params == {"target": {"x": 0.0, "y": 0.0, "z": 0.0, "roll": 0.0,
+                                         "pitch": 0.0, "yaw": 0.0}, "speed": 2.0}  # fmt: skip
+    assert checked.skill == "navigate_to" and checked.after == 30.0
+    hold = LostLinkPolicy(LostLinkKind.HOLD, 3)
+    assert hold.checked(shipped_library, "drone") is hold
+    with pytest.raises(NotFound):
+        LostLinkPolicy(LostLinkKind.SAFE_SKILL, 3, "teleport").checked(shipped_library, "drone")
+    with pytest.raises(InvalidRequest):
+        LostLinkPolicy(LostLinkKind.SAFE_SKILL, 3, "navigate_to", {"speed": 99.0}).checked(
+            shipped_library, "drone"
+        )
