@@ -3,7 +3,9 @@
 :class:`MarkerServer` stages inserts, pose changes and erases and publishes them with one
 ``applyChanges()`` (one ``InteractiveMarkerUpdate`` per batch). Feedback for markers the
 server does not hold is dropped by the stock server without a word; here it is logged as
-a warning.
+a warning. And the stock server refuses every feedback for a marker's first second (it
+takes the marker's creation for a feedback from a client called ""); here the first
+client to send feedback is simply taken as the marker's current client.
 """
 
 from __future__ import annotations
@@ -31,6 +33,9 @@ class _Server(InteractiveMarkerServer):  # type: ignore[misc]
                 feedback.client_id or "?",
             )
             return
+        context = self.marker_contexts[feedback.marker_name]
+        if not context.last_client_id:
+            context.last_client_id = feedback.client_id
         super().processFeedback(feedback)
 
 

@@ -306,6 +306,11 @@ class Interaction:
             lambda c: c.add_marker(marker, base_revision=self._base(revision)), f"new {what} marker"
         )
 
+    def on_reset(self, revision: int) -> None:
+        """A snapshot came; one older than this node's last result means a new server."""
+        if self._own_revision is not None and self._own_revision > revision:
+            self._own_revision = None
+
     def _base(self, seen: int | None) -> int | None:
         """The revision a call is made against: what the operator saw when clicking, or
         the result of this node's own previous call if that is newer (calls run in order,

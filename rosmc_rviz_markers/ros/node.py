@@ -35,7 +35,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 
 from rosmc_server.core import AgentStatus, Library, MissionState, load_library
 from rosmc_server.core.mirror import MissionMirror
-from rosmc_server.core.updates import MirrorUpdate
+from rosmc_server.core.updates import MirrorUpdate, MissionReset
 from rosmc_server.ros.client import MissionFollower, Outcome
 from rosmc_server.ros.logging_bridge import bridge_logging_to_rosout
 
@@ -168,6 +168,8 @@ class MarkerNode:
     def _on_update(self, update: MirrorUpdate) -> None:
         # Called with the mirror lock held: only note what changed; the worker does the rest.
         scene = self._scene
+        if any(isinstance(change, MissionReset) for change in update.changes):
+            self.interaction.on_reset(update.revision)
         if scene is not None:
             touched = scene.touched(update)
             if touched:
