@@ -57,8 +57,10 @@ def coverage_warnings(view: MissionView) -> list[str]:
 class ParameterChecker:
     """Finds skills with a parameter the library refuses; re-checks only changed skills."""
 
-    def __init__(self) -> None:
+    def __init__(self, budget: int = 500) -> None:
         self._seen: dict[str, tuple[SkillInstance, str]] = {}
+        self._budget = budget
+        self.incomplete = False  # skills were left for the next call (keeps each call short)
 
     def warnings(self, view: MissionView) -> list[str]:
         """One sentence per unfinished skill with an invalid parameter."""
@@ -67,6 +69,8 @@ class ParameterChecker:
             return []
         out = []
         seen: dict[str, tuple[SkillInstance, str]] = {}
+        checks = 0
+        self.incomplete = False
         for task in view.agents.values():
             for skill in task.skills:
                 if skill.status.is_final:
@@ -74,6 +78,10 @@ class ParameterChecker:
                 cached = self._seen.get(skill.id)
                 problem = cached[1] if cached is not None and cached[0] is skill else ""
                 if cached is None or cached[0] is not skill:
+                    checks += 1
+                    if checks > self._budget:
+                        self.incomplete = True
+                        continue
                     try:
                         spec = library.skill(skill.agent, skill.skill)
                         for name, value in skill.params.items():

@@ -379,6 +379,8 @@ class CommandWidget(QWidget):  # type: ignore[misc]
             *self._checker.warnings(self.view),
         ]
         self.messages.show_warnings(warnings)
+        if self._checker.incomplete:
+            self._warn_timer.start()  # the rest of a big mission next time
 
     # -- enabling -------------------------------------------------------------------------------
     def _update_legal(self, agents: list[str] | None = None) -> None:
