@@ -1,8 +1,12 @@
-"""Every ROS graph name ROSMC uses, in one place.
+"""Every ROS graph name the mission server, its clients and the robots share, in one place.
 
-The mission server, the robot executors, the GUIs, the simulator and the CLI
-all import their topic, service and parameter names from here, so a rename
-happens once. Names are plain strings; nothing here imports rospy.
+The mission server, the robot executors, the GUIs, the simulator, the CLI and the
+journal (whose channels are these topics) import their topic, service and TF frame
+names from here, so a rename happens once. Names are plain strings; nothing here
+imports rospy. Names that only one component uses live next to it (the simulator's
+in ``rosmc_sim/ros/topics.py``, the marker node's in ``rosmc_rviz_markers/topics.py``),
+and every node reads its private parameters (``~name``) once, into its config, listing
+them in its docstring.
 """
 
 from __future__ import annotations
@@ -12,10 +16,12 @@ from dataclasses import dataclass
 NAMESPACE = "/rosmc"
 SERVER_NODE = f"{NAMESPACE}/mission_server"
 
-# Published by the mission server.
+# Published by the mission server, and journaled (the journal's channels carry these names).
 MISSION_TOPIC = f"{NAMESPACE}/mission"  # rosmc/Mission, latched snapshot
 EVENTS_TOPIC = f"{NAMESPACE}/mission_events"  # rosmc/MissionEvent, one per change
 AGENT_STATES_TOPIC = f"{NAMESPACE}/agent_states"  # rosmc/AgentStates, steady rate
+# Journaled only (the robots' skill status reports, for the audit trail); a replay publishes it.
+ROBOT_REPORTS_TOPIC = f"{NAMESPACE}/robot_reports"  # rosmc/RobotReport
 # Published by robots (or the simulator), one topic per agent.
 TELEMETRY_TOPIC = "/{agent}/telemetry"  # rosmc/Telemetry
 
@@ -64,6 +70,16 @@ def prefixed(name: str, prefix: str) -> str:
     return base + name
 
 
+# TF frames: every pose on the graph is in the map frame; each agent's body frame hangs
+# below it (the simulator, or a real robot's localisation, publishes map -> base_link).
+MAP_FRAME = "map"
+
+
+def base_link(agent: str) -> str:
+    """The body frame of ``agent`` on TF, e.g. ``drone/base_link``."""
+    return f"{agent}/base_link"
+
+
 # Which skills and task markers an operator has selected, shared by the command GUI and
 # rviz so that selecting in one highlights in the other (rosmc/Selection, latched).
 SELECTION_TOPIC = f"{NAMESPACE}/selection"
@@ -110,12 +126,3 @@ def ground_link(agent: str) -> LinkTopics:
 def robot_link(agent: str) -> LinkTopics:
     """The robot's side of ``agent``'s link when an emulator relays it."""
     return LinkTopics.under(f"/{agent}/link")
-
-
-# Private parameters of the mission server (~name).
-PARAM_LIBRARY = "library"  # path of the skill library YAML
-PARAM_JOURNAL = "journal"  # journal file to write ("" = new file under journal_dir)
-PARAM_JOURNAL_DIR = "journal_dir"  # directory for new journals
-PARAM_RESUME = "resume"  # resume from the journal file given in ~journal
-PARAM_LINK_TIMEOUT = "link_timeout"  # seconds without hearing a robot before DOWN
-PARAM_STATE_RATE = "agent_state_rate"  # Hz of /rosmc/agent_states

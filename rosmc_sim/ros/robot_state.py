@@ -28,7 +28,8 @@ from geometry_msgs.msg import Quaternion, TransformStamped, Vector3
 from nav_msgs.msg import Odometry
 from std_msgs.msg import Bool
 
-from rosmc_server.interface import TELEMETRY_TOPIC
+from rosmc_server.core.frames import quaternion_from_rpy
+from rosmc_server.interface import MAP_FRAME, TELEMETRY_TOPIC, base_link
 
 from ..core.sim import Robot, Simulation
 from ..core.world import BOX_SIZE
@@ -39,21 +40,15 @@ TF_PERIOD = 0.05
 TELEMETRY_PERIOD = 0.5
 BLACKOUT_PERIOD = 1.0
 COVERAGE_PERIOD = 0.25
-MAP_FRAME = "map"
 LANDER = "lander"
 
 _log = logging.getLogger(__name__)
 Pose4 = tuple[float, float, float, float]  # x, y, z, yaw
 
 
-def base_link(agent: str) -> str:
-    """The body frame of an agent."""
-    return f"{agent}/base_link"
-
-
 def yaw_quaternion(yaw: float) -> Quaternion:
-    """A rotation about z as a quaternion message."""
-    return Quaternion(0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2))
+    """A rotation about z as a ``geometry_msgs/Quaternion``."""
+    return Quaternion(*quaternion_from_rpy(yaw=yaw))
 
 
 class RobotStatePublisher:

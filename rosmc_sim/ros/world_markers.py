@@ -20,9 +20,11 @@ from geometry_msgs.msg import Point
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
+from rosmc_server.interface import MAP_FRAME
+
 from ..core.sim import Simulation
 from ..core.world import BOX_SIZE, COLORS, STONE_RADIUS
-from .robot_state import MAP_FRAME, yaw_quaternion
+from .robot_state import yaw_quaternion
 from .timing import Throttle
 from .topics import WORLD_TOPIC
 

@@ -322,6 +322,8 @@ def test_there_are_core_modules_to_scan() -> None:
             "markers",
             "mission",
             "persistence",
+            "policy",
+            "frames",
         )
     }
     assert expected <= modules
