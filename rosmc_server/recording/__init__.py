@@ -20,6 +20,7 @@ Typical use::
 """
 
 from rosmc_server.recording._files import default_journal_path
+from rosmc_server.recording.channels import JOURNAL_TOPICS
 from rosmc_server.recording.errors import JournalError
 from rosmc_server.recording.reader import (
     JournalRecord,
@@ -28,21 +29,10 @@ from rosmc_server.recording.reader import (
     latest_state,
     read_journal,
 )
-from rosmc_server.recording.topics import (
-    AGENT_STATES_TOPIC,
-    JOURNAL_TOPICS,
-    MISSION_EVENTS_TOPIC,
-    MISSION_TOPIC,
-    ROBOT_REPORTS_TOPIC,
-)
 from rosmc_server.recording.writer import JournalOptions, JournalWriter
 
 __all__ = [
-    "AGENT_STATES_TOPIC",
     "JOURNAL_TOPICS",
-    "MISSION_EVENTS_TOPIC",
-    "MISSION_TOPIC",
-    "ROBOT_REPORTS_TOPIC",
     "JournalError",
     "JournalOptions",
     "JournalRecord",

@@ -17,8 +17,8 @@ from mcap.records import Schema
 from mcap_ros1.decoder import DecoderFactory
 
 from rosmc_server.recording import _format as fmt
+from rosmc_server.recording.channels import SCHEMA_ENCODING
 from rosmc_server.recording.errors import JournalError
-from rosmc_server.recording.topics import SCHEMA_ENCODING
 
 RosMessage = Any
 """A genpy message instance (generated classes carry no type information)."""

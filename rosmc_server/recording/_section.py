@@ -14,7 +14,7 @@ from mcap.opcode import Opcode
 from rosmc_server.recording import _format as fmt
 from rosmc_server.recording._codec import schema_of
 from rosmc_server.recording._scan import ScanResult
-from rosmc_server.recording.topics import MESSAGE_ENCODING, SCHEMA_ENCODING
+from rosmc_server.recording.channels import MESSAGE_ENCODING, SCHEMA_ENCODING
 
 
 @dataclass

@@ -31,10 +31,10 @@ from rosmc_server.core import (
     RosmcError,
 )
 from rosmc_server.core.updates import apply_event
+from rosmc_server.interface import EVENTS_TOPIC, MISSION_TOPIC, ROBOT_REPORTS_TOPIC
 from rosmc_server.recording.errors import JournalError
 from rosmc_server.recording.reader import JournalResult, read_journal
 from rosmc_server.recording.timeline import Timeline, TimelineBuilder
-from rosmc_server.recording.topics import MISSION_EVENTS_TOPIC, MISSION_TOPIC, ROBOT_REPORTS_TOPIC
 
 CHECKPOINT_EVERY = 256
 """Revisions between two kept copies of the content (bounds the replay per lookup)."""
@@ -95,7 +95,7 @@ class MissionHistory:
         Raises:
             JournalError: The file is not a readable journal or holds no snapshot.
         """
-        return cls(read_journal(path, (MISSION_TOPIC, MISSION_EVENTS_TOPIC, ROBOT_REPORTS_TOPIC)))
+        return cls(read_journal(path, (MISSION_TOPIC, EVENTS_TOPIC, ROBOT_REPORTS_TOPIC)))
 
     # -- queries ---------------------------------------------------------------------
     @property
@@ -202,7 +202,7 @@ class MissionHistory:
                 self._timeline.reset(mission, info.log_time)
                 broken_at, since_checkpoint = None, 0
                 continue
-            if mission is None or record.topic != MISSION_EVENTS_TOPIC:
+            if mission is None or record.topic != EVENTS_TOPIC:
                 continue
             revision = int(record.message.revision)
             if revision <= mission.revision or broken_at is not None:

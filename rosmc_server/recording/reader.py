@@ -5,10 +5,10 @@ from collections.abc import Collection
 from dataclasses import dataclass
 from pathlib import Path
 
+from rosmc_server.interface import EVENTS_TOPIC, MISSION_TOPIC
 from rosmc_server.recording import _scan
 from rosmc_server.recording._codec import Decoder, RosMessage
 from rosmc_server.recording.errors import JournalError
-from rosmc_server.recording.topics import MISSION_EVENTS_TOPIC, MISSION_TOPIC
 
 _log = logging.getLogger(__name__)
 
@@ -158,7 +158,7 @@ def latest_state(result: JournalResult) -> LatestState:
     tail = [
         r.message
         for r in result.records
-        if r.topic == MISSION_EVENTS_TOPIC and int(r.message.revision) > after
+        if r.topic == EVENTS_TOPIC and int(r.message.revision) > after
     ]
     notes: list[str] = []
     if tail and tail[-1].kind == tail[-1].MISSION_REPLACED:

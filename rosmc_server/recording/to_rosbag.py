@@ -15,13 +15,13 @@ from pathlib import Path
 import genpy
 import rosbag
 
+from rosmc_server.interface import MISSION_TOPIC, SERVER_NODE
 from rosmc_server.recording.errors import JournalError
 from rosmc_server.recording.reader import read_journal
-from rosmc_server.recording.topics import MISSION_TOPIC
 
 _log = logging.getLogger(__name__)
 
-CALLER_ID = "/rosmc/mission_server"
+CALLER_ID = SERVER_NODE
 """The publisher the bag names: the node that published these topics live."""
 
 

@@ -8,21 +8,20 @@ from pathlib import Path
 from types import TracebackType
 from typing import Self
 
+from rosmc_server.interface import (
+    AGENT_STATES_TOPIC,
+    EVENTS_TOPIC,
+    MISSION_TOPIC,
+    ROBOT_REPORTS_TOPIC,
+)
 from rosmc_server.recording import _format as fmt
 from rosmc_server.recording import _scan
 from rosmc_server.recording._codec import RosMessage, serialize
 from rosmc_server.recording._files import fsync_directory, open_locked, save_tail
 from rosmc_server.recording._section import DataSection
+from rosmc_server.recording.channels import JOURNAL_TOPICS, PROFILE
 from rosmc_server.recording.errors import JournalError
 from rosmc_server.recording.reader import JournalResult, decode_scan
-from rosmc_server.recording.topics import (
-    AGENT_STATES_TOPIC,
-    JOURNAL_TOPICS,
-    MISSION_EVENTS_TOPIC,
-    MISSION_TOPIC,
-    PROFILE,
-    ROBOT_REPORTS_TOPIC,
-)
 
 _log = logging.getLogger(__name__)
 LIBRARY = "rosmc-journal/1"
@@ -190,7 +189,7 @@ class JournalWriter:
 
     def append_event(self, event: RosMessage, log_time_ns: int) -> None:
         """Record one accepted change (``rosmc/MissionEvent``); durable when this returns."""
-        self._append(MISSION_EVENTS_TOPIC, event, log_time_ns, sync=True)
+        self._append(EVENTS_TOPIC, event, log_time_ns, sync=True)
 
     def append_snapshot(self, mission: RosMessage, log_time_ns: int) -> None:
         """Record a full ``rosmc/Mission`` snapshot; durable when this returns."""
@@ -261,7 +260,7 @@ class JournalWriter:
             self._section.count(channel_id, log_time_ns, chunk_index)
             if topic == MISSION_TOPIC:
                 self._events_since_snapshot = 0
-            elif topic == MISSION_EVENTS_TOPIC:
+            elif topic == EVENTS_TOPIC:
                 self._events_since_snapshot += 1
 
     def _write(self, data: bytes, sync: bool) -> None:
@@ -302,5 +301,5 @@ class JournalWriter:
         for record in self.recovered.records if self.recovered else ():
             if record.topic == MISSION_TOPIC:
                 self._events_since_snapshot = 0
-            elif record.topic == MISSION_EVENTS_TOPIC:
+            elif record.topic == EVENTS_TOPIC:
                 self._events_since_snapshot += 1

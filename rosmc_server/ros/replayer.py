@@ -42,7 +42,7 @@ import rospy
 from .. import interface
 from ..conversions import event_from_msg, mission_to_msg
 from ..core import EventKind, InvalidRequest, MissionEvent, NotFound, RosmcError
-from ..recording import AGENT_STATES_TOPIC, ROBOT_REPORTS_TOPIC, JournalRecord
+from ..recording import JournalRecord
 from ..recording.history import MissionHistory
 from .client import ServerUnavailable, init_node
 
@@ -62,8 +62,8 @@ GET_MISSION = interface.service_name("get_mission")
 TYPES: dict[str, Any] = {
     interface.MISSION_TOPIC: wire.Mission,
     interface.EVENTS_TOPIC: wire.MissionEvent,
-    AGENT_STATES_TOPIC: wire.AgentStates,
-    ROBOT_REPORTS_TOPIC: wire.RobotReport,
+    interface.AGENT_STATES_TOPIC: wire.AgentStates,
+    interface.ROBOT_REPORTS_TOPIC: wire.RobotReport,
 }
 
 
@@ -192,9 +192,9 @@ class RecordingReplayer:
                 name, msg_type, queue_size=1000, latch=latched
             )
         self._publish_snapshot(self._history.at_time(self._config.start).revision)
-        states = [r for r in self._before if r.topic == AGENT_STATES_TOPIC]
+        states = [r for r in self._before if r.topic == interface.AGENT_STATES_TOPIC]
         if states:
-            self._publishers[AGENT_STATES_TOPIC].publish(states[-1].message)
+            self._publishers[interface.AGENT_STATES_TOPIC].publish(states[-1].message)
         service = rospy.Service(
             self._config.topic(GET_MISSION), wire_srv.GetMission, self._on_get_mission
         )

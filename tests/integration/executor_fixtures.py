@@ -36,7 +36,7 @@ from rosmc_server import interface
 from rosmc_server.conversions import mission_from_msg, param_to_msg, skill_to_msg
 from rosmc_server.core import MissionState, SkillInstance, SkillStatus
 from rosmc_server.core.commands import CommandKind
-from rosmc_server.recording import MISSION_EVENTS_TOPIC, ROBOT_REPORTS_TOPIC, read_journal
+from rosmc_server.recording import read_journal
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 TEST_LIBRARY = REPO_ROOT / "tests" / "data" / "test_team.yaml"
@@ -523,7 +523,7 @@ class Transition:
 
 def journal_timelines(path: Path) -> dict[str, list[Transition]]:
     """Every skill's sequence of (status, transfer) changes from a closed journal."""
-    result = read_journal(path, [MISSION_EVENTS_TOPIC])
+    result = read_journal(path, [interface.EVENTS_TOPIC])
     timelines: dict[str, list[Transition]] = {}
     for record in result.records:
         event = record.message
@@ -544,7 +544,7 @@ def journal_timelines(path: Path) -> dict[str, list[Transition]]:
 
 def journal_reports(path: Path) -> list[wire.RobotReport]:
     """The robot reports the server journaled, in journal order."""
-    return [r.message for r in read_journal(path, [ROBOT_REPORTS_TOPIC]).records]
+    return [r.message for r in read_journal(path, [interface.ROBOT_REPORTS_TOPIC]).records]
 
 
 def running_stamps(path: Path) -> dict[str, float]:

@@ -26,7 +26,8 @@ import rospy
 
 from rosmc_server.core import MarkerType, Pose, SkillStatus, TaskMarker, Unavailable
 from rosmc_server.core.changes import EventKind
-from rosmc_server.recording import MISSION_EVENTS_TOPIC, read_journal
+from rosmc_server.interface import EVENTS_TOPIC
+from rosmc_server.recording import read_journal
 from rosmc_sim.ros.demo_operator import OPERATOR_KINDS, WIFI_SPOT_ADAPTED
 from tests.integration.scenario_fixtures import Operator, Team, TeamSettings, wait_for
 
@@ -88,7 +89,7 @@ def test_the_demo_mission_completes_with_a_score_and_a_full_recording(tmp_path: 
 
     journal = read_journal(recording.group(1))
     assert journal.clean, journal.warnings
-    events = journal.messages(MISSION_EVENTS_TOPIC)
+    events = journal.messages(EVENTS_TOPIC)
     assert [e.revision for e in events] == list(range(1, len(events) + 1)), "revision gap"
     assert events[-1].revision == int(changes.group(2))
     kinds = Counter(EventKind(e.kind) for e in events)

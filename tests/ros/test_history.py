@@ -37,13 +37,8 @@ from rosmc_server.core import (  # noqa: E402
     SkillStatus,
     Transfer,
 )
-from rosmc_server.recording import (  # noqa: E402
-    MISSION_EVENTS_TOPIC,
-    MISSION_TOPIC,
-    ROBOT_REPORTS_TOPIC,
-    JournalWriter,
-    read_journal,
-)
+from rosmc_server.interface import EVENTS_TOPIC, MISSION_TOPIC, ROBOT_REPORTS_TOPIC  # noqa: E402
+from rosmc_server.recording import JournalWriter, read_journal  # noqa: E402
 from rosmc_server.recording.history import MissionHistory  # noqa: E402
 from rosmc_server.recording.timeline_svg import (  # noqa: E402
     OLIVE,
@@ -244,9 +239,9 @@ def test_a_missing_revision_is_reported_and_the_next_snapshot_resumes(
     path = tmp_path / "gap.mcap"
     with JournalWriter.create(path, records[0].message, records[0].log_time) as writer:
         for record in records[1:]:
-            if record.topic == MISSION_EVENTS_TOPIC and record.message.revision == 20:
+            if record.topic == EVENTS_TOPIC and record.message.revision == 20:
                 continue
-            if record.topic == MISSION_EVENTS_TOPIC:
+            if record.topic == EVENTS_TOPIC:
                 writer.append_event(record.message, record.log_time)
             elif record.topic == MISSION_TOPIC:
                 writer.append_snapshot(record.message, record.log_time)
@@ -353,7 +348,7 @@ def test_rosbag_holds_every_message_at_its_log_time(recording: Recording, tmp_pa
     for record in journal.records:
         expected[record.topic] = expected.get(record.topic, 0) + 1
     assert summary.counts == expected
-    assert set(expected) == {MISSION_TOPIC, MISSION_EVENTS_TOPIC, ROBOT_REPORTS_TOPIC}
+    assert set(expected) == {MISSION_TOPIC, EVENTS_TOPIC, ROBOT_REPORTS_TOPIC}
     with rosbag.Bag(str(summary.path)) as bag:
         info = bag.get_type_and_topic_info().topics
         assert {topic: info[topic].message_count for topic in info} == expected
@@ -365,8 +360,8 @@ def test_rosbag_holds_every_message_at_its_log_time(recording: Recording, tmp_pa
         latched = {c.topic: c.header.get("latching") for c in bag._connections.values()}
     recorded = sorted(((r.log_time, r.topic, r.message) for r in journal.records), key=_key)
     assert [(t, topic) for t, topic, _ in played] == [(t, topic) for t, topic, _ in recorded]
-    assert [m.revision for t, topic, m in played if topic == MISSION_EVENTS_TOPIC] == [
-        m.revision for t, topic, m in recorded if topic == MISSION_EVENTS_TOPIC
+    assert [m.revision for t, topic, m in played if topic == EVENTS_TOPIC] == [
+        m.revision for t, topic, m in recorded if topic == EVENTS_TOPIC
     ]
     assert latched[MISSION_TOPIC] == b"1"
 

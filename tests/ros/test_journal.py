@@ -27,11 +27,14 @@ from mcap_ros1.writer import Writer as Ros1Writer
 
 msg = pytest.importorskip("rosmc.msg", reason="rosmc messages are not built (source build/devel)")
 
-from rosmc_server.recording import (  # noqa: E402
+from rosmc_server.interface import (  # noqa: E402
     AGENT_STATES_TOPIC,
-    MISSION_EVENTS_TOPIC,
+    EVENTS_TOPIC,
     MISSION_TOPIC,
     ROBOT_REPORTS_TOPIC,
+)
+from rosmc_server.recording import (  # noqa: E402
+    JOURNAL_TOPICS,
     JournalError,
     JournalOptions,
     JournalWriter,
@@ -81,7 +84,7 @@ def write_sample(path: Path, chunked: bool, events: int = 8) -> tuple[JournalWri
     for rev in range(1, events + 1):
         t = T0 + rev * 1000
         writer.append_event(event(rev), t)
-        rows.append((MISSION_EVENTS_TOPIC, t, event(rev), writer.offset))
+        rows.append((EVENTS_TOPIC, t, event(rev), writer.offset))
         if rev == events // 2:
             writer.append_snapshot(mission(rev, skills=rev), t + 1)
             rows.append((MISSION_TOPIC, t + 1, mission(rev, skills=rev), writer.offset))
@@ -142,9 +145,7 @@ def test_round_trip(tmp_path: Path, chunked: bool) -> None:
     result = read_journal(path)
     assert result.clean and result.complete and result.dropped_bytes == 0
     assert_prefix(result, rows)
-    assert result.messages(MISSION_EVENTS_TOPIC) == [
-        r[2] for r in rows if r[0] == MISSION_EVENTS_TOPIC
-    ]
+    assert result.messages(EVENTS_TOPIC) == [r[2] for r in rows if r[0] == EVENTS_TOPIC]
     assert type(result.records[1].message) is msg.MissionEvent  # the installed class
 
 
@@ -162,7 +163,7 @@ def test_closed_journal_is_standard_mcap(tmp_path: Path, chunked: bool) -> None:
         assert {s.name for s in summary.schemas.values()} >= {"rosmc/MissionEvent", "rosmc/Mission"}
         assert all(s.encoding == "ros1msg" for s in summary.schemas.values())
         assert reader.get_header().profile == "ros1"
-        decoded = list(reader.iter_decoded_messages(topics=[MISSION_EVENTS_TOPIC]))
+        decoded = list(reader.iter_decoded_messages(topics=[EVENTS_TOPIC]))
     assert [d.decoded_message.revision for d in decoded] == list(range(1, 9))
     schema = decoded[0].schema
     assert schema is not None and schema.data == msg.MissionEvent._full_text.encode()
@@ -253,11 +254,11 @@ def test_resume_after_a_cut_then_append_and_close(tmp_path: Path, chunked: bool)
         resumed.close()
         result = read_journal(work)
         assert result.clean, result.warnings
-        assert_prefix(result, [*kept, (MISSION_EVENTS_TOPIC, T0 + 10**6, event(100))])
+        assert_prefix(result, [*kept, (EVENTS_TOPIC, T0 + 10**6, event(100))])
         expected = [(r[0], r[1], serialized(r[2])) for r in kept]
         assert mcap_messages(work) == [
             *expected,
-            (MISSION_EVENTS_TOPIC, T0 + 10**6, serialized(event(100))),
+            (EVENTS_TOPIC, T0 + 10**6, serialized(event(100))),
         ]
 
 
@@ -373,7 +374,7 @@ def test_kill_9_loses_no_acknowledged_change(tmp_path: Path) -> None:
         state = latest_state(result)
         assert state.problems == ()
         assert state.revision >= acked[-1]
-        revisions = [e.revision for e in result.messages(MISSION_EVENTS_TOPIC)]
+        revisions = [e.revision for e in result.messages(EVENTS_TOPIC)]
         assert set(acked) <= set(revisions)
         assert revisions == list(range(1, len(revisions) + 1))
         with JournalWriter.resume(path) as resumed:
@@ -421,7 +422,7 @@ def test_latest_state_without_events_and_without_snapshot(tmp_path: Path) -> Non
     state = latest_state(read_journal(path))
     assert state.events == () and state.problems == () and state.revision == 5
     with pytest.raises(JournalError, match="no mission snapshot"):
-        latest_state(read_journal(path, topics=[MISSION_EVENTS_TOPIC]))
+        latest_state(read_journal(path, topics=[EVENTS_TOPIC]))
 
 
 def test_snapshot_due_counts_events_also_across_resume(tmp_path: Path) -> None:
@@ -547,7 +548,7 @@ def test_mcap_ros1_recording_reads_and_resumes(tmp_path: Path, compression: Any)
         writer = Ros1Writer(file, chunk_size=2000, compression=compression)
         writer.write_message(MISSION_TOPIC, mission(0), log_time=T0)
         for rev in range(1, 20):
-            writer.write_message(MISSION_EVENTS_TOPIC, event(rev), log_time=T0 + rev)
+            writer.write_message(EVENTS_TOPIC, event(rev), log_time=T0 + rev)
         writer.finish()
     result = read_journal(path)
     assert result.clean, result.warnings
@@ -586,7 +587,7 @@ def test_rosbags_decodes_the_journal_with_its_embedded_definitions(tmp_path: Pat
             if name not in store.fielddefs:
                 store.register(typesys.get_types_from_msg(schema.data.decode(), name))
             decoded.append(store.deserialize_ros1(message.data, name))
-    events = [d for d, row in zip(decoded, rows, strict=True) if row[0] == MISSION_EVENTS_TOPIC]
+    events = [d for d, row in zip(decoded, rows, strict=True) if row[0] == EVENTS_TOPIC]
     assert [(e.revision, e.put_skills[0].skill.id) for e in events] == [
         (r, f"s{r}") for r in range(1, 9)
     ]
@@ -636,11 +637,14 @@ def test_copy_of_an_open_journal_reads_as_unclosed(tmp_path: Path) -> None:
     assert not result.complete and result.dropped_bytes == 0
 
 
-def test_journal_topics_are_the_graph_names() -> None:
-    interface = pytest.importorskip("rosmc_server.interface")
-    assert MISSION_TOPIC == interface.MISSION_TOPIC
-    assert MISSION_EVENTS_TOPIC == interface.EVENTS_TOPIC
-    assert AGENT_STATES_TOPIC == interface.AGENT_STATES_TOPIC
+def test_journal_channels_are_the_graph_names() -> None:
+    assert list(JOURNAL_TOPICS) == [
+        EVENTS_TOPIC,
+        MISSION_TOPIC,
+        ROBOT_REPORTS_TOPIC,
+        AGENT_STATES_TOPIC,
+    ]
+    assert EVENTS_TOPIC == "/rosmc/mission_events" and MISSION_TOPIC == "/rosmc/mission"
 
 
 def test_latest_state_takes_a_late_snapshot_with_the_events_written_before_it(

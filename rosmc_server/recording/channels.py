@@ -1,0 +1,32 @@
+"""Channels of the mission journal: which graph topics it records, their types and encodings.
+
+The journal records the topics the mission server publishes, under the same names
+(:mod:`rosmc_server.interface` holds them), so a recording replays onto the live
+graph unchanged.
+"""
+
+from collections.abc import Mapping
+from types import MappingProxyType
+from typing import Final
+
+from rosmc_server.interface import (
+    AGENT_STATES_TOPIC,
+    EVENTS_TOPIC,
+    MISSION_TOPIC,
+    ROBOT_REPORTS_TOPIC,
+)
+
+JOURNAL_TOPICS: Final[Mapping[str, str]] = MappingProxyType(
+    {
+        EVENTS_TOPIC: "rosmc/MissionEvent",  # one per accepted change of the mission
+        MISSION_TOPIC: "rosmc/Mission",  # full snapshots: the first record, then periodically
+        ROBOT_REPORTS_TOPIC: "rosmc/RobotReport",  # skill status reports of the robots
+        AGENT_STATES_TOPIC: "rosmc/AgentStates",  # agent states for timelines (low rate)
+    }
+)
+"""Every journal channel with the ROS message type it carries, in channel-id order."""
+
+PROFILE: Final = "ros1"
+MESSAGE_ENCODING: Final = "ros1"
+SCHEMA_ENCODING: Final = "ros1msg"
+"""MCAP profile and encodings: ROS 1 serialisation with ``.msg`` text schemas."""
