@@ -4,7 +4,7 @@
 #   make setup   Debian packages, .venv (pinned PyPI packages), messages built into build/
 #   make demo    setup, then the demo mission (scripts/rosmc_demo); DEMO_ARGS=... passes options
 #   make test    setup, lint, then pytest over tests/; PYTEST_ARGS=... passes options
-#   make lint    ruff check, ruff format --check, mypy --strict on every core/ package
+#   make lint    ruff check, ruff format --check, mypy --strict on every rosmc_* package
 #   make format  ruff format and the safe ruff fixes, in place
 #   make clean   remove build/ and the tool caches (keeps .venv)
 
@@ -34,10 +34,9 @@ APT_PACKAGES := \
 BUILD_INPUTS := CMakeLists.txt package.xml setup.py \
 	$(wildcard rosmc_msgs/msg/*.msg rosmc_msgs/srv/*.srv scripts/* rosmc_*/__init__.py)
 
-# Every core/ package, at any depth below a rosmc_* package (rosmc_server/core,
-# rosmc_server/executor/core, ...): these are type-checked with mypy --strict.
-CORE_PACKAGES = $(patsubst %/__init__.py,%,$(wildcard rosmc_*/core/__init__.py \
-	rosmc_*/*/core/__init__.py rosmc_*/*/*/core/__init__.py))
+# Every rosmc_* package (server, simulator, markers, command GUI): type-checked with
+# mypy --strict. Untyped third-party modules are listed in pyproject.toml.
+PACKAGES = $(patsubst %/__init__.py,%,$(wildcard rosmc_*/__init__.py))
 
 # Run a command inside the environment of env.sh.
 IN_ENV := source ./env.sh &&
@@ -97,10 +96,8 @@ pytest: setup
 lint: setup
 	$(IN_ENV) ruff check .
 	$(IN_ENV) ruff format --check .
-	@if [[ -n "$(strip $(CORE_PACKAGES))" ]]; then \
-	  echo "mypy --strict $(CORE_PACKAGES)"; \
-	  $(IN_ENV) mypy --strict $(CORE_PACKAGES); \
-	else echo "mypy: no core/ package yet"; fi
+	@echo "mypy --strict $(PACKAGES)"
+	@$(IN_ENV) mypy --strict $(PACKAGES)
 
 format: setup
 	$(IN_ENV) ruff check --fix .

@@ -20,7 +20,7 @@ class Wait(ThreadedSkill):
 
     def run(self, ctx: SkillContext) -> Outcome:
         """Sleep in slices, reporting the time left every second."""
-        duration = float(ctx.params["duration"])
+        duration = ctx.number("duration")
         end = ctx.now() + duration
         while (left := end - ctx.now()) > 0:
             ctx.progress(f"{left:.0f} s left")
@@ -33,7 +33,7 @@ class Probe(ThreadedSkill):
 
     def run(self, ctx: SkillContext) -> Outcome:
         """Sleep ``duration``; fail with a clear reason when ``fail`` is set."""
-        self.sleep(float(ctx.params["duration"]), ctx.clock)
+        self.sleep(ctx.number("duration"), ctx.clock)
         if ctx.params["fail"]:
             return Outcome.failed("the probe failed as its parameters asked")
         return Outcome.ok("probe done")
@@ -52,20 +52,20 @@ class Count(SkillBehavior):
     def start(self, ctx: SkillContext) -> None:
         """Remember the parameters; the first step ends one period from now."""
         self._ctx = ctx
-        self._next = ctx.now() + float(ctx.params["period"])
+        self._next = ctx.now() + ctx.number("period")
 
     def update(self, now: float) -> Outcome | None:
         """Count a step whenever a period has passed."""
         assert self._ctx is not None
         if self._cancelled:
             return Outcome.failed("cancelled")
-        steps = int(self._ctx.params["steps"])
+        steps = self._ctx.integer("steps")
         if self._paused:
-            self._next = now + float(self._ctx.params["period"])
+            self._next = now + self._ctx.number("period")
             return None
         if now >= self._next:
             self._done += 1
-            self._next = now + float(self._ctx.params["period"])
+            self._next = now + self._ctx.number("period")
             self._ctx.progress(f"step {self._done} of {steps}")
         return Outcome.ok() if self._done >= steps else None
 

@@ -77,7 +77,7 @@ def error_code(error: RosmcError) -> int:
     for kind, code in _CODES:
         if isinstance(error, kind):
             return code
-    return ErrorCode.INVALID
+    return int(ErrorCode.INVALID)
 
 
 # Line breaks and other control characters an error may quote from the request.

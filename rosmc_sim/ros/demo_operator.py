@@ -23,8 +23,9 @@ import sys
 import threading
 import time
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TypeVar
 
 import rosmc.msg as wire
 import rospy
@@ -34,6 +35,8 @@ from rosmc_server.core.changes import EventKind
 from rosmc_server.ros.client import ControlCommand, MissionClient, MissionWatch
 
 from .topics import SCIENCE_TOPIC
+
+T = TypeVar("T")
 
 SURVEY = ((9.0, 3.0), (23.0, 3.0), (23.0, 15.0), (9.0, 15.0))
 WIFI_SPOT_PLANNED = Pose(21.5, -8.0)  # on the ridge: not traversable
@@ -107,6 +110,8 @@ class DemoOperator:
         client.move_marker("Wi-Fi spot", WIFI_SPOT_ADAPTED)
         client.synchronize("manipulator_rover")
         region = self._wait("the drone discovered a region", self._discovered_region)
+        if region is None:
+            return 1
         say(f"{region.name} discovered at ({region.x:.1f}, {region.y:.1f}): planning the sampling")
         self._plan_sampling(region)
         done = self._wait("every synchronized skill finished", self._all_settled, fail_fast=True)
@@ -157,13 +162,14 @@ class DemoOperator:
             raise RuntimeError(f"'{failed[0].id}' failed: {failed[0].status_text}")
         return bool(skills) and all(s.is_settled for s in skills)
 
-    def _wait(self, what: str, condition: object, fail_fast: bool = False) -> object:
+    def _wait(self, what: str, condition: Callable[[], T], fail_fast: bool = False) -> T | None:
+        """Poll ``condition`` until it holds; its result, or None if a check stopped it."""
         say(f"waiting until {what}")
         while time.monotonic() < self.deadline and not rospy.is_shutdown():
             self._drain_events()
             self._progress()
             try:
-                result = condition()  # type: ignore[operator]
+                result = condition()
             except RuntimeError as error:
                 say(f"stopped: {error}")
                 return None

@@ -13,6 +13,7 @@ Use one function per robot kind as the executor's ``~skills`` parameter:
 
 from __future__ import annotations
 
+import functools
 import threading
 import time
 from collections.abc import Mapping
@@ -134,7 +135,7 @@ class ForwardedSkill(SkillBehavior):
 def _skills(agent: str, kind: str) -> list[SkillType]:
     controller = RobotController(agent)
     return [
-        SkillType(name, lambda name=name: ForwardedSkill(controller, name), _PARAMS[name])
+        SkillType(name, functools.partial(ForwardedSkill, controller, name), _PARAMS[name])
         for name, task in TASKS.items()
         if kind in task.kinds
     ]

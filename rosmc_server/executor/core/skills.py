@@ -59,6 +59,20 @@ class SkillContext:
         """The executor's clock (sim time in simulation)."""
         return self.clock()
 
+    def number(self, name: str) -> float:
+        """A FLOAT (or INT) parameter as a float; TypeError if it is no number."""
+        value = self.params[name]
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise TypeError(f"parameter '{name}' is not a number: {value!r}")
+        return float(value)
+
+    def integer(self, name: str) -> int:
+        """An INT parameter; TypeError if it is no integer."""
+        value = self.params[name]
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise TypeError(f"parameter '{name}' is not an integer: {value!r}")
+        return value
+
 
 class SkillBehavior(ABC):
     """One execution of a skill."""
