@@ -254,26 +254,26 @@ def agent_body(kind: BodyKind) -> tuple[Primitive, ...]:
 
 
 # -- task markers ------------------------------------------------------------------------------
-FLAG_HEIGHT = 1.6
+FLAG_HEIGHT = 2.4
 
 
 def flag(color: Color) -> tuple[Primitive, ...]:
     """A flag: pole, triangular cloth and a ground disc (its foot is at the marker's origin)."""
     cloth = (
         (0.0, 0.0, FLAG_HEIGHT),
-        (0.0, 0.0, FLAG_HEIGHT - 0.5),
-        (0.7, 0.0, FLAG_HEIGHT - 0.25),
+        (0.0, 0.0, FLAG_HEIGHT - 0.8),
+        (1.1, 0.0, FLAG_HEIGHT - 0.4),
     )
     return (
-        Primitive(Shape.CYLINDER, DARK, (0.0, 0.0, FLAG_HEIGHT / 2), (0.06, 0.06, FLAG_HEIGHT)),
+        Primitive(Shape.CYLINDER, DARK, (0.0, 0.0, FLAG_HEIGHT / 2), (0.1, 0.1, FLAG_HEIGHT)),
         Primitive(Shape.TRIANGLE_LIST, color.with_alpha(1.0), points=cloth + cloth[::-1]),
-        Primitive(Shape.CYLINDER, color, (0.0, 0.0, 0.02), (0.9, 0.9, 0.04)),
+        Primitive(Shape.CYLINDER, color, (0.0, 0.0, 0.02), (1.2, 1.2, 0.04)),
     )
 
 
 def heading_arrow(color: Color) -> Primitive:
     """An arrow along the marker's x axis (its heading), lying on the ground."""
-    return Primitive(Shape.ARROW, color.with_alpha(1.0), (0.0, 0.0, 0.08), (1.6, 0.18, 0.18))
+    return Primitive(Shape.ARROW, color.with_alpha(1.0), (0.0, 0.0, 0.1), (2.2, 0.3, 0.3))
 
 
 def ring(color: Color, radius: float, z: float = 0.05, width: float = 0.12) -> Primitive:

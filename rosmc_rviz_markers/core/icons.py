@@ -88,12 +88,22 @@ def skill_row(skill: str, status: SkillStatus | None, waiting_on: str = "") -> I
     return IconRow("skill", f"{sign} {skill}: {words}", color)
 
 
-def status_rows(status: AgentStatus | None, skill_label: str = "") -> tuple[IconRow, ...]:
-    """The icon block of one robot, top row first.
+def status_rows(
+    status: AgentStatus | None, skill_label: str = "", agent: str = ""
+) -> tuple[IconRow, ...]:
+    """The icon block of one robot, top row first (the robot's name before its skill).
 
     ``skill_label`` names the current skill as operators know it (its label); without it
     the skill id the robot reports is shown.
     """
+    rows = _rows(status, skill_label)
+    if not agent:
+        return rows
+    first = rows[0]
+    return (IconRow(first.key, f"{agent}: {first.text}", first.color), *rows[1:])
+
+
+def _rows(status: AgentStatus | None, skill_label: str) -> tuple[IconRow, ...]:
     if status is None:
         return (
             IconRow("skill", "no status yet", DIM),

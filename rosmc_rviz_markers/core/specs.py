@@ -142,7 +142,7 @@ def agent_spec(
         description=agent,
         controls=(ControlSpec("body", mode, body, geo.IDENTITY),),
         menu=menu,
-        scale=1.6 if robot else 1.0,
+        scale=3.0 if robot else 1.5,
     )
 
 
@@ -183,7 +183,7 @@ def task_specs(
         yaw = marker.pose.yaw
         arrow = geo.heading_arrow(color)
         if movable:
-            ring = geo.ring(color.with_alpha(0.9), 1.6, z=0.06, width=0.1)
+            ring = geo.ring(color.with_alpha(0.9), 2.3, z=0.06, width=0.12)
             controls.append(ControlSpec("heading", Interaction.ROTATE_AXIS, (arrow, ring)))
         else:
             controls.append(ControlSpec("heading", menu_mode, (arrow,), geo.IDENTITY))
@@ -196,7 +196,7 @@ def task_specs(
             description,
             tuple(controls),
             menu,
-            scale=2.0,
+            scale=3.0,
         )
     ]
 
@@ -221,7 +221,7 @@ def _area_specs(
         description,
         (ControlSpec("area", move_mode, visuals, UP if movable else geo.IDENTITY),),
         menu,
-        scale=3.0,
+        scale=4.0,
     )
     specs = [centre]
     if movable:

@@ -19,9 +19,11 @@ from ..core.icons import IconRow
 from ..core.menus import FlatMenu
 from ..core.specs import ControlSpec, MarkerSpec
 
-ICON_BASE = 2.4  # metres above the robot's frame where the lowest icon row sits
-ICON_ROW = 0.75
-ICON_TEXT = 0.62
+ICON_BASE = 2.6  # metres above the robot's frame where the lowest icon row sits
+ICON_ROW = 0.95
+ICON_TEXT = 0.85
+ICON_GAP = 0.6
+ICON_LEVELS = 3  # robots take turns at these heights
 ICONS_NS = "icons"
 
 
@@ -91,10 +93,20 @@ def interactive_marker_msg(spec: MarkerSpec) -> InteractiveMarker:
 
 
 def icon_markers(
-    agent: str, rows: tuple[IconRow, ...], frame: str, position: geo.Point, base_id: int
+    agent: str,
+    rows: tuple[IconRow, ...],
+    frame: str,
+    position: geo.Point,
+    base_id: int,
+    level: int = 0,
 ) -> list[Marker]:
-    """A robot's status rows as camera-facing text above ``position`` in ``frame``."""
+    """A robot's status rows as camera-facing text above ``position`` in ``frame``.
+
+    ``level`` lifts the block by whole blocks, so that robots standing close together
+    (at the lander, at one region) do not write over each other.
+    """
     out = []
+    lift = level * (ICON_ROW * len(rows) + ICON_GAP)
     for index, row in enumerate(rows):
         marker = Marker()
         marker.header.frame_id = frame
@@ -104,7 +116,7 @@ def icon_markers(
         marker.id = base_id + index
         marker.type = Marker.TEXT_VIEW_FACING
         marker.action = Marker.ADD
-        z = position[2] + ICON_BASE + ICON_ROW * (len(rows) - 1 - index)
+        z = position[2] + ICON_BASE + lift + ICON_ROW * (len(rows) - 1 - index)
         marker.pose.position = PointMsg(position[0], position[1], z)
         marker.pose.orientation.w = 1.0
         marker.scale.z = ICON_TEXT

@@ -45,7 +45,7 @@ from ..core.icons import status_rows
 from ..core.scene import Scene, Touched
 from ..core.specs import MarkerSpec
 from .adapter import MarkerServer
-from .convert import icon_markers, interactive_marker_msg, pose_msg
+from .convert import ICON_LEVELS, icon_markers, interactive_marker_msg, pose_msg
 from .interaction import Interaction
 
 _log = logging.getLogger(__name__)
@@ -256,7 +256,8 @@ class MarkerNode:
                 frame = geo.MAP_FRAME
                 if status is not None and status.pose is not None:
                     position = (status.pose.x, status.pose.y, status.pose.z)
-            out += icon_markers(agent, status_rows(status, label), frame, position, index * 10)
+            rows = status_rows(status, label, agent)
+            out += icon_markers(agent, rows, frame, position, index * 10, index % ICON_LEVELS)
         return out
 
     # -- feedback ---------------------------------------------------------------------------------
