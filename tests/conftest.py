@@ -11,6 +11,11 @@ or, after ``source env.sh``, plain ``python -m pytest``.
 ``launch_process``
     Starts a process (a node, ``roslaunch``, a CLI) with its output in a log file, and stops
     it, with all of its children, when the test ends.
+
+:func:`wait_until` is how every tier waits for something to happen: it polls a condition
+instead of sleeping for a fixed time (a test that sleeps is slow on a fast machine and
+flaky on a loaded one). A fixed sleep is left only where a test checks that nothing
+happens for a while, or measures a rate over a time window.
 """
 
 from __future__ import annotations
@@ -25,13 +30,33 @@ import xmlrpc.client
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypeVar
 
 import pytest
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
+T = TypeVar("T")
 LOOPBACK = "127.0.0.1"
 MASTER_START_TIMEOUT = 20.0
 STOP_TIMEOUT = 10.0
+
+
+def wait_until(
+    condition: Callable[[], T | None], timeout: float, what: str, period: float = 0.02
+) -> T:
+    """Poll ``condition`` every ``period`` seconds until it returns something true; return it.
+
+    Raises:
+        AssertionError: ``timeout`` seconds passed first (the message says ``what``).
+    """
+    deadline = time.monotonic() + timeout
+    while True:
+        value = condition()
+        if value:
+            return value
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout:g} s waiting until {what}")
+        time.sleep(period)
 
 
 def free_port() -> int:

@@ -37,6 +37,7 @@ from rosmc_server.conversions import mission_from_msg, param_to_msg, skill_to_ms
 from rosmc_server.core import MissionState, SkillInstance, SkillStatus
 from rosmc_server.core.commands import CommandKind
 from rosmc_server.recording import read_journal
+from tests.conftest import wait_until
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 TEST_LIBRARY = REPO_ROOT / "tests" / "data" / "test_team.yaml"
@@ -197,7 +198,7 @@ class Operator:
         if publisher is None:
             publisher = rospy.Publisher(f"/{agent}/link/blackout", Bool, queue_size=10, latch=True)
             self._blackouts[agent] = publisher
-            wait_for(lambda: publisher.get_num_connections() > 0, 10.0, "the link emulator")
+            wait_until(lambda: publisher.get_num_connections() > 0, 10.0, "the link emulator")
         publisher.publish(Bool(data=on))
 
     # -- waiting --------------------------------------------------------------------
@@ -266,7 +267,9 @@ class LinkEnd:
 
     As ``"ground"`` it publishes commands and report acks and hears acks,
     reports and snapshots; as ``"robot"`` the other way round. Everything heard
-    is kept in ``heard[topic field]``.
+    is kept in ``heard[topic field]``. With ``robot_names`` it uses the names of
+    the robot's side of an emulated link: as ``"ground"``, it then hears what the
+    robot says even while the emulator blacks the link out.
     """
 
     _GROUND_SENDS = (("command", wire.RobotCommand), ("report_ack", wire.ReportAck))
@@ -276,9 +279,9 @@ class LinkEnd:
         ("snapshot", wire.ExecutorSnapshot),
     )
 
-    def __init__(self, agent: str, side: str) -> None:
+    def __init__(self, agent: str, side: str, robot_names: bool = False) -> None:
         init_test_node()
-        topics = interface.ground_link(agent)
+        topics = interface.robot_link(agent) if robot_names else interface.ground_link(agent)
         sends, hears = self._GROUND_SENDS, self._ROBOT_SENDS
         if side == "robot":
             sends, hears = hears, sends
@@ -350,15 +353,6 @@ def command_msg(
         barriers=list(barriers),
         argument=argument,
     )
-
-
-def wait_for(predicate: Callable[[], bool], timeout: float, what: str) -> None:
-    """Poll ``predicate`` until true; fail after ``timeout`` seconds."""
-    deadline = time.monotonic() + timeout
-    while not predicate():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out waiting for {what}")
-        time.sleep(0.02)
 
 
 def describe(state: MissionState) -> str:

@@ -36,6 +36,7 @@ from rosgraph_msgs.msg import Clock
 from rosmc_server.core import AgentStatus, MissionState, RosmcError, SkillStatus, Transfer
 from rosmc_server.ros.client import ControlCommand, MissionClient, MissionWatch
 from rosmc_sim.ros.topics import SCIENCE_TOPIC, blackout_topic
+from tests.conftest import wait_until
 
 REPO = Path(__file__).resolve().parents[2]
 SCENARIO = REPO / "tests" / "data" / "scenario_team.yaml"
@@ -51,23 +52,6 @@ HELD = (S.IDLE_SYNCHRONIZED, S.SYNCWAITING, S.RUNNING, S.PAUSED)  # on a robot, 
 T = TypeVar("T")
 
 
-def wait_for(condition: Callable[[], T | None], timeout: float, what: str) -> T:
-    """Poll ``condition`` until it returns something truthy, and return that.
-
-    Raises:
-        AssertionError: ``timeout`` wall seconds passed first.
-    """
-    deadline = time.monotonic() + timeout
-    while True:
-        value = condition()
-        if value:
-            return value
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout:g} s waiting until {what}")
-        time.sleep(POLL)
-
-
-# -- processes ------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class TeamSettings:
     """How the team runs (sim seconds unless said otherwise).
@@ -157,7 +141,7 @@ class Team:
         """
         for robot in ROBOTS:
             topic = blackout_topic(robot)
-            wait_for(
+            wait_until(
                 functools.partial(subscribed, EMULATOR_NODE, topic),
                 timeout,
                 f"the link emulator hears {topic}",
@@ -443,7 +427,7 @@ class Operator:
             state = self.agent_state(agent)
             return state if state is not None and state.link == link else None
 
-        return wait_for(reached, timeout, f"the server calls {agent}'s link {link}")
+        return wait_until(reached, timeout, f"the server calls {agent}'s link {link}")
 
     def wait_links_up(self, timeout: float = 60.0) -> None:
         """Wait until the server hears every robot."""
@@ -452,7 +436,7 @@ class Operator:
 
     def where(self, robot: str) -> wire.Telemetry:
         """The robot's latest telemetry (pose, battery, coverage), straight from the sim."""
-        return wait_for(lambda: self.telemetry[robot].last, 10.0, f"{robot}'s telemetry")
+        return wait_until(lambda: self.telemetry[robot].last, 10.0, f"{robot}'s telemetry")
 
     def sim_now(self) -> float:
         """A sim time at least as late as the call (one ``/clock`` message heard afresh).
@@ -489,7 +473,7 @@ class Operator:
             telemetry = self.telemetry[robot].last
             return telemetry if telemetry is not None and predicate(telemetry) else None
 
-        return wait_for(reached, timeout, f"{robot}: {what}")
+        return wait_until(reached, timeout, f"{robot}: {what}")
 
 
 def describe(state: MissionState) -> str:

@@ -36,6 +36,7 @@ from rosmc_server.core import (
 from rosmc_server.core.commands import CommandKind
 from rosmc_server.core.link import queue_hash
 from rosmc_server.ros.client import MissionClient
+from tests.conftest import wait_until
 from tests.integration.executor_fixtures import (
     LinkEnd,
     Operator,
@@ -47,7 +48,6 @@ from tests.integration.executor_fixtures import (
     journal_reports,
     journal_timelines,
     running_stamps,
-    wait_for,
 )
 
 pytestmark = pytest.mark.integration
@@ -229,13 +229,19 @@ def test_barrier_release_skew_over_repeated_runs(rosmc: Start) -> None:
 # -- the ground link ---------------------------------------------------------------------
 def test_skills_complete_during_a_blackout_and_report_in_order_after_it(rosmc: Start) -> None:
     system, op = rosmc(agents=("r1",), emulated=("r1",), server_params=("_link_timeout:=1.0",))
+    robot_side = LinkEnd("r1", "ground", robot_names=True)  # hears r1 behind the emulator
+    wait_until(robot_side.connected, 10.0, "r1's side of the link")
     ids = [op.add("r1", "wait", {"duration": 0.6}) for _ in range(3)]
     op.sync("r1")
     wait_all_synced(op, ids)
     op.start("r1")
     op.wait_status(ids[:1], S.RUNNING)
     op.blackout("r1", True)
-    time.sleep(2.5)  # all three finish 1.8 s after the first started
+    robot_side.wait_heard("report", lambda r: r.skill_id == ids[2] and r.status.value == S.SUCCESS)
+    wait_until(
+        lambda: op.agent_state("r1").link.state == wire.LinkState.DOWN, 10.0, "the link DOWN"
+    )
+    robot_side.close()
     during = op.mission()
     assert during.skill(ids[2]).status is S.IDLE_SYNCHRONIZED, describe(during)
     assert op.agent_state("r1").link.state == wire.LinkState.DOWN
@@ -270,7 +276,7 @@ def test_unsync_while_running_keeps_the_running_skill(rosmc: Start) -> None:
     )
     assert state.skill(first).status is S.RUNNING
     op.wait_status([first], S.SUCCESS)
-    time.sleep(0.5)
+    time.sleep(0.5)  # the later skills stay in the blueprint: nothing to wait on
     state = op.mission()
     assert [state.skill(i).status for i in later] == [S.IDLE, S.IDLE]
     assert all(state.skill(i).started == 0.0 for i in later)
@@ -358,8 +364,8 @@ def test_failure_retry_skip_and_a_retry_that_succeeds(rosmc: Start) -> None:
     op.start()
     state = op.wait_status([probe, probe2], S.FAILURE)
     assert state.skill(probe).status_text == "the probe failed as its parameters asked"
-    time.sleep(0.5)
-    assert op.mission().skill(after).status is S.IDLE_SYNCHRONIZED  # holding
+    time.sleep(0.5)  # the robot holds: what follows does not start
+    assert op.mission().skill(after).status is S.IDLE_SYNCHRONIZED
     with pytest.raises(OperatorError) as refused:
         op.edit(probe, {"fail": False})
     assert refused.value.code == ErrorCode.RULE
@@ -430,7 +436,7 @@ def test_an_executor_that_lost_its_state_does_not_run_finished_skills_again(
     system.state_file("r1").unlink()  # a new disk
     system.start_executor("r1")
     op.wait_links(["r1"])
-    wait_for(
+    wait_until(
         lambda: op.agent_state("r1").link.robot_queue_hash == queue_hash(done),
         15.0,
         "the ground to repair the robot's queue",
@@ -456,7 +462,7 @@ def test_a_new_mission_after_a_finished_one(rosmc: Start) -> None:
     op.start("r1")
     op.wait_status([done], S.SUCCESS)
     op.change("new_mission", keep_markers=True)
-    wait_for(
+    wait_until(
         lambda: op.agent_state("r1").link.robot_queue_hash == queue_hash([]),
         10.0,
         "the robot to drop the old mission",
@@ -464,7 +470,9 @@ def test_a_new_mission_after_a_finished_one(rosmc: Start) -> None:
     fresh = op.add("r1", "wait", {"duration": 0.1})
     op.sync("r1")
     op.wait_status([fresh], S.SUCCESS)
-    time.sleep(2.5)  # a few snapshots: the hashes agree, no repair goes on
+    snapshots = LinkEnd("r1", "ground")  # hears what the server hears
+    wait_until(lambda: len(snapshots.received("snapshot")) >= 3, 10.0, "three more snapshots")
+    snapshots.close()  # the hashes agreed on each of them: no repair goes on
     link = op.agent_state("r1").link
     assert (link.robot_queue_hash, link.hash_mismatch) == (queue_hash([fresh]), False)
     assert link.commands_in_flight == 0
@@ -530,7 +538,7 @@ def test_bad_commands_over_the_link_are_refused_clearly(rosmc: Start) -> None:
     system, _ = rosmc(agents=("r1",), server=False)
     ground = LinkEnd("r1", "ground")
     ground.wait_heard("snapshot", lambda m: True, timeout=20.0)  # the executor is up
-    wait_for(ground.connected, 10.0, "the link topics to connect")
+    wait_until(ground.connected, 10.0, "the link topics to connect")
 
     def send(seq: int, kind: CommandKind, **fields: object) -> wire.RobotAck:
         ground.publish("command", command_msg("r1", seq, kind, **fields))  # type: ignore[arg-type]
@@ -556,7 +564,7 @@ def test_bad_commands_over_the_link_are_refused_clearly(rosmc: Start) -> None:
     )
     # An early command waits for the one before it (the ground resends in order).
     ground.publish("command", command_msg("r1", 4, K.START))
-    time.sleep(0.5)
+    time.sleep(0.5)  # no answer comes
     assert not [a for a in ground.received("ack") if a.seq == 4]
     answered.append(send(3, K.UPLOAD, skills=[wait_skill("w3")]))
     assert answered[-1].result == wire.RobotAck.ACCEPTED
@@ -585,7 +593,7 @@ def test_bad_commands_over_the_link_are_refused_clearly(rosmc: Start) -> None:
     ground.publish("command", command_msg("r2", 8, K.UPLOAD, skills=[wait_skill("x", "r2")]))
     ground.publish("report_ack", wire.ReportAck(agent="r2", seq=1000))
     barriers = rospy.Publisher(interface.BARRIER_TOPIC, wire.BarrierSignal, queue_size=10)
-    wait_for(lambda: barriers.get_num_connections() > 0, 10.0, "the barrier topic")
+    wait_until(lambda: barriers.get_num_connections() > 0, 10.0, "the barrier topic")
     barriers.publish(wire.BarrierSignal(agent="r9", barrier_id="B", skill_id="x", kind=9))
 
     last = send(8, K.UPLOAD, skills=[wait_skill("w8")])
@@ -604,7 +612,7 @@ def test_lost_link_policy_hold_on_a_silent_link(rosmc: Start) -> None:
     system, _ = rosmc(agents=("r1",), server=False)
     ground = LinkEnd("r1", "ground")
     ground.wait_heard("snapshot", lambda m: True, timeout=20.0)
-    wait_for(ground.connected, 10.0, "the link topics to connect")
+    wait_until(ground.connected, 10.0, "the link topics to connect")
     options = json.dumps({"lost_link": {"policy": "hold", "after": 1.0}})
     commands = [
         command_msg("r1", 1, K.SET_OPTIONS, argument=options),
@@ -635,7 +643,7 @@ def test_the_server_survives_bad_reports(rosmc: Start) -> None:
     """A fake r3 reports on a skill the server does not know, out of order and twice."""
     system, op = rosmc(agents=())
     robot = LinkEnd("r3", "robot")
-    wait_for(robot.connected, 10.0, "the server's link to r3")
+    wait_until(robot.connected, 10.0, "the server's link to r3")
     revision = op.mission().revision
 
     def snapshot() -> wire.ExecutorSnapshot:
@@ -658,12 +666,12 @@ def test_the_server_survives_bad_reports(rosmc: Start) -> None:
         return [a.seq for a in robot.received("report_ack")]
 
     robot.publish("snapshot", snapshot())
-    wait_for(lambda: 0 in acked(), 10.0, "the server to learn r3's numbering")
+    wait_until(lambda: 0 in acked(), 10.0, "the server to learn r3's numbering")
     report(2)  # early: report 1 is missing
     report(1)  # a skill the server does not know
     report(1)  # again
     report(2, status=42)  # a status that does not exist
-    wait_for(lambda: acked()[-1:] == [2], 10.0, "the server to acknowledge report 2")
+    wait_until(lambda: acked()[-1:] == [2], 10.0, "the server to acknowledge report 2")
     assert acked().count(1) >= 2  # the duplicate was acknowledged again
     assert op.mission().revision == revision  # nothing applied
     assert system.alive("server")
@@ -679,6 +687,8 @@ def test_the_server_survives_bad_reports(rosmc: Start) -> None:
 
 def test_lost_link_policy_hold_set_by_the_operator(rosmc: Start) -> None:
     system, op = rosmc(agents=("r1",), emulated=("r1",))
+    robot_side = LinkEnd("r1", "ground", robot_names=True)  # hears r1 behind the emulator
+    wait_until(robot_side.connected, 10.0, "r1's side of the link")
     with MissionClient(timeout=20.0) as client:
         client.set_robot_options("r1", LostLinkPolicy(LostLinkKind.HOLD, after=1.0))
     op.wait_mission(
@@ -690,11 +700,12 @@ def test_lost_link_policy_hold_set_by_the_operator(rosmc: Start) -> None:
     op.start("r1")
     op.wait_status([long], S.RUNNING)
     op.blackout("r1", True)
-    time.sleep(2.0)
+    robot_side.wait_heard("report", lambda r: r.skill_id == long and r.status.value == S.PAUSED)
+    robot_side.close()
     op.blackout("r1", False)
     state = op.wait_status([long], S.PAUSED)
     assert state.skill(long).status_text == "held after 1 s without ground contact"
-    wait_for(
+    wait_until(
         lambda: "ground contact is back" in op.agent_state("r1").policy, 10.0, "the robot to say so"
     )
     assert op.mission().skill(long).status is S.PAUSED  # the operator decides when to go on
@@ -709,9 +720,9 @@ def test_a_snapshot_overtaken_by_newer_reports_does_not_stall_the_report_stream(
     """A snapshot processed after a newer report must not look like a robot restart."""
     _system, op = rosmc(agents=())
     robot = LinkEnd("r3", "robot")
-    wait_for(robot.connected, 10.0, "the server's link to r3")
+    wait_until(robot.connected, 10.0, "the server's link to r3")
     robot.publish("snapshot", wire.ExecutorSnapshot(agent="r3", queue_hash=queue_hash([])))
-    wait_for(lambda: robot.received("report_ack"), 10.0, "the server to learn r3's numbering")
+    wait_until(lambda: robot.received("report_ack"), 10.0, "the server to learn r3's numbering")
     a, b = op.add("r3", "wait", {"duration": 1.0}), op.add("r3", "wait", {"duration": 1.0})
     op.sync("r3")
     upload = robot.wait_heard("command", lambda c: c.type == wire.RobotCommand.UPLOAD)
@@ -748,9 +759,9 @@ def test_a_snapshot_overtaken_by_newer_reports_does_not_stall_the_report_stream(
         state="running",
     )
     report(2, a, S.SUCCESS, began + 0.2)
-    time.sleep(0.3)
+    op.wait_status([a], S.SUCCESS)
     robot.publish("snapshot", stale)  # taken before report 2, processed after it
-    time.sleep(0.3)
+    time.sleep(0.3)  # the server drops it without a word: nothing to wait on
     report(3, b, S.RUNNING, began + 0.3)
-    wait_for(lambda: op.mission().skill(b).status is S.RUNNING, 10.0, "report 3 to be applied")
+    wait_until(lambda: op.mission().skill(b).status is S.RUNNING, 10.0, "report 3 to be applied")
     assert [m.seq for m in robot.received("report_ack")][-1] == 3

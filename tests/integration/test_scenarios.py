@@ -29,7 +29,8 @@ from rosmc_server.core.changes import EventKind
 from rosmc_server.interface import EVENTS_TOPIC
 from rosmc_server.recording import read_journal
 from rosmc_sim.ros.demo_operator import OPERATOR_KINDS, WIFI_SPOT_ADAPTED
-from tests.integration.scenario_fixtures import Operator, Team, TeamSettings, wait_for
+from tests.conftest import wait_until
+from tests.integration.scenario_fixtures import Operator, Team, TeamSettings
 
 pytestmark = pytest.mark.integration
 
@@ -199,7 +200,7 @@ def test_collaborative_identification_scores_the_region_maximum(op: Operator) ->
     ]
     op.sync_and_start([DRONE, SCIENCE, ARM])
 
-    region = wait_for(lambda: op.science.region("RSS North"), 30.0, "the drone finds RSS North")
+    region = wait_until(lambda: op.science.region("RSS North"), 30.0, "the drone finds RSS North")
     assert region.identified_by == "" and region.stones_left == 1
     c.add_marker(TaskMarker("RSS North", MarkerType.POSITION, Pose(region.x, region.y)))
     at_rss = {"position": "RSS North"}
@@ -217,7 +218,7 @@ def test_collaborative_identification_scores_the_region_maximum(op: Operator) ->
     op.wait_status(survey + staging + sampling, S.SUCCESS, timeout=60.0)
 
     assert op.science.identified_by("RSS North") == "collaborative"
-    wait_for(lambda: op.science.score() > start_score, 10.0, "the score counts the stone")
+    wait_until(lambda: op.science.score() > start_score, 10.0, "the score counts the stone")
     assert op.science.score() - start_score == pytest.approx(region.max_score)
     assert any("RSS North together" in line for line in op.science.lines)
 
@@ -229,7 +230,7 @@ def test_without_identification_a_stone_scores_the_minimum(op: Operator) -> None
     explore = c.add_skill(SCIENCE, "explore", bindings={"area": "west"}).skill_id
     op.sync_and_start([SCIENCE])
 
-    region = wait_for(lambda: op.science.region("RSS West"), 60.0, "the rover finds RSS West")
+    region = wait_until(lambda: op.science.region("RSS West"), 60.0, "the rover finds RSS West")
     c.add_marker(TaskMarker("RSS West", MarkerType.POSITION, Pose(region.x, region.y)))
     fetch = [
         c.add_skill(ARM, "pick_stone", bindings={"position": "RSS West"}).skill_id,
@@ -239,7 +240,7 @@ def test_without_identification_a_stone_scores_the_minimum(op: Operator) -> None
     op.wait_status([explore, *fetch], S.SUCCESS, timeout=60.0)
 
     assert op.science.identified_by("RSS West") == ""
-    wait_for(lambda: op.science.score() > start_score, 10.0, "the score counts the stone")
+    wait_until(lambda: op.science.score() > start_score, 10.0, "the score counts the stone")
     assert op.science.score() - start_score == pytest.approx(0.1)
     assert any("RSS West stone 1 worth 0.10" in line for line in op.science.lines)
 

@@ -18,7 +18,7 @@ import sys
 import threading
 import time
 import xmlrpc.client
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -42,6 +42,7 @@ from rosmc_sim.ros.topics import (
     task_status_topic,
     task_topic,
 )
+from tests.conftest import wait_until
 
 REPO = Path(__file__).resolve().parents[2]
 MARS = REPO / "rosmc_sim" / "scenarios" / "mars_sample_return.yaml"
@@ -50,17 +51,6 @@ RTF = 20.0
 TIMEOUT = 15.0
 S = wire.RobotTaskStatus
 AREA_A = [{"x": 10, "y": 4}, {"x": 22, "y": 4}, {"x": 22, "y": 14}, {"x": 10, "y": 14}]
-
-
-def wait_for(predicate: Callable[[], Any], timeout: float = TIMEOUT, what: str = "") -> Any:
-    """Poll until ``predicate()`` is truthy; its value."""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        value = predicate()
-        if value:
-            return value
-        time.sleep(0.02)
-    pytest.fail(f"timed out waiting for {what or predicate}")
 
 
 class Latest:
@@ -98,7 +88,9 @@ class Robot:
         self.odom = Latest(odom_topic(name), Odometry)
         self.telemetry = Latest(f"/{name}/telemetry", wire.Telemetry)
         self.blackout = Latest(blackout_topic(name), Bool)
-        wait_for(lambda: self._task.get_num_connections() > 0, what=f"{name}'s task subscriber")
+        wait_until(
+            lambda: self._task.get_num_connections() > 0, TIMEOUT, f"{name}'s task subscriber"
+        )
 
     def send(self, task_id: str, action: int, skill: str = "", **params: Any) -> None:
         self._task.publish(
@@ -121,10 +113,18 @@ class Robot:
         def reached() -> Any:
             return next((m for m in self.statuses(task_id) if m.state in states), None)
 
-        return wait_for(reached, timeout, f"{self.name} {task_id} in state {states}")
+        return wait_until(reached, timeout, f"{self.name} {task_id} in state {states}")
+
+    def still(self) -> bool:
+        """The latest odometry says the robot stands still (no odometry from before a stop)."""
+        last = self.odom.last
+        if last is None:
+            return False
+        twist = last.twist.twist
+        return max(abs(twist.linear.x), abs(twist.linear.y), abs(twist.linear.z)) < 1e-9
 
     def position(self) -> tuple[float, float, float]:
-        p = wait_for(lambda: self.odom.last, what=f"{self.name} odometry").pose.pose.position
+        p = wait_until(lambda: self.odom.last, TIMEOUT, f"{self.name} odometry").pose.pose.position
         return (p.x, p.y, p.z)
 
     def close(self) -> None:
@@ -181,9 +181,9 @@ def sim(ros_master: Any, tmp_path_factory: pytest.TempPathFactory) -> Iterator[d
 def test_clock_advances_at_the_real_time_factor(sim: dict[str, Robot]) -> None:
     clock = Latest("/clock", Clock)
     try:
-        first = wait_for(lambda: clock.last, what="/clock").clock.to_sec()
+        first = wait_until(lambda: clock.last, TIMEOUT, "/clock").clock.to_sec()
         start = time.monotonic()
-        time.sleep(1.0)
+        time.sleep(1.0)  # a window to measure the rate over
         advanced = clock.last.clock.to_sec() - first
         assert 0.5 * RTF < advanced / (time.monotonic() - start) < 1.5 * RTF
     finally:
@@ -207,7 +207,7 @@ def test_tf_has_every_agent(sim: dict[str, Robot]) -> None:
 
 def test_telemetry_per_robot(sim: dict[str, Robot]) -> None:
     for name, robot in sim.items():
-        msg = wait_for(lambda robot=robot: robot.telemetry.last, what=f"{name} telemetry")
+        msg = wait_until(lambda robot=robot: robot.telemetry.last, TIMEOUT, f"{name} telemetry")
         assert msg.agent == name and msg.frame_id == "map"
         assert 0.0 < msg.battery <= 1.0
         assert msg.wifi_signal < 0.0
@@ -221,7 +221,9 @@ def test_take_off_then_navigate(sim: dict[str, Robot]) -> None:
     done = drone.wait_state("go", S.SUCCEEDED, S.FAILED)
     assert (done.state, done.text) == (S.SUCCEEDED, "arrived at (8.0, -4.0)")
     assert any(m.state == S.RUNNING and "to go" in m.text for m in drone.statuses("go"))
-    wait_for(lambda: math.dist(drone.position(), (8.0, -4.0, 6.0)) < 0.05, what="odom at target")
+    wait_until(
+        lambda: math.dist(drone.position(), (8.0, -4.0, 6.0)) < 0.05, TIMEOUT, "odom at target"
+    )
 
 
 def test_unknown_and_foreign_skills_fail_with_a_reason(sim: dict[str, Robot]) -> None:
@@ -237,35 +239,38 @@ def test_unknown_and_foreign_skills_fail_with_a_reason(sim: dict[str, Robot]) ->
 def test_pause_resume_cancel_preempt(sim: dict[str, Robot]) -> None:
     arm = sim["manipulator_rover"]
     arm.start("p1", "navigate_to", target=Pose(-20.0, -3.5))
-    wait_for(lambda: arm.position()[0] < -5.0, what="the rover driving")
+    wait_until(lambda: arm.position()[0] < -5.0, TIMEOUT, "the rover driving")
     arm.send("p1", wire.RobotTask.PAUSE)
     assert arm.wait_state("p1", S.PAUSED).text.startswith("paused")
-    time.sleep(0.3)
+    wait_until(arm.still, TIMEOUT, "the paused rover to stand still")
     held = arm.position()
-    time.sleep(0.5)
+    time.sleep(0.5)  # and it stays where it is
     assert math.dist(arm.position(), held) < 1e-6
     arm.send("p1", wire.RobotTask.RESUME)
-    wait_for(lambda: math.dist(arm.position(), held) > 0.5, what="the rover going on")
+    wait_until(lambda: math.dist(arm.position(), held) > 0.5, TIMEOUT, "the rover going on")
     assert arm.statuses("p1")[-1].state == S.RUNNING
     arm.start("p2", "navigate_to", target=Pose(-6.0, -6.0))  # preempts p1
     assert arm.wait_state("p1", S.FAILED).text == "preempted by p2"
     arm.send("p2", wire.RobotTask.CANCEL)
     assert arm.wait_state("p2", S.FAILED).text == "cancelled"
-    time.sleep(0.2)  # odometry sent before the cancel may still arrive
+    wait_until(arm.still, TIMEOUT, "the cancelled rover to stand still")
     where = arm.position()
+    answers = len(arm.statuses("p2"))
     arm.start("p2", "navigate_to", target=Pose(-6.0, -6.0))  # a retransmission: answered
-    time.sleep(0.5)
+    wait_until(lambda: len(arm.statuses("p2")) > answers, TIMEOUT, "the answer to the resend")
     assert arm.statuses("p2")[-1].text == "cancelled"
     assert math.dist(arm.position(), where) < 1e-6
 
 
 def test_leaving_coverage_blacks_out_the_link(sim: dict[str, Robot]) -> None:
     rover = sim["science_rover"]
-    assert wait_for(lambda: rover.blackout.last, what="blackout state").data is False
+    assert wait_until(lambda: rover.blackout.last, TIMEOUT, "blackout state").data is False
     rover.start("out", "navigate_to", target=Pose(3.5, -30.0), speed=1.0)
     assert rover.wait_state("out", S.SUCCEEDED, S.FAILED, timeout=30.0).state == S.SUCCEEDED
-    wait_for(lambda: rover.blackout.last.data is True, what="blackout true")
-    wait_for(lambda: rover.telemetry.last.in_coverage is False, what="telemetry out of coverage")
+    wait_until(lambda: rover.blackout.last.data is True, TIMEOUT, "blackout true")
+    wait_until(
+        lambda: rover.telemetry.last.in_coverage is False, TIMEOUT, "telemetry out of coverage"
+    )
 
 
 def test_fly_over_discovers_a_region(sim: dict[str, Robot]) -> None:
@@ -277,7 +282,7 @@ def test_fly_over_discovers_a_region(sim: dict[str, Robot]) -> None:
         drone.wait_state("climb", S.SUCCEEDED)
         drone.start("survey", "fly_over", area=AREA_A, altitude=8.0, spacing=4.0)
         assert drone.wait_state("survey", S.SUCCEEDED, S.FAILED).text == "found RSS A"
-        regions = wait_for(lambda: science.last and science.last.regions, what="a region")
+        regions = wait_until(lambda: science.last and science.last.regions, TIMEOUT, "a region")
         assert [r.name for r in regions] == ["RSS A"]
         assert regions[0].stones_left == 3 and regions[0].identified_by == ""
         events = [line for msg in science.all() for line in msg.events]
@@ -286,7 +291,7 @@ def test_fly_over_discovers_a_region(sim: dict[str, Robot]) -> None:
         def world_shows_region() -> bool:
             return bool(world.last) and any(m.ns == "regions" for m in world.last.markers)
 
-        wait_for(world_shows_region, what="the region in the world markers")
+        wait_until(world_shows_region, TIMEOUT, "the region in the world markers")
         namespaces = {m.ns for m in world.last.markers}
         assert {"ground", "obstacles", "lander", "boxes", "wifi", "stones"} <= namespaces
     finally:
@@ -326,7 +331,7 @@ def test_under_sim_time_the_clock_source_does_not_hear_itself(tmp_path: Path) ->
     log_path = tmp_path / "sim_node.log"
     proxy = xmlrpc.client.ServerProxy(uri)
     try:
-        wait_for(lambda: _answers(proxy), what="the private master")
+        wait_until(lambda: _answers(proxy), TIMEOUT, "the private master")
         proxy.setParam("/test", "/use_sim_time", True)
         with log_path.open("wb") as log:
             node = subprocess.Popen(
@@ -343,8 +348,8 @@ def test_under_sim_time_the_clock_source_does_not_hear_itself(tmp_path: Path) ->
             subs = next((nodes for topic, nodes in subscribers if topic == "/clock"), [])
             return (pubs, subs) if "/rosmc/sim" in pubs else None
 
-        wait_for(clock_nodes, what="the node publishing /clock")
-        time.sleep(1.0)
+        wait_until(clock_nodes, TIMEOUT, "the node publishing /clock")
+        time.sleep(1.0)  # and it never subscribes to /clock
         assert "/rosmc/sim" not in clock_nodes()[1]
         stop(node)
         assert node.returncode == 0
