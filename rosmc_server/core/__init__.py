@@ -1,7 +1,7 @@
 """The mission core: the ROSMC mission model and its rules, in pure Python.
 
-No rospy, genpy, generated messages, Qt or pybullet are imported here; the
-ROS adapters in :mod:`rosmc_server.ros` translate between this and the wire.
+No rospy, genpy, generated messages, Qt or pybullet are imported here;
+:mod:`rosmc_server.conversions` translates between this and the messages.
 """
 
 from .agent_status import AgentStatus

@@ -1,5 +1,8 @@
 """What the simulated robots can do: one task per skill, stepped with the simulation.
 
+A *robot task* here is the simulated controllers' run of one skill (``rosmc/RobotTask``
+asks for it), not the mission's *task* of an agent (its skills in order).
+
 Each task is a generator that sets the robot moving or working and yields
 progress text while it waits for the world to catch up; it returns a closing
 text on success and raises :class:`TaskFailed` with the reason on failure.

@@ -1,0 +1,299 @@
+"""The import rules of the layers, and a scanner that finds where a module breaks them.
+
+Used by ``test_layering.py``. Layering: who may import what, on every module of the
+``rosmc_*`` packages.
+
+DESIGN §2 and the issue that split the conversions out: the packages form one
+order of layers, and a module imports only from its own layer or below::
+
+    core < conversions < recording < ros < client < app
+    (0)(1)(2)(3)(4)(5)
+
+* **core**: every ``core/`` package (``rosmc_server/core``, ``rosmc_server/executor/core``,
+  ``rosmc_sim/core``, ``rosmc_rviz_markers/core``), ``rosmc_server/interface.py`` (graph
+  names) and the executor's plain skills. Pure Python.
+* **conversions**: ``rosmc_server/conversions`` (the only msg <-> core boundary; generated
+  messages and genpy, no rospy) and ``rosmc_server/text`` (plain-text rendering).
+* **recording**: ``rosmc_server/recording`` (the MCAP journal, history, timelines).
+* **ros**: the ROS adapters of the server, the executor and the simulator
+  (``rosmc_server/ros``, ``rosmc_server/executor/ros``, ``rosmc_sim/ros``).
+* **client**: ``rosmc_server/ros/client`` and ``rosmc_server/ros/replayer.py`` (it plays a
+  recording for clients, driven by ``rosmc replay``).
+* **app**: the CLI (``rosmc_server/cli``), the GUIs (everything of ``rosmc_rviz_markers``
+  and ``rosmc_rqt_command`` outside their ``core/``), the demos and the scripted demo
+  operator (``rosmc_sim/ros/demo_operator.py``).
+
+Besides the order, by what a module imports from outside:
+
+* **ROS runtime** (rospy, rosgraph, interactive_markers, tf2_ros, ...) only in a *ROS
+  adapter module*: one inside a ``ros/`` package, or named ``ros_*.py`` or ``node.py``;
+  and in a GUI's *entry modules* (``plugin.py``, the rqt Plugin, and ``standalone.py``,
+  the window's ``main``: they make the node and build the bridge and the widgets). So the
+  command GUI's Qt models and widgets never import rospy; its one adapter is
+  ``rosmc_rqt_command/ros_bridge.py``, and the marker servers' rospy lives in
+  ``rosmc_rviz_markers/ros/``.
+* **Messages** (genpy, ``rosmc.msg``/``rosmc.srv``, std/geometry/visualization messages,
+  rosbag) only in conversions, recording and ROS adapter modules: never in a core, the
+  text rendering, the CLI or a GUI model/widget (they get core objects from the client).
+* **Qt** only in the GUI packages outside their ``core/``.
+* **pybullet** only in ``rosmc_sim/core``.
+* **The server's insides**: apps reach the graph through the client. They import nothing
+  of ``rosmc_server.ros`` but the client, the replayer and the logging bridge; a GUI
+  model or widget (neither a ROS adapter nor an entry module) imports nothing of
+  ``rosmc_server.ros`` at all: the bridge hands it core objects.
+
+The scanner reads every module with :mod:`ast`, so a forbidden import is found even where
+it would never run (inside a function, an ``if`` or ``TYPE_CHECKING``).
+"""
+
+from __future__ import annotations
+
+import ast
+from dataclasses import dataclass
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+PACKAGES = ("rosmc_server", "rosmc_sim", "rosmc_rviz_markers", "rosmc_rqt_command")
+
+LAYERS = ("core", "conversions", "recording", "ros", "client", "app")
+RANK = {name: rank for rank, name in enumerate(LAYERS)}
+
+# Path (a folder ending in "/" or one file) -> layer; the longest matching entry wins. A new
+# folder or top-level module needs an entry (test_every_module_has_a_layer says so).
+LAYER_OF_PATH = {
+    "rosmc_server/__init__.py": "core",
+    "rosmc_server/core/": "core",
+    "rosmc_server/interface.py": "core",
+    "rosmc_server/executor/__init__.py": "core",
+    "rosmc_server/executor/core/": "core",
+    "rosmc_server/executor/basic_skills.py": "core",
+    "rosmc_server/conversions/": "conversions",
+    "rosmc_server/text/": "conversions",
+    "rosmc_server/recording/": "recording",
+    "rosmc_server/ros/": "ros",
+    "rosmc_server/executor/ros/": "ros",
+    "rosmc_server/ros/client/": "client",
+    "rosmc_server/ros/replayer.py": "client",
+    "rosmc_server/cli/": "app",
+    "rosmc_server/demo.py": "app",
+    "rosmc_sim/__init__.py": "core",
+    "rosmc_sim/core/": "core",
+    "rosmc_sim/ros/": "ros",
+    "rosmc_sim/ros/demo_operator.py": "app",
+    "rosmc_sim/demo.py": "app",
+    "rosmc_rviz_markers/": "app",
+    "rosmc_rviz_markers/core/": "core",
+    "rosmc_rqt_command/": "app",
+    "rosmc_rqt_command/core/": "core",
+}
+
+ROS_RUNTIME = {
+    "rospy",
+    "rosgraph",
+    "roslaunch",
+    "rosnode",
+    "rosservice",
+    "rostopic",
+    "rosparam",
+    "interactive_markers",
+    "tf2_ros",
+    "tf",
+    "actionlib",
+}
+MESSAGES = {
+    "genpy",
+    "roslib",
+    "rosbag",
+    "rosmc",
+    "std_msgs",
+    "std_srvs",
+    "geometry_msgs",
+    "visualization_msgs",
+    "nav_msgs",
+    "sensor_msgs",
+    "tf2_msgs",
+}
+QT = {
+    "PyQt5",
+    "PyQt6",
+    "PySide2",
+    "PySide6",
+    "python_qt_binding",
+    "Qt",
+    "qt_gui",
+    "rqt_gui",
+    "rqt_gui_py",
+}
+PYBULLET = {"pybullet", "pybullet_data"}
+WHY = {
+    **dict.fromkeys(ROS_RUNTIME, "the ROS runtime: only ROS adapter modules"),
+    **dict.fromkeys(MESSAGES, "messages: only conversions, recording and ROS adapters"),
+    **dict.fromkeys(QT, "Qt: only the GUI packages outside core/"),
+    **dict.fromkeys(PYBULLET, "pybullet: only rosmc_sim/core"),
+}
+GUI_PACKAGES = ("rosmc_rviz_markers/", "rosmc_rqt_command/")
+TEXT = "rosmc_server/text/"  # with the conversions in the order, but speaks no messages
+PYBULLET_ALLOWED = ("rosmc_sim/core/",)
+# What the apps may use of rosmc_server.ros: the client and what serves clients.
+FOR_APPS = (
+    "rosmc_server.ros.client",
+    "rosmc_server.ros.replayer",
+    "rosmc_server.ros.logging_bridge",
+)
+CONVERSIONS = "rosmc_server.conversions"
+# Dynamic imports with a literal module name are checked too.
+IMPORT_FUNCTIONS = {"import_module", "__import__"}
+
+
+@dataclass(frozen=True)
+class Violation:
+    """One forbidden import."""
+
+    path: str
+    line: int
+    module: str
+    why: str
+
+    def __str__(self) -> str:
+        return f"{self.path}:{self.line} imports {self.module} ({self.why})"
+
+
+def package_modules(root: Path = REPO) -> list[Path]:
+    """Every module of the repository's rosmc_* packages."""
+    return sorted(
+        path
+        for package in PACKAGES
+        for path in (root / package).glob("**/*.py")
+        if "__pycache__" not in path.parts
+    )
+
+
+def core_modules(root: Path = REPO) -> list[Path]:
+    """Every module of every ``core`` package of the repository's rosmc_* packages."""
+    return sorted(
+        path for path in root.glob("rosmc_*/**/core/**/*.py") if "__pycache__" not in path.parts
+    )
+
+
+def layer_of(relative: str) -> str | None:
+    """The layer of a module given by its path below the repository (None: no entry)."""
+    matches = [
+        key
+        for key in LAYER_OF_PATH
+        if key == relative or (key.endswith("/") and relative.startswith(key))
+    ]
+    return LAYER_OF_PATH[max(matches, key=len)] if matches else None
+
+
+def is_gui_entry(relative: str) -> bool:
+    """A GUI package's ``plugin.py`` or ``standalone.py`` (they start the GUI)."""
+    package, *rest = relative.split("/")
+    return f"{package}/" in GUI_PACKAGES and rest in (["plugin.py"], ["standalone.py"])
+
+
+def is_ros_adapter(relative: str) -> bool:
+    """A module that may use the ROS runtime: in a ``ros/`` package, ``ros_*.py`` or ``node.py``."""
+    *folders, name = relative.split("/")
+    return "ros" in folders[1:] or name.startswith("ros_") or name == "node.py"
+
+
+def module_name(path: Path, root: Path) -> list[str]:
+    """The dotted module name of ``path`` (below ``root``), as its parts."""
+    parts = list(path.relative_to(root).with_suffix("").parts)
+    return parts[:-1] if parts[-1] == "__init__" else parts
+
+
+def _absolute(node: ast.ImportFrom, path: Path, root: Path) -> str:
+    """The absolute module an ``from ... import`` names (resolving leading dots)."""
+    if node.level == 0:
+        return node.module or ""
+    package = module_name(path, root)
+    if path.name != "__init__.py":
+        package = package[:-1]
+    base = package[: len(package) - (node.level - 1)] if node.level > 1 else package
+    return ".".join([*base, *([node.module] if node.module else [])])
+
+
+def _imported(tree: ast.AST, path: Path, root: Path) -> list[tuple[int, str]]:
+    found: list[tuple[int, str]] = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found += [(node.lineno, alias.name) for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            module = _absolute(node, path, root)
+            found.append((node.lineno, module))
+            # "from rosmc_server import ros" imports the ros layer too.
+            found += [(node.lineno, f"{module}.{alias.name}") for alias in node.names]
+        elif isinstance(node, ast.Call):
+            func = node.func
+            name = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", "")
+            if name in IMPORT_FUNCTIONS and node.args:
+                first = node.args[0]
+                if isinstance(first, ast.Constant) and isinstance(first.value, str):
+                    found.append((node.lineno, first.value))
+    return found
+
+
+def _module_path(module: str, root: Path) -> str:
+    """The path of the file an imported ``rosmc_*`` name lives in (its longest module part)."""
+    parts = module.split(".")
+    for end in range(len(parts), 0, -1):
+        stem = "/".join(parts[:end])
+        if (root / f"{stem}.py").is_file():
+            return f"{stem}.py"
+        if (root / stem / "__init__.py").is_file():
+            return f"{stem}/__init__.py"
+    return "/".join(parts) + ".py"
+
+
+def _outside_rule(relative: str, top: str) -> bool:
+    """Whether ``relative`` may import the third-party module ``top``."""
+    layer = layer_of(relative)
+    gui = relative.startswith(GUI_PACKAGES)
+    if top in ROS_RUNTIME:
+        return is_ros_adapter(relative) or is_gui_entry(relative)
+    if top in MESSAGES:
+        if is_ros_adapter(relative):
+            return True
+        return layer in ("conversions", "recording") and not relative.startswith(TEXT)
+    if top in QT:
+        return gui and layer != "core"
+    if top in PYBULLET:
+        return relative.startswith(PYBULLET_ALLOWED)
+    return True
+
+
+def _inside_rule(relative: str, module: str, root: Path) -> str | None:
+    """Why ``relative`` may not import the rosmc_* name ``module`` (None: it may)."""
+    layer = layer_of(relative)
+    target = _module_path(module, root)
+    target_layer = layer_of(target)
+    if layer is None or target_layer is None:
+        return None  # reported by the test that every module has a layer
+    if RANK[target_layer] > RANK[layer]:
+        return f"the {target_layer} layer, above this {layer} module"
+    if layer == "app" and module.startswith(CONVERSIONS) and not is_ros_adapter(relative):
+        return "message conversions: apps get core objects from the client"
+    if layer == "app" and module.startswith("rosmc_server.ros"):
+        gui_model = not (is_ros_adapter(relative) or is_gui_entry(relative))
+        if relative.startswith(GUI_PACKAGES) and gui_model:
+            return "rosmc_server.ros: a GUI model or widget gets it from the GUI's ROS adapter"
+        if module != "rosmc_server.ros" and not module.startswith(FOR_APPS):
+            return "the server's ROS adapters: apps go through the client"
+    return None
+
+
+def scan(path: Path, root: Path = REPO) -> list[Violation]:
+    """The forbidden imports of one module of the rosmc_* packages."""
+    relative = path.relative_to(root).as_posix()
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    violations = []
+    for line, module in _imported(tree, path, root):
+        top = module.split(".")[0]
+        if top.startswith("rosmc_"):
+            why = _inside_rule(relative, module, root)
+        else:
+            why = None if _outside_rule(relative, top) else WHY[top]
+        if why is not None:
+            violations.append(Violation(relative, line, module, why))
+    return violations
