@@ -106,14 +106,15 @@ def run(args: argparse.Namespace, server: Server) -> int:
     widget.resize(1600, 900)
     widget.show()
 
-    def after_update(update: ViewUpdate) -> None:  # runs after the widget's own slot
+    def after_update(batch: tuple[ViewUpdate, ...]) -> None:  # after the widget's own slot
         now = time.monotonic()
-        if update.reset and not shown:
+        if any(update.reset for update in batch) and not shown:
             QTimer.singleShot(0, lambda: shown.append(time.monotonic()))
         with lock:
-            for view in update.agents:
-                for skill in view.skills:
-                    if pending.get(skill.id) == skill.label:
+            for update in batch:
+                for skill_id in update.changed_ids & pending.keys():
+                    skill = widget.view.skill(skill_id)
+                    if skill is not None and pending.get(skill_id) == skill.label:
                         seen[skill.id + skill.label] = now
                         del pending[skill.id]
 

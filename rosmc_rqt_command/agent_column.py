@@ -8,12 +8,11 @@ can be reordered by drag and drop. The buttons act on this robot; they are enabl
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from python_qt_binding.QtCore import QSize, Qt, Signal
 from python_qt_binding.QtWidgets import (
     QAbstractItemView,
-    QComboBox,
     QFrame,
     QHBoxLayout,
     QHeaderView,
@@ -27,22 +26,18 @@ from python_qt_binding.QtWidgets import (
     QWidget,
 )
 
-from rosmc_server.core import AgentStatus
+from rosmc_server.core import AgentStatus, LostLinkPolicy
 
 from . import presentation
 from .legality import RobotAction
 from .mission_view import MissionView
+from .policy_dialog import ask_policy
 from .schedule_model import NUMBER, PARAMS, SKILL, STATUS, TAG, SectionModel
 from .view_state import AgentView
 
 ROW_HEIGHT = 22
 COLUMN_WIDTH = 350
-# Lost-link policies an operator picks from: (label, policy, safe skill or "").
-POLICIES = (
-    ("keep going if the link is lost", "continue", ""),
-    ("hold if the link is lost for 30 s", "hold", ""),
-    ("return to the lander if the link is lost for 30 s", "safe_skill", "return_to_lander"),
-)
+AskPolicy = Callable[[str, Sequence[str], QWidget], LostLinkPolicy | None]
 
 
 class SectionTable(QTableView):  # type: ignore[misc]
@@ -106,7 +101,7 @@ class AgentColumn(QFrame):  # type: ignore[misc]
 
     robot_action = Signal(str, object)  # agent, RobotAction
     add_requested = Signal(str, str)  # agent, skill name
-    policy_chosen = Signal(str, str, str)  # agent, policy, safe skill
+    policy_chosen = Signal(str, object)  # agent, LostLinkPolicy
 
     def __init__(self, agent: str, view: MissionView, parent: QWidget | None = None) -> None:
         super().__init__(parent)
@@ -125,13 +120,14 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         self.status_label = QLabel(presentation.link_summary(None))
         self.status_label.setWordWrap(True)
         self.status_label.setObjectName(f"status_{agent}")
-        self.policy_combo = QComboBox()
-        self.policy_combo.setObjectName(f"policy_{agent}")
-        self.policy_combo.setToolTip("What the robot does when it loses contact with the ground")
-        self.policy_combo.setSizePolicy(QSizePolicy.Ignored, QSizePolicy.Fixed)
-        for label, _, _ in POLICIES:
-            self.policy_combo.addItem(label)
-        self.policy_combo.activated.connect(self._on_policy_combo_activated)
+        self.skill_names: list[str] = []
+        self.ask_policy: AskPolicy = ask_policy  # tests answer the dialog through this
+        self.policy_button = self._tool(
+            "If the link is lost…", "", "What the robot does when it loses contact with the ground"
+        )
+        self.policy_button.setObjectName(f"policy_{agent}")
+        self.policy_button.setSizePolicy(QSizePolicy.Ignored, QSizePolicy.Fixed)
+        self.policy_button.clicked.connect(self._on_policy_button_clicked)
 
         self.add_menu = QMenu(self)
         self.add_button = self._tool("Add skill", "", f"Add a skill to {agent}'s blueprint")
@@ -155,7 +151,7 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         top.addStretch(1)
         header.addLayout(top)
         header.addWidget(self.status_label)
-        header.addWidget(self.policy_combo)
+        header.addWidget(self.policy_button)
         bar = QHBoxLayout()
         bar.addWidget(self.add_button)
         for button in self.buttons.values():
@@ -201,7 +197,8 @@ class AgentColumn(QFrame):  # type: ignore[misc]
     def set_skills(self, names: Sequence[str]) -> None:
         """The skills the Add menu offers (the robot's skills)."""
         self.add_menu.clear()
-        for name in sorted(names):
+        self.skill_names = sorted(names)
+        for name in self.skill_names:
             self.add_menu.addAction(name)
 
     def set_legal(self, legal: set[RobotAction], read_only: bool) -> None:
@@ -209,11 +206,12 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         for action, button in self.buttons.items():
             button.setEnabled(not read_only and action in legal)
         self.add_button.setEnabled(not read_only and not self.add_menu.isEmpty())
-        self.policy_combo.setEnabled(not read_only)
+        self.policy_button.setEnabled(not read_only and bool(self.skill_names))
 
     def _on_add_menu_triggered(self, action: object) -> None:
         self.add_requested.emit(self.agent, action.text())  # type: ignore[attr-defined]
 
-    def _on_policy_combo_activated(self, index: int) -> None:
-        _, policy, safe_skill = POLICIES[index]
-        self.policy_chosen.emit(self.agent, policy, safe_skill)
+    def _on_policy_button_clicked(self) -> None:
+        policy = self.ask_policy(self.agent, self.skill_names, self)
+        if policy is not None:
+            self.policy_chosen.emit(self.agent, policy)

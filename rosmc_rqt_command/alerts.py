@@ -11,9 +11,11 @@ No Qt here.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import itertools
+import time
+from collections.abc import Iterable, Sequence
 
-from rosmc_server.core import RosmcError, SkillInstance, SkillStatus
+from rosmc_server.core import Library, RosmcError, SkillInstance, SkillStatus
 
 from .mission_view import MissionView
 
@@ -55,41 +57,62 @@ def coverage_warnings(view: MissionView) -> list[str]:
 
 
 class ParameterChecker:
-    """Finds skills with a parameter the library refuses; re-checks only changed skills."""
+    """Finds skills with a parameter the library refuses, checking only what changed.
 
-    def __init__(self, budget: int = 500) -> None:
-        self._seen: dict[str, tuple[SkillInstance, str]] = {}
+    :meth:`note` marks the skills an update touched (all of them after a new mission or
+    library); :meth:`warnings` checks marked skills for at most ``budget`` seconds per
+    call, so a 10,000-skill mission never blocks the window: the rest waits for the
+    next call (:attr:`incomplete`).
+    """
+
+    def __init__(self, budget: float = 0.01) -> None:
         self._budget = budget
-        self.incomplete = False  # skills were left for the next call (keeps each call short)
+        self._dirty: dict[str, None] = {}  # ordered set of skill ids to check
+        self._all = True  # everything needs checking (start, new mission, new library)
+        self._problems: dict[str, str] = {}
+
+    @property
+    def incomplete(self) -> bool:
+        """Skills are left to check (call :meth:`warnings` again soon)."""
+        return self._all or bool(self._dirty)
+
+    def note(self, skill_ids: Iterable[str] | None) -> None:
+        """These skills changed (None: every skill, e.g. a new mission or library)."""
+        if skill_ids is None:
+            self._all = True
+            self._dirty = {}
+        elif not self._all:
+            self._dirty.update(dict.fromkeys(skill_ids))
 
     def warnings(self, view: MissionView) -> list[str]:
         """One sentence per unfinished skill with an invalid parameter."""
         library = view.library
         if library is None:
             return []
-        out = []
-        seen: dict[str, tuple[SkillInstance, str]] = {}
-        checks = 0
-        self.incomplete = False
-        for task in view.agents.values():
-            for skill in task.skills:
-                if skill.status.is_final:
-                    continue
-                cached = self._seen.get(skill.id)
-                problem = cached[1] if cached is not None and cached[0] is skill else ""
-                if cached is None or cached[0] is not skill:
-                    checks += 1
-                    if checks > self._budget:
-                        self.incomplete = True
-                        continue
-                    try:
-                        spec = library.skill(skill.agent, skill.skill)
-                        for name, value in skill.params.items():
-                            spec.parameter(name).check(value, skill.skill)
-                    except RosmcError as error:
-                        problem = f"{skill.agent}'s '{skill.label or skill.skill}': {error}."
-                seen[skill.id] = (skill, problem)
+        if self._all:
+            self._all = False
+            self._problems = {}
+            self._dirty = {s.id: None for task in view.agents.values() for s in task.skills}
+        deadline = time.monotonic() + self._budget
+        while self._dirty and time.monotonic() < deadline:
+            for skill_id in list(itertools.islice(self._dirty, 10)):
+                del self._dirty[skill_id]
+                skill = view.skill(skill_id)
+                problem = "" if skill is None else _problem(library, skill)
                 if problem:
-                    out.append(problem)
-        self._seen = seen
-        return out
+                    self._problems[skill_id] = problem
+                else:
+                    self._problems.pop(skill_id, None)
+        return list(self._problems.values())
+
+
+def _problem(library: Library, skill: SkillInstance) -> str:
+    if skill.status.is_final:
+        return ""
+    try:
+        spec = library.skill(skill.agent, skill.skill)
+        for name, value in skill.params.items():
+            spec.parameter(name).check(value, skill.skill)
+    except RosmcError as error:
+        return f"{skill.agent}'s '{skill.label or skill.skill}': {error}."
+    return ""

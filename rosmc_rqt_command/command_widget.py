@@ -10,7 +10,7 @@ shown as a sentence.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from typing import Any
 
 from python_qt_binding.QtCore import QPoint, Qt, QTimer
@@ -24,14 +24,15 @@ from python_qt_binding.QtWidgets import (
     QWidget,
 )
 
-from rosmc_server.core import Library, SkillInstance
+from rosmc_server.core import AgentStatus, Library, LostLinkPolicy
 
 from . import alerts
 from .actions import CommandActions
 from .agent_column import SectionTable
 from .control_panel import ControlPanel
+from .dispatch import Dispatcher
 from .file_menu import FileController
-from .legality import Action, RobotAction, legal_actions, legal_for_all, legal_robot_actions
+from .legality import Action, RobotAction, RobotLegality, legal_actions
 from .message_area import MessageArea
 from .mission_view import MissionView
 from .parameter_panel import ParameterPanel
@@ -39,12 +40,9 @@ from .requests import Answer, Backend, Request
 from .schedule_widget import ScheduleWidget
 from .view_state import ViewUpdate
 
-CONTROL_WORDS = {
-    RobotAction.START: "START",
-    RobotAction.PAUSE: "PAUSE",
-    RobotAction.RESUME: "RESUME",
-    RobotAction.STOP: "STOP",
-}
+# Robot headers and robot buttons follow live reports at most this often (ms): robots
+# report at up to 10 Hz each, and nobody reads a battery figure faster than that.
+STATUS_REPAINT_MS = 200
 
 
 class CommandWidget(QWidget):  # type: ignore[misc]
@@ -63,7 +61,10 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.messages = MessageArea()
         self.files = FileController(self, self.actions_, self.view, self.messages, self.send)
         self._checker = alerts.ParameterChecker()
+        self._robot_legal = RobotLegality()
+        self.dispatcher = Dispatcher(self.view, self.send, self._confirm, self._robot_legal.any)
         self._select_when_seen: list[str] = []
+        self._pending_statuses: dict[str, AgentStatus] = {}
         self.connected = False
         self._build_layout()
         self._connect()
@@ -71,6 +72,10 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self._warn_timer.setSingleShot(True)
         self._warn_timer.setInterval(300)
         self._warn_timer.timeout.connect(self._on_warn_timer_timeout)
+        self._status_timer = QTimer(self)
+        self._status_timer.setSingleShot(True)
+        self._status_timer.setInterval(STATUS_REPAINT_MS)
+        self._status_timer.timeout.connect(self._on_status_timer_timeout)
         self.banner.setText("Waiting for the mission server…")
         self._update_legal()
 
@@ -135,30 +140,57 @@ class CommandWidget(QWidget):  # type: ignore[misc]
     # -- from the backend ---------------------------------------------------------------------
     def on_update(self, update: ViewUpdate) -> None:
         """Show one mission update (GUI thread, in revision order)."""
-        first = not self.view.loaded and update.reset
-        self.view.apply(update)
-        self.schedule.apply(update)
-        if update.agents or update.markers is not None or update.barriers is not None:
-            self.parameters.refresh(force=update.markers is not None or update.reset)
+        self.on_updates((update,))
+
+    def on_updates(self, updates: Sequence[ViewUpdate]) -> None:
+        """Show several mission updates at once (GUI thread, in revision order).
+
+        Rows change update by update (only those an update touched); what depends on the
+        whole picture (buttons, parameter panel, warnings) is worked out once per batch.
+        Robot reports are only collected here and shown by a timer (STATUS_REPAINT_MS).
+        """
+        agents: set[str] = set()
+        changed: set[str] = set()
+        first = reset = refresh_parameters = False
+        for update in updates:
+            first = first or (not self.view.loaded and update.reset)
+            reset = reset or update.reset
+            self.view.apply(update)
+            self.schedule.apply(update)
+            agents.update(view.agent for view in update.agents)
+            changed |= update.changed_ids
+            refresh_parameters = refresh_parameters or bool(
+                update.agents or update.markers is not None or update.barriers is not None
+            )
+            for status in update.statuses:
+                self._pending_statuses[status.agent] = status
+        if refresh_parameters:
+            self.parameters.refresh(force=reset or any(u.markers is not None for u in updates))
         if self._select_when_seen and all(self.view.skill(i) for i in self._select_when_seen):
             self.schedule.select_ids(self._select_when_seen)
             self._select_when_seen = []
-        self._update_legal([v.agent for v in update.agents] + [s.agent for s in update.statuses])
+        self._checker.note(None if reset else changed)
+        self._update_legal(None if reset else agents)
         self.files.on_mission_shown()
         if first:
             self.files.mark_saved()
-            self.messages.say(f"Mission shown (revision {update.revision}).", "ok")
-        if update.reset:
+            self.messages.say(f"Mission shown (revision {self.view.revision}).", "ok")
+        if reset:
             self.banner.hide()
-        if not self._warn_timer.isActive():
-            self._warn_timer.start()
+        if self._pending_statuses and not self._status_timer.isActive():
+            self._status_timer.start()
+        if (agents or reset) and not self._warn_timer.isActive():
+            self._warn_timer.start(300)
 
     def on_library(self, library: Library) -> None:
         """The skill library arrived: offer each robot's skills."""
         self.view.library = library
         self.schedule.set_library(library)
         self.parameters.refresh(force=True)
+        self._checker.note(None)
         self._update_legal()
+        if not self._warn_timer.isActive():
+            self._warn_timer.start(300)
 
     def on_connection(self, connected: bool) -> None:
         """The mission server appeared or went away."""
@@ -217,82 +249,17 @@ class CommandWidget(QWidget):  # type: ignore[misc]
             return
         self.backend.request(request)
 
-    def _request(self, operation: str, *args: Any, what: str, **kwargs: Any) -> None:
-        self.send(Request(operation, args, kwargs, what, self.view.revision))
-
     def do(self, kind: Action) -> None:
         """Run a skill action on the selection (if it is legal now)."""
-        selected = self.view.skills(self.schedule.selected_ids)
-        if kind not in legal_actions(self.view, selected) or self.backend.read_only:
-            return
-        first = selected[0]
-        names = ", ".join(f"'{s.label or s.skill}'" for s in selected)
-        if kind is Action.DELETE:
-            ids = [s.id for s in selected]
-            self._request("delete_skills", ids, what=f"delete {names}")
-        elif kind in (Action.MOVE_UP, Action.MOVE_DOWN):
-            order = self._moved([s.id for s in selected], first.agent, kind is Action.MOVE_UP)
-            self._request("reorder", first.agent, order, what=f"move {names}")
-        elif kind is Action.SYNC:
-            editable = self.view.view(first.agent).editable
-            last = max(self.view.position(s) for s in selected)
-            upto = next(s for s in editable if self.view.position(s) == last)
-            sending = [s for s in editable if self.view.position(s) <= last]
-            if self._confirm_barriers(sending):
-                self._request(
-                    "synchronize",
-                    first.agent,
-                    upto.id,
-                    what=f"send {first.agent}'s plan up to {names}",
-                )
-        elif kind is Action.UNSYNC:
-            start = min(selected, key=self.view.position)
-            self._request(
-                "unsynchronize",
-                first.agent,
-                start.id,
-                what=f"take back {first.agent}'s skills from '{start.label or start.skill}'",
-            )
-        elif kind is Action.RETRY:
-            self._request("retry", first.id, what=f"retry {names}")
-        elif kind is Action.SKIP:
-            self._request("skip", first.id, what=f"skip {names}")
-        elif kind is Action.BARRIER:
-            self._request("add_barrier", [s.id for s in selected], what=f"start {names} together")
-        elif kind is Action.DELETE_BARRIER:
-            barriers = {b.id for s in selected if (b := self.view.barrier_of(s.id)) is not None}
-            for barrier_id in sorted(barriers):
-                self._request("delete_barrier", barrier_id, what=f"remove barrier of {names}")
+        if not self.backend.read_only:
+            self.dispatcher.skill_action(kind, self.view.skills(self.schedule.selected_ids))
 
     def do_robot(self, agent: str | None, kind: RobotAction) -> None:
-        """Run a robot action on ``agent`` (None: every robot)."""
-        legal = legal_for_all(self.view) if agent is None else legal_robot_actions(self.view, agent)
-        if kind not in legal or self.backend.read_only:
-            return
-        who = "every robot" if agent is None else agent
-        if kind is RobotAction.SYNC_ALL and agent is not None:
-            if self._confirm_barriers(self.view.view(agent).editable):
-                self._request("synchronize", agent, None, what=f"send {agent}'s whole plan")
-        elif kind is RobotAction.UNSYNC_ALL and agent is not None:
-            self._request("unsynchronize", agent, None, what=f"take back {agent}'s plan")
-        elif kind in CONTROL_WORDS:
-            word = kind.value
-            self._request("control", CONTROL_WORDS[kind], agent, what=f"{word} {who}")
+        """Run a robot action on ``agent`` (None: every robot), if it is legal now."""
+        if not self.backend.read_only:
+            self.dispatcher.robot_action(agent, kind)
 
-    def _moved(self, ids: list[str], agent: str, up: bool) -> list[str]:
-        order = [s.id for s in self.view.view(agent).editable]
-        step = -1 if up else 1
-        positions = sorted((order.index(i) for i in ids if i in order), reverse=not up)
-        for position in positions:
-            target = position + step
-            if 0 <= target < len(order) and order[target] not in ids:
-                order[position], order[target] = order[target], order[position]
-        return order
-
-    def _confirm_barriers(self, sending: Sequence[SkillInstance]) -> bool:
-        warnings = alerts.barrier_warnings(self.view, sending)
-        if not warnings:
-            return True
+    def _confirm(self, warnings: list[str]) -> bool:
         for warning in warnings:
             self.messages.say(warning, "warning")
         answer = QMessageBox.warning(
@@ -351,22 +318,24 @@ class CommandWidget(QWidget):  # type: ignore[misc]
             )
         )
 
-    def _on_schedule_policy_chosen(self, agent: str, policy: str, safe_skill: str) -> None:
-        self._request(
-            "set_robot_options", agent, policy, safe_skill, what=f"set {agent}'s lost-link policy"
+    def _on_schedule_policy_chosen(self, agent: str, policy: LostLinkPolicy) -> None:
+        self.dispatcher.request(
+            "set_robot_options", agent, policy, what=f"set {agent}'s policy ({policy.describe()})"
         )
 
     def _on_schedule_reorder_requested(self, agent: str, order: list[str]) -> None:
-        self._request("reorder", agent, order, what=f"reorder {agent}'s plan")
+        self.dispatcher.request("reorder", agent, order, what=f"reorder {agent}'s plan")
 
     def _on_parameters_edit_requested(self, skill_id: str, fields: dict[str, Any]) -> None:
         skill = self.view.skill(skill_id)
         name = f"'{skill.label or skill.skill}'" if skill is not None else skill_id
         changed = ", ".join(fields.get("params", {}) or fields.get("bindings", {}) or fields)
-        self._request("edit_skill", skill_id, what=f"change {changed} of {name}", **fields)
+        self.dispatcher.request(
+            "edit_skill", skill_id, what=f"change {changed} of {name}", **fields
+        )
 
     def _on_parameters_rename_requested(self, old: str, new: str) -> None:
-        self._request("rename_marker", old, new, what=f"rename marker {old} to {new}")
+        self.dispatcher.request("rename_marker", old, new, what=f"rename marker {old} to {new}")
 
     def _on_refresh_triggered(self) -> None:
         self.backend.refresh()
@@ -380,20 +349,31 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         ]
         self.messages.show_warnings(warnings)
         if self._checker.incomplete:
-            self._warn_timer.start()  # the rest of a big mission next time
+            self._warn_timer.start(50)  # the rest of a big mission in a moment
+
+    def _on_status_timer_timeout(self) -> None:
+        statuses, self._pending_statuses = self._pending_statuses, {}
+        self.schedule.show_statuses(statuses.values())
+        self._update_legal(statuses)
+        if not self._warn_timer.isActive():
+            self._warn_timer.start(300)
 
     # -- enabling -------------------------------------------------------------------------------
-    def _update_legal(self, agents: list[str] | None = None) -> None:
+    def _update_legal(self, agents: Iterable[str] | None = None) -> None:
+        """Enable what is legal now; only ``agents``' robot actions are recomputed."""
         read_only = self.backend.read_only
+        agents = None if agents is None else list(agents)
+        self._robot_legal.update(self.view, agents)
         selected = self.view.skills(self.schedule.selected_ids)
         legal = set() if read_only else legal_actions(self.view, selected)
         for kind, action in self.actions_.skill.items():
             action.setEnabled(kind in legal)
-        everyone = set() if read_only else legal_for_all(self.view)
+        everyone = set() if read_only else self._robot_legal.any()
         for robot_action, action in self.actions_.all_robots.items():
             action.setEnabled(robot_action in everyone)
         for name, action in self.actions_.file.items():
             action.setEnabled(not read_only or name in ("save_as",))
-        for agent, column in self.schedule.columns.items():
-            if agents is None or agent in agents:
-                column.set_legal(legal_robot_actions(self.view, agent), read_only)
+        for agent in self.schedule.columns if agents is None else agents:
+            column = self.schedule.columns.get(agent)
+            if column is not None:
+                column.set_legal(self._robot_legal.of(agent), read_only)

@@ -13,6 +13,8 @@ from pathlib import Path
 
 from python_qt_binding.QtWidgets import QFileDialog, QInputDialog, QMessageBox, QWidget
 
+from rosmc_server.core import Barrier, SkillInstance, TaskMarker
+
 from .actions import CommandActions
 from .message_area import MessageArea
 from .mission_view import MissionView
@@ -22,20 +24,32 @@ FILTER = "Mission files (*.yaml *.yml);;All files (*)"
 Send = Callable[[Request], None]
 
 
-def plan_fingerprint(view: MissionView) -> tuple[object, ...]:
-    """What a mission file keeps of the plan (ignores statuses and robot progress)."""
-    tasks = tuple(
+Plan = tuple[
+    str,
+    tuple[tuple[str, tuple[SkillInstance, ...]], ...],
+    tuple[Barrier, ...],
+    tuple[TaskMarker, ...],
+]
+
+
+def plan_of(view: MissionView) -> Plan:
+    """The plan as it is now, by reference (cheap: the view holds immutable values)."""
+    tasks = tuple((agent, task.skills) for agent, task in view.agents.items())
+    return (view.library_name, tasks, view.barriers, tuple(view.markers.values()))
+
+
+def plan_fingerprint(plan: Plan) -> tuple[object, ...]:
+    """What a mission file keeps of a plan (ignores statuses and robot progress)."""
+    library, tasks, barriers, markers = plan
+    steps = tuple(
         (
             agent,
-            tuple(
-                (s.skill, s.label, repr(dict(s.params)), repr(dict(s.bindings))) for s in v.skills
-            ),
+            tuple((s.skill, s.label, repr(dict(s.params)), repr(dict(s.bindings))) for s in skills),
         )
-        for agent, v in view.agents.items()
+        for agent, skills in tasks
     )
-    barriers = tuple(sorted(tuple(sorted(b.skill_ids)) for b in view.barriers))
-    markers = tuple(sorted(repr(m) for m in view.markers.values()))
-    return (view.library_name, tasks, barriers, markers)
+    barrier_sets = tuple(sorted(tuple(sorted(b.skill_ids)) for b in barriers))
+    return (library, steps, barrier_sets, tuple(sorted(repr(m) for m in markers)))
 
 
 class FileController:
@@ -54,7 +68,7 @@ class FileController:
         self._messages = messages
         self._send = send
         self.location: tuple[str, str] | None = None  # ("local" | "server", path)
-        self._saved: tuple[object, ...] | None = None
+        self._saved: Plan | None = None
         self.ask: Callable[[str], str] = self._ask_save_changes
         handlers = {
             "new": self.new_mission,
@@ -70,14 +84,15 @@ class FileController:
     # -- unsaved changes ------------------------------------------------------------------------
     def mark_saved(self) -> None:
         """The plan as it is now counts as saved (after a load, save or new mission)."""
-        self._saved = plan_fingerprint(self._view)
+        self._saved = plan_of(self._view)
 
     @property
     def dirty(self) -> bool:
         """The plan changed since it was last saved, loaded or started anew."""
         if self._saved is None:
             return any(view.skills for view in self._view.agents.values())
-        return plan_fingerprint(self._view) != self._saved
+        now = plan_of(self._view)
+        return now != self._saved and plan_fingerprint(now) != plan_fingerprint(self._saved)
 
     def confirm_discard(self, doing: str) -> bool:
         """Ask to save unsaved changes before ``doing``; False if the operator cancels."""
@@ -152,7 +167,7 @@ class FileController:
 
     def save_local(self, path: str) -> None:
         """Save the mission to a file on this computer."""
-        fingerprint = plan_fingerprint(self._view)
+        fingerprint = plan_of(self._view)
         self._send(
             Request(
                 "save_mission",
@@ -163,7 +178,7 @@ class FileController:
 
     def save_server(self, path: str) -> None:
         """Save the mission to a file on the server's computer."""
-        fingerprint = plan_fingerprint(self._view)
+        fingerprint = plan_of(self._view)
         self._send(
             Request(
                 "save_mission",
@@ -193,9 +208,7 @@ class FileController:
             self.pending_mark = False
             self.mark_saved()
 
-    def _on_saved_document(
-        self, answer: Answer, path: str, fingerprint: tuple[object, ...]
-    ) -> None:
+    def _on_saved_document(self, answer: Answer, path: str, fingerprint: Plan) -> None:
         if not answer.ok:
             return
         try:
@@ -206,9 +219,7 @@ class FileController:
         self._messages.say(f"Saved the mission to {path}.", "ok")
         self._on_saved(answer, ("local", path), fingerprint)
 
-    def _on_saved(
-        self, answer: Answer, location: tuple[str, str], fingerprint: tuple[object, ...]
-    ) -> None:
+    def _on_saved(self, answer: Answer, location: tuple[str, str], fingerprint: Plan) -> None:
         if answer.ok:
             self.location = location
             self._saved = fingerprint

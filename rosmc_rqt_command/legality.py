@@ -9,7 +9,7 @@ the mirror computed. No Qt here.
 from __future__ import annotations
 
 import enum
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 
 from rosmc_server.core import Resolution, SkillInstance, SkillStatus, Transfer
 
@@ -125,3 +125,33 @@ def legal_for_all(view: MissionView) -> set[RobotAction]:
     for agent in view.agents:
         legal |= legal_robot_actions(view, agent)
     return legal
+
+
+class RobotLegality:
+    """Each robot's legal actions, recomputed only for robots an update touched.
+
+    Enabling the all-robot buttons needs every robot's actions; walking every robot's
+    task on every live update would cost O(mission) each time.
+    """
+
+    def __init__(self) -> None:
+        self._by_agent: dict[str, frozenset[RobotAction]] = {}
+
+    def update(self, view: MissionView, agents: Iterable[str] | None = None) -> None:
+        """Recompute ``agents`` (None: every robot, e.g. after a new mission)."""
+        if agents is None:
+            self._by_agent = {}
+            agents = view.agents
+        for agent in agents:
+            self._by_agent[agent] = frozenset(legal_robot_actions(view, agent))
+
+    def of(self, agent: str) -> set[RobotAction]:
+        """``agent``'s legal actions as last computed."""
+        return set(self._by_agent.get(agent, ()))
+
+    def any(self) -> set[RobotAction]:
+        """Actions legal on at least one robot."""
+        legal: set[RobotAction] = set()
+        for actions in self._by_agent.values():
+            legal |= actions
+        return legal

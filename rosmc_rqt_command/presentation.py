@@ -18,19 +18,23 @@ from rosmc_server.core import (
     Value,
 )
 
-# Row background per status: light, distinct, dark text stays readable on all of them.
+# Row background per status. Planned work is plain white, work on the robot blue, work
+# in progress green (amber while it waits for a partner), finished work fades to a warm
+# grey, and a failure is a strong red with white text: it must catch the eye.
 STATUS_COLOURS: dict[SkillStatus, str] = {
     SkillStatus.IDLE: "#ffffff",
-    SkillStatus.IDLE_SYNCHRONIZED: "#d7e6f7",
-    SkillStatus.SYNCWAITING: "#ffe08a",
-    SkillStatus.RUNNING: "#8fd99b",
-    SkillStatus.PAUSED: "#cfcfcf",
-    SkillStatus.SUCCESS: "#cbe6e3",
-    SkillStatus.FAILURE: "#f29a90",
+    SkillStatus.IDLE_SYNCHRONIZED: "#bcd4f6",
+    SkillStatus.SYNCWAITING: "#ffc94d",
+    SkillStatus.RUNNING: "#6fcf7f",
+    SkillStatus.PAUSED: "#b9a6d9",
+    SkillStatus.SUCCESS: "#e4e0d6",
+    SkillStatus.FAILURE: "#d7382b",
 }
-TRANSFER_COLOUR = "#eef3fb"  # uploading or removing: on its way, not settled
-SETTLED_FAILURE_COLOUR = "#f6d9d5"  # a failure the operator retried or skipped
+TRANSFER_COLOUR = "#e9eef5"  # uploading or removing: on its way, not settled (italic too)
+SETTLED_FAILURE_COLOUR = "#f2c9c3"  # a failure the operator retried or skipped
 TEXT_COLOUR = "#1d1d1d"
+DONE_TEXT_COLOUR = "#55524c"  # finished work reads as the past
+ALARM_TEXT_COLOUR = "#ffffff"  # on the failure red
 # Barrier tags: saturated colours that stay apart from the status colours.
 BARRIER_COLOURS = (
     "#7b3fa0",
@@ -61,6 +65,17 @@ def row_colour(skill: SkillInstance) -> str:
     if skill.status is SkillStatus.FAILURE and skill.resolution is not Resolution.NONE:
         return SETTLED_FAILURE_COLOUR
     return STATUS_COLOURS[skill.status]
+
+
+def text_colour(skill: SkillInstance) -> str:
+    """The text colour of a skill's row (readable on :func:`row_colour`)."""
+    if skill.transfer is not Transfer.NONE:
+        return TEXT_COLOUR
+    if skill.status is SkillStatus.FAILURE and skill.resolution is Resolution.NONE:
+        return ALARM_TEXT_COLOUR
+    if skill.is_settled:
+        return DONE_TEXT_COLOUR
+    return TEXT_COLOUR
 
 
 def barrier_colour(number: int) -> str:
@@ -134,3 +149,8 @@ def link_summary(status: AgentStatus | None) -> str:
     if status.policy:
         parts.append(status.policy)
     return " · ".join(parts)
+
+
+def is_alarm(skill: SkillInstance) -> bool:
+    """The skill needs the operator: an unresolved failure."""
+    return skill.status is SkillStatus.FAILURE and skill.resolution is Resolution.NONE

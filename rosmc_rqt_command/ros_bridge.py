@@ -4,8 +4,10 @@
 :class:`~rosmc_server.ros.client.MissionFollower` and runs every request through an
 :class:`~rosmc_server.ros.client.AsyncMissionClient`; nothing here waits on the GUI thread.
 Mirror listeners run on ROS threads with the mirror's lock held: they only copy what
-changed into a :class:`~.view_state.ViewUpdate` and emit a signal, which Qt queues to the
-GUI thread.
+changed into a :class:`~.view_state.ViewUpdate` and queue it; the GUI thread is woken
+once per batch and takes every queued update in one slot (:attr:`RosBridge.updated`
+carries a tuple of them), so a burst of events costs one pass of the window's
+per-batch work, not one per event.
 
 ROS interface (each name behind ``prefix``, e.g. ``/replay``):
     Subscribes ``/rosmc/mission_events`` (rosmc/MissionEvent) and ``/rosmc/agent_states``
@@ -17,6 +19,8 @@ ROS interface (each name behind ``prefix``, e.g. ``/replay``):
 from __future__ import annotations
 
 import logging
+import threading
+from collections import deque
 from typing import Any
 
 import rosmc.msg as wire
@@ -35,33 +39,11 @@ from rosmc_server.ros.client import (
     RevisionConflict,
     ServerUnavailable,
 )
-from rosmc_server.ros.client.connection import raise_for
-from rosmc_server.ros.client.results import Result
 
 from .requests import MUTATING, Answer, Request
-from .view_state import view_update
+from .view_state import ViewUpdate, view_update
 
 _log = logging.getLogger(__name__)
-
-
-def set_robot_options(client: MissionClient, agent: str, policy: str, safe_skill: str) -> Result:
-    """Set a robot's lost-link policy (``MissionClient.set_robot_options`` once it exists)."""
-    method = getattr(client, "set_robot_options", None)
-    if callable(method):
-        result: Result = method(agent, policy, safe_skill=safe_skill)
-        return result
-    after = 0.0 if policy == "continue" else 30.0
-    # Private until the client has the method (another change adds it).
-    response = client._caller.call(
-        "set_robot_options",
-        agent=agent,
-        lost_link_policy=policy,
-        after=after,
-        safe_skill=safe_skill,
-        safe_skill_parameters=[],
-    )
-    raise_for(response, response.revision)
-    return Result(response.revision)
 
 
 def run_request(client: MissionClient, request: Request) -> Any:
@@ -74,8 +56,6 @@ def run_request(client: MissionClient, request: Request) -> Any:
     if request.operation == "control":
         command, agent = request.args
         return client.control(ControlCommand[command], agent)
-    if request.operation == "set_robot_options":
-        return set_robot_options(client, *request.args)
     return getattr(client, request.operation)(*request.args, **kwargs)
 
 
@@ -90,7 +70,8 @@ class RosBridge(QObject):  # type: ignore[misc]
         timeout: Seconds a service call waits for the server.
     """
 
-    updated = Signal(object)  # ViewUpdate
+    updated = Signal(object)  # tuple[ViewUpdate, ...], in revision order
+    _wake = Signal()  # ROS thread -> GUI thread: updates are queued
     library_ready = Signal(object)  # Library
     answered = Signal(object)  # Answer
     connection_changed = Signal(bool)
@@ -102,6 +83,9 @@ class RosBridge(QObject):  # type: ignore[misc]
         self.read_only = bool(prefix.strip().strip("/"))
         self._follower = MissionFollower(prefix, timeout=timeout, on_connection=self._on_connection)
         self._have_library = False
+        self._queue: deque[ViewUpdate] = deque()
+        self._queue_lock = threading.Lock()
+        self._wake.connect(self._on_wake)  # queued: emitted on ROS threads
         self._client = AsyncMissionClient(MissionClient(timeout, prefix), "rosmc-command")
         self._unsubscribe = self._follower.mirror.subscribe(self._on_mirror_update)
         self._name = rospy.get_name()
@@ -159,7 +143,20 @@ class RosBridge(QObject):  # type: ignore[misc]
 
     # -- callbacks (ROS and worker threads: only emit) ---------------------------------------------
     def _on_mirror_update(self, update: MirrorUpdate) -> None:
-        self.updated.emit(view_update(update, self._follower.mirror.state))
+        converted = view_update(update, self._follower.mirror.state)
+        with self._queue_lock:
+            wake = not self._queue
+            self._queue.append(converted)
+        if wake:
+            self._wake.emit()
+
+    def _on_wake(self) -> None:
+        """GUI thread: hand every queued update over at once."""
+        with self._queue_lock:
+            batch = tuple(self._queue)
+            self._queue.clear()
+        if batch:
+            self.updated.emit(batch)
 
     def _on_library(self, outcome: Outcome[Library]) -> None:
         if outcome.value is not None:

@@ -95,13 +95,19 @@ class SectionModel(QAbstractTableModel):  # type: ignore[misc]
         shift = end_old - end_new
         for row in kept:
             before = old[row if row < start else row + shift]
-            if renumber or before != new[row]:
+            if renumber or (before is not new[row] and before != new[row]):
                 self._changed(row, row)
 
     def refresh(self) -> None:
         """Repaint every row (barriers or robot statuses changed)."""
         if self._rows:
             self._changed(0, len(self._rows) - 1)
+
+    def refresh_skill(self, skill_id: str) -> None:
+        """Repaint the row of ``skill_id`` (if shown here)."""
+        row = self.row_of(skill_id)
+        if row >= 0:
+            self._changed(row, row)
 
     def _changed(self, first: int, last: int) -> None:
         self.dataChanged.emit(self.index(first, 0), self.index(last, len(HEADERS) - 1))
@@ -133,11 +139,11 @@ class SectionModel(QAbstractTableModel):  # type: ignore[misc]
         if role == Qt.ForegroundRole:
             if column == TAG and self._view.barrier_number(skill.id):
                 return self._brush("#ffffff")
-            return self._brush(presentation.TEXT_COLOUR)
+            return self._brush(presentation.text_colour(skill))
         if role == Qt.FontRole:
             if skill.transfer.value:
                 return self._italic
-            if column == TAG:
+            if column == TAG or (column == STATUS and presentation.is_alarm(skill)):
                 return self._bold
             return None
         if role == Qt.ToolTipRole:

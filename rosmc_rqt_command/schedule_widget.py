@@ -14,7 +14,7 @@ from collections.abc import Iterable, Sequence
 from python_qt_binding.QtCore import QItemSelection, QItemSelectionModel, QPoint, Qt, Signal
 from python_qt_binding.QtWidgets import QApplication, QHBoxLayout, QScrollArea, QWidget
 
-from rosmc_server.core import Library
+from rosmc_server.core import AgentStatus, Library
 
 from .agent_column import AgentColumn, SectionTable
 from .mission_view import MissionView
@@ -28,7 +28,7 @@ class ScheduleWidget(QScrollArea):  # type: ignore[misc]
     context_menu_requested = Signal(object, QPoint)  # table, global position
     robot_action = Signal(str, object)  # agent, RobotAction
     add_requested = Signal(str, str)  # agent, skill
-    policy_chosen = Signal(str, str, str)  # agent, policy, safe skill
+    policy_chosen = Signal(str, object)  # agent, LostLinkPolicy
     reorder_requested = Signal(str, list)  # agent, new blueprint order
 
     def __init__(self, view: MissionView, parent: QWidget | None = None) -> None:
@@ -80,16 +80,28 @@ class ScheduleWidget(QScrollArea):  # type: ignore[misc]
             for column in touched:
                 column.synced_model.refresh()
                 column.blueprint_model.refresh()
-        for status in update.statuses:
+        elif update.changed_ids and self._view.barriers:
+            self._refresh_partners(update.changed_ids)
+        self._restore(touched)
+
+    def _refresh_partners(self, changed: Iterable[str]) -> None:
+        """Repaint barrier partners of changed skills ("waiting on <robot>" may change)."""
+        for skill_id in changed:
+            barrier = self._view.barrier_of(skill_id)
+            if barrier is None:
+                continue
+            for partner in self._view.skills(barrier.skill_ids):
+                column = self.columns.get(partner.agent)
+                if partner.id != skill_id and column is not None:
+                    for model in (column.synced_model, column.blueprint_model):
+                        model.refresh_skill(partner.id)
+
+    def show_statuses(self, statuses: Iterable[AgentStatus]) -> None:
+        """Show the robots' latest reports in their column headers."""
+        for status in statuses:
             column = self.columns.get(status.agent)
             if column is not None:
                 column.show_status(status)
-        if update.agents and self._view.barriers:
-            # Barrier partners' statuses show as "waiting on <robot>" in other columns.
-            for column in self.columns.values():
-                if column not in touched:
-                    column.synced_model.refresh()
-        self._restore(touched)
 
     def select_ids(self, skill_ids: Sequence[str]) -> None:
         """Select these skills (e.g. chosen in rviz) and scroll to the first."""

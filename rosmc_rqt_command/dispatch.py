@@ -1,0 +1,128 @@
+"""What each operator action asks of the mission server, as :class:`~.requests.Request` values.
+
+:class:`Dispatcher` turns a skill action on the selection, or a robot action, into the
+request(s) that carry it out, in words the message area can repeat ("send alpha's plan
+up to 'go to A'"). It checks legality first (a shortcut may fire while its button is
+disabled) and asks before sending a barrier member whose partners stay behind.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from rosmc_server.core import SkillInstance
+
+from . import alerts
+from .legality import Action, RobotAction, legal_actions, legal_robot_actions
+from .mission_view import MissionView
+from .requests import Request
+
+CONTROL_WORDS = {
+    RobotAction.START: "START",
+    RobotAction.PAUSE: "PAUSE",
+    RobotAction.RESUME: "RESUME",
+    RobotAction.STOP: "STOP",
+}
+Confirm = Callable[[list[str]], bool]  # warnings -> send anyway?
+
+
+class Dispatcher:
+    """Builds and sends the requests of the operator's actions.
+
+    Args:
+        view: The mission as shown.
+        send: Hands a request to the backend.
+        confirm: Asked with the warnings before a barrier member goes alone.
+        legal_for_all: The robot actions legal on at least one robot now.
+    """
+
+    def __init__(
+        self,
+        view: MissionView,
+        send: Callable[[Request], None],
+        confirm: Confirm,
+        legal_for_all: Callable[[], set[RobotAction]],
+    ) -> None:
+        self._view = view
+        self._send = send
+        self._confirm = confirm
+        self._legal_for_all = legal_for_all
+
+    def request(self, operation: str, *args: Any, what: str, **kwargs: Any) -> None:
+        """Send one client call made against the revision shown."""
+        self._send(Request(operation, args, kwargs, what, self._view.revision))
+
+    def skill_action(self, kind: Action, selected: Sequence[SkillInstance]) -> None:
+        """Run ``kind`` on the selected skills (nothing if it is not legal for them)."""
+        view = self._view
+        if not selected or kind not in legal_actions(view, selected):
+            return
+        first = selected[0]
+        names = ", ".join(f"'{s.label or s.skill}'" for s in selected)
+        if kind is Action.DELETE:
+            self.request("delete_skills", [s.id for s in selected], what=f"delete {names}")
+        elif kind in (Action.MOVE_UP, Action.MOVE_DOWN):
+            order = moved([s.id for s in view.view(first.agent).editable], selected, kind)
+            self.request("reorder", first.agent, order, what=f"move {names}")
+        elif kind is Action.SYNC:
+            editable = view.view(first.agent).editable
+            last = max(view.position(s) for s in selected)
+            sending = [s for s in editable if view.position(s) <= last]
+            if self._barriers_ok(sending):
+                self.request(
+                    "synchronize",
+                    first.agent,
+                    sending[-1].id,
+                    what=f"send {first.agent}'s plan up to {names}",
+                )
+        elif kind is Action.UNSYNC:
+            start = min(selected, key=view.position)
+            self.request(
+                "unsynchronize",
+                first.agent,
+                start.id,
+                what=f"take back {first.agent}'s skills from '{start.label or start.skill}'",
+            )
+        elif kind is Action.RETRY:
+            self.request("retry", first.id, what=f"retry {names}")
+        elif kind is Action.SKIP:
+            self.request("skip", first.id, what=f"skip {names}")
+        elif kind is Action.BARRIER:
+            self.request("add_barrier", [s.id for s in selected], what=f"start {names} together")
+        elif kind is Action.DELETE_BARRIER:
+            barriers = {b.id for s in selected if (b := view.barrier_of(s.id)) is not None}
+            for barrier_id in sorted(barriers):
+                self.request("delete_barrier", barrier_id, what=f"remove barrier of {names}")
+
+    def robot_action(self, agent: str | None, kind: RobotAction) -> None:
+        """Run ``kind`` on ``agent`` (None: every robot), if it is legal now."""
+        legal = self._legal_for_all() if agent is None else legal_robot_actions(self._view, agent)
+        if kind not in legal:
+            return
+        who = "every robot" if agent is None else agent
+        if kind is RobotAction.SYNC_ALL and agent is not None:
+            if self._barriers_ok(self._view.view(agent).editable):
+                self.request("synchronize", agent, None, what=f"send {agent}'s whole plan")
+        elif kind is RobotAction.UNSYNC_ALL and agent is not None:
+            self.request("unsynchronize", agent, None, what=f"take back {agent}'s plan")
+        elif kind in CONTROL_WORDS:
+            self.request("control", CONTROL_WORDS[kind], agent, what=f"{kind.value} {who}")
+
+    def _barriers_ok(self, sending: Sequence[SkillInstance]) -> bool:
+        warnings = alerts.barrier_warnings(self._view, sending)
+        return not warnings or self._confirm(warnings)
+
+
+def moved(order: list[str], selected: Sequence[SkillInstance], kind: Action) -> list[str]:
+    """``order`` with the selected skills one place earlier (MOVE_UP) or later."""
+    order = list(order)
+    ids = {s.id for s in selected}
+    up = kind is Action.MOVE_UP
+    step = -1 if up else 1
+    positions = sorted((order.index(i) for i in ids if i in order), reverse=not up)
+    for position in positions:
+        target = position + step
+        if 0 <= target < len(order) and order[target] not in ids:
+            order[position], order[target] = order[target], order[position]
+    return order

@@ -1,0 +1,120 @@
+"""The lost-link policy picker: what a robot does when it stops hearing the ground.
+
+:class:`PolicyDialog` offers the three choices of
+:class:`~rosmc_server.core.LostLinkPolicy`: keep going, hold after N seconds, or run a
+safe skill (one of that robot's skills) after N seconds and then hold. It only builds
+the typed policy; the robot's column sends it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from python_qt_binding.QtWidgets import (
+    QComboBox,
+    QDialog,
+    QDialogButtonBox,
+    QDoubleSpinBox,
+    QFormLayout,
+    QLabel,
+    QWidget,
+)
+
+from rosmc_server.core import InvalidRequest, LostLinkKind, LostLinkPolicy
+from rosmc_server.core.policy import DEFAULT_AFTER
+
+KIND_WORDS = {
+    LostLinkKind.CONTINUE: "keep going",
+    LostLinkKind.HOLD: "hold (pause) after a while",
+    LostLinkKind.SAFE_SKILL: "run a safe skill after a while, then hold",
+}
+
+
+class PolicyDialog(QDialog):  # type: ignore[misc]
+    """Choose ``agent``'s lost-link policy among ``skills`` (the robot's skills).
+
+    Args:
+        agent: The robot.
+        skills: The skills the robot can run as its safe skill.
+        preferred: The safe skill offered first if the robot has it.
+    """
+
+    def __init__(
+        self,
+        agent: str,
+        skills: Sequence[str],
+        preferred: str = "return_to_lander",
+        parent: QWidget | None = None,
+    ) -> None:
+        super().__init__(parent)
+        self.setWindowTitle(f"{agent}: when the link is lost")
+        self.kind_combo = QComboBox()
+        self.kind_combo.setObjectName("policy_kind")
+        for kind, words in KIND_WORDS.items():
+            self.kind_combo.addItem(words, kind)
+        self.after_spin = QDoubleSpinBox()
+        self.after_spin.setObjectName("policy_after")
+        self.after_spin.setRange(1.0, 86400.0)
+        self.after_spin.setDecimals(0)
+        self.after_spin.setSuffix(" s without the ground")
+        self.after_spin.setValue(DEFAULT_AFTER)
+        self.skill_combo = QComboBox()
+        self.skill_combo.setObjectName("policy_skill")
+        names = sorted(skills)
+        self.skill_combo.addItems(names)
+        if preferred in names:
+            self.skill_combo.setCurrentIndex(names.index(preferred))
+        self.problem = QLabel("")
+        self.problem.setStyleSheet("QLabel { color:#b00020; }")
+        self.problem.setWordWrap(True)
+        self.buttons = QDialogButtonBox(QDialogButtonBox.Ok | QDialogButtonBox.Cancel)
+        form = QFormLayout(self)
+        form.addRow(QLabel(f"What should <b>{agent}</b> do when it stops hearing the ground?"))
+        form.addRow("Then", self.kind_combo)
+        form.addRow("After", self.after_spin)
+        form.addRow("Safe skill", self.skill_combo)
+        form.addRow(self.problem)
+        form.addRow(self.buttons)
+        self.buttons.accepted.connect(self._on_buttons_accepted)
+        self.buttons.rejected.connect(self.reject)
+        self.kind_combo.currentIndexChanged.connect(self._on_kind_combo_current_index_changed)
+        self._on_kind_combo_current_index_changed(0)
+
+    def set_kind(self, kind: LostLinkKind) -> None:
+        """Pick ``kind`` (as the operator would in the first list)."""
+        self.kind_combo.setCurrentIndex(self.kind_combo.findData(kind))
+
+    def policy(self) -> LostLinkPolicy:
+        """The policy chosen (InvalidRequest with a sentence if it cannot be one)."""
+        kind = LostLinkKind(self.kind_combo.currentData())
+        if kind is LostLinkKind.CONTINUE:
+            return LostLinkPolicy()
+        if kind is LostLinkKind.HOLD:
+            return LostLinkPolicy(kind, self.after_spin.value())
+        skill = self.skill_combo.currentText()
+        if not skill:
+            raise InvalidRequest("this robot has no skill to run as its safe skill")
+        return LostLinkPolicy(kind, self.after_spin.value(), skill)
+
+    def _on_kind_combo_current_index_changed(self, _index: int) -> None:
+        kind = LostLinkKind(self.kind_combo.currentData())
+        self.after_spin.setEnabled(kind is not LostLinkKind.CONTINUE)
+        self.skill_combo.setEnabled(kind is LostLinkKind.SAFE_SKILL)
+
+    def _on_buttons_accepted(self) -> None:
+        try:
+            self.policy()
+        except InvalidRequest as error:
+            self.problem.setText(f"{error}.")
+            return
+        self.accept()
+
+
+def ask_policy(
+    agent: str, skills: Sequence[str], parent: QWidget | None = None
+) -> LostLinkPolicy | None:
+    """Show the dialog; the chosen policy, or None if the operator cancels."""
+    dialog = PolicyDialog(agent, skills, parent=parent)
+    if dialog.exec_() != QDialog.Accepted:
+        return None
+    return dialog.policy()
