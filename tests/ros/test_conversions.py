@@ -1,0 +1,308 @@
+"""Every core <-> message conversion keeps every field (rosmc_server.conversions).
+
+Each core value is built with *every* field set to something other than its default, sent
+through its ``x_to_msg``, serialized and read back as the receiver would, and rebuilt with
+``x_from_msg``: the result must equal the original. A helper first checks that the value
+really differs from the defaults in every field, so a field that a conversion drops (and
+that would come back as its default) cannot pass unnoticed. Conversions with one direction
+only (agent states, executor commands) are checked field by field from a message in which
+every field is set.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import io
+import math
+from typing import Any
+
+import pytest
+import rosmc.msg as wire
+
+from rosmc_server.conversions import (
+    agent_status_from_msg,
+    barrier_from_msg,
+    barrier_to_msg,
+    event_from_msg,
+    event_to_msg,
+    library_from_msg,
+    library_to_msg,
+    marker_from_msg,
+    marker_to_msg,
+    mission_from_msg,
+    mission_to_msg,
+    param_from_msg,
+    param_to_msg,
+    pose_from_msg,
+    pose_to_msg,
+    skill_from_msg,
+    skill_to_msg,
+)
+from rosmc_server.conversions.robot_link import (
+    command_from_msg,
+    signal_from_msg,
+    signal_to_msg,
+)
+from rosmc_server.core import (
+    AgentKind,
+    AgentSpec,
+    AgentStatus,
+    Barrier,
+    Change,
+    EventKind,
+    Library,
+    MarkerType,
+    MissionContent,
+    MissionEvent,
+    ParameterSpec,
+    ParamType,
+    PlacedSkill,
+    Pose,
+    Resolution,
+    SkillInstance,
+    SkillSpec,
+    SkillStatus,
+    TaskMarker,
+    Transfer,
+)
+from rosmc_server.core.commands import CommandKind
+from rosmc_server.executor.core import Signal, SignalKind
+
+
+def over_the_wire(msg: Any) -> Any:
+    buffer = io.BytesIO()
+    msg.serialize(buffer)
+    return type(msg)().deserialize(buffer.getvalue())
+
+
+def assert_no_default_field(*values: Any) -> None:
+    """Every field with a default differs from it in at least one of the dataclass ``values``."""
+    for field in dataclasses.fields(values[0]):
+        if field.default is not dataclasses.MISSING:
+            default = field.default
+        elif field.default_factory is not dataclasses.MISSING:
+            default = field.default_factory()
+        else:
+            continue
+        assert any(getattr(v, field.name) != default for v in values), (
+            f"{type(values[0]).__name__}.{field.name} is left at its default"
+        )
+
+
+POSE = Pose(1.5, -2.25, 0.5, 0.1, -0.2, 1.25)
+AREA = (Pose(0, 0), Pose(4, 0), Pose(4, 3), Pose(0, 3))
+PARAMS: dict[str, Any] = {
+    "flag": True,
+    "count": -7,
+    "speed": 0.75,
+    "note": "avoid the dune ✓",
+    "path": [{"x": 1.0, "y": 2.0}, {"x": 3.5, "y": -4.0}],
+    "options": {"mode": "scan", "bands": [1, 2]},
+    "target": POSE,
+}
+
+
+def full_skill(skill_id: str = "rover-1", agent: str = "rover") -> SkillInstance:
+    return SkillInstance(
+        id=skill_id,
+        agent=agent,
+        skill="identify_stones",
+        label="look closely",
+        params=PARAMS,
+        bindings={"target": "rss_a"},
+        status=SkillStatus.FAILURE,
+        transfer=Transfer.REMOVING,
+        resolution=Resolution.RETRIED,
+        attempt=3,
+        timeout=120.5,
+        max_retries=2,
+        status_text="wheel slip",
+        started=1000.25,
+        finished=1010.5,
+    )
+
+
+def test_poses_and_every_parameter_type_survive() -> None:
+    assert pose_from_msg(over_the_wire(pose_to_msg(POSE))) == POSE
+    for name, value in PARAMS.items():
+        assert param_from_msg(over_the_wire(param_to_msg(name, value))) == (name, value), name
+    msg = over_the_wire(param_to_msg("target", POSE, "rss_a"))
+    assert msg.marker == "rss_a"
+
+
+def test_a_skill_survives_with_every_field() -> None:
+    skill = full_skill()
+    assert_no_default_field(skill)
+    assert skill_from_msg(over_the_wire(skill_to_msg(skill))) == skill
+
+
+@pytest.mark.parametrize(
+    "marker",
+    [
+        TaskMarker("rss_a", MarkerType.POSITION, Pose(3, 4, 0.5)),
+        TaskMarker("goal", MarkerType.POSE, POSE),
+        TaskMarker("survey", MarkerType.AREA, Pose(2, 1.5), AREA),
+    ],
+    ids=lambda marker: marker.type.name,
+)
+def test_task_markers_of_each_kind_survive(marker: TaskMarker) -> None:
+    assert marker_from_msg(over_the_wire(marker_to_msg(marker))) == marker
+
+
+def test_barriers_survive_with_their_agents() -> None:
+    barrier = Barrier("together", ("drone-1", "rover-2"))
+    msg = over_the_wire(barrier_to_msg(barrier, lambda skill_id: skill_id.split("-")[0]))
+    assert list(msg.agents) == ["drone", "rover"]
+    assert barrier_from_msg(msg) == barrier
+
+
+def full_content() -> MissionContent:
+    drone = dataclasses.replace(full_skill("drone-1", "drone"), status=SkillStatus.SUCCESS)
+    rover = full_skill()
+    idle = SkillInstance("rover-2", "rover", "explore", "explore", {"speed": 1.0})
+    return MissionContent(
+        "mars_team",
+        {"drone": [drone], "rover": [rover, idle]},
+        {"b1": Barrier("b1", ("drone-1", "rover-2"))},
+        {
+            "rss_a": TaskMarker("rss_a", MarkerType.POSE, POSE),
+            "survey": TaskMarker("survey", MarkerType.AREA, Pose(2, 1.5), AREA),
+        },
+    )
+
+
+def test_a_mission_snapshot_survives_with_its_revision() -> None:
+    content = full_content()
+    msg = over_the_wire(mission_to_msg(content, 42, 1234.5))
+    assert mission_from_msg(msg) == (content, 42)
+
+
+def test_an_event_survives_with_every_part_of_its_change() -> None:
+    content = full_content()
+    change = Change(
+        put_skills=(PlacedSkill(1, full_skill()),),
+        removed_skill_ids=("rover-9",),
+        order_agent="rover",
+        blueprint_order=("rover-2", "rover-3"),
+        put_barriers=(Barrier("b2", ("drone-1", "rover-1")),),
+        removed_barrier_ids=("b0",),
+        put_markers=(content.markers["survey"],),
+        removed_marker_names=("old",),
+    )
+    event = MissionEvent(43, EventKind.SKILL_EDITED, "rover", "edited rover-1", 1234.5, change)
+    agents = {"drone-1": "drone", "rover-1": "rover"}
+    msg = over_the_wire(event_to_msg(event, agents.__getitem__))
+    assert event_from_msg(msg) == event
+    for field in dataclasses.fields(change):
+        if field.name != "replacement":  # a replacement travels as a snapshot instead
+            assert getattr(change, field.name), field.name
+
+
+def test_a_replaced_mission_travels_without_its_content() -> None:
+    event = MissionEvent(
+        7, EventKind.MISSION_REPLACED, "", "loaded", 5.0, Change(replacement=full_content())
+    )
+    back = event_from_msg(over_the_wire(event_to_msg(event, lambda s: "")))
+    assert back == dataclasses.replace(event, change=Change())
+
+
+def test_the_library_survives_with_every_parameter_attribute() -> None:
+    speed = ParameterSpec(
+        name="speed",
+        type=ParamType.FLOAT,
+        default=0.5,
+        minimum=0.1,
+        maximum=2.0,
+        unit="m/s",
+        description="Cruise speed.",
+    )
+    target = ParameterSpec("target", ParamType.POSE, POSE, marker_type=MarkerType.POSE)
+    mode = ParameterSpec("mode", ParamType.STRING, "quick", choices=("quick", "deep"))
+    tries = ParameterSpec("tries", ParamType.INT, 2, minimum=1, maximum=5, choices=(1, 2, 5))
+    assert_no_default_field(speed, target, mode, tries)
+    skill = SkillSpec("drive", (speed, target, mode, tries), "Drive somewhere.", 60.0)
+    assert_no_default_field(skill)
+    library = Library(
+        "mars_team",
+        (
+            AgentSpec("rover", AgentKind.DYNAMIC, "rover_model", "The rover."),
+            AgentSpec("lander", AgentKind.STATIC, "lander", "Home."),
+        ),
+        {"rover_model": {"drive": skill}},
+    )
+    back = library_from_msg(over_the_wire(library_to_msg(library)))
+    assert back.name == library.name and back.agents == library.agents
+    assert back.skills_of("rover") == library.skills_of("rover")
+
+
+def test_every_agent_state_field_reaches_the_agent_status() -> None:
+    msg = wire.AgentState(
+        agent="rover",
+        telemetry=wire.Telemetry(
+            agent="rover",
+            frame_id="map",
+            pose=pose_to_msg(POSE),
+            battery=0.5,
+            wifi_signal=-61.5,
+            in_coverage=True,
+        ),
+        link=wire.LinkState(
+            state=wire.LinkState.DOWN,
+            last_heard=12.5,
+            round_trip=0.25,
+            commands_in_flight=3,
+            queue_hash="9f2c",
+            robot_queue_hash="77aa",
+            hash_mismatch=True,
+        ),
+        current_skill_id="rover-1",
+        current_status=wire.SkillStatus(value=wire.SkillStatus.SYNCWAITING),
+        executor_state="waiting",
+        waiting_on="drone",
+        policy="on link loss: hold after 30 s",
+    )
+    status = agent_status_from_msg(over_the_wire(msg))
+    assert_no_default_field(status)
+    assert status == AgentStatus(
+        agent="rover",
+        link="down",
+        last_heard=12.5,
+        round_trip=0.25,
+        commands_in_flight=3,
+        hash_mismatch=True,
+        queue_hash="9f2c",
+        robot_queue_hash="77aa",
+        battery=0.5,
+        wifi_signal=-61.5,
+        in_coverage=True,
+        pose=POSE,
+        current_skill="rover-1",
+        current_status=SkillStatus.SYNCWAITING,
+        executor_state="waiting",
+        waiting_on="drone",
+        policy="on link loss: hold after 30 s",
+    )
+    nan = wire.AgentState(agent="lander", telemetry=wire.Telemetry(battery=math.nan))
+    assert agent_status_from_msg(nan).battery is None
+
+
+def test_executor_commands_and_barrier_signals_survive() -> None:
+    skills = [full_skill(), full_skill("rover-2")]
+    msg = wire.RobotCommand(
+        agent="rover",
+        seq=9,
+        type=int(CommandKind.UPLOAD),
+        skills=[skill_to_msg(s) for s in skills],
+        skill_ids=["rover-1", "rover-2"],
+        barriers=[barrier_to_msg(Barrier("b1", ("drone-1", "rover-1")), lambda s: s[:-2])],
+        argument='{"lost_link": {"policy": "hold", "after": 5}}',
+    )
+    command = command_from_msg(over_the_wire(msg))
+    assert command.seq == 9 and command.kind is CommandKind.UPLOAD
+    assert list(command.skills) == skills
+    assert command.skill_ids == ("rover-1", "rover-2")
+    assert command.barriers[0].id == "b1"
+    assert command.barriers[0].members == (("drone-1", "drone"), ("rover-1", "rover"))
+    assert command.argument == msg.argument
+    signal = Signal("rover", "b1", "rover-1", SignalKind.READY, 12.5)
+    assert signal_from_msg(over_the_wire(signal_to_msg(signal))) == signal
