@@ -46,7 +46,7 @@ class Dispatcher:
     ) -> None:
         self._view = view
         self._send = send
-        self._confirm = confirm
+        self.confirm = confirm  # tests answer the question through this
         self._legal_for_all = legal_for_all
 
     def request(self, operation: str, *args: Any, what: str, **kwargs: Any) -> None:
@@ -111,7 +111,7 @@ class Dispatcher:
 
     def _barriers_ok(self, sending: Sequence[SkillInstance]) -> bool:
         warnings = alerts.barrier_warnings(self._view, sending)
-        return not warnings or self._confirm(warnings)
+        return not warnings or self.confirm(warnings)
 
 
 def moved(order: list[str], selected: Sequence[SkillInstance], kind: Action) -> list[str]:

@@ -197,15 +197,18 @@ class FileController:
     def _on_loaded(self, answer: Answer, location: tuple[str, str]) -> None:
         if answer.ok:
             self.location = location
-            self._saved = None  # taken when the loaded mission arrives (mark_saved_on_next)
-            self.pending_mark = True
+            self._saved = None
+            # The loaded mission counts as saved once it is shown; its update may have
+            # arrived before this answer, or may still be on its way.
+            self._mark_at = int(getattr(answer.value, "revision", self._view.revision))
+            self.on_mission_shown()
 
-    pending_mark = False
+    _mark_at: int | None = None
 
     def on_mission_shown(self) -> None:
         """Called after each update: a freshly loaded mission counts as saved."""
-        if self.pending_mark:
-            self.pending_mark = False
+        if self._mark_at is not None and self._view.revision >= self._mark_at:
+            self._mark_at = None
             self.mark_saved()
 
     def _on_saved_document(self, answer: Answer, path: str, fingerprint: Plan) -> None:

@@ -23,15 +23,15 @@ from rosmc_server.core import (
 # grey, and a failure is a strong red with white text: it must catch the eye.
 STATUS_COLOURS: dict[SkillStatus, str] = {
     SkillStatus.IDLE: "#ffffff",
-    SkillStatus.IDLE_SYNCHRONIZED: "#bcd4f6",
+    SkillStatus.IDLE_SYNCHRONIZED: "#b4cff5",
     SkillStatus.SYNCWAITING: "#ffc94d",
     SkillStatus.RUNNING: "#6fcf7f",
     SkillStatus.PAUSED: "#b9a6d9",
-    SkillStatus.SUCCESS: "#e4e0d6",
+    SkillStatus.SUCCESS: "#d9d6c6",
     SkillStatus.FAILURE: "#d7382b",
 }
-TRANSFER_COLOUR = "#e9eef5"  # uploading or removing: on its way, not settled (italic too)
-SETTLED_FAILURE_COLOUR = "#f2c9c3"  # a failure the operator retried or skipped
+TRANSFER_COLOUR = "#dae6fa"  # uploading or removing: on its way, not settled (italic too)
+SETTLED_FAILURE_COLOUR = "#f9bbb0"  # a failure the operator retried or skipped
 TEXT_COLOUR = "#1d1d1d"
 DONE_TEXT_COLOUR = "#55524c"  # finished work reads as the past
 ALARM_TEXT_COLOUR = "#ffffff"  # on the failure red

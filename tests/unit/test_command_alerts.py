@@ -1,0 +1,159 @@
+"""Warnings an operator needs in time: barriers that would wait for ever, robots leaving
+Wi-Fi range with planned work, parameters the library refuses.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+
+from rosmc_rqt_command import alerts
+from rosmc_rqt_command.legality import Action
+from rosmc_server.core import AgentStatus, Library, Mission, SkillStatus
+from rosmc_server.core.library import library_from_dict
+from tests.unit.test_command_harness import Gui, open_gui
+
+S = SkillStatus
+
+
+@pytest.fixture
+def gui(mission: Mission, library: Library) -> Iterator[Gui]:
+    """A command widget following the ``mission`` fixture."""
+    yield from open_gui(mission, library)
+
+
+def test_sending_a_barrier_member_without_its_partner_asks_first(gui: Gui) -> None:
+    feed = gui.feed
+    first, partner = feed.add("alpha", "wait"), feed.add("bravo", "wait")
+    feed("add_barrier", [first, partner])
+    asked: list[list[str]] = []
+    answers = [False, True]
+
+    def confirm(warnings: list[str]) -> bool:
+        asked.append(warnings)
+        return answers.pop(0)
+
+    gui.widget.dispatcher.confirm = confirm
+    gui.click_row("alpha", True, 0)
+    gui.widget.do(Action.SYNC)  # answered No: nothing is sent
+    assert asked == [["alpha will wait at a barrier for ever unless you also send bravo's 'wait'."]]
+    assert gui.backend.requests == []
+    gui.widget.do(Action.SYNC)  # answered Yes
+    assert gui.backend.operations() == ["synchronize"]
+    assert gui.backend.requests[0].args == ("alpha", first)
+
+
+def test_a_member_on_the_robot_with_its_partner_planned_is_a_standing_warning(gui: Gui) -> None:
+    feed = gui.feed
+    first, partner = feed.add("alpha", "wait"), feed.add("bravo", "wait")
+    feed("add_barrier", [first, partner])
+    assert alerts.barrier_warnings(gui.widget.view) == []
+    feed.sync("alpha")
+    _warn_now(gui)
+    assert gui.widget.messages.warnings == [
+        "alpha will wait at a barrier for ever unless you also send bravo's 'wait'."
+    ]
+    assert gui.widget.messages.warnings_label.isVisibleTo(gui.widget)
+    feed.sync("bravo")
+    _warn_now(gui)
+    assert gui.widget.messages.warnings == []
+    assert not gui.widget.messages.warnings_label.isVisibleTo(gui.widget)
+    # Sending both together is fine: no question.
+    assert alerts.barrier_warnings(gui.widget.view, gui.widget.view.skills([first, partner])) == []
+
+
+@pytest.mark.parametrize(
+    ("signal", "in_coverage", "planned", "expected"),
+    [
+        (-50.0, True, 2, None),
+        (-80.0, True, 2, "alpha is about to leave Wi-Fi range (-80 dBm) with 2 planned skills"),
+        (-95.0, False, 1, "alpha is out of Wi-Fi range; its 1 planned skills cannot be sent."),
+        (-80.0, True, 0, None),  # nothing planned: nothing to lose
+        (None, False, 2, None),  # no telemetry yet: no guess
+    ],
+)
+def test_a_robot_leaving_coverage_with_planned_work(
+    gui: Gui, signal: float | None, in_coverage: bool, planned: int, expected: str | None
+) -> None:
+    feed = gui.feed
+    on_board = feed.add("alpha")
+    feed.sync("alpha", on_board)  # work on board is not at risk
+    for _ in range(planned):
+        feed.add("alpha")
+    feed.statuses(
+        AgentStatus("alpha", link="up", wifi_signal=signal, in_coverage=in_coverage, battery=0.5)
+    )
+    warnings = alerts.coverage_warnings(gui.widget.view)
+    gui.widget._on_status_timer_timeout()
+    _warn_now(gui)
+    if expected is None:
+        assert warnings == []
+    else:
+        assert len(warnings) == 1 and warnings[0].startswith(expected), warnings
+        assert gui.widget.messages.warnings == warnings
+
+
+def stricter(library_data: dict[str, Any]) -> Library:
+    """The unit library after an update: 'move' may go at most 1.5 m/s."""
+    library_data["models"]["walker"]["skills"]["move"]["parameters"]["speed"]["max"] = 1.5
+    return library_from_dict(library_data, "unit_team.yaml")
+
+
+def test_a_parameter_the_library_refuses(gui: Gui, library_data: dict[str, Any]) -> None:
+    feed = gui.feed
+    fast = feed.add("alpha", "move", params={"speed": 1.8})
+    feed.add("alpha", "move", params={"speed": 1.0})
+    done = feed.add("bravo", "move", params={"speed": 1.9})
+    feed.sync("bravo")
+    feed("report_status", done, S.RUNNING)
+    feed("report_status", done, S.SUCCESS)  # finished work is history, not a warning
+    _warn_now(gui)
+    assert gui.widget.messages.warnings == []
+    gui.widget.on_library(stricter(library_data))
+    _warn_now(gui)
+    [warning] = gui.widget.messages.warnings
+    assert warning.startswith("alpha's 'move': ") and "speed" in warning and "1.5" in warning
+    feed("delete_skills", [fast])
+    _warn_now(gui)
+    assert gui.widget.messages.warnings == []
+
+
+def test_parameter_checks_are_sliced_and_cover_only_changes(
+    mission: Mission, library: Library, library_data: dict[str, Any]
+) -> None:
+    harness = Gui(mission, library)
+    try:
+        feed = harness.feed
+        bad = [feed.add(agent, "move", params={"speed": 1.9}) for agent in ("alpha", "bravo")]
+        for _ in range(200):
+            feed.add("charlie", "move")
+        view = harness.widget.view
+        view.library = stricter(library_data)
+        checker = alerts.ParameterChecker(budget=0.0)
+        assert checker.warnings(view) == [] and checker.incomplete  # no time: nothing checked
+        sliced = alerts.ParameterChecker(budget=0.0005)
+        rounds = 0
+        while True:
+            found = sliced.warnings(view)
+            rounds += 1
+            if not sliced.incomplete:
+                break
+        assert rounds > 1
+        assert len(found) == 2 and all("speed" in w for w in found)
+        # Later, only what changed is checked again.
+        feed("edit_skill", bad[0], {"speed": 1.0})
+        sliced.note(feed.updates[-1].changed_ids)
+        assert sliced.incomplete
+        assert len(sliced.warnings(view)) == 1 and not sliced.incomplete
+    finally:
+        harness.close()
+
+
+def _warn_now(gui: Gui) -> None:
+    """Run the warnings pass now (the widget runs it 300 ms after changes)."""
+    for _ in range(100):
+        gui.widget._on_warn_timer_timeout()
+        if not gui.widget._checker.incomplete:
+            return

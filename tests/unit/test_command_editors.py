@@ -1,0 +1,233 @@
+"""Parameter editors: every type shows a value and sends it back, keeps to its bounds, and
+refuses what the library would refuse with a sentence (nothing is sent then).
+
+The editors are driven through the parameter panel of the real widget, by typing and
+clicking; what the panel sends is applied to the real mission, and the panel must then
+show the mission's value.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+from python_qt_binding.QtCore import Qt
+from python_qt_binding.QtTest import QTest
+
+from rosmc_rqt_command.param_editors import (
+    BoolEditor,
+    ChoiceEditor,
+    NumberEditor,
+    PoseEditor,
+    TextEditor,
+    VertexEditor,
+    make_editor,
+)
+from rosmc_rqt_command.requests import Request
+from rosmc_server.core import InvalidRequest, Library, Mission, ParamType, Pose
+from rosmc_server.core.library import ParameterSpec
+from tests.unit.test_command_harness import Gui, open_gui
+
+
+@pytest.fixture
+def gui(mission: Mission, library: Library) -> Iterator[Gui]:
+    """A command widget following the ``mission`` fixture."""
+    yield from open_gui(mission, library)
+
+
+def shown(gui: Gui, agent: str, skill: str, **params: Any) -> str:
+    """Add a skill and select it; its id."""
+    skill_id = gui.feed.add(agent, skill, params=params or None)
+    row = gui.ids(agent, True).index(skill_id)
+    gui.click_row(agent, True, row)
+    gui.app.processEvents()  # the new editors are laid out before anyone clicks them
+    assert gui.widget.parameters.skill is not None
+    assert gui.widget.parameters.skill.id == skill_id
+    return skill_id
+
+
+def type_into(line: Any, text: str) -> None:
+    """Replace a line edit's text as a person does, then press Enter."""
+    line.selectAll()
+    QTest.keyClicks(line, text)
+    QTest.keyClick(line, Qt.Key_Return)
+
+
+def sent(gui: Gui) -> Request:
+    """The one request sent since the last call; applied to the mission as the server would."""
+    [request] = gui.backend.requests
+    gui.backend.requests.clear()
+    assert request.operation == "edit_skill"
+    gui.feed("edit_skill", *request.args, **request.kwargs)
+    return request
+
+
+def refused(gui: Gui) -> str:
+    """Nothing was sent; the message the operator got."""
+    assert gui.backend.requests == []
+    message = gui.widget.messages.messages()[0]
+    assert "Not sent:" in message
+    return message
+
+
+def test_numbers_keep_to_their_bounds_and_units(gui: Gui) -> None:
+    skill_id = shown(gui, "alpha", "move")
+    editor = gui.widget.parameters.editors["speed"]
+    assert isinstance(editor, NumberEditor)
+    assert editor.spin.suffix() == " m/s"
+    assert (editor.spin.minimum(), editor.spin.maximum()) == (0.1, 2.0)
+    type_into(editor.spin.lineEdit(), "1.25")
+    assert sent(gui).kwargs == {"params": {"speed": 1.25}}
+    assert gui.feed.mission.state.skill(skill_id).params["speed"] == 1.25
+    assert editor.value() == 1.25  # shown again from the mission
+    type_into(editor.spin.lineEdit(), "7")  # above the maximum: the key is refused
+    assert gui.backend.requests == [] and editor.value() == 1.25
+    passes = shown(gui, "alpha", "scan")
+    spin = gui.widget.parameters.editors["passes"].spin
+    assert (spin.minimum(), spin.maximum()) == (1, 5)
+    type_into(spin.lineEdit(), "4")
+    assert sent(gui).kwargs == {"params": {"passes": 4}}
+    assert gui.feed.mission.state.skill(passes).params["passes"] == 4
+
+
+def test_bool_choice_text_and_dict(gui: Gui) -> None:
+    skill_id = shown(gui, "alpha", "wait")
+    editors = gui.widget.parameters.editors
+    verbose = editors["verbose"]
+    assert isinstance(verbose, BoolEditor) and verbose.value() is False
+    QTest.mouseClick(verbose.box, Qt.LeftButton)
+    assert sent(gui).kwargs == {"params": {"verbose": True}}
+    note = editors["note"]
+    assert isinstance(note, TextEditor)
+    type_into(note.line, "basalt near the ridge")
+    assert sent(gui).kwargs == {"params": {"note": "basalt near the ridge"}}
+    options = editors["options"]
+    type_into(options.line, '{"exposure": 3, "filters": ["red"]}')
+    assert sent(gui).kwargs == {"params": {"options": {"exposure": 3, "filters": ["red"]}}}
+    params = gui.feed.mission.state.skill(skill_id).params
+    assert params["verbose"] is True and params["options"] == {"exposure": 3, "filters": ["red"]}
+    assert options.value() == {"exposure": 3, "filters": ["red"]}
+
+    shown(gui, "alpha", "scan")
+    mode = gui.widget.parameters.editors["mode"]
+    assert isinstance(mode, ChoiceEditor)
+    assert [mode.combo.itemText(i) for i in range(mode.combo.count())] == ["fast", "slow"]
+    QTest.keyClick(mode.combo, Qt.Key_Down)
+    assert sent(gui).kwargs == {"params": {"mode": "slow"}}
+
+
+def test_bad_text_is_refused_with_a_sentence(gui: Gui) -> None:
+    skill_id = shown(gui, "alpha", "wait")
+    options = gui.widget.parameters.editors["options"]
+    type_into(options.line, "[1, 2]")  # a list where a dict belongs
+    message = refused(gui)
+    assert "options" in message and message.rstrip().endswith(".")
+    assert options.styleSheet()  # tinted while it cannot be sent
+    type_into(options.line, "{unclosed")
+    refused(gui)
+    assert gui.feed.mission.state.skill(skill_id).params["options"] == {}
+    type_into(options.line, '{"ok": true}')
+    assert sent(gui).kwargs == {"params": {"options": {"ok": True}}}
+    assert not options.styleSheet()
+
+
+def test_pose_in_metres_and_degrees(gui: Gui) -> None:
+    skill_id = shown(gui, "alpha", "move")
+    pose = gui.widget.parameters.editors["target"]
+    assert isinstance(pose, PoseEditor)
+    assert pose.spins["yaw"].suffix() == "°" and pose.spins["x"].suffix() == " m"
+    type_into(pose.spins["x"].lineEdit(), "12.5")
+    assert sent(gui).kwargs["params"]["target"]["x"] == 12.5
+    type_into(pose.spins["yaw"].lineEdit(), "90")
+    data = sent(gui).kwargs["params"]["target"]
+    assert data["yaw"] == pytest.approx(math.pi / 2) and data["x"] == 12.5
+    target = gui.feed.mission.state.skill(skill_id).params["target"]
+    assert isinstance(target, Pose) and target.yaw == pytest.approx(math.pi / 2)
+    assert pose.spins["yaw"].value() == pytest.approx(90.0)
+    type_into(pose.spins["roll"].lineEdit(), "400")  # beyond a half turn: the last 0 is refused
+    assert sent(gui).kwargs["params"]["target"]["roll"] == pytest.approx(math.radians(40))
+
+
+def test_area_corners_are_added_removed_and_checked(gui: Gui) -> None:
+    skill_id = shown(gui, "alpha", "scan")
+    area = gui.widget.parameters.editors["area"]
+    assert isinstance(area, VertexEditor)
+    assert area.table.rowCount() == 3
+    QTest.mouseClick(area.add_button, Qt.LeftButton)
+    corners = sent(gui).kwargs["params"]["area"]
+    assert len(corners) == 4 and corners[-1] == {"x": 1.0, "y": 1.0}
+    assert len(gui.feed.mission.state.skill(skill_id).params["area"]) == 4
+    area.table.item(0, 0).setText("abc")  # a person typing a word into a corner
+    message = refused(gui)
+    assert "corner 1 needs a number for x, not 'abc'" in message
+    area.table.item(0, 0).setText("-0.5")
+    assert sent(gui).kwargs["params"]["area"][0] == {"x": -0.5, "y": 0.0}
+    area.table.setCurrentCell(3, 0)
+    QTest.mouseClick(area.remove_button, Qt.LeftButton)
+    assert len(sent(gui).kwargs["params"]["area"]) == 3
+    QTest.mouseClick(area.remove_button, Qt.LeftButton)  # two corners are no area
+    message = refused(gui)
+    assert "area" in message
+    assert len(gui.feed.mission.state.skill(skill_id).params["area"]) == 3
+
+
+def test_only_planned_skills_are_editable(gui: Gui) -> None:
+    skill_id = shown(gui, "alpha", "wait")
+    panel = gui.widget.parameters
+    assert panel.editable and panel.label_edit.isEnabled()
+    gui.feed.sync("alpha")
+    gui.click_row("alpha", False, 0)
+    assert panel.skill is not None and panel.skill.id == skill_id
+    assert not panel.editable
+    assert not panel.label_edit.isEnabled()
+    assert not panel.editors["note"].line.isEnabled()
+
+
+def test_label_time_limit_and_retries(gui: Gui) -> None:
+    skill_id = shown(gui, "alpha", "wait")
+    panel = gui.widget.parameters
+    type_into(panel.label_edit, "rest at the lander")
+    assert sent(gui).kwargs == {"label": "rest at the lander"}
+    type_into(panel.retries_spin.lineEdit(), "2")
+    assert sent(gui).kwargs == {"timeout": 0.0, "max_retries": 2}
+    skill = gui.feed.mission.state.skill(skill_id)
+    assert skill.label == "rest at the lander" and skill.max_retries == 2
+    assert gui.cell("alpha", True, 0, 2, Qt.DisplayRole) == "rest at the lander"
+
+
+@pytest.mark.parametrize(
+    ("ptype", "value"),
+    [
+        (ParamType.BOOL, True),
+        (ParamType.INT, -3),
+        (ParamType.FLOAT, 2.5),
+        (ParamType.STRING, "olivine"),
+        (ParamType.LIST, ["a", 1]),
+        (ParamType.DICT, {"k": [1, 2]}),
+        (ParamType.POSE, Pose(1.0, -2.0, 0.5, 0.0, 0.0, 0.25)),
+    ],
+)
+def test_every_type_round_trips(ptype: ParamType, value: Any, gui: Gui) -> None:
+    spec = ParameterSpec("p", ptype, value)
+    editor = make_editor(spec)
+    editor.set_value(value)
+    back = spec.check(editor.value(), "test")
+    if isinstance(value, Pose):
+        assert isinstance(back, Pose)
+        fields = Pose.FIELDS
+        assert [getattr(back, f) for f in fields] == pytest.approx(
+            [getattr(value, f) for f in fields], abs=1e-3
+        )  # angles are shown in 0.1° steps
+    else:
+        assert back == value
+
+
+def test_unreadable_list_text_raises_a_sentence(gui: Gui) -> None:
+    editor = make_editor(ParameterSpec("tags", ParamType.LIST, []))
+    assert isinstance(editor, TextEditor)
+    editor.line.setText("[unclosed")
+    with pytest.raises(InvalidRequest) as caught:
+        editor.value()
+    assert "\n" not in str(caught.value) and str(caught.value)
