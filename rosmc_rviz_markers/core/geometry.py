@@ -3,6 +3,8 @@
 A :class:`Primitive` is one shape (cube, sphere, cylinder, arrow, lines, triangles,
 camera-facing text) relative to its interactive marker's pose. The ROS layer turns each
 into a ``visualization_msgs/Marker`` field by field; nothing here knows rospy.
+Orientation math and frame names are the shared ones (:mod:`rosmc_server.core.frames`,
+:mod:`rosmc_server.interface`).
 Robot bodies are recognisable at the default zoom: a drone with four rotors, rovers with
 six wheels and a camera mast, the manipulator with its arm.
 """
@@ -14,16 +16,10 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from rosmc_server.core.frames import IDENTITY, Quaternion
+from rosmc_server.core.frames import quaternion_from_rpy as quaternion
+
 Point = tuple[float, float, float]
-Quaternion = tuple[float, float, float, float]  # x, y, z, w
-IDENTITY: Quaternion = (0.0, 0.0, 0.0, 1.0)
-
-MAP_FRAME = "map"
-
-
-def base_link(agent: str) -> str:
-    """The body frame of an agent, as the simulator and robots publish it on TF."""
-    return f"{agent}/base_link"
 
 
 @dataclass(frozen=True)
@@ -72,25 +68,6 @@ class Primitive:
     orientation: Quaternion = IDENTITY
     points: tuple[Point, ...] = ()
     text: str = ""
-
-
-def quaternion(roll: float = 0.0, pitch: float = 0.0, yaw: float = 0.0) -> Quaternion:
-    """The quaternion of roll, pitch and yaw (radians, applied z-y-x)."""
-    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
-    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
-    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    return (
-        sr * cp * cy - cr * sp * sy,
-        cr * sp * cy + sr * cp * sy,
-        cr * cp * sy - sr * sp * cy,
-        cr * cp * cy + sr * sp * sy,
-    )
-
-
-def yaw_of(q: Quaternion) -> float:
-    """The heading (rotation about z) of a quaternion."""
-    x, y, z, w = q
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
 
 def is_finite(*values: float) -> bool:

@@ -25,6 +25,7 @@ from rosmc_server.core.updates import (
     SkillChanged,
     SkillRemoved,
 )
+from rosmc_server.interface import MAP_FRAME
 
 from . import geometry as geo
 from .menus import flatten, robot_menu, static_agent_menu, task_marker_menu
@@ -139,7 +140,7 @@ class Scene:
         )
         frame, position, yaw = None, (0.0, 0.0, 0.0), 0.0
         if not self.follow_tf:
-            frame = geo.MAP_FRAME
+            frame = MAP_FRAME
             if status is not None and status.pose is not None:
                 position = (status.pose.x, status.pose.y, status.pose.z)
                 yaw = status.pose.yaw

@@ -13,11 +13,13 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
+from rosmc_server.core.frames import IDENTITY, Quaternion
 from rosmc_server.core.model import SkillInstance, TaskMarker
 from rosmc_server.core.params import MarkerType
+from rosmc_server.interface import MAP_FRAME, base_link
 
 from . import geometry as geo
-from .geometry import Color, Point, Primitive, Quaternion
+from .geometry import Color, Point, Primitive
 from .menus import FlatMenu
 from .styling import HIGHLIGHT, LOCK_COLOR, USE_COLORS, MarkerUse
 
@@ -136,11 +138,11 @@ def agent_spec(
     mode = Interaction.MENU if menu.entries else Interaction.NONE
     return MarkerSpec(
         name=(robot_name if robot else object_name)(agent),
-        frame=frame or geo.base_link(agent),
+        frame=frame or base_link(agent),
         position=position,
         yaw=yaw,
         description=agent,
-        controls=(ControlSpec("body", mode, body, geo.IDENTITY),),
+        controls=(ControlSpec("body", mode, body, IDENTITY),),
         menu=menu,
         scale=3.0 if robot else 1.5,
     )
@@ -177,7 +179,7 @@ def task_specs(
     if marker.type is MarkerType.AREA:
         return _area_specs(marker, color, menu, move_mode, movable, extra, description)
     visuals = geo.flag(color) + extra
-    controls = [ControlSpec("flag", move_mode, visuals, UP if movable else geo.IDENTITY)]
+    controls = [ControlSpec("flag", move_mode, visuals, UP if movable else IDENTITY)]
     yaw = 0.0
     if marker.type is MarkerType.POSE:
         yaw = marker.pose.yaw
@@ -186,11 +188,11 @@ def task_specs(
             ring = geo.ring(color.with_alpha(0.9), 2.3, z=0.06, width=0.12)
             controls.append(ControlSpec("heading", Interaction.ROTATE_AXIS, (arrow, ring)))
         else:
-            controls.append(ControlSpec("heading", menu_mode, (arrow,), geo.IDENTITY))
+            controls.append(ControlSpec("heading", menu_mode, (arrow,), IDENTITY))
     return [
         MarkerSpec(
             task_name(marker.name),
-            geo.MAP_FRAME,
+            MAP_FRAME,
             (x, y, 0.0),
             yaw,
             description,
@@ -215,11 +217,11 @@ def _area_specs(
     visuals = (*geo.polygon(relative, color), geo.handle(color), *extra)
     centre = MarkerSpec(
         task_name(marker.name),
-        geo.MAP_FRAME,
+        MAP_FRAME,
         (cx, cy, 0.0),
         0.0,
         description,
-        (ControlSpec("area", move_mode, visuals, UP if movable else geo.IDENTITY),),
+        (ControlSpec("area", move_mode, visuals, UP if movable else IDENTITY),),
         menu,
         scale=4.0,
     )
@@ -229,7 +231,7 @@ def _area_specs(
             specs.append(
                 MarkerSpec(
                     vertex_name(marker.name, index),
-                    geo.MAP_FRAME,
+                    MAP_FRAME,
                     (vertex.x, vertex.y, 0.0),
                     0.0,
                     "",

@@ -14,6 +14,8 @@ from visualization_msgs.msg import (
     MenuEntry,
 )
 
+from rosmc_server.core.frames import quaternion_from_rpy, yaw_of
+
 from ..core import geometry as geo
 from ..core.icons import IconRow
 from ..core.menus import FlatMenu
@@ -49,7 +51,7 @@ def primitive_msg(primitive: geo.Primitive, ident: int) -> Marker:
 
 def pose_msg(position: geo.Point, yaw: float) -> Pose:
     """A position and heading as ``geometry_msgs/Pose``."""
-    return Pose(PointMsg(*position), Quaternion(*geo.quaternion(yaw=yaw)))
+    return Pose(PointMsg(*position), Quaternion(*quaternion_from_rpy(yaw=yaw)))
 
 
 def menu_msgs(menu: FlatMenu) -> list[MenuEntry]:
@@ -138,5 +140,5 @@ def pose_numbers(pose: Pose) -> tuple[float, float, float]:
     if not geo.is_finite(*quat) or sum(c * c for c in quat) < 1e-12:
         yaw = float("nan") if not geo.is_finite(*quat) else 0.0
     else:
-        yaw = geo.yaw_of(quat)
+        yaw = yaw_of(quat)
     return float(pose.position.x), float(pose.position.y), yaw

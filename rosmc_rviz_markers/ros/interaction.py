@@ -36,7 +36,6 @@ from rosmc_server.ros.client import AsyncMissionClient, MissionClient, Outcome
 
 from .. import topics
 from ..core import areas
-from ..core import geometry as geo
 from ..core.menus import AddSkill, DeleteMarker, MenuAction, RenameMarker
 from ..core.requests import SkillPlan, moved_area, moved_pose, new_marker, robot_skill_plan
 from ..core.scene import Selection
@@ -291,7 +290,7 @@ class Interaction:
 
     def _create(self, kind: MarkerType, frame: str, x: float, y: float, yaw: float) -> None:
         what = kind.name.lower()
-        if frame.lstrip("/") not in ("", geo.MAP_FRAME):
+        if frame.lstrip("/") not in ("", interface.MAP_FRAME):
             _log.warning(
                 "ignored a new %s marker in frame '%s' (set the fixed frame to map)", what, frame
             )

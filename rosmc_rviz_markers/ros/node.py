@@ -36,11 +36,11 @@ from visualization_msgs.msg import Marker, MarkerArray
 from rosmc_server.core import AgentStatus, Library, MissionState, load_library
 from rosmc_server.core.mirror import MissionMirror
 from rosmc_server.core.updates import MirrorUpdate, MissionReset
+from rosmc_server.interface import MAP_FRAME, base_link
 from rosmc_server.ros.client import MissionFollower, Outcome
 from rosmc_server.ros.logging_bridge import bridge_logging_to_rosout
 
 from .. import topics
-from ..core import geometry as geo
 from ..core.icons import status_rows
 from ..core.scene import Scene, Touched
 from ..core.specs import MarkerSpec
@@ -251,9 +251,9 @@ class MarkerNode:
                 and state.has_skill(status.current_skill)
             ):
                 label = state.skill(status.current_skill).label
-            frame, position = geo.base_link(agent), (0.0, 0.0, 0.0)
+            frame, position = base_link(agent), (0.0, 0.0, 0.0)
             if not self.config.follow_tf:
-                frame = geo.MAP_FRAME
+                frame = MAP_FRAME
                 if status is not None and status.pose is not None:
                     position = (status.pose.x, status.pose.y, status.pose.z)
             rows = status_rows(status, label, agent)

@@ -95,11 +95,6 @@ def test_bodies_are_recognisable() -> None:
         assert all(math.isfinite(v) for v in (*part.position, *part.scale, *part.orientation))
 
 
-def test_quaternion_round_trip() -> None:
-    for yaw in (-3.0, -1.0, 0.0, 0.5, 3.1):
-        assert geometry.yaw_of(geometry.quaternion(yaw=yaw)) == pytest.approx(yaw)
-
-
 # -- areas --------------------------------------------------------------------------------------
 def test_area_checks() -> None:
     areas.check_area([(0, 0), (4, 0), (4, 4), (0, 4)])
