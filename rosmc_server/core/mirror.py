@@ -62,6 +62,7 @@ class MissionMirror:
         self._statuses: dict[str, AgentStatus] = {}
         self._listeners: list[Listener] = []
         self._held_at_request = -1
+        self._server_revision: int | None = None
         self.snapshots_requested = 0
         self.ignored_events = 0
 
@@ -146,6 +147,26 @@ class MissionMirror:
             if self._state is None and not self._awaiting_snapshot:
                 need = self._claim_snapshot_request()
         if need:
+            self._ask_snapshot()
+
+    def on_server_revision(self, revision: int) -> None:
+        """The server says it is at ``revision`` (agent states carry it, at a steady rate).
+
+        Events are published as they happen, so by the server's next word every event up
+        to the revision it gave last time has arrived, unless one was lost (a subscriber
+        that connected late, a dropped connection). A loss at the end of a burst shows no
+        gap, so this is how it is noticed: the mirror then asks for a snapshot.
+        """
+        with self.lock:
+            said_before, self._server_revision = self._server_revision, revision
+            lagging = (
+                self._state is not None
+                and said_before is not None
+                and self._state.revision < min(said_before, revision)
+            )
+            need = lagging and self._claim_snapshot_request()
+        if need:
+            _log.info("the mission mirror missed events up to revision %d; refetching", revision)
             self._ask_snapshot()
 
     def on_agent_statuses(self, statuses: Mapping[str, AgentStatus]) -> None:

@@ -312,3 +312,21 @@ def test_a_failing_listener_does_not_stop_the_others() -> None:
     mirror.on_snapshot(snapshot_of(mission))
     mirror.on_event(mission.add_skill("drone", "land"))
     assert view.matches(mission.state)
+
+
+def test_a_lost_last_event_is_noticed_from_the_servers_revision() -> None:
+    mission = make_mission()
+    asked: list[int] = []
+    mirror = MissionMirror(lambda: asked.append(1))
+    mirror.on_snapshot(snapshot_of(mission))
+    mirror.on_event(mission.add_skill("drone", "land"))
+    mission.add_skill("drone", "take_off")  # published, never arrives; nothing comes after it
+    mirror.on_server_revision(2)  # the server's word may overtake an event in flight
+    assert asked == []
+    mirror.on_server_revision(2)  # by its next word, revision 2 should have arrived
+    assert asked == [1]
+    mirror.on_snapshot(snapshot_of(mission))
+    assert mirror.revision == 2 and mirror.synced
+    mirror.on_server_revision(2)
+    mirror.on_server_revision(0)  # a server that started anew: its restart is seen elsewhere
+    assert asked == [1]

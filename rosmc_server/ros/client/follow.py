@@ -2,7 +2,8 @@
 
 Subscribes (each name behind ``prefix``, e.g. ``/replay``):
     ``/rosmc/mission_events`` (rosmc/MissionEvent): one message per accepted change.
-    ``/rosmc/agent_states`` (rosmc/AgentStates): every robot's link and telemetry.
+    ``/rosmc/agent_states`` (rosmc/AgentStates): every robot's link and telemetry, and the
+    server's revision (an event lost at the end of a burst shows there).
 
 Calls (on its own worker thread, never the caller's):
     ``/rosmc/get_mission`` (rosmc/GetMission): the snapshot, at start, after a revision gap,
@@ -144,6 +145,7 @@ class MissionFollower:
             _log.exception("cannot read agent states")
             return
         self.mirror.on_agent_statuses(statuses)
+        self.mirror.on_server_revision(int(msg.revision))
 
     # -- is the server there, and the same process? ----------------------------------------------
     def _watch(self) -> None:
