@@ -14,6 +14,7 @@ Use one function per robot kind as the executor's ``~skills`` parameter:
 from __future__ import annotations
 
 import functools
+import itertools
 import threading
 import time
 from collections.abc import Mapping
@@ -54,6 +55,7 @@ class RobotController:
         self.robot = robot
         self._lock = threading.Lock()
         self._status: dict[str, wire.RobotTaskStatus] = {}
+        self._runs = itertools.count(1)
         self._publisher = rospy.Publisher(task_topic(robot), wire.RobotTask, queue_size=100)
         self._subscriber = rospy.Subscriber(
             task_status_topic(robot), wire.RobotTaskStatus, self._on_status, queue_size=100
@@ -62,6 +64,20 @@ class RobotController:
     def _on_status(self, msg: wire.RobotTaskStatus) -> None:
         with self._lock:
             self._status[msg.task_id] = msg
+
+    def new_task_id(self, skill_id: str, attempt: int) -> str:
+        """A task id for one run of a skill, never used before by this controller.
+
+        A stopped skill runs again under the same skill id and attempt when the robot is
+        started again; the controllers' answer about the cancelled run must not be taken
+        for the new one's (it made the restarted skill fail at once as "cancelled").
+        """
+        return f"{skill_id}#{attempt}.{next(self._runs)}"
+
+    def forget(self, task_id: str) -> None:
+        """Drop what was heard about a task that is over (keeps the table small)."""
+        with self._lock:
+            self._status.pop(task_id, None)
 
     def status(self, task_id: str) -> wire.RobotTaskStatus | None:
         """The latest status heard for a task."""
@@ -94,7 +110,7 @@ class ForwardedSkill(SkillBehavior):
     def start(self, ctx: SkillContext) -> None:
         """Ask the controllers to start."""
         self._ctx = ctx
-        self._task_id = f"{ctx.skill_id}#{ctx.attempt}"
+        self._task_id = self._controller.new_task_id(ctx.skill_id, ctx.attempt)
         self._send_start()
 
     def _send_start(self) -> None:
@@ -111,8 +127,10 @@ class ForwardedSkill(SkillBehavior):
                 self._send_start()
             return None
         if status.state == wire.RobotTaskStatus.SUCCEEDED:
+            self._controller.forget(self._task_id)
             return Outcome.ok(status.text)
         if status.state == wire.RobotTaskStatus.FAILED:
+            self._controller.forget(self._task_id)
             return Outcome.failed(status.text or "failed")
         if status.text and status.text != self._last_text:
             self._last_text = status.text

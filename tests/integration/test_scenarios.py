@@ -28,6 +28,7 @@ from rosmc_server.core import MarkerType, Pose, SkillStatus, TaskMarker, Unavail
 from rosmc_server.core.changes import EventKind
 from rosmc_server.interface import EVENTS_TOPIC
 from rosmc_server.recording import read_journal
+from rosmc_server.ros.client import ControlCommand
 from rosmc_sim.ros.demo_operator import OPERATOR_KINDS, WIFI_SPOT_ADAPTED
 from tests.conftest import wait_until
 from tests.integration.scenario_fixtures import Operator, Team, TeamSettings
@@ -243,6 +244,23 @@ def test_without_identification_a_stone_scores_the_minimum(op: Operator) -> None
     wait_until(lambda: op.science.score() > start_score, 10.0, "the score counts the stone")
     assert op.science.score() - start_score == pytest.approx(0.1)
     assert any("RSS West stone 1 worth 0.10" in line for line in op.science.lines)
+
+
+# -- stop, then start ---------------------------------------------------------------------------
+def test_a_stopped_skill_runs_again_on_start(op: Operator) -> None:
+    """As `rosmc stop --help` promises: stop sends the skill back, start runs it again."""
+    c = op.client
+    drive = c.add_skill(SCIENCE, "navigate_to", target(-6.0, -6.0, speed=0.3)).skill_id
+    back = c.add_skill(SCIENCE, "return_to_lander").skill_id
+    op.sync_and_start([SCIENCE])
+    op.wait_status([drive], S.RUNNING, timeout=20.0)
+    c.control(ControlCommand.STOP, SCIENCE)
+    op.wait_status([drive], S.IDLE_SYNCHRONIZED, timeout=20.0)
+    c.control(ControlCommand.START, SCIENCE)
+    op.wait_status([drive], S.RUNNING, timeout=20.0)
+    op.wait_status([drive, back], S.SUCCESS, timeout=90.0)
+    skill = op.mission().skill(drive)
+    assert skill.attempt == 1 and "cancel" not in skill.status_text
 
 
 # -- 3. coverage ---------------------------------------------------------------------------------
