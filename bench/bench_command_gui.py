@@ -20,6 +20,7 @@ Usage: ``python bench/bench_command_gui.py [--agents 20 --skills 500 --seconds 1
 from __future__ import annotations
 
 import argparse
+import gc
 import itertools
 import json
 import os
@@ -129,6 +130,9 @@ def run(args: argparse.Namespace, server: Server) -> int:
     editor = MissionClient(30.0)
     editor.get_mission()
     editor.library()
+    # It stands for another operator's process: its copy of the mission is kept out of
+    # this process's garbage collector, as the window keeps its own (standalone.py).
+    gc.freeze()
 
     # Load: robots report at --rate Hz, an operator edits one label every 100 ms.
     ticks: list[float] = []

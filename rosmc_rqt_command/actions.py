@@ -13,11 +13,11 @@ from python_qt_binding.QtWidgets import QAction, QWidget
 
 from .legality import Action, RobotAction
 
-# (text, shortcut, tooltip) of each skill action.
+# (text, shortcuts, tooltip) of each skill action ("A|B": either key sequence).
 SKILL_ACTIONS: dict[Action, tuple[str, str, str]] = {
     Action.DELETE: ("Delete", "Delete", "Delete the selected planned skills"),
-    Action.MOVE_UP: ("Move up", "Alt+Up", "Move the selected skills one place earlier"),
-    Action.MOVE_DOWN: ("Move down", "Alt+Down", "Move the selected skills one place later"),
+    Action.MOVE_UP: ("Move up", "Alt+Up|Ctrl+Up", "Move the selected skills one earlier"),
+    Action.MOVE_DOWN: ("Move down", "Alt+Down|Ctrl+Down", "Move the selected skills one later"),
     Action.SYNC: (
         "Send to robot",
         "Ctrl+Return",
@@ -91,9 +91,11 @@ class CommandActions(QObject):  # type: ignore[misc]
         action = QAction(text, owner)
         action.setObjectName(f"action_{name}")
         if keys:
-            action.setShortcut(QKeySequence(keys))
+            # "A|B": two key sequences for one action (the first is shown in menus).
+            action.setShortcuts([QKeySequence(k) for k in keys.split("|")])
             action.setShortcutContext(Qt.WidgetWithChildrenShortcut)
-            tip = f"{tip} ({keys})" if tip else keys
+            words = keys.replace("|", " or ")
+            tip = f"{tip} ({words})" if tip else words
         action.setToolTip(tip)
         action.setStatusTip(tip)
         owner.addAction(action)
