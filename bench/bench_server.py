@@ -108,8 +108,14 @@ def ros_master(home: Path) -> Iterator[dict[str, str]]:
             time.sleep(0.05)
         yield env
     finally:
+        # SIGINT may be ignored where the benchmark runs (a CI shell, nohup): then SIGKILL,
+        # so that the figures are still printed.
         os.killpg(master.pid, signal.SIGINT)
-        master.wait(10)
+        try:
+            master.wait(5)
+        except subprocess.TimeoutExpired:
+            os.killpg(master.pid, signal.SIGKILL)
+            master.wait(5)
 
 
 class Server:
