@@ -384,7 +384,7 @@ def take_screenshot(
         rviz_env = rviz_environment(display, env or os.environ)
         crash = ""
         for attempt in range(1, attempts + 1):
-            with _running_rviz(config, rviz_env, log) as rviz:
+            with running_rviz(config, rviz_env, log) as rviz:
                 try:
                     shot, problems = _wait_until_drawn(display, rviz, check, timeout, log)
                 except _RvizCrashed as error:
@@ -412,7 +412,7 @@ _FATAL_MARKERS = ("free(): ", "malloc(): ", "double free", "corrupted ", "Segmen
 
 
 @contextlib.contextmanager
-def _running_rviz(
+def running_rviz(
     config: Path, env: Mapping[str, str], log: Path
 ) -> Iterator[subprocess.Popen[bytes]]:
     """rviz with ``config`` (no splash screen), stopped with its children afterwards."""

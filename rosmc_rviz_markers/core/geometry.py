@@ -14,7 +14,7 @@ from __future__ import annotations
 import enum
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from rosmc_server.core.frames import IDENTITY, Quaternion
 from rosmc_server.core.frames import quaternion_from_rpy as quaternion
@@ -214,36 +214,62 @@ def static_shell(kind: BodyKind) -> tuple[Primitive, ...]:
     return (_box(color, 0.0, 0.0, 0.27, 0.62, 0.62, 0.62),)
 
 
+# Robots are drawn larger than life, so that an operator tells them apart at the default
+# view of the whole work area (the drone the most: it is the smallest and flies highest).
+ROBOT_SCALE = {BodyKind.DRONE: 2.2}
+DEFAULT_ROBOT_SCALE = 1.6
+
+
+def scaled(parts: Sequence[Primitive], factor: float) -> tuple[Primitive, ...]:
+    """``parts`` grown by ``factor`` about the frame origin (positions, sizes, points)."""
+
+    def grow(p: Point) -> Point:
+        return (p[0] * factor, p[1] * factor, p[2] * factor)
+
+    out = []
+    for part in parts:
+        scale = part.scale
+        if part.shape not in (Shape.LINE_STRIP, Shape.LINE_LIST, Shape.TEXT):
+            scale = grow(scale)  # a line's width and a text's height stay as they are
+        points = tuple(grow(p) for p in part.points)
+        out.append(replace(part, position=grow(part.position), scale=scale, points=points))
+    return tuple(out)
+
+
 def agent_body(kind: BodyKind) -> tuple[Primitive, ...]:
-    """The body of a robot or static agent of ``kind`` (frame at the bottom, x forward)."""
+    """The body of a robot or static agent of ``kind`` (frame at the bottom, x forward).
+
+    Robots are scaled by :data:`ROBOT_SCALE`; static agents' shells fit the world's objects.
+    """
     color = BODY_COLORS[kind]
-    if kind is BodyKind.DRONE:
-        return drone_body(color)
-    if kind is BodyKind.SCIENCE_ROVER:
-        return rover_body(color, science=True)
-    if kind is BodyKind.ROVER:
-        return rover_body(color)
-    if kind is BodyKind.MANIPULATOR_ROVER:
-        return manipulator_body(color)
     if kind in (BodyKind.LANDER, BodyKind.PAYLOAD_BOX):
         return static_shell(kind)
-    return generic_body(color)
+    if kind is BodyKind.DRONE:
+        body = drone_body(color)
+    elif kind is BodyKind.SCIENCE_ROVER:
+        body = rover_body(color, science=True)
+    elif kind is BodyKind.ROVER:
+        body = rover_body(color)
+    elif kind is BodyKind.MANIPULATOR_ROVER:
+        body = manipulator_body(color)
+    else:
+        body = generic_body(color)
+    return scaled(body, ROBOT_SCALE.get(kind, DEFAULT_ROBOT_SCALE))
 
 
 # -- task markers ------------------------------------------------------------------------------
-FLAG_HEIGHT = 2.4
+FLAG_HEIGHT = 2.2
 
 
 def flag(color: Color) -> tuple[Primitive, ...]:
-    """A flag: pole, triangular cloth and a ground disc (its foot is at the marker's origin)."""
-    cloth = (
-        (0.0, 0.0, FLAG_HEIGHT),
-        (0.0, 0.0, FLAG_HEIGHT - 0.8),
-        (1.1, 0.0, FLAG_HEIGHT - 0.4),
-    )
+    """A flag: pole, cloth and a ground disc (its foot is at the marker's origin).
+
+    The cloth is a thin box (lit from both sides; a triangle list has no normals in rviz
+    and shows black).
+    """
     return (
         Primitive(Shape.CYLINDER, DARK, (0.0, 0.0, FLAG_HEIGHT / 2), (0.1, 0.1, FLAG_HEIGHT)),
-        Primitive(Shape.TRIANGLE_LIST, color.with_alpha(1.0), points=cloth + cloth[::-1]),
+        _box(color.with_alpha(1.0), 0.55, 0.0, FLAG_HEIGHT - 0.35, 1.0, 0.05, 0.7),
         Primitive(Shape.CYLINDER, color, (0.0, 0.0, 0.02), (1.2, 1.2, 0.04)),
     )
 

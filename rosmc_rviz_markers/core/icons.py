@@ -1,19 +1,29 @@
-"""Status icons above each robot: what they say and in which colour.
+"""Status icons above each robot: what they say, in which colour, and at which height.
 
-Rows, top to bottom: the current skill and its status, the ground link, Wi-Fi, battery.
-Every row is short camera-facing text in a colour that carries the threshold (green,
-yellow, red), so the block is legible at the default zoom. No data is shown as such
-("no telemetry"), never left out.
+A robot's block is two short camera-facing lines, so that it stays above its own robot
+without covering the others:
+
+* the robot's name, its current skill and that skill's status
+  (``science_rover: navigate_to > running``), coloured by the status;
+* its health: battery, Wi-Fi and ground link
+  (``BAT 97% | WiFi -54 dBm | link up``), coloured by the worst of the three (green,
+  yellow, red; the part past its threshold is written in capitals).
+
+No data is shown as such (``?``, "never heard"), never left out. Robots standing close
+together (at the lander, at one region) get their blocks lifted by whole blocks
+(:func:`icon_levels`), so they do not write over each other.
 """
 
 from __future__ import annotations
 
+import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from rosmc_server.core.agent_status import AgentStatus
 from rosmc_server.core.model import SkillStatus
 
-from .geometry import Color
+from .geometry import Color, Point
 
 GOOD = Color(0.30, 1.00, 0.35)
 WARN = Color(1.00, 0.85, 0.15)
@@ -26,11 +36,21 @@ BATTERY_MID = 0.5  # below: yellow
 WIFI_WEAK = -68.0  # dBm, below: red
 WIFI_FAIR = -60.0  # dBm, below: yellow
 LINK_STALE = 5.0  # seconds since heard while up: yellow
+SEPARATOR = " | "
+
+# Where the block sits, in metres (the ROS layer turns rows into text markers).
+ICON_BASE = 1.9  # above the robot's frame: the lower line's centre, clear of mast and arm
+ICON_ROW = 0.6  # from one line's centre to the next
+ICON_TEXT = 0.45  # letter height
+ICON_GAP = 0.35  # between two lifted blocks
+NEAR = 10.0  # robots closer than this (horizontally) stack their blocks
+
+_SEVERITY = {GOOD: 0, NEUTRAL: 0, DIM: 1, WARN: 2, BAD: 3}
 
 
 @dataclass(frozen=True)
 class IconRow:
-    """One line of a robot's status block."""
+    """One line (or one part of a line) of a robot's status block."""
 
     key: str
     text: str
@@ -38,72 +58,61 @@ class IconRow:
 
 
 def battery_row(level: float | None) -> IconRow:
-    """Battery: a five-cell gauge and the percentage, red below 25 %, yellow below 50 %."""
+    """Battery: the percentage, red below 25 %, yellow below 50 %."""
     if level is None:
-        return IconRow("battery", "BAT  no telemetry", DIM)
+        return IconRow("battery", "BAT ?", DIM)
     level = min(max(level, 0.0), 1.0)
-    cells = round(level * 5)
-    gauge = "[" + "#" * cells + "." * (5 - cells) + "]"
     color = BAD if level < BATTERY_LOW else WARN if level < BATTERY_MID else GOOD
-    return IconRow("battery", f"BAT {gauge} {level * 100:.0f}%", color)
+    word = "BAT LOW" if color == BAD else "BAT"
+    return IconRow("battery", f"{word} {level * 100:.0f}%", color)
 
 
 def wifi_row(dbm: float | None) -> IconRow:
-    """Wi-Fi: bars and dBm, red below -68 dBm, yellow below -60 dBm."""
+    """Wi-Fi: the signal in dBm, red below -68 dBm, yellow below -60 dBm."""
     if dbm is None:
-        return IconRow("wifi", "WIFI no telemetry", DIM)
-    bars = 4 if dbm >= -55 else 3 if dbm >= WIFI_FAIR else 2 if dbm >= WIFI_WEAK else 1
-    gauge = "|" * bars + "." * (4 - bars)
+        return IconRow("wifi", "WiFi ?", DIM)
     color = BAD if dbm < WIFI_WEAK else WARN if dbm < WIFI_FAIR else GOOD
-    return IconRow("wifi", f"WIFI {gauge} {dbm:.0f} dBm", color)
+    word = "WIFI WEAK" if color == BAD else "WiFi"
+    return IconRow("wifi", f"{word} {dbm:.0f} dBm", color)
 
 
 def link_row(link: str, last_heard: float) -> IconRow:
     """Ground link: up / down / never heard, with seconds since the robot was heard."""
     if link == "unknown" or last_heard < 0:
-        return IconRow("link", "LINK never heard", DIM if link == "unknown" else BAD)
-    ago = f"{last_heard:.0f} s ago" if last_heard >= 1 else "now"
+        return IconRow("link", "link never heard", DIM if link == "unknown" else BAD)
     if link == "up":
-        return IconRow("link", f"LINK up ({ago})", WARN if last_heard > LINK_STALE else GOOD)
-    return IconRow("link", f"LINK DOWN ({ago})", BAD)
+        if last_heard > LINK_STALE:
+            return IconRow("link", f"link up, {last_heard:.0f} s ago", WARN)
+        return IconRow("link", "link up", GOOD)
+    return IconRow("link", f"LINK DOWN {last_heard:.0f} s", BAD)
 
 
 _STATUS_WORDS = {
-    SkillStatus.RUNNING: (">", "running", GOOD),
-    SkillStatus.SYNCWAITING: ("||", "waiting at barrier", WARN),
-    SkillStatus.PAUSED: ("||", "paused", DIM),
-    SkillStatus.FAILURE: ("X", "FAILED", BAD),
-    SkillStatus.SUCCESS: ("OK", "done", Color(0.2, 0.9, 1.0)),
-    SkillStatus.IDLE_SYNCHRONIZED: ("v", "uploaded, not started", NEUTRAL),
+    SkillStatus.RUNNING: ("> running", GOOD),
+    SkillStatus.SYNCWAITING: ("|| waiting at barrier", WARN),
+    SkillStatus.PAUSED: ("|| paused", DIM),
+    SkillStatus.FAILURE: ("X FAILED", BAD),
+    SkillStatus.SUCCESS: ("done", Color(0.2, 0.9, 1.0)),
+    SkillStatus.IDLE_SYNCHRONIZED: ("uploaded, not started", NEUTRAL),
 }
 
 
 def skill_row(skill: str, status: SkillStatus | None, waiting_on: str = "") -> IconRow:
     """The robot's current skill and its status (waiting: on whom)."""
     if not skill or status is None or status is SkillStatus.IDLE:
-        return IconRow("skill", "no skill synchronized", DIM)
-    sign, words, color = _STATUS_WORDS[status]
+        return IconRow("skill", "idle", NEUTRAL)
+    words, color = _STATUS_WORDS[status]
     if status is SkillStatus.SYNCWAITING and waiting_on:
-        words = f"waiting for {waiting_on}"
-    return IconRow("skill", f"{sign} {skill}: {words}", color)
+        words = f"|| waits for {waiting_on}"
+    return IconRow("skill", f"{skill} {words}", color)
 
 
-def status_rows(
-    status: AgentStatus | None, skill_label: str = "", agent: str = ""
-) -> tuple[IconRow, ...]:
-    """The icon block of one robot, top row first (the robot's name before its skill).
+def status_parts(status: AgentStatus | None, skill_label: str = "") -> tuple[IconRow, ...]:
+    """Every part of a block: skill, link, Wi-Fi, battery (each with its own colour).
 
     ``skill_label`` names the current skill as operators know it (its label); without it
     the skill id the robot reports is shown.
     """
-    rows = _rows(status, skill_label)
-    if not agent:
-        return rows
-    first = rows[0]
-    return (IconRow(first.key, f"{agent}: {first.text}", first.color), *rows[1:])
-
-
-def _rows(status: AgentStatus | None, skill_label: str) -> tuple[IconRow, ...]:
     if status is None:
         return (
             IconRow("skill", "no status yet", DIM),
@@ -117,3 +126,56 @@ def _rows(status: AgentStatus | None, skill_label: str) -> tuple[IconRow, ...]:
         wifi_row(status.wifi_signal),
         battery_row(status.battery),
     )
+
+
+def worst(colors: Sequence[Color]) -> Color:
+    """The colour of the most severe part (red over yellow over grey over green)."""
+    return max(colors, key=lambda c: _SEVERITY.get(c, 0))
+
+
+def status_rows(
+    status: AgentStatus | None, skill_label: str = "", agent: str = ""
+) -> tuple[IconRow, IconRow]:
+    """The two lines of one robot's block, top line first.
+
+    ``skill``: ``<agent>: <skill> <status>`` in the status colour; ``health``:
+    ``BAT .. | WiFi .. | link ..`` in the worst of their colours.
+    """
+    skill, link, wifi, battery = status_parts(status, skill_label)
+    head = f"{agent}: {skill.text}" if agent else skill.text
+    health = SEPARATOR.join(part.text for part in (battery, wifi, link))
+    return (
+        IconRow("skill", head, skill.color),
+        IconRow("health", health, worst([battery.color, wifi.color, link.color])),
+    )
+
+
+def icon_levels(positions: Mapping[str, Point | None], near: float = NEAR) -> dict[str, int]:
+    """How many whole blocks to lift each robot's block (0 = right above the robot).
+
+    Robots are taken from south to north (the default view looks north, so a robot further
+    north stands higher on screen and its block goes higher still); each gets the lowest
+    level that no robot taken before within ``near`` metres (horizontally, at about the
+    same height) holds. Robots without a known position come last, in the order given,
+    and stack on each other as if together.
+    """
+    placed: list[tuple[Point | None, int]] = []
+    out: dict[str, int] = {}
+    order = sorted(positions.items(), key=lambda item: (item[1] is None, (item[1] or (0, 0))[1]))
+    for agent, position in order:
+        taken = {level for other, level in placed if _close(position, other, near)}
+        level = next(n for n in range(len(placed) + 1) if n not in taken)
+        out[agent] = level
+        placed.append((position, level))
+    return out
+
+
+def _close(a: Point | None, b: Point | None, near: float) -> bool:
+    if a is None or b is None:
+        return a is None and b is None
+    return math.hypot(a[0] - b[0], a[1] - b[1]) < near and abs(a[2] - b[2]) < ICON_ROW * 3
+
+
+def block_height(level: int, rows: int = 2) -> float:
+    """Height (m above the robot's frame) of the lowest line of a block at ``level``."""
+    return ICON_BASE + level * (ICON_ROW * rows + ICON_GAP)

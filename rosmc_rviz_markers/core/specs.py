@@ -134,14 +134,14 @@ def agent_spec(
     """A robot or static agent: its body, clickable for its menu, following its TF frame."""
     body = geo.agent_body(kind)
     if highlighted:
-        body = (*body, geo.ring(HIGHLIGHT, 1.1 if robot else 0.7))
+        body = (*body, geo.ring(HIGHLIGHT, 1.8 if robot else 0.7))
     mode = Interaction.MENU if menu.entries else Interaction.NONE
     return MarkerSpec(
         name=(robot_name if robot else object_name)(agent),
         frame=frame or base_link(agent),
         position=position,
         yaw=yaw,
-        description=agent,
+        description="" if robot else agent,  # a robot's status icons start with its name
         controls=(ControlSpec("body", mode, body, IDENTITY),),
         menu=menu,
         scale=3.0 if robot else 1.5,
@@ -198,7 +198,7 @@ def task_specs(
             description,
             tuple(controls),
             menu,
-            scale=3.0,
+            scale=2.2,  # rviz writes the label 1.4 x scale up: just above the flag
         )
     ]
 
@@ -223,7 +223,7 @@ def _area_specs(
         description,
         (ControlSpec("area", move_mode, visuals, UP if movable else IDENTITY),),
         menu,
-        scale=4.0,
+        scale=2.5,  # the label stays low, under what flies over the area
     )
     specs = [centre]
     if movable:

@@ -17,15 +17,10 @@ from visualization_msgs.msg import (
 from rosmc_server.core.frames import quaternion_from_rpy, yaw_of
 
 from ..core import geometry as geo
-from ..core.icons import IconRow
+from ..core.icons import ICON_ROW, ICON_TEXT, IconRow, block_height
 from ..core.menus import FlatMenu
 from ..core.specs import ControlSpec, MarkerSpec
 
-ICON_BASE = 2.6  # metres above the robot's frame where the lowest icon row sits
-ICON_ROW = 0.95
-ICON_TEXT = 0.85
-ICON_GAP = 0.6
-ICON_LEVELS = 3  # robots take turns at these heights
 ICONS_NS = "icons"
 
 
@@ -105,10 +100,11 @@ def icon_markers(
     """A robot's status rows as camera-facing text above ``position`` in ``frame``.
 
     ``level`` lifts the block by whole blocks, so that robots standing close together
-    (at the lander, at one region) do not write over each other.
+    (at the lander, at one region) do not write over each other
+    (:func:`~rosmc_rviz_markers.core.icons.icon_levels`).
     """
     out = []
-    lift = level * (ICON_ROW * len(rows) + ICON_GAP)
+    bottom = position[2] + block_height(level, len(rows))
     for index, row in enumerate(rows):
         marker = Marker()
         marker.header.frame_id = frame
@@ -118,7 +114,7 @@ def icon_markers(
         marker.id = base_id + index
         marker.type = Marker.TEXT_VIEW_FACING
         marker.action = Marker.ADD
-        z = position[2] + ICON_BASE + lift + ICON_ROW * (len(rows) - 1 - index)
+        z = bottom + ICON_ROW * (len(rows) - 1 - index)
         marker.pose.position = PointMsg(position[0], position[1], z)
         marker.pose.orientation.w = 1.0
         marker.scale.z = ICON_TEXT

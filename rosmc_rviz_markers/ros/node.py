@@ -41,11 +41,11 @@ from rosmc_server.ros.client import MissionFollower, Outcome
 from rosmc_server.ros.logging_bridge import bridge_logging_to_rosout
 
 from .. import topics
-from ..core.icons import status_rows
+from ..core.icons import icon_levels, status_rows
 from ..core.scene import Scene, Touched
 from ..core.specs import MarkerSpec
 from .adapter import MarkerServer
-from .convert import ICON_LEVELS, icon_markers, interactive_marker_msg, pose_msg
+from .convert import icon_markers, interactive_marker_msg, pose_msg
 from .interaction import Interaction
 
 _log = logging.getLogger(__name__)
@@ -242,7 +242,10 @@ class MarkerNode:
         self, scene: Scene, statuses: Mapping[str, AgentStatus], state: MissionState
     ) -> list[Marker]:
         out: list[Marker] = []
-        for index, agent in enumerate(scene.library.dynamic_agents):
+        agents = scene.library.dynamic_agents
+        poses = {agent: statuses[agent].pose if agent in statuses else None for agent in agents}
+        levels = icon_levels({a: (p.x, p.y, p.z) if p else None for a, p in poses.items()})
+        for index, agent in enumerate(agents):
             status = statuses.get(agent)
             label = ""
             if (
@@ -252,12 +255,13 @@ class MarkerNode:
             ):
                 label = state.skill(status.current_skill).label
             frame, position = base_link(agent), (0.0, 0.0, 0.0)
+            pose = poses[agent]
             if not self.config.follow_tf:
                 frame = MAP_FRAME
-                if status is not None and status.pose is not None:
-                    position = (status.pose.x, status.pose.y, status.pose.z)
+                if pose is not None:
+                    position = (pose.x, pose.y, pose.z)
             rows = status_rows(status, label, agent)
-            out += icon_markers(agent, rows, frame, position, index * 10, index % ICON_LEVELS)
+            out += icon_markers(agent, rows, frame, position, index * 10, levels[agent])
         return out
 
     # -- feedback ---------------------------------------------------------------------------------

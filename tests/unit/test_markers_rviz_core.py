@@ -14,7 +14,17 @@ from typing import Any
 import pytest
 
 from rosmc_rviz_markers.core import areas, geometry
-from rosmc_rviz_markers.core.icons import BAD, DIM, GOOD, WARN, status_rows
+from rosmc_rviz_markers.core.icons import (
+    BAD,
+    DIM,
+    GOOD,
+    ICON_ROW,
+    WARN,
+    block_height,
+    icon_levels,
+    status_parts,
+    status_rows,
+)
 from rosmc_rviz_markers.core.menus import (
     AddSkill,
     DeleteMarker,
@@ -159,9 +169,9 @@ def test_marker_use_and_lock() -> None:
 
 # -- icons --------------------------------------------------------------------------------------
 def test_icon_thresholds() -> None:
-    rows = {r.key: r for r in status_rows(None)}
-    assert rows["battery"].color == DIM and "no telemetry" in rows["battery"].text
-    assert "never heard" in rows["link"].text
+    parts = {r.key: r for r in status_parts(None)}
+    assert parts["battery"].color == DIM and parts["battery"].text == "BAT ?"
+    assert "never heard" in parts["link"].text
     status = AgentStatus(
         "drone",
         link="up",
@@ -172,19 +182,60 @@ def test_icon_thresholds() -> None:
         current_status=SkillStatus.SYNCWAITING,
         waiting_on="science_rover",
     )
-    rows = {r.key: r for r in status_rows(status, "fly over A")}
-    assert rows["battery"].color == BAD and "20%" in rows["battery"].text
-    assert rows["wifi"].color == BAD and "-72 dBm" in rows["wifi"].text
-    assert rows["link"].color == GOOD
-    assert rows["skill"].text == "|| fly over A: waiting for science_rover"
+    parts = {r.key: r for r in status_parts(status, "fly over A")}
+    assert parts["battery"].color == BAD and "20%" in parts["battery"].text
+    assert parts["wifi"].color == BAD and "-72 dBm" in parts["wifi"].text
+    assert parts["link"].color == GOOD
+    assert parts["skill"].text == "fly over A || waits for science_rover"
     status = replace(status, battery=0.4, wifi_signal=-63.0, link="down", last_heard=12.0)
-    rows = {r.key: r for r in status_rows(status)}
-    assert rows["battery"].color == WARN and rows["wifi"].color == WARN
-    assert rows["link"].text == "LINK DOWN (12 s ago)" and rows["link"].color == BAD
+    parts = {r.key: r for r in status_parts(status)}
+    assert parts["battery"].color == WARN and parts["wifi"].color == WARN
+    assert parts["link"].text == "LINK DOWN 12 s" and parts["link"].color == BAD
     status = replace(status, battery=0.9, wifi_signal=-50.0, current_status=SkillStatus.FAILURE)
-    rows = {r.key: r for r in status_rows(status)}
-    assert rows["battery"].color == GOOD and rows["wifi"].color == GOOD
-    assert "FAILED" in rows["skill"].text and rows["skill"].color == BAD
+    parts = {r.key: r for r in status_parts(status)}
+    assert parts["battery"].color == GOOD and parts["wifi"].color == GOOD
+    assert "FAILED" in parts["skill"].text and parts["skill"].color == BAD
+
+
+def test_icon_block_is_two_short_lines_in_the_worst_colour() -> None:
+    status = AgentStatus(
+        "science_rover",
+        link="up",
+        last_heard=0.1,
+        battery=0.97,
+        wifi_signal=-54.0,
+        current_skill="s-1",
+        current_status=SkillStatus.RUNNING,
+    )
+    head, health = status_rows(status, "navigate_to", "science_rover")
+    assert head.text == "science_rover: navigate_to > running" and head.color == GOOD
+    assert health.text == "BAT 97% | WiFi -54 dBm | link up" and health.color == GOOD
+    assert max(len(head.text), len(health.text)) <= 40
+    _, health = status_rows(replace(status, wifi_signal=-64.0))
+    assert health.color == WARN
+    _, health = status_rows(replace(status, wifi_signal=-64.0, battery=0.1))
+    assert health.color == BAD and "BAT LOW 10%" in health.text
+    head, health = status_rows(None, agent="drone")
+    assert head.text == "drone: no status yet" and health.color == DIM
+
+
+def test_icon_levels_stack_only_robots_standing_together() -> None:
+    apart = {"a": (0.0, 0.0, 0.0), "b": (12.0, 0.0, 0.0), "c": (0.0, 12.0, 0.0)}
+    assert icon_levels(apart) == {"a": 0, "b": 0, "c": 0}
+    together = {"a": (0.0, 0.0, 0.0), "b": (6.0, 0.0, 0.0), "c": (1.0, 1.0, 0.0)}
+    assert icon_levels(together) == {"a": 0, "b": 1, "c": 2}
+    # a drone flying over a rover does not lift the rover's block
+    assert icon_levels({"rover": (0.0, 0.0, 0.0), "drone": (0.5, 0.0, 6.0)}) == {
+        "rover": 0,
+        "drone": 0,
+    }
+    assert icon_levels({"a": None, "b": None, "c": (0.0, 0.0, 0.0)}) == {"a": 0, "b": 1, "c": 0}
+    # the robot further north (higher on screen in the default view) is the one lifted
+    assert icon_levels({"north": (0.0, 3.0, 0.0), "south": (1.0, 0.0, 0.0)}) == {
+        "north": 1,
+        "south": 0,
+    }
+    assert block_height(1) > block_height(0) + 2 * ICON_ROW
 
 
 # -- menus --------------------------------------------------------------------------------------
