@@ -2,7 +2,8 @@
 # `make setup` first, which installs only what is missing and is a no-op the second time.
 #
 #   make setup   Debian packages, .venv (pinned PyPI packages), messages built into build/
-#   make demo    setup, then the demo mission (scripts/rosmc_demo); DEMO_ARGS=... passes options
+#   make demo    setup, then the demo mission (scripts/rosmc_demo); DEMO_ARGS=... passes options;
+#                GUI=1 also opens rviz and the command GUI on it
 #   make test    setup, lint, then pytest over tests/; PYTEST_ARGS=... passes options
 #   make lint    ruff check, ruff format --check, mypy --strict on every rosmc_* package
 #   make format  ruff format and the safe ruff fixes, in place
@@ -85,7 +86,7 @@ $(BUILD)/rosmc.stamp: $(BUILD_INPUTS) | apt
 	@touch $@
 
 demo: setup
-	$(IN_ENV) rosmc_demo $(DEMO_ARGS)
+	$(IN_ENV) rosmc_demo $(if $(filter 1 yes true,$(GUI)),--gui) $(DEMO_ARGS)
 
 test: setup lint pytest
 
