@@ -35,6 +35,7 @@ import argparse
 import contextlib
 import math
 import os
+import shutil
 import signal
 import socket
 import subprocess
@@ -257,6 +258,7 @@ def take(args: argparse.Namespace) -> int:
                 file=sys.stderr,
             )
             return 1
+    shutil.rmtree(home, ignore_errors=True)  # kept (logs) only when something went wrong
     print(f"rviz_operator_screenshot: {args.output} written")
     return 0
 
