@@ -32,11 +32,15 @@ from . import presentation
 from .legality import RobotAction
 from .mission_view import MissionView
 from .policy_dialog import ask_policy
+from .row_delegate import RowDelegate
 from .schedule_model import NUMBER, PARAMS, SKILL, STATUS, TAG, SectionModel
 from .view_state import AgentView
 
 ROW_HEIGHT = 22
-COLUMN_WIDTH = 350
+# A column is at least this wide (more robots than fit: the schedule scrolls sideways)
+# and at most that wide (few robots: the columns share the width).
+COLUMN_WIDTH = 330
+MAX_COLUMN_WIDTH = 460
 AskPolicy = Callable[[str, Sequence[str], QWidget], LostLinkPolicy | None]
 
 
@@ -50,6 +54,7 @@ class SectionTable(QTableView):  # type: ignore[misc]
         super().__init__(parent)
         self.last_modifiers = Qt.NoModifier  # of the last click or key press here
         self.setModel(model)
+        self.setItemDelegate(RowDelegate(self))
         self.setSelectionBehavior(QAbstractItemView.SelectRows)
         self.setSelectionMode(QAbstractItemView.ExtendedSelection)
         self.setContextMenuPolicy(Qt.CustomContextMenu)
@@ -64,9 +69,9 @@ class SectionTable(QTableView):  # type: ignore[misc]
         rows.setDefaultSectionSize(ROW_HEIGHT)
         columns = self.horizontalHeader()
         columns.setHighlightSections(False)
-        for column, width in ((TAG, 30), (NUMBER, 26), (SKILL, 112), (PARAMS, 104)):
+        for column, width in ((TAG, 26), (NUMBER, 22), (SKILL, 100), (STATUS, 174)):
             columns.resizeSection(column, width)
-        columns.setSectionResizeMode(STATUS, QHeaderView.Stretch)
+        columns.setSectionResizeMode(PARAMS, QHeaderView.Stretch)
         if model.blueprint:
             self.setDragEnabled(True)
             self.setAcceptDrops(True)
@@ -108,7 +113,9 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         self.agent = agent
         self.setObjectName(f"column_{agent}")
         self.setFrameShape(QFrame.StyledPanel)
-        self.setFixedWidth(COLUMN_WIDTH)
+        self.setMinimumWidth(COLUMN_WIDTH)
+        self.setMaximumWidth(MAX_COLUMN_WIDTH)
+        self.setSizePolicy(QSizePolicy.Expanding, QSizePolicy.Preferred)
         self.synced_model = SectionModel(agent, False, view, self)
         self.blueprint_model = SectionModel(agent, True, view, self)
         self.synced_table = SectionTable(self.synced_model, self)
@@ -123,10 +130,9 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         self.skill_names: list[str] = []
         self.ask_policy: AskPolicy = ask_policy  # tests answer the dialog through this
         self.policy_button = self._tool(
-            "If the link is lost…", "", "What the robot does when it loses contact with the ground"
+            "Link loss…", "", "Choose what the robot does when it loses contact with the ground"
         )
         self.policy_button.setObjectName(f"policy_{agent}")
-        self.policy_button.setSizePolicy(QSizePolicy.Ignored, QSizePolicy.Fixed)
         self.policy_button.clicked.connect(self._on_policy_button_clicked)
 
         self.add_menu = QMenu(self)
@@ -149,9 +155,9 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         top = QHBoxLayout()
         top.addWidget(self.name_label)
         top.addStretch(1)
+        top.addWidget(self.policy_button)
         header.addLayout(top)
         header.addWidget(self.status_label)
-        header.addWidget(self.policy_button)
         bar = QHBoxLayout()
         bar.addWidget(self.add_button)
         for button in self.buttons.values():

@@ -33,6 +33,7 @@ from .control_panel import ControlPanel
 from .dispatch import Dispatcher
 from .file_menu import FileController
 from .legality import Action, RobotAction, RobotLegality, legal_actions
+from .legend import StatusLegend
 from .message_area import MessageArea
 from .mission_view import MissionView
 from .parameter_panel import ParameterPanel
@@ -107,13 +108,20 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         right.addWidget(self.messages)
         right.setStretchFactor(0, 3)
         right.setStretchFactor(2, 1)
+        self.legend = StatusLegend()
+        left = QWidget()
+        left_layout = QVBoxLayout(left)
+        left_layout.setContentsMargins(0, 0, 0, 0)
+        left_layout.setSpacing(2)
+        left_layout.addWidget(self.schedule, 1)
+        left_layout.addWidget(self.legend)
         self.splitter = QSplitter(Qt.Horizontal)
-        self.splitter.addWidget(self.schedule)
+        self.splitter.addWidget(left)
         self.splitter.addWidget(right)
         self.splitter.setStretchFactor(0, 1)
         self.splitter.setStretchFactor(1, 0)
-        self.splitter.setSizes([1100, 420])
-        right.setMaximumWidth(480)
+        self.splitter.setSizes([1230, 370])
+        right.setMaximumWidth(370)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(2, 2, 2, 2)
         layout.setMenuBar(self.menu_bar)

@@ -21,9 +21,11 @@ from python_qt_binding.QtWidgets import (
 from .actions import CommandActions
 from .legality import Action, RobotAction
 
+# Three to a row, so the panel stays narrow and the schedule gets the width.
 SKILL_ROWS = (
-    (Action.SYNC, Action.UNSYNC, Action.MOVE_UP, Action.MOVE_DOWN, Action.DELETE),
-    (Action.BARRIER, Action.DELETE_BARRIER, Action.RETRY, Action.SKIP),
+    (Action.SYNC, Action.UNSYNC, Action.DELETE),
+    (Action.MOVE_UP, Action.MOVE_DOWN, Action.BARRIER),
+    (Action.DELETE_BARRIER, Action.RETRY, Action.SKIP),
 )
 ROBOT_ROW = (RobotAction.START, RobotAction.PAUSE, RobotAction.RESUME, RobotAction.STOP)
 

@@ -25,6 +25,7 @@ from python_qt_binding.QtWidgets import (
     QLabel,
     QLineEdit,
     QPushButton,
+    QSizePolicy,
     QSpinBox,
     QTableWidget,
     QTableWidgetItem,
@@ -178,6 +179,8 @@ class PoseEditor(Editor):
         for position, name in enumerate(Pose.FIELDS):
             spin = QDoubleSpinBox()
             spin.setObjectName(name)
+            spin.setMinimumWidth(70)  # three to a row must fit a narrow panel
+            spin.setSizePolicy(QSizePolicy.Ignored, QSizePolicy.Fixed)
             spin.setKeyboardTracking(False)
             angle = position >= 3
             spin.setDecimals(1 if angle else 2)

@@ -46,7 +46,7 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
         self.pickers: dict[str, MarkerPicker] = {}
         self._spec: SkillSpec | None = None
         self.setWidgetResizable(True)
-        self.setMinimumWidth(340)
+        self.setMinimumWidth(320)
         body = QWidget()
         layout = QVBoxLayout(body)
         self.title = QLabel("<i>Select a skill to see its parameters.</i>")

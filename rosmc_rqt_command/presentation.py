@@ -119,7 +119,7 @@ def value_summary(value: Value) -> str:
         return f"{len(value)} items" if len(value) != 1 else "1 item"
     if isinstance(value, dict):
         return f"{len(value)} keys" if len(value) != 1 else "1 key"
-    return str(value)
+    return str(value) if value != "" else "–"
 
 
 def params_summary(skill: SkillInstance, limit: int = 3) -> str:

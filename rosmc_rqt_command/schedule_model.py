@@ -24,8 +24,9 @@ from .mission_view import MissionView
 MIME_TYPE = "application/x-rosmc-skill-ids"
 SKILL_ID_ROLE = Qt.UserRole + 1
 
-TAG, NUMBER, SKILL, PARAMS, STATUS = range(5)
-HEADERS = ("", "#", "Skill", "Parameters", "Status")
+# Status before parameters: it is what an operator scans for; parameters take what is left.
+TAG, NUMBER, SKILL, STATUS, PARAMS = range(5)
+HEADERS = ("", "#", "Skill", "Status", "Details")
 
 
 class SectionModel(QAbstractTableModel):  # type: ignore[misc]

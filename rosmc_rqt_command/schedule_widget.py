@@ -41,7 +41,7 @@ class ScheduleWidget(QScrollArea):  # type: ignore[misc]
         self._inner = QWidget()
         self._row = QHBoxLayout(self._inner)
         self._row.setContentsMargins(2, 2, 2, 2)
-        self._row.addStretch(1)
+        self._row.addStretch(0)  # columns take the width first, up to their maximum
         self.setWidget(self._inner)
         self.setWidgetResizable(True)
         self.setHorizontalScrollBarPolicy(Qt.ScrollBarAsNeeded)
@@ -141,7 +141,7 @@ class ScheduleWidget(QScrollArea):  # type: ignore[misc]
         self.columns = {}
         for position, agent in enumerate(agents):
             column = AgentColumn(agent, self._view, self._inner)
-            self._row.insertWidget(position, column)
+            self._row.insertWidget(position, column, 1)
             self.columns[agent] = column
             column.robot_action.connect(self.robot_action)
             column.add_requested.connect(self.add_requested)

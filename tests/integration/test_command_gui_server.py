@@ -23,7 +23,7 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
 from python_qt_binding.QtCore import Qt, QTimer
 from python_qt_binding.QtTest import QTest
-from python_qt_binding.QtWidgets import QApplication, QDialogButtonBox, QFileDialog
+from python_qt_binding.QtWidgets import QApplication, QDialogButtonBox, QFileDialog, QLineEdit
 
 from rosmc_rqt_command.command_widget import CommandWidget
 from rosmc_rqt_command.legality import Action
@@ -297,16 +297,24 @@ def add_skill(agent: str, skill: str) -> str:
 
 
 def answer_file_dialog(path: str) -> None:
-    """Choose ``path`` in the next file dialog as soon as it opens."""
+    """Type ``path`` into the next file dialog and press its Save / Open button."""
 
     def choose() -> None:
-        dialog = QApplication.activeModalWidget()
-        if not isinstance(dialog, QFileDialog):
+        dialogs = [
+            w
+            for w in QApplication.topLevelWidgets()
+            if isinstance(w, QFileDialog) and w.isVisible()
+        ]
+        if not dialogs:
             QTimer.singleShot(20, choose)
             return
-        dialog.selectFile(path)
+        dialog = dialogs[0]
+        dialog.findChild(QLineEdit, "fileNameEdit").setText(path)  # as the operator types it
         buttons = dialog.findChild(QDialogButtonBox)
         accept = next(b for b in buttons.buttons() if buttons.buttonRole(b) == buttons.AcceptRole)
-        accept.click()  # Save / Open, as the operator clicks it
+        if not accept.isEnabled():  # the dialog is still reading the folder
+            QTimer.singleShot(20, choose)
+            return
+        accept.click()
 
     QTimer.singleShot(20, choose)

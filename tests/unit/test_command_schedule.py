@@ -14,7 +14,7 @@ import pytest
 from python_qt_binding.QtCore import Qt
 from python_qt_binding.QtTest import QTest
 
-from rosmc_rqt_command.schedule_model import SectionModel
+from rosmc_rqt_command.schedule_model import STATUS, SectionModel
 from rosmc_server.core import AgentStatus, Library, Mission, SkillStatus
 from tests.unit.test_command_harness import Gui, open_gui
 
@@ -129,7 +129,7 @@ def test_a_barrier_partner_repaints_only_its_own_row(gui: Gui) -> None:
         ("alpha/synced", "changed", 0, 0),
         ("bravo/synced", "changed", 0, 0),
     ]
-    assert gui.cell("alpha", False, 0, 4, Qt.DisplayRole) == "waiting on bravo"
+    assert gui.cell("alpha", False, 0, STATUS, Qt.DisplayRole) == "waiting on bravo"
     assert gui.ids("alpha", False) == [first, other]
 
 
