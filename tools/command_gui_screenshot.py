@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 import subprocess
 import sys
 import tempfile
@@ -64,7 +65,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             return run(args, env, Path(tmp), launches, display)
         finally:
             for process in reversed(launches):
-                stop_group(process, __import__("signal").SIGINT)
+                stop_group(process, signal.SIGINT)
 
 
 def launch(env: dict[str, str], log: Path, *args: str) -> subprocess.Popen[bytes]:
@@ -257,7 +258,6 @@ def stage(client: object, wait: Callable[..., None]) -> dict[str, str]:
 
 
 if __name__ == "__main__":
-    import faulthandler
-
-    faulthandler.dump_traceback_later(200, exit=True)
+    # SIGTERM (e.g. from `timeout`) unwinds like Ctrl-C, so every process is stopped.
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
     sys.exit(main())
