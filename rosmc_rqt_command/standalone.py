@@ -54,8 +54,8 @@ class CommandWindow(QMainWindow):  # type: ignore[misc]
 def freeze_after_reset(batch: Sequence[ViewUpdate]) -> None:
     """Once a whole mission has arrived, keep the cyclic garbage collector off it.
 
-    A 10,000-skill mission is a few million objects; every full collection walked them
-    all (100-160 ms measured, the window's longest stall). They live as long as the
+    A 10,000-skill mission is hundreds of thousands of objects; every full collection
+    walked them all (65-160 ms measured, the window's longest stall). They live as long as the
     mission is shown and are freed by reference counting when it is replaced, so they
     are moved to the collector's permanent generation (``gc.freeze``).
     """
