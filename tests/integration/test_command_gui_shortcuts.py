@@ -14,6 +14,7 @@ import os
 import shutil
 import subprocess
 import sys
+import time
 from pathlib import Path
 from typing import Any
 
@@ -53,10 +54,17 @@ def test_shortcuts_fire_in_a_real_window(tmp_path: Path) -> None:
         "Ctrl+B": [["add_barrier", [["alpha-1", "bravo-5"]]]],
         "Ctrl+Shift+B": [["delete_barrier", ["barrier-6"]]],
         "Ctrl+Backspace": [["unsynchronize", ["alpha", "alpha-1"]]],
-        "F6": [["control", ["START", None]]],
         "Ctrl+R": [["retry", ["alpha-1"]]],
         "Ctrl+K": [["skip", ["alpha-1"]]],
+        "F6": [["control", ["START", None]]],
+        "F7": [["control", ["PAUSE", None]]],
+        "F8": [["control", ["RESUME", None]]],
+        "F9": [["control", ["STOP", None]]],
         "Ctrl+S": [["save_mission", []]],
+        "Ctrl+O": "Open mission file",
+        "Ctrl+Shift+O": "Open file on server",
+        "Ctrl+Shift+S": "Save mission file",
+        "Ctrl+Alt+S": "Save on server",
         "Ctrl+N": "asked: starting a new mission",
         "F5": "refreshed",
         "Escape": [],
@@ -68,12 +76,13 @@ def drive() -> None:
     """Press every shortcut in a real window; print what each sent as JSON."""
     import copy
 
-    from python_qt_binding.QtCore import Qt
+    from python_qt_binding.QtCore import Qt, QTimer
     from python_qt_binding.QtGui import QKeySequence
     from python_qt_binding.QtTest import QTest
 
+    from rosmc_rqt_command.legality import RobotAction
     from rosmc_rqt_command.requests import Answer
-    from rosmc_server.core import SkillStatus
+    from rosmc_server.core import AgentStatus, SkillStatus
     from rosmc_server.core.library import library_from_dict
     from tests.unit.conftest import TEST_LIBRARY, make_mission
     from tests.unit.test_command_harness import Gui
@@ -100,6 +109,13 @@ def drive() -> None:
         report[keys] = sent
         return sent
 
+    def until(condition: Any, timeout: float = 5.0) -> None:
+        deadline = time.monotonic() + timeout
+        while not condition():
+            if time.monotonic() > deadline:
+                raise AssertionError(f"timed out waiting for {condition}")
+            QTest.qWait(20)
+
     def select(agent: str, row: int, blueprint: bool = True, extend: bool = False) -> None:
         gui.click_row(agent, blueprint, row, Qt.ControlModifier if extend else Qt.NoModifier)
         gui.table(agent, blueprint).setFocus()
@@ -123,11 +139,25 @@ def drive() -> None:
     feed.sync("alpha", alpha[0])
     select("alpha", 0, blueprint=False)
     press("Ctrl+Backspace")
-    press("F6")
     feed("report_status", alpha[0], SkillStatus.RUNNING)
     feed("report_status", alpha[0], SkillStatus.FAILURE)
     press("Ctrl+R")
     press("Ctrl+K")
+    # Every robot at once: bravo starts, runs, pauses (robot reports reach the buttons).
+    feed.sync("bravo")
+    press("F6")
+    for state, status, key in (
+        ("running", SkillStatus.RUNNING, "F7"),
+        ("paused", SkillStatus.PAUSED, "F8"),
+    ):
+        feed.statuses(AgentStatus("bravo", link="up", executor_state=state))
+        feed("report_status", bravo, status)
+        action = widget.actions_.all_robots[
+            RobotAction.PAUSE if key == "F7" else RobotAction.RESUME
+        ]
+        until(action.isEnabled)
+        press(key)
+    press("F9")
     widget.files.location = ("local", os.environ["ROSMC_SHORTCUT_FILE"])
     press("Ctrl+S")
     asked: list[str] = []
@@ -140,6 +170,25 @@ def drive() -> None:
     press("Escape")
     if widget.schedule.selected_ids:
         report["Escape"] = ["still selected", widget.schedule.selected_ids]
+    # The file dialogs: each key opens its dialog (closed again with Escape).
+    widget.files.ask = lambda doing: "discard"
+    for keys in ("Ctrl+O", "Ctrl+Shift+O", "Ctrl+Shift+S", "Ctrl+Alt+S"):
+        titles: list[str] = []
+
+        def close_dialog(titles: list[str] = titles) -> None:
+            dialog = gui.app.activeModalWidget()
+            if dialog is None:
+                QTimer.singleShot(20, close_dialog)
+                return
+            titles.append(dialog.windowTitle())
+            dialog.reject()
+
+        QTimer.singleShot(20, close_dialog)
+        widget.activateWindow()  # back from the last dialog
+        QTest.qWaitForWindowActive(widget, 5000)
+        gui.table("alpha", True).setFocus()
+        press(keys)
+        report[keys] = titles[0] if titles else "no dialog"
     for request in backend.requests:
         widget.on_answer(Answer(request, error="not served here"))
     print(json.dumps(report))
