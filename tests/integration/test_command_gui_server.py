@@ -28,6 +28,7 @@ from python_qt_binding.QtWidgets import QApplication, QDialogButtonBox, QFileDia
 from rosmc_rqt_command.command_widget import CommandWidget
 from rosmc_rqt_command.legality import Action
 from rosmc_rqt_command.standalone import build
+from rosmc_server.core import LostLinkKind, LostLinkPolicy
 from rosmc_server.ros.client import MissionClient
 from tests.integration.server_fixtures import ServerProcess, StartServer
 
@@ -256,6 +257,15 @@ def test_two_windows_stay_consistent_and_a_stale_edit_is_a_conflict(
     wait_until(lambda: second.ids("drone") == [land, take_off], 10, "the refreshed view")
     wait_until(lambda: first.ids("drone") == [land, take_off], 10, "the first window too")
     no_traceback(second)
+
+    # The lost-link policy goes through the client's typed call (the server keeps it for
+    # the robot, which is not running here).
+    column = first.w.schedule.columns["drone"]
+    column.ask_policy = lambda *_: LostLinkPolicy(LostLinkKind.HOLD, 30.0)
+    QTest.mouseClick(column.policy_button, Qt.LeftButton)
+    message = first.said("set drone's policy (on link loss: hold after 30 s)")
+    assert "Done:" in message, message
+    no_traceback(first)
 
 
 def test_save_to_a_local_file_and_open_it_again(

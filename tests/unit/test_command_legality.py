@@ -6,14 +6,24 @@ enabling path is the one the operator sees); robot actions per executor state.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 
 import pytest
 from python_qt_binding.QtCore import Qt
+from python_qt_binding.QtTest import QTest
 
 from rosmc_rqt_command.legality import RobotAction, RobotLegality, legal_robot_actions
-from rosmc_server.core import AgentStatus, Library, Mission, SkillStatus
-from tests.unit.test_command_harness import Gui, open_gui
+from rosmc_rqt_command.policy_dialog import PolicyDialog
+from rosmc_server.core import (
+    AgentStatus,
+    InvalidRequest,
+    Library,
+    LostLinkKind,
+    LostLinkPolicy,
+    Mission,
+    SkillStatus,
+)
+from tests.unit.test_command_harness import Gui, open_gui, qt_app
 
 S = SkillStatus
 R = RobotAction
@@ -164,3 +174,45 @@ def test_robot_legality_is_recomputed_only_for_touched_robots(gui: Gui) -> None:
     cache.update(gui.widget.view, ["bravo"])
     assert cache.of("bravo") == legal_robot_actions(gui.widget.view, "bravo") == {R.SYNC_ALL}
     assert cache.any() == {R.SYNC_ALL}
+
+
+def test_the_lost_link_policy_is_chosen_among_the_robots_skills(gui: Gui) -> None:
+    column = gui.widget.schedule.columns["alpha"]
+    assert column.policy_button.isEnabled()
+    offered: list[list[str]] = []
+
+    def ask(agent: str, skills: Sequence[str], parent: object) -> LostLinkPolicy | None:
+        offered.append(list(skills))
+        dialog = PolicyDialog(agent, skills, preferred="wait")
+        dialog.set_kind(LostLinkKind.SAFE_SKILL)
+        dialog.after_spin.setValue(45)
+        return dialog.policy()
+
+    column.ask_policy = ask
+    QTest.mouseClick(column.policy_button, Qt.LeftButton)
+    assert offered == [["move", "noop", "scan", "wait"]]
+    [request] = gui.backend.requests
+    assert request.operation == "set_robot_options"
+    assert request.args == ("alpha", LostLinkPolicy(LostLinkKind.SAFE_SKILL, 45.0, "wait"))
+    assert "run wait after 45 s" in request.what
+    column.ask_policy = lambda *_: None  # the operator cancels
+    QTest.mouseClick(column.policy_button, Qt.LeftButton)
+    assert len(gui.backend.requests) == 1
+
+
+def test_the_policy_dialog_offers_each_kind() -> None:
+    app = qt_app()  # kept alive for the whole test
+    dialog = PolicyDialog("alpha", [])
+    assert dialog.policy() == LostLinkPolicy()  # keep going
+    assert not dialog.after_spin.isEnabled()
+    dialog.set_kind(LostLinkKind.HOLD)
+    dialog.after_spin.setValue(30)
+    assert dialog.after_spin.isEnabled() and not dialog.skill_combo.isEnabled()
+    assert dialog.policy() == LostLinkPolicy(LostLinkKind.HOLD, 30.0)
+    dialog.set_kind(LostLinkKind.SAFE_SKILL)  # this robot has no skill to run
+    with pytest.raises(InvalidRequest, match="no skill"):
+        dialog.policy()
+    dialog.buttons.button(dialog.buttons.Ok).click()
+    assert dialog.problem.text() == "this robot has no skill to run as its safe skill."
+    assert dialog.result() != dialog.Accepted
+    app.processEvents()
