@@ -306,8 +306,14 @@ def add_skill(agent: str, skill: str) -> str:
         client.close()
 
 
-def answer_file_dialog(path: str) -> None:
-    """Type ``path`` into the next file dialog and press its Save / Open button."""
+def answer_file_dialog(path: str, timeout: float = 20.0) -> None:
+    """Type ``path`` into the next file dialog and press its Save / Open button.
+
+    A dialog that cannot be answered within ``timeout`` is cancelled, so the test fails
+    on its assertions instead of waiting in the dialog's own event loop for ever (where
+    pytest's timeout cannot reach it).
+    """
+    deadline = time.monotonic() + timeout
 
     def choose() -> None:
         dialogs = [
@@ -315,6 +321,10 @@ def answer_file_dialog(path: str) -> None:
             for w in QApplication.topLevelWidgets()
             if isinstance(w, QFileDialog) and w.isVisible()
         ]
+        if time.monotonic() > deadline:
+            for dialog in dialogs:
+                dialog.reject()
+            return
         if not dialogs:
             QTimer.singleShot(20, choose)
             return
