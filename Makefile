@@ -23,7 +23,7 @@ BUILD := build
 APT_PACKAGES := \
 	python3-rospy python3-rosmaster python3-interactive-markers python3-visualization-msgs \
 	python3-geometry-msgs python3-std-msgs python3-std-srvs python3-rosbag python3-rostest \
-	python3-roslaunch python3-rosservice python3-rostopic catkin python3-genpy python3-genmsg \
+	python3-roslaunch python3-rosservice python3-rostopic python3-rosnode catkin python3-genpy python3-genmsg \
 	python3-nav-msgs \
 	ros-message-generation ros-message-runtime python3-tf2-ros python3-python-qt-binding \
 	ros-geometry-msgs ros-std-msgs ros-visualization-msgs ros-std-srvs rosbash \
