@@ -42,9 +42,16 @@ STOP_TIMEOUT = 10.0
 
 
 def wait_until(
-    condition: Callable[[], T | None], timeout: float, what: str, period: float = 0.02
+    condition: Callable[[], T | None],
+    timeout: float,
+    what: str,
+    period: float = 0.02,
+    pause: Callable[[float], object] = time.sleep,
 ) -> T:
     """Poll ``condition`` every ``period`` seconds until it returns something true; return it.
+
+    ``pause`` waits between polls: a Qt test passes one that runs the event loop meanwhile
+    (:func:`qt_pause`), so the widget under test keeps working while the test waits.
 
     Raises:
         AssertionError: ``timeout`` seconds passed first (the message says ``what``).
@@ -56,7 +63,14 @@ def wait_until(
             return value
         if time.monotonic() > deadline:
             raise AssertionError(f"timed out after {timeout:g} s waiting until {what}")
-        time.sleep(period)
+        pause(period)
+
+
+def qt_pause(seconds: float) -> None:
+    """Run the Qt event loop for ``seconds`` (a ``pause`` for :func:`wait_until`)."""
+    from python_qt_binding.QtTest import QTest
+
+    QTest.qWait(max(1, round(seconds * 1000)))
 
 
 def free_port() -> int:

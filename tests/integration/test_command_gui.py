@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import math
 import os
-import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
@@ -31,6 +30,7 @@ from rosmc_rqt_command.schedule_model import SKILL, STATUS, TAG
 from rosmc_rqt_command.standalone import build
 from rosmc_server.core import MarkerType, Pose, SkillStatus, TaskMarker
 from rosmc_server.ros.client import MissionClient
+from tests import conftest
 from tests.integration.executor_fixtures import Operator, RosmcSystem
 
 S = SkillStatus
@@ -67,14 +67,7 @@ AGENTS = ("r1", "r2")
 # -- helpers -------------------------------------------------------------------------------
 def wait_until(condition: Callable[[], Any], timeout: float, what: str) -> Any:
     """Run the Qt event loop until ``condition()`` is truthy; fail after ``timeout``."""
-    deadline = time.monotonic() + timeout
-    while True:
-        value = condition()
-        if value:
-            return value
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout} s waiting until {what}")
-        QTest.qWait(20)
+    return conftest.wait_until(condition, timeout, what, pause=conftest.qt_pause)
 
 
 class Gui:

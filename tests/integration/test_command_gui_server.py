@@ -30,6 +30,7 @@ from rosmc_rqt_command.legality import Action
 from rosmc_rqt_command.standalone import build
 from rosmc_server.core import LostLinkKind, LostLinkPolicy
 from rosmc_server.ros.client import MissionClient
+from tests import conftest
 from tests.integration.server_fixtures import ServerProcess, StartServer
 
 pytest_plugins = ["tests.integration.server_fixtures"]
@@ -39,14 +40,7 @@ STALL_LIMIT_S = 1.0  # generous: the benchmark holds the real figure (bench/READ
 
 def wait_until(condition: Callable[[], Any], timeout: float, what: str) -> Any:
     """Run the Qt event loop until ``condition()`` is truthy; fail after ``timeout``."""
-    deadline = time.monotonic() + timeout
-    while True:
-        value = condition()
-        if value:
-            return value
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout} s waiting until {what}")
-        QTest.qWait(20)
+    return conftest.wait_until(condition, timeout, what, pause=conftest.qt_pause)
 
 
 class Heartbeat:

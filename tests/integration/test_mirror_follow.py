@@ -10,8 +10,7 @@ calls on the non-blocking client answer by callback, also when the server is gon
 from __future__ import annotations
 
 import threading
-import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from typing import Any
 
 import pytest
@@ -28,18 +27,11 @@ from rosmc_server.ros.client import (
     Outcome,
     ServerUnavailable,
 )
+from tests.conftest import wait_until
 from tests.integration.server_fixtures import ServerProcess, StartServer
 
 pytest_plugins = ["tests.integration.server_fixtures"]
 pytestmark = pytest.mark.integration
-
-
-def wait_for(condition: Callable[[], bool], timeout: float, what: str) -> None:
-    deadline = time.monotonic() + timeout
-    while not condition():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
-        time.sleep(0.01)
 
 
 @pytest.fixture
@@ -70,14 +62,14 @@ def test_the_mirror_follows_changes_made_through_the_services(
     updates: list[MirrorUpdate] = []
     follower.mirror.subscribe(updates.append)
     with MissionClient(timeout=10.0) as client:
-        wait_for(lambda: follower.mirror.state is not None, 10.0, "the first snapshot")
+        wait_until(lambda: follower.mirror.state is not None, 10.0, "the first snapshot")
         client.add_marker(TaskMarker("rss", MarkerType.POSE, Pose(4.0, 2.0)))
         first = client.add_skill("drone", "take_off", {"altitude": 6.0}).skill_id
         second = client.add_skill("drone", "navigate_to", bindings={"target": "rss"}).skill_id
         client.reorder("drone", [second, first])
         client.move_marker("rss", Pose(7.0, 1.0))
         client.edit_skill(first, {"altitude": 9.0}, label="higher")
-        wait_for(lambda: mirrored(follower, client), 10.0, "the mirror to catch up")
+        wait_until(lambda: mirrored(follower, client), 10.0, "the mirror to catch up")
     assert follower.mirror.snapshots_requested == 1
     assert isinstance(updates[0].changes[0], MissionReset)
     added = [c.skill.id for u in updates for c in u.changes if isinstance(c, SkillAdded)]
@@ -88,21 +80,21 @@ def test_the_mirror_follows_changes_made_through_the_services(
 
 def test_a_revision_gap_fetches_one_snapshot(follower: MissionFollower) -> None:
     with MissionClient(timeout=10.0) as client:
-        wait_for(lambda: follower.mirror.state is not None, 10.0, "the first snapshot")
+        wait_until(lambda: follower.mirror.state is not None, 10.0, "the first snapshot")
         client.add_skill("drone", "land")
-        wait_for(lambda: mirrored(follower, client), 10.0, "the mirror to catch up")
+        wait_until(lambda: mirrored(follower, client), 10.0, "the mirror to catch up")
         # Another publisher on the events topic: an event three revisions ahead.
         forger = rospy.Publisher(interface.EVENTS_TOPIC, wire.MissionEvent, queue_size=1)
         try:
-            wait_for(lambda: forger.get_num_connections() > 0, 10.0, "the follower")
+            wait_until(lambda: forger.get_num_connections() > 0, 10.0, "the follower")
             # An event far ahead: the server never reached it; waiting for it would make
             # the mirror ask for snapshots for ever.
             ahead = client.fetch_mission().revision + 1000
             forger.publish(wire.MissionEvent(revision=ahead, kind=wire.MissionEvent.SKILL_ADDED))
-            wait_for(lambda: follower.mirror.ignored_events == 1, 10.0, "the phantom dropped")
+            wait_until(lambda: follower.mirror.ignored_events == 1, 10.0, "the phantom dropped")
             for _ in range(3):
                 client.add_skill("drone", "take_off")
-            wait_for(lambda: mirrored(follower, client), 10.0, "the mirror to go on")
+            wait_until(lambda: mirrored(follower, client), 10.0, "the mirror to go on")
             assert follower.mirror.snapshots_requested == 2, "one refetch for the gap"
         finally:
             forger.unregister()
@@ -118,15 +110,15 @@ def test_a_restarted_server_is_followed_from_its_new_mission(
         with MissionClient(timeout=10.0) as client:
             for _ in range(4):
                 client.add_skill("drone", "land")
-            wait_for(lambda: mirrored(follower, client), 10.0, "the mirror to catch up")
+            wait_until(lambda: mirrored(follower, client), 10.0, "the mirror to catch up")
             server.stop()
-            wait_for(lambda: connection[-1:] == [False], 10.0, "the server to be missed")
+            wait_until(lambda: connection[-1:] == [False], 10.0, "the server to be missed")
             fresh = start_server("follow-again")  # a new journal: revisions begin again
             assert fresh.alive
             client.close()
             client.get_mission()  # this client's known revision is the old server's
             client.add_skill("science_rover", "explore")
-            wait_for(lambda: mirrored(follower, client), 15.0, "the mirror of the new server")
+            wait_until(lambda: mirrored(follower, client), 15.0, "the mirror of the new server")
         assert follower.mirror.revision == 1
         assert connection == [True, False, True]
     finally:
