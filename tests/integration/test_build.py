@@ -64,6 +64,16 @@ rosrun --prefix echo rosmc rosmc_demo
 roslaunch --files rosmc mission_server.launch
 roslaunch --nodes rosmc mission_server.launch
 {SYSTEM_PYTHON} -c '{top_level_imports()}'
+rosmsg show rosmc/Pose6D | head -n 1
+rossrv show rosmc/AddSkill | head -n 1
+"""
+
+# What an entry script does first: find the project's PyPI packages (rosmc_server/venv.py),
+# then import them. Prints the venv it used and where mcap and pybullet came from.
+PYPI_IMPORTS = f"""{SYSTEM_PYTHON} -c 'from rosmc_server.venv import use_project_venv
+print(use_project_venv())
+import mcap, pybullet, rosbags
+print(mcap.__file__)'
 """
 
 
@@ -74,6 +84,14 @@ def check_lookups(lines: list[str], share: Path, script: Path, launch: Path, pyt
     assert lines[2] == str(launch / "mission_server.launch")
     assert lines[3] == "/rosmc/mission_server"
     assert Path(lines[4]).is_relative_to(python), lines[4]
+    assert lines[5:7] == ["float64 x", "uint64 base_revision"], lines[5:]
+
+
+def check_pypi_packages(setup: Path, env: dict[str, str], in_workspace, venv: Path) -> None:
+    """Outside env.sh an entry script finds the PyPI packages in ``venv``."""
+    lines = in_workspace(setup, PYPI_IMPORTS, env)
+    assert lines[0] == str(venv), lines
+    assert Path(lines[1]).is_relative_to(venv), lines
 
 
 def test_standalone_cmake_build(tmp_path: Path, clean_env, run, in_workspace) -> None:
@@ -90,6 +108,7 @@ def test_standalone_cmake_build(tmp_path: Path, clean_env, run, in_workspace) ->
         launch=REPO_ROOT / "launch",
         python=devel / "lib" / "python3" / "dist-packages",
     )
+    check_pypi_packages(devel / "setup.bash", clean_env, in_workspace, REPO_ROOT / ".venv")
     if (REPO_ROOT / "rosmc_server" / "demo.py").exists():
         # The relay runs the script in scripts/ with Debian's python.
         lines = in_workspace(devel / "setup.bash", "rosrun rosmc rosmc_demo --help", clean_env)
@@ -113,12 +132,16 @@ def test_catkin_make_devel_and_install(tmp_path: Path, clean_env, run, in_worksp
         launch=source / "launch",
         python=devel / "lib" / "python3" / "dist-packages",
     )
+    check_pypi_packages(devel / "setup.bash", clean_env, in_workspace, REPO_ROOT / ".venv")
 
     run(["catkin_make", "install", JOBS], clean_env, cwd=workspace)
     install = workspace / "install"
     share = install / "share" / "rosmc"
     lines = in_workspace(install / "setup.bash", PRINT_LOOKUPS, clean_env)
     check_install_space(lines, install, share, install / "lib" / "rosmc")
+    # An install space has no checkout beside it: ROSMC_VENV names the venv.
+    venv_env = {**clean_env, "ROSMC_VENV": str(REPO_ROOT / ".venv")}
+    check_pypi_packages(install / "setup.bash", venv_env, in_workspace, REPO_ROOT / ".venv")
 
 
 def check_install_space(lines: list[str], prefix: Path, share: Path, bin_dir: Path) -> None:

@@ -64,6 +64,7 @@ LAYER_OF_PATH = {
     "rosmc_server/__init__.py": "core",
     "rosmc_server/core/": "core",
     "rosmc_server/interface.py": "core",
+    "rosmc_server/venv.py": "core",  # sys.path only: entry scripts call it before anything
     "rosmc_server/executor/__init__.py": "core",
     "rosmc_server/executor/core/": "core",
     "rosmc_server/executor/basic_skills.py": "core",

@@ -1,0 +1,68 @@
+"""Find the project's PyPI packages when a node is started outside ``env.sh``.
+
+ROSMC needs a few packages that Debian's ROS 1 does not ship (pybullet, mcap, rosbags;
+``requirements.txt``). ``make setup`` installs them into ``.venv`` in the checkout. In a
+catkin or colcon workspace, ``rosrun`` / ``roslaunch`` start the entry scripts with
+``/usr/bin/python3``, which does not see that venv. Every entry script therefore calls
+:func:`use_project_venv` first: it puts the venv's ``site-packages`` on ``sys.path``, in front
+of Debian's ``dist-packages`` (where the venv's own interpreter has it), when it finds one:
+
+1. ``$ROSMC_VENV`` (a venv folder), for install spaces and custom layouts;
+2. ``.venv`` in the source checkout this package is imported from (devel spaces and
+   ``source env.sh``).
+
+Nothing changes when the interpreter already runs inside a venv or none is found; a module
+that is still missing then fails with its usual ``ImportError``.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+VENV_VARIABLE = "ROSMC_VENV"
+
+
+def site_packages(venv: Path) -> Path:
+    """The ``site-packages`` folder of ``venv`` for the running interpreter's version."""
+    version = f"python{sys.version_info.major}.{sys.version_info.minor}"
+    return venv / "lib" / version / "site-packages"
+
+
+def candidate_venvs(environ: dict[str, str] | None = None) -> list[Path]:
+    """Venv folders to try, in order: ``$ROSMC_VENV``, then ``.venv`` beside each source root."""
+    environ = dict(os.environ) if environ is None else environ
+    found: list[Path] = []
+    if environ.get(VENV_VARIABLE):
+        found.append(Path(environ[VENV_VARIABLE]))
+    # In a devel space the package's __path__ lists the source folder too (catkin's relay).
+    package_dirs = [Path(entry) for entry in _package_path()]
+    found.extend(directory.resolve().parent / ".venv" for directory in package_dirs)
+    return found
+
+
+def use_project_venv(environ: dict[str, str] | None = None) -> Path | None:
+    """Put the first venv found on ``sys.path`` before Debian's packages; return its folder."""
+    if sys.prefix != sys.base_prefix:
+        return None  # already inside a venv (env.sh, .venv/bin/python)
+    for venv in candidate_venvs(environ):
+        packages = site_packages(venv)
+        if packages.is_dir():
+            _insert_before_dist_packages(str(packages), sys.path)
+            return venv
+    return None
+
+
+def _insert_before_dist_packages(entry: str, path: list[str]) -> None:
+    """Insert ``entry`` into ``path`` just before the first ``dist-packages`` folder."""
+    if entry in path:
+        return
+    debian = [i for i, item in enumerate(path) if item.rstrip("/").endswith("dist-packages")]
+    path.insert(debian[0] if debian else len(path), entry)
+
+
+def _package_path() -> list[str]:
+    import rosmc_server
+
+    return list(getattr(rosmc_server, "__path__", []))
