@@ -5,6 +5,8 @@
 #   make demo    setup, then the demo mission (scripts/rosmc_demo); DEMO_ARGS=... passes options;
 #                GUI=1 also opens rviz and the command GUI on it
 #   make test    setup, lint, then pytest over tests/; PYTEST_ARGS=... passes options
+#   make bench   setup, then every bench/ script: bench/results.json, bench/results.md and the
+#                README's figures table; BENCH=server,scale runs only those
 #   make lint    ruff check, ruff format --check, mypy --strict on every rosmc_* package
 #   make format  ruff format and the safe ruff fixes, in place
 #   make clean   remove build/ and the tool caches (keeps .venv)
@@ -42,7 +44,7 @@ PACKAGES = $(patsubst %/__init__.py,%,$(wildcard rosmc_*/__init__.py))
 # Run a command inside the environment of env.sh.
 IN_ENV := source ./env.sh &&
 
-.PHONY: help setup apt venv requirements msgs demo test pytest lint format clean
+.PHONY: help setup apt venv requirements msgs demo test pytest bench lint format clean
 
 help:
 	@sed -n '1,/^$$/s/^# \{0,1\}//p' Makefile
@@ -93,6 +95,10 @@ test: setup lint pytest
 # pytest's own exit codes pass through: 5 (no test collected) fails the target.
 pytest: setup
 	$(IN_ENV) python -m pytest $(PYTEST_ARGS)
+
+# Benchmarks print JSON figures; run_all collects them (one after another: they measure time).
+bench: setup
+	$(IN_ENV) python bench/run_all.py --readme $(if $(BENCH),--only $(BENCH))
 
 lint: setup
 	$(IN_ENV) ruff check .

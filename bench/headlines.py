@@ -1,0 +1,109 @@
+"""Which figures of a benchmark's JSON make its headline table (used by run_all.py).
+
+A benchmark's JSON is flattened to dotted keys (``sizes.20x500.latency.add.p50``). Its
+headline rows are the keys matching the glob patterns listed for it in :data:`HEADLINES`, or,
+for a benchmark not listed, the keys whose last part looks like a figure (percentiles,
+maxima, sizes, rates, memory), at most :data:`MAX_ROWS` of them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fnmatch import fnmatchcase
+from typing import Any
+
+MAX_ROWS = 30
+
+# Names that label the items of a list of results better than their index.
+LIST_LABELS = ("name", "size", "label", "skills", "robots", "agents")
+
+DEFAULT_PATTERNS = (
+    "*p50*",
+    "*p95*",
+    "*median*",
+    "*.max",
+    "*max_ms",
+    "*rtf",
+    "*rss*",
+    "*bytes*",
+    "*ratio*",
+    "*score",
+    "*_per_*",
+)
+
+# Never headlines: the targets a benchmark prints beside its figures, sample counts.
+EXCLUDED_PATTERNS = ("target*", "*.target*", "*.n", "*samples*")
+
+HEADLINES: dict[str, tuple[str, ...]] = {
+    "server": (
+        "sizes.*.latency.*.p50",
+        "sizes.*.latency.*.p95",
+        "sizes.*.event_bytes.*",
+        "sizes.*.snapshot_bytes",
+        "sizes.*.journal_bytes_per_change",
+        "sizes.*.server_peak_rss_mib",
+    ),
+    "executor": ("*sync_to_start*median_ms", "*barrier_skew*median_ms", "*barrier_skew*max_ms"),
+    "sim": ("*.rtf", "*cpu_share"),
+    "demo": ("runs.*.score", "runs.*.mission_sim_s", "runs.*.mission_wall_s"),
+}
+
+
+@dataclass(frozen=True)
+class Figure:
+    """One row of a headline table."""
+
+    label: str
+    value: str
+
+
+def flatten(value: Any, prefix: str = "") -> dict[str, Any]:
+    """Every leaf of a JSON value under its dotted key."""
+    if isinstance(value, dict):
+        items = list(value.items())
+    elif isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+        items = [(_list_label(item, index), item) for index, item in enumerate(value)]
+    else:
+        return {prefix: value} if prefix else {"value": value}
+    flat: dict[str, Any] = {}
+    for key, item in items:
+        flat.update(flatten(item, f"{prefix}.{key}" if prefix else str(key)))
+    return flat
+
+
+def headline_rows(name: str, flat: dict[str, Any]) -> list[Figure]:
+    """The headline figures of benchmark ``name`` from its flattened JSON."""
+    patterns = HEADLINES.get(name, DEFAULT_PATTERNS)
+    if name in HEADLINES:
+        keys = [k for p in patterns for k in flat if fnmatchcase(k, p)]
+    else:
+        keys = [k for k in flat if any(fnmatchcase(k, p) for p in patterns)]
+    unique = list(
+        dict.fromkeys(
+            k
+            for k in keys
+            if _is_figure(flat[k]) and not any(fnmatchcase(k, p) for p in EXCLUDED_PATTERNS)
+        )
+    )
+    return [Figure(key, _format(flat[key])) for key in unique[:MAX_ROWS]]
+
+
+def _list_label(item: dict[str, Any], index: int) -> str:
+    if "agents" in item and "skills_per_agent" in item:
+        return f"{item['agents']}x{item['skills_per_agent']}"
+    for key in LIST_LABELS:
+        if isinstance(item.get(key), (str, int)):
+            return f"{key}={item[key]}"
+    return str(index)
+
+
+def _is_figure(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _format(value: float) -> str:
+    if isinstance(value, int) or float(value).is_integer():
+        return f"{int(value):,}"
+    if abs(value) >= 100:
+        return f"{value:,.0f}"
+    return f"{value:.3g}"

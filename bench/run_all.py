@@ -1,0 +1,183 @@
+"""Run every benchmark in bench/ and collect its figures: ``make bench``.
+
+Each ``bench/bench_*.py`` prints one JSON object. This runs them one after another (each in
+its own process group, killed whole if it overruns), then writes
+
+* ``bench/results.json``: the machine it ran on, and per benchmark its wall time, exit code
+  and figures;
+* ``bench/results.md``: the headline figures as Markdown tables, the same text that
+  ``--readme`` puts into README.md between the ``bench:begin`` / ``bench:end`` markers.
+
+Usage::
+
+    python bench/run_all.py [--only server,scale] [--timeout 900] [--readme]
+
+A benchmark that fails or prints no JSON is recorded with its exit code and the tail of its
+output; the run goes on with the next one and exits 1 at the end.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import os
+import platform
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from headlines import flatten, headline_rows
+
+BENCH_DIR = Path(__file__).resolve().parent
+REPO = BENCH_DIR.parent
+README = REPO / "README.md"
+BEGIN, END = "<!-- bench:begin -->", "<!-- bench:end -->"
+
+
+def machine() -> dict[str, Any]:
+    """What the figures were measured on."""
+    cpu = ""
+    cpuinfo = Path("/proc/cpuinfo")
+    if cpuinfo.exists():
+        for line in cpuinfo.read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    memory_kib = 0
+    meminfo = Path("/proc/meminfo")
+    if meminfo.exists():
+        memory_kib = int(meminfo.read_text().split()[1])
+    commit = subprocess.run(
+        ["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"],
+        capture_output=True,
+        text=True,
+        check=False,
+    ).stdout.strip()
+    return {
+        "cpu": cpu,
+        "cores": os.cpu_count(),
+        "memory_gib": round(memory_kib / 2**20, 1),
+        "kernel": platform.release(),
+        "python": platform.python_version(),
+        "commit": commit,
+        "date": datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M UTC"),
+    }
+
+
+def last_json(text: str) -> Any:
+    """The last JSON object printed at the start of a line in ``text`` (None if none)."""
+    decoder = json.JSONDecoder()
+    found = None
+    position = 0
+    while (start := text.find("{", position)) >= 0:
+        if start == 0 or text[start - 1] == "\n":
+            try:
+                found, end = decoder.raw_decode(text, start)
+                position = end
+                continue
+            except json.JSONDecodeError:
+                pass
+        position = start + 1
+    return found
+
+
+def run_one(script: Path, timeout: float) -> dict[str, Any]:
+    """Run one benchmark; its figures, wall time, exit code (and output tail on failure)."""
+    began = time.monotonic()
+    process = subprocess.Popen(
+        [sys.executable, str(script)],
+        cwd=REPO,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        start_new_session=True,  # its masters and nodes go with it on a timeout
+    )
+    try:
+        output, _ = process.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(process.pid, signal.SIGKILL)
+        output, _ = process.communicate()
+        output += f"\n(run_all: killed after {timeout:.0f} s)"
+    figures = last_json(output)
+    result: dict[str, Any] = {
+        "seconds": round(time.monotonic() - began, 1),
+        "returncode": process.returncode,
+        "figures": figures,
+    }
+    if process.returncode != 0 or figures is None:
+        result["output_tail"] = output[-3000:]
+    return result
+
+
+def markdown(results: dict[str, Any]) -> str:
+    """The headline figures of ``results`` as Markdown: one table per benchmark."""
+    host = results["machine"]
+    lines = [
+        f"Last `make bench` run: {host['date']}, commit {host['commit']}, {host['cores']} cores "
+        f"({host['cpu'] or 'unknown CPU'}), {host['memory_gib']} GiB, Linux {host['kernel']}, "
+        f"Python {host['python']}. All figures from `bench/results.json`.",
+        "",
+    ]
+    for name, bench in results["benchmarks"].items():
+        title = f"**{name}** ({bench['seconds']:.0f} s, commit {bench.get('commit', '?')})"
+        if bench["figures"] is None:
+            lines += [f"{title}: failed (exit {bench['returncode']}), no figures.", ""]
+            continue
+        rows = headline_rows(name, flatten(bench["figures"]))
+        if not rows:
+            continue
+        lines += [title, "", "| figure | value |", "| --- | --- |"]
+        lines += [f"| {row.label} | {row.value} |" for row in rows]
+        lines.append("")
+    return "\n".join(lines).rstrip() + "\n"
+
+
+def update_readme(text: str, table: str) -> str:
+    """``text`` with the part between the bench markers replaced by ``table``."""
+    if BEGIN not in text or END not in text:
+        raise SystemExit(f"README.md has no {BEGIN} ... {END} markers")
+    head, rest = text.split(BEGIN, 1)
+    _, tail = rest.split(END, 1)
+    return f"{head}{BEGIN}\n{table}{END}{tail}"
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the benchmarks, write results.json and results.md (and README.md with --readme)."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--only", default="", help="comma-separated names, e.g. server,scale")
+    parser.add_argument("--timeout", type=float, default=900.0, help="seconds per benchmark")
+    parser.add_argument("--readme", action="store_true", help="also update README.md")
+    args = parser.parse_args(argv)
+    wanted = {name.strip() for name in args.only.split(",") if name.strip()}
+    scripts = sorted(BENCH_DIR.glob("bench_*.py"))
+    if wanted:
+        scripts = [s for s in scripts if s.stem.removeprefix("bench_") in wanted]
+    results: dict[str, Any] = {"machine": machine(), "benchmarks": {}}
+    previous = BENCH_DIR / "results.json"
+    if wanted and previous.exists():  # a partial run keeps the other benchmarks' figures
+        results["benchmarks"] = json.loads(previous.read_text()).get("benchmarks", {})
+    for script in scripts:
+        name = script.stem.removeprefix("bench_")
+        print(f"run_all: {name} ...", file=sys.stderr, flush=True)
+        results["benchmarks"][name] = bench = run_one(script, args.timeout)
+        bench["commit"] = results["machine"]["commit"]
+        state = "ok" if bench["returncode"] == 0 and bench["figures"] is not None else "FAILED"
+        print(f"run_all: {name} {state} in {bench['seconds']:.0f} s", file=sys.stderr, flush=True)
+    (BENCH_DIR / "results.json").write_text(json.dumps(results, indent=2) + "\n")
+    table = markdown(results)
+    (BENCH_DIR / "results.md").write_text(table)
+    if args.readme:
+        README.write_text(update_readme(README.read_text(), table))
+    print(table)
+    failed = [n for n, b in results["benchmarks"].items() if b["returncode"] or not b["figures"]]
+    if failed:
+        print(f"run_all: failed: {', '.join(failed)}", file=sys.stderr)
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
