@@ -440,9 +440,10 @@ class RosmcSystem:
             ],
         )
 
-    def start_executor(self, agent: str, robot_side: bool = False, *params: str) -> None:
-        """Start ``agent``'s executor (behind the emulator if ``robot_side``)."""
+    def start_executor(self, agent: str, robot_side: bool | None = False, *params: str) -> None:
+        """Start ``agent``'s executor (behind the emulator if ``robot_side``; None: not given)."""
         env = dict(self.env, ROS_NAMESPACE=f"/{agent}")
+        side = [] if robot_side is None else [f"_robot_side:={str(robot_side).lower()}"]
         self._start(
             agent,
             [
@@ -450,7 +451,7 @@ class RosmcSystem:
                 str(REPO_ROOT / "scripts" / "mission_executor"),
                 f"_agent:={agent}",
                 f"_state_file:={self.state_file(agent)}",
-                f"_robot_side:={'true' if robot_side else 'false'}",
+                *side,
                 *params,
             ],
             env,

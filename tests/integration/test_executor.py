@@ -765,3 +765,19 @@ def test_a_snapshot_overtaken_by_newer_reports_does_not_stall_the_report_stream(
     report(3, b, S.RUNNING, began + 0.3)
     wait_until(lambda: op.mission().skill(b).status is S.RUNNING, 10.0, "report 3 to be applied")
     assert [m.seq for m in robot.received("report_ack")][-1] == 3
+
+
+def test_a_new_executor_does_not_inherit_the_previous_ones_parameters(rosmc: Start) -> None:
+    system, op = rosmc(agents=())
+    system.start_executor("r1", True)  # behind a link emulator that is not running: no link
+    wait_until(
+        lambda: "mission executor ready" in system.log("r1").read_text(),
+        30.0,
+        "the first executor to start",
+    )
+    for name in ("agent", "robot_side", "state_file"):
+        assert not rospy.has_param(f"/r1/mission_executor/{name}"), name
+    system.stop("r1")
+    system.start_executor("r1", None)  # as a launch file without robot_side starts it
+    op.wait_links(["r1"])
+    assert "(direct link)" in system.log("r1").read_text()

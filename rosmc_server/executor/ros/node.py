@@ -19,6 +19,8 @@ Parameters (private):
         (default ``$ROS_HOME/rosmc/<agent>_executor.json``; "" = keep nothing).
     ``~snapshot_period`` (float, s, 1.0), ``~report_retry`` (float, s, 0.5),
     ``~tick_rate`` (float, Hz, 50), ``~robot_side`` (bool, false).
+    They are read once at start and deleted, so a later executor of the same name starts
+    from its own settings, never from a previous run's.
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ import sys
 import threading
 import time
 from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import rosmc.msg as wire
@@ -206,6 +209,55 @@ def default_state_file(agent: str) -> Path:
     return Path(ros_home) / "rosmc" / f"{agent}_executor.json"
 
 
+@dataclass(frozen=True)
+class ExecutorConfig:
+    """The executor's private parameters (``~name``), read once at start."""
+
+    agent: str
+    skills: str = DEFAULT_SKILLS
+    state_file: Path | None = None
+    robot_side: bool = False
+    tick_rate: float = 50.0
+    snapshot_period: float = 1.0
+    report_retry: float = 0.5
+
+    @classmethod
+    def from_params(cls) -> ExecutorConfig:
+        """Read every private parameter, then delete them from the parameter server.
+
+        Left there, they would configure the next executor started under the same name:
+        a ``~robot_side`` left by a run behind the link emulator made a later direct
+        executor talk on the wrong topics and never link.
+        """
+        agent = str(rospy.get_param("~agent", ""))
+        default_state = str(default_state_file(agent)) if agent else ""
+        state = str(rospy.get_param("~state_file", default_state))
+        config = cls(
+            agent=agent,
+            skills=str(rospy.get_param("~skills", DEFAULT_SKILLS)),
+            state_file=Path(state).expanduser() if state else None,
+            robot_side=bool(rospy.get_param("~robot_side", False)),
+            tick_rate=float(rospy.get_param("~tick_rate", 50.0)),
+            snapshot_period=float(rospy.get_param("~snapshot_period", 1.0)),
+            report_retry=float(rospy.get_param("~report_retry", 0.5)),
+        )
+        for name in PRIVATE_PARAMS:
+            if rospy.has_param(f"~{name}"):
+                rospy.delete_param(f"~{name}")
+        return config
+
+
+PRIVATE_PARAMS = (
+    "agent",
+    "skills",
+    "state_file",
+    "robot_side",
+    "tick_rate",
+    "snapshot_period",
+    "report_retry",
+)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``mission_executor``."""
     args = rospy.myargv(list(argv) if argv is not None else sys.argv)
@@ -217,26 +269,21 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.parse_args(args[1:])
     rospy.init_node("mission_executor")
     bridge_logging_to_rosout()
-    agent = str(rospy.get_param("~agent", ""))
-    if not agent:
+    config = ExecutorConfig.from_params()
+    if not config.agent:
         _log.critical("mission executor: set ~agent to the robot's agent name")
         return 2
-    state = str(rospy.get_param("~state_file", str(default_state_file(agent))))
     try:
-        skill_types = load_skill_types(str(rospy.get_param("~skills", DEFAULT_SKILLS)), agent)
+        skill_types = load_skill_types(config.skills, config.agent)
     except (ImportError, AttributeError, ValueError) as error:
-        _log.critical("mission executor %s: cannot load skills: %s", agent, error)
+        _log.critical("mission executor %s: cannot load skills: %s", config.agent, error)
         return 1
-    node = ExecutorNode(
-        agent,
-        skill_types,
-        Path(state) if state else None,
-        bool(rospy.get_param("~robot_side", False)),
+    node = ExecutorNode(config.agent, skill_types, config.state_file, config.robot_side)
+    _log.info(
+        "%s: mission executor ready with skills %s (%s link)",
+        config.agent,
+        ", ".join(sorted(skill_types)),
+        "robot-side" if config.robot_side else "direct",
     )
-    _log.info("%s: mission executor ready with skills %s", agent, ", ".join(sorted(skill_types)))
-    node.spin(
-        float(rospy.get_param("~tick_rate", 50.0)),
-        float(rospy.get_param("~snapshot_period", 1.0)),
-        float(rospy.get_param("~report_retry", 0.5)),
-    )
+    node.spin(config.tick_rate, config.snapshot_period, config.report_retry)
     return 0
