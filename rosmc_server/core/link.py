@@ -128,10 +128,13 @@ class Outbox(Generic[Payload]):
             if item.seq == seq and seq > 0:
                 self._pending.remove(item)
                 if item.attempts == 1:  # only unambiguous samples update the round trip
-                    sample = now - item.first_sent
-                    self._rtt = sample if self._rtt is None else 0.8 * self._rtt + 0.2 * sample
+                    self.round_trip_sample(now - item.first_sent)
                 return item
         return None
+
+    def round_trip_sample(self, seconds: float) -> None:
+        """One measured round trip (a command's ack, or an echoed heartbeat); smoothed."""
+        self._rtt = seconds if self._rtt is None else 0.8 * self._rtt + 0.2 * seconds
 
     def robot_numbering(self, last_executed: int, now: float) -> bool:
         """Learn where the robot's numbering stands from its snapshot.

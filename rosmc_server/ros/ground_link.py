@@ -84,6 +84,7 @@ class GroundLink:
     ) -> None:
         self._host = host
         self._clock = clock
+        self._started = clock()
         self._links: dict[str, AgentLink] = {}
         self._next_heartbeat = 0.0
         for agent in agents:
@@ -154,7 +155,7 @@ class GroundLink:
             if heartbeat and link.reports is not None:
                 # Robots judge ground contact by what they hear; this keeps a quiet
                 # but healthy link from looking lost.
-                link.report_ack_pub.publish(wire.ReportAck(agent=link.agent, seq=link.reports.last))
+                link.report_ack_pub.publish(self._report_ack(link.agent, link.reports.last))
 
     def resend_pending_transfers(self) -> None:
         """After a restart, ask again for the uploads and removals the journal shows pending."""
@@ -241,7 +242,7 @@ class GroundLink:
             link.reports.accept(msg.seq)
             self._host.record_report(msg)
             self._apply_report(msg)
-        link.report_ack_pub.publish(wire.ReportAck(agent=agent, seq=link.reports.last))
+        link.report_ack_pub.publish(self._report_ack(agent, link.reports.last))
 
     def _apply_report(self, msg: wire.RobotReport) -> None:
         try:
@@ -262,8 +263,21 @@ class GroundLink:
             )
         )
 
+    def _report_ack(self, agent: str, seq: int) -> wire.ReportAck:
+        """A report ack stamped with the ground's clock (echoed back for the round trip)."""
+        return wire.ReportAck(agent=agent, seq=seq, sent=self._clock())
+
+    def _measure_round_trip(self, link: AgentLink, msg: wire.ExecutorSnapshot) -> None:
+        """Time from a stamped report ack to its echo, less what the robot held it."""
+        if msg.echo_sent < self._started:
+            return  # none yet, or sent by an earlier server
+        sample = self._clock() - msg.echo_sent - max(0.0, msg.echo_held)
+        if sample >= 0.0:
+            link.outbox.round_trip_sample(sample)
+
     def _on_snapshot(self, agent: str, msg: wire.ExecutorSnapshot) -> None:
         link = self._links[agent]
+        self._measure_round_trip(link, msg)
         stamp = msg.stamp.to_sec()
         if stamp < link.newest_stamp:
             # Older than something already heard (it queued behind newer reports): its
@@ -277,7 +291,7 @@ class GroundLink:
         if fresh:
             # Every report up to last_report_seq is reflected in the snapshot itself.
             link.reports = InboundSequence(msg.last_report_seq)
-            link.report_ack_pub.publish(wire.ReportAck(agent=agent, seq=msg.last_report_seq))
+            link.report_ack_pub.publish(self._report_ack(agent, msg.last_report_seq))
         assert link.reports is not None
         if fresh or msg.last_report_seq == link.reports.last:
             self._reconcile(agent, msg)

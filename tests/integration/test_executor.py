@@ -781,3 +781,14 @@ def test_a_new_executor_does_not_inherit_the_previous_ones_parameters(rosmc: Sta
     system.start_executor("r1", None)  # as a launch file without robot_side starts it
     op.wait_links(["r1"])
     assert "(direct link)" in system.log("r1").read_text()
+
+
+def test_the_round_trip_is_measured_on_a_quiet_link(rosmc: Start) -> None:
+    _, op = rosmc(agents=("r1",))  # linked; no command has been sent
+    link = wait_until(
+        lambda: (state := op.agent_state("r1").link).round_trip >= 0.0 and state,
+        10.0,
+        "a round-trip figure from the heartbeat echo",
+    )
+    assert link.state == wire.LinkState.UP
+    assert 0.0 <= link.round_trip < 0.5, link.round_trip  # one machine, no emulated latency

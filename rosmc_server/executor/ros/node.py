@@ -81,6 +81,7 @@ class ExecutorNode:
         self._state_file = state_file
         self._dirty = False
         self._held_reports: list[Report] | None = None  # while a command is being answered
+        self._echo: tuple[float, float] | None = None  # newest stamped report ack: sent, heard
         topics = interface.robot_link(agent) if robot_side else interface.ground_link(agent)
         self._ack_pub = rospy.Publisher(topics.ack, wire.RobotAck, queue_size=100)
         self._report_pub = rospy.Publisher(topics.report, wire.RobotReport, queue_size=1000)
@@ -165,6 +166,15 @@ class ExecutorNode:
         if msg.agent == self.agent:
             with self._lock:
                 self.engine.report_acknowledged(msg.seq)
+                if msg.sent > 0.0:  # echoed in the next snapshot: the ground's round trip
+                    self._echo = (msg.sent, time.monotonic())
+
+    def _snapshot_msg(self) -> wire.ExecutorSnapshot:
+        msg = snapshot_to_msg(self.agent, self.engine.snapshot())
+        if self._echo is not None:
+            sent, received = self._echo
+            msg.echo_sent, msg.echo_held = sent, time.monotonic() - received
+        return msg
 
     def _on_signal(self, msg: wire.BarrierSignal) -> None:
         try:
@@ -193,7 +203,7 @@ class ExecutorNode:
                         self._report_pub.publish(report_to_msg(self.agent, report))
                 if now >= next_snapshot:
                     next_snapshot = now + snapshot_period
-                    self._snapshot_pub.publish(snapshot_to_msg(self.agent, self.engine.snapshot()))
+                    self._snapshot_pub.publish(self._snapshot_msg())
                 self._persist()
             time.sleep(max(0.0, period - (time.monotonic() - now)))
 
