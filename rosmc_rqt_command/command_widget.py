@@ -220,7 +220,11 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         if answer.ok:
             revision = getattr(answer.value, "revision", None)
             suffix = f" (revision {revision})" if revision is not None else ""
-            self.messages.say(f"Done: {what}{suffix}.", "ok")
+            note = getattr(answer.value, "note", "")
+            if note:  # accepted, but the operator should know (queued, a barrier partner)
+                self.messages.say(f"Done: {what}{suffix}; {note}.", "warning")
+            else:
+                self.messages.say(f"Done: {what}{suffix}.", "ok")
         elif answer.conflict:
             self.messages.say(
                 f"Could not {what}: someone else changed the mission first ({answer.error}). "

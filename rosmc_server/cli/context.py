@@ -57,7 +57,9 @@ class Context:
 
     def emit_result(self, result: Result, text: str | None = None) -> int:
         """Print a result (default text: the new revision); return exit code 0."""
-        self.emit(text if text is not None else f"revision {result.revision}", asdict(result))
+        line = text if text is not None else f"revision {result.revision}"
+        note = getattr(result, "note", "")
+        self.emit(f"{line}\n{note}" if note else line, asdict(result))
         return 0
 
     def agent_states(self) -> dict[str, AgentStatus]:

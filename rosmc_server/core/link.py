@@ -94,6 +94,20 @@ class Outbox(Generic[Payload]):
         """Commands not yet acknowledged, oldest first."""
         return tuple(self._pending)
 
+    def unsent(self) -> Sequence[Outgoing[Payload]]:
+        """Commands never transmitted (so never numbered), oldest first.
+
+        Only these may still be changed or withdrawn: the robot cannot have seen them, and
+        no sequence number has been given out for them.
+        """
+        return tuple(item for item in self._pending if item.seq == 0 and item.attempts == 0)
+
+    def withdraw(self, item: Outgoing[Payload]) -> None:
+        """Drop an unsent command (superseded before it ever left)."""
+        if item.seq or item.attempts:
+            raise ValueError("a command already transmitted cannot be withdrawn")
+        self._pending.remove(item)
+
     def due(self, now: float) -> list[Outgoing[Payload]]:
         """Commands to transmit now, oldest first; numbers them on first send.
 

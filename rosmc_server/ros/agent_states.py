@@ -15,6 +15,7 @@ import rospy
 
 from .. import interface
 from ..core import SkillStatus
+from ..core.advice import waiting_on_unsynced
 
 if TYPE_CHECKING:
     from .server_node import MissionServer
@@ -98,4 +99,8 @@ class AgentStatePublisher:
             state.executor_state = link.snapshot.state
             state.waiting_on = link.snapshot.waiting_on
             state.policy = link.snapshot.policy
+        unsynced = waiting_on_unsynced(server.mission.state, agent)
+        if unsynced and not state.waiting_on:
+            # The robot cannot know: its partners' skills are still on the ground.
+            state.waiting_on = f"{', '.join(unsynced)} (not synchronized)"
         return state

@@ -32,6 +32,7 @@ from ..core.commands import CommandKind, CommandSpec, queued_barriers, repair_co
 from ..core.link import Arrival, InboundSequence, LinkReport, LinkStatus, Outbox, queue_hash
 from ..core.reconcile import RobotSkill
 from ..interface import ground_link
+from .command_queue import collapse
 
 _log = logging.getLogger(__name__)
 
@@ -141,8 +142,14 @@ class GroundLink:
             barriers=[barrier_to_msg(b, lambda s: state.locate(s)[0]) for b in spec.barriers],
             argument=spec.argument,
         )
-        link.outbox.enqueue(msg)
+        kept = collapse(link.outbox, msg)
+        if kept is not None:
+            link.outbox.enqueue(kept)
         self._transmit(link)
+
+    def unsent(self, agent: str) -> int:
+        """How many commands wait, never transmitted, for ``agent``'s robot."""
+        return len(self._links[agent].outbox.unsent())
 
     def tick(self) -> None:
         """Retransmit whatever is due; repeat report acks as the ground's heartbeat."""

@@ -45,9 +45,11 @@ from ..core import (
     parse_mission,
     save_mission,
 )
+from ..core.advice import unsynced_partners
 from ..core.commands import CommandKind, CommandSpec
 from ..core.link import LinkStatus
 from ..core.policy import options_argument
+from .command_queue import MAX_UNSENT
 
 if TYPE_CHECKING:
     from .server_node import MissionServer
@@ -82,6 +84,11 @@ def error_code(error: RosmcError) -> int:
 
 # Line breaks and other control characters an error may quote from the request.
 _CONTROL_CHARS = re.compile(r"[\x00-\x1f\x7f\x85\u2028\u2029]")
+
+
+def notes(*parts: str) -> str:
+    """The non-empty parts, as one line."""
+    return "; ".join(part for part in parts if part)
 
 
 def one_line(message: str) -> str:
@@ -173,6 +180,11 @@ class OperatorServices:
             raise RuleViolation(f"'{agent}' is a static agent and has no robot link")
         if self._server.link.status(agent) is LinkStatus.DOWN:
             raise Unavailable(f"{agent} cannot be reached (its link is down); try again later")
+        if self._server.link.unsent(agent) >= MAX_UNSENT:
+            raise Unavailable(
+                f"{agent} has {MAX_UNSENT} commands waiting for its first report; "
+                "wait until it is heard"
+            )
 
     # -- blueprint ----------------------------------------------------------------
     def _add_skill(self, req: Any, resp: Any) -> MissionEvent:
@@ -225,7 +237,11 @@ class OperatorServices:
                     req.agent, req.upto_id or None, base_revision=req.base_revision
                 )
             )
-        resp.skill_ids = [placed.skill.id for placed in event.change.put_skills]
+            resp.skill_ids = [placed.skill.id for placed in event.change.put_skills]
+            partners = unsynced_partners(self._server.mission.state, resp.skill_ids)
+            resp.note = notes(
+                self._queued_note([req.agent]), *(f"warning: {p.sentence()}" for p in partners)
+            )
         return event
 
     def _unsynchronize(self, req: Any, resp: Any) -> MissionEvent:
@@ -243,8 +259,20 @@ class OperatorServices:
                     req.agent, req.from_id or None, base_revision=req.base_revision
                 )
             )
+            resp.note = self._queued_note([req.agent])
         resp.skill_ids = [placed.skill.id for placed in event.change.put_skills]
         return event
+
+    def _queued_note(self, agents: list[str]) -> str:
+        """Say so when a command waits for robots never heard since the server started."""
+        unheard = [a for a in agents if self._server.link.status(a) is LinkStatus.UNKNOWN]
+        if not unheard:
+            return ""
+        who = ", ".join(unheard)
+        return (
+            f"queued for {who}: not heard since the server started; "
+            "it goes out when the robot first reports"
+        )
 
     def _uploading(self, agent: str) -> bool:
         state = self._server.mission.state
@@ -261,6 +289,7 @@ class OperatorServices:
                 self._require_link(agent)
             for agent in agents:
                 self._server.link.send(CommandSpec(agent, _CONTROL[req.command]))
+            resp.note = self._queued_note(agents)
         resp.agents = agents
         return None
 
@@ -271,6 +300,7 @@ class OperatorServices:
             self._require_link(agent)
             argument = options_argument(policy)
             self._server.link.send(CommandSpec(agent, CommandKind.SET_OPTIONS, argument=argument))
+            resp.note = self._queued_note([agent])
         return None
 
     def _retry_skill(self, req: Any, resp: Any) -> MissionEvent:

@@ -93,6 +93,8 @@ def format_agent_status(status: AgentStatus | None) -> str:
     if status is None:
         return "link unknown"
     link = f"link {status.link}"
+    if status.link == "unknown":
+        link = "link never heard since the server started (commands wait for it)"
     details = []
     if status.last_heard >= 0:
         details.append(f"heard {status.last_heard:.1f} s ago")

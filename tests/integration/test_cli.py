@@ -479,7 +479,12 @@ def test_sync_shows_uploading(server: Server, fresh: MissionClient) -> None:
     started, refused_edit = run_many(
         server.env, [["start", "drone"], ["edit", ids["climb"], "altitude=3"]]
     )
-    assert started.stdout == "start sent to drone\n", (started.stdout, started.stderr)
+    # No executor runs in this test: the answer says the start waits for the robot.
+    assert started.stdout == (
+        "start sent to drone\n"
+        "queued for drone: not heard since the server started; "
+        "it goes out when the robot first reports\n"
+    ), (started.stdout, started.stderr)
     fresh.get_mission()
     with pytest.raises(RuleViolation, match="cannot start a new mission while drone holds"):
         fresh.new_mission()

@@ -792,3 +792,49 @@ def test_the_round_trip_is_measured_on_a_quiet_link(rosmc: Start) -> None:
     )
     assert link.state == wire.LinkState.UP
     assert 0.0 <= link.round_trip < 0.5, link.round_trip  # one machine, no emulated latency
+
+
+def test_commands_for_a_robot_never_heard_are_queued_collapsed_and_sent_when_it_appears(
+    rosmc: Start,
+) -> None:
+    system, op = rosmc(agents=())  # r1's executor is not running yet
+    ids = [op.add("r1", "wait", {"duration": 0.05}) for _ in range(2)]
+    for _ in range(30):  # an operator changing their mind while the robot is out of reach
+        answer = op.change("synchronize", agent="r1", upto_id="")
+        assert "queued for r1" in answer.note, answer.note
+        op.change("unsynchronize", agent="r1", from_id="")
+    assert op.agent_state("r1").link.commands_in_flight == 0, "every upload was cancelled"
+    assert "queued for r1" in op.change("synchronize", agent="r1", upto_id="").note
+    for _ in range(3):
+        answer = op.call("control", agent="r1", command=srv.ControlRequest.START)
+        assert "queued for r1" in answer.note
+    link = op.agent_state("r1").link
+    assert link.state == wire.LinkState.UNKNOWN
+    assert link.commands_in_flight == 2, "one upload and one start wait"
+
+    system.start_executor("r1")
+    op.wait_links(["r1"])
+    op.wait_status(ids, S.SUCCESS)
+    snapshot = rospy.wait_for_message(
+        interface.ground_link("r1").snapshot, wire.ExecutorSnapshot, timeout=10.0
+    )
+    assert snapshot.last_command_seq == 2, "the robot received exactly the upload and a start"
+
+
+def test_synchronizing_a_barrier_member_alone_warns_and_shows_what_it_waits_on(
+    rosmc: Start,
+) -> None:
+    _, op = rosmc(agents=("r1", "r2"))
+    first = op.add("r1", "wait", {"duration": 0.05})
+    partner = op.add("r2", "wait", {"duration": 0.05})
+    barrier = op.add_barrier([first, partner])
+    answer = op.change("synchronize", agent="r1", upto_id="")
+    assert answer.note.startswith(f"warning: barrier {barrier} also waits on r2's wait")
+    assert partner in answer.note
+    state = wait_until(
+        lambda: (s := op.agent_state("r1")).waiting_on and s,
+        10.0,
+        "r1's state to show what it waits on",
+    )
+    assert state.waiting_on == "r2 (not synchronized)"
+    assert op.change("synchronize", agent="r2", upto_id="").note == ""

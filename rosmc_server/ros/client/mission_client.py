@@ -184,7 +184,7 @@ class MissionClient(ClientBase):
         response = self._mutate(
             "synchronize", base_revision, retry_on_conflict, agent=agent, upto_id=upto_id or ""
         )
-        return Transferred(response.revision, tuple(response.skill_ids))
+        return Transferred(response.revision, tuple(response.skill_ids), response.note)
 
     def unsynchronize(
         self,
@@ -198,13 +198,13 @@ class MissionClient(ClientBase):
         response = self._mutate(
             "unsynchronize", base_revision, retry_on_conflict, agent=agent, from_id=from_id or ""
         )
-        return Transferred(response.revision, tuple(response.skill_ids))
+        return Transferred(response.revision, tuple(response.skill_ids), response.note)
 
     def control(self, command: ControlCommand, agent: str | None = None) -> ControlSent:
         """Start, pause, resume or stop one robot, or every robot (``agent`` None)."""
         response = self._caller.call("control", agent=agent or "", command=int(command))
         raise_for(response, response.revision)
-        return ControlSent(response.revision, tuple(response.agents))
+        return ControlSent(response.revision, tuple(response.agents), response.note)
 
     def set_robot_options(self, agent: str, policy: LostLinkPolicy) -> Result:
         """Set ``agent``'s lost-link policy (what it does when it stops hearing the ground).

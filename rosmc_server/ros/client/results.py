@@ -58,6 +58,7 @@ class Transferred(Result):
     """``synchronize``/``unsynchronize`` succeeded for ``skill_ids`` (in transfer now)."""
 
     skill_ids: tuple[str, ...]
+    note: str = ""  # what the operator should know: queued, barrier partners not synchronized
 
 
 @dataclass(frozen=True)
@@ -65,6 +66,7 @@ class ControlSent(Result):
     """A control command was sent to the robots of ``agents``."""
 
     agents: tuple[str, ...]
+    note: str = ""  # e.g. queued for robots not heard since the server started
 
 
 @dataclass(frozen=True)
