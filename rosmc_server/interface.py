@@ -24,6 +24,11 @@ AGENT_STATES_TOPIC = f"{NAMESPACE}/agent_states"  # rosmc/AgentStates, steady ra
 ROBOT_REPORTS_TOPIC = f"{NAMESPACE}/robot_reports"  # rosmc/RobotReport
 # Published by robots (or the simulator), one topic per agent.
 TELEMETRY_TOPIC = "/{agent}/telemetry"  # rosmc/Telemetry
+# Published by the robots or the simulator, and journaled by the server (low rate) so that a
+# recording shows where the robots were, the site and the score.
+TF_TOPIC = "/tf"  # tf2_msgs/TFMessage: map -> <agent>/base_link
+SCIENCE_TOPIC = f"{NAMESPACE}/sim/science"  # rosmc/ScienceState, latched: regions and score
+WORLD_TOPIC = f"{NAMESPACE}/sim/world"  # visualization_msgs/MarkerArray, latched: the site
 
 # Operator services of the mission server: name -> srv type name.
 SERVICES = {

@@ -14,6 +14,9 @@ from rosmc_server.interface import (
     EVENTS_TOPIC,
     MISSION_TOPIC,
     ROBOT_REPORTS_TOPIC,
+    SCIENCE_TOPIC,
+    TF_TOPIC,
+    WORLD_TOPIC,
 )
 
 JOURNAL_TOPICS: Final[Mapping[str, str]] = MappingProxyType(
@@ -21,10 +24,22 @@ JOURNAL_TOPICS: Final[Mapping[str, str]] = MappingProxyType(
         EVENTS_TOPIC: "rosmc/MissionEvent",  # one per accepted change of the mission
         MISSION_TOPIC: "rosmc/Mission",  # full snapshots: the first record, then periodically
         ROBOT_REPORTS_TOPIC: "rosmc/RobotReport",  # skill status reports of the robots
-        AGENT_STATES_TOPIC: "rosmc/AgentStates",  # agent states for timelines (low rate)
+        AGENT_STATES_TOPIC: "rosmc/AgentStates",  # on change, at most 2 Hz
+        TF_TOPIC: "tf2_msgs/TFMessage",  # map -> <robot>/base_link, 2 Hz
+        SCIENCE_TOPIC: "rosmc/ScienceState",  # the score and discovered regions, on change
+        WORLD_TOPIC: "visualization_msgs/MarkerArray",  # the simulated site, on change
     }
 )
 """Every journal channel with the ROS message type it carries, in channel-id order."""
+
+TELEMETRY_TOPICS: Final = (
+    ROBOT_REPORTS_TOPIC,
+    AGENT_STATES_TOPIC,
+    TF_TOPIC,
+    SCIENCE_TOPIC,
+    WORLD_TOPIC,
+)
+"""Channels of what the robots and the site did: written, never fsynced on their own."""
 
 PROFILE: Final = "ros1"
 MESSAGE_ENCODING: Final = "ros1"

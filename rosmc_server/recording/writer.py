@@ -19,7 +19,7 @@ from rosmc_server.recording import _scan
 from rosmc_server.recording._codec import RosMessage, serialize
 from rosmc_server.recording._files import fsync_directory, open_locked, save_tail
 from rosmc_server.recording._section import DataSection
-from rosmc_server.recording.channels import JOURNAL_TOPICS, PROFILE
+from rosmc_server.recording.channels import JOURNAL_TOPICS, PROFILE, TELEMETRY_TOPICS
 from rosmc_server.recording.errors import JournalError
 from rosmc_server.recording.reader import JournalResult, decode_scan
 
@@ -202,6 +202,16 @@ class JournalWriter:
     def append_agent_states(self, states: RosMessage, log_time_ns: int) -> None:
         """Record a ``rosmc/AgentStates`` (telemetry: written, never fsynced on its own)."""
         self._append(AGENT_STATES_TOPIC, states, log_time_ns, sync=False)
+
+    def append_telemetry(self, topic: str, msg: RosMessage, log_time_ns: int) -> None:
+        """Record a message of one of :data:`TELEMETRY_TOPICS` (TF, science, world, ...).
+
+        Written at once but never fsynced on its own: the next mission event's sync (or
+        the close) makes it durable.
+        """
+        if topic not in TELEMETRY_TOPICS:
+            raise JournalError(f"{topic} is not a telemetry channel of the journal")
+        self._append(topic, msg, log_time_ns, sync=False)
 
     def sync(self) -> None:
         """Flush everything appended so far to the disk (fdatasync)."""

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import threading
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import rosmc.msg as wire
@@ -24,9 +25,15 @@ if TYPE_CHECKING:
 class AgentStatePublisher:
     """Merges telemetry, link state and mission progress per agent."""
 
-    def __init__(self, server: MissionServer, rate: float) -> None:
+    def __init__(
+        self,
+        server: MissionServer,
+        rate: float,
+        on_published: Callable[[wire.AgentStates], None] | None = None,
+    ) -> None:
         self._server = server
         self._period = 1.0 / rate if rate > 0 else 0.5
+        self._on_published = on_published  # the journal's recorder
         self._telemetry: dict[str, wire.Telemetry] = {}
         self._telemetry_lock = threading.Lock()
         self._publisher = rospy.Publisher(
@@ -65,7 +72,10 @@ class AgentStatePublisher:
     def publish(self) -> None:
         """Publish one AgentStates message."""
         if not rospy.is_shutdown():
-            self._publisher.publish(self.build())
+            msg = self.build()
+            self._publisher.publish(msg)
+            if self._on_published is not None:
+                self._on_published(msg)
 
     def _agent_state(self, agent: str) -> wire.AgentState:
         server = self._server

@@ -13,6 +13,10 @@ Publishes (each name behind ``prefix``):
     ``/rosmc/mission_events`` (rosmc/MissionEvent): every recorded event after the start.
     ``/rosmc/agent_states`` (rosmc/AgentStates): as recorded (the latest one at once).
     ``/rosmc/robot_reports`` (rosmc/RobotReport): as recorded.
+    ``/tf`` (tf2_msgs/TFMessage): the robots' recorded transforms (``<prefix>/tf`` with a
+    prefix: ``roslaunch rosmc rviz.launch ns:=/replay`` remaps rviz's ``/tf`` to it).
+    ``/rosmc/sim/science`` (rosmc/ScienceState, latched), ``/rosmc/sim/world``
+    (visualization_msgs/MarkerArray, latched): the site and the score, as recorded.
 
 Services (behind ``prefix``):
     ``/rosmc/get_mission`` (rosmc/GetMission): the mission as replayed so far, so clients that
@@ -38,6 +42,8 @@ import rosgraph
 import rosmc.msg as wire
 import rosmc.srv as wire_srv
 import rospy
+from tf2_msgs.msg import TFMessage
+from visualization_msgs.msg import MarkerArray
 
 from .. import interface
 from ..conversions import event_from_msg, mission_to_msg
@@ -64,7 +70,21 @@ TYPES: dict[str, Any] = {
     interface.EVENTS_TOPIC: wire.MissionEvent,
     interface.AGENT_STATES_TOPIC: wire.AgentStates,
     interface.ROBOT_REPORTS_TOPIC: wire.RobotReport,
+    interface.TF_TOPIC: TFMessage,
+    interface.SCIENCE_TOPIC: wire.ScienceState,
+    interface.WORLD_TOPIC: MarkerArray,
 }
+
+LATCHED = (interface.MISSION_TOPIC, interface.SCIENCE_TOPIC, interface.WORLD_TOPIC)
+"""Latched as their publishers latch them: a late rviz still gets the site and the score."""
+
+CURRENT_AT_START = (
+    interface.AGENT_STATES_TOPIC,
+    interface.TF_TOPIC,
+    interface.SCIENCE_TOPIC,
+    interface.WORLD_TOPIC,
+)
+"""Topics whose newest message before the start time is published at once."""
 
 
 EventCallback = Callable[[int, MissionEvent | None, float], None]
@@ -187,14 +207,14 @@ class RecordingReplayer:
         init_node(f"rosmc_replay_{os.getpid()}")
         for topic, msg_type in TYPES.items():
             name = self._config.topic(topic)
-            latched = topic == interface.MISSION_TOPIC
             self._publishers[topic] = rospy.Publisher(
-                name, msg_type, queue_size=1000, latch=latched
+                name, msg_type, queue_size=1000, latch=topic in LATCHED
             )
         self._publish_snapshot(self._history.at_time(self._config.start).revision)
-        states = [r for r in self._before if r.topic == interface.AGENT_STATES_TOPIC]
-        if states:
-            self._publishers[interface.AGENT_STATES_TOPIC].publish(states[-1].message)
+        for topic in CURRENT_AT_START:
+            before = [r for r in self._before if r.topic == topic]
+            if before:
+                self._publishers[topic].publish(before[-1].message)
         service = rospy.Service(
             self._config.topic(GET_MISSION), wire_srv.GetMission, self._on_get_mission
         )

@@ -11,9 +11,12 @@ Publishes:
     ``/rosmc/agent_states`` (rosmc/AgentStates): every agent's state at ``~agent_state_rate``.
     The robot links' command and report_ack topics (see :mod:`.ground_link`).
 
+Journals, beside every change: agent states on change, TF of the robots at 2 Hz, the
+simulator's science state and world markers on change (see :mod:`.recorder`).
+
 Subscribes:
     ``/<agent>/telemetry`` (rosmc/Telemetry) and the robot links' ack, report and
-    snapshot topics.
+    snapshot topics; ``/tf``, ``/rosmc/sim/science`` and ``/rosmc/sim/world`` (to journal).
 
 Parameters (private):
     ``~library`` (str): skill library YAML (default: the shipped Mars team library).
@@ -64,6 +67,7 @@ from .ground_link import GroundLink
 from .logging_bridge import bridge_logging_to_rosout
 from .operator_services import OperatorServices
 from .publishing import SnapshotPublisher
+from .recorder import TelemetryRecorder
 
 _log = logging.getLogger(__name__)
 
@@ -126,7 +130,10 @@ class MissionServer:
             interface.MISSION_TOPIC, self.snapshot_msg, on_published=self._journal_snapshot
         )
         self.link = GroundLink(self, library.dynamic_agents, timeout=config.link_timeout)
-        self._agent_states = AgentStatePublisher(self, config.agent_state_rate)
+        self._recorder = TelemetryRecorder(lambda: self._journal, frozenset(library.dynamic_agents))
+        self._agent_states = AgentStatePublisher(
+            self, config.agent_state_rate, on_published=self._recorder.agent_states
+        )
         self._services = OperatorServices(self)
 
     # -- lifecycle -----------------------------------------------------------------
@@ -136,6 +143,7 @@ class MissionServer:
             self.link.resend_pending_transfers()
         self._snapshots.start()
         self._agent_states.start()
+        self._recorder.start()
         self._services.advertise()
         threading.Thread(target=self._tick_link, name="link", daemon=True).start()
         _log.info(
@@ -149,6 +157,7 @@ class MissionServer:
         with self._lock:
             self._stopping = True
             self._snapshots.stop()
+            self._recorder.stop()
             if not self._journal.closed:
                 self._journal.close()
 

@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+# The science state and world markers are journaled by the server: their names live in the
+# shared table.
+from rosmc_server.interface import SCIENCE_TOPIC, WORLD_TOPIC
+
+__all__ = ["SCIENCE_TOPIC", "SIM_NODE", "WORLD_TOPIC"]
+
 SIM_NODE = "/rosmc/sim"
-SCIENCE_TOPIC = "/rosmc/sim/science"  # rosmc/ScienceState, latched
-WORLD_TOPIC = "/rosmc/sim/world"  # visualization_msgs/MarkerArray, latched
 
 
 def task_topic(robot: str) -> str:

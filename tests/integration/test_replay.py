@@ -19,10 +19,14 @@ from typing import Any
 import pytest
 import rosmc.msg as wire
 import rospy
+from geometry_msgs.msg import TransformStamped
+from tf2_msgs.msg import TFMessage
+from visualization_msgs.msg import Marker, MarkerArray
 
 from rosmc_server.conversions import event_to_msg, mission_to_msg
 from rosmc_server.core import Mission, Pose, TaskMarker, load_library
 from rosmc_server.core.params import MarkerType
+from rosmc_server.interface import MAP_FRAME, SCIENCE_TOPIC, TF_TOPIC, WORLD_TOPIC, base_link
 from rosmc_server.recording import JournalWriter
 
 REPO = Path(__file__).resolve().parents[2]
@@ -52,8 +56,26 @@ def journal(tmp_path_factory: pytest.TempPathFactory) -> Path:
             else:
                 event = mission.add_skill("drone", "take_off", {"altitude": float(index)})
             msg = event_to_msg(event, lambda skill_id: mission.state.locate(skill_id)[0])
-            writer.append_event(msg, t0 + round(index * SPACING * 1e9))
+            stamp = t0 + round(index * SPACING * 1e9)
+            writer.append_event(msg, stamp)
+            for topic, telemetry in telemetry_at(index):
+                writer.append_telemetry(topic, telemetry, stamp + 1000)
     return path
+
+
+def telemetry_at(index: int) -> list[tuple[str, Any]]:
+    """What the server journals beside the changes: the drone climbing, the site, the score."""
+    transform = TransformStamped()
+    transform.header.frame_id = MAP_FRAME
+    transform.child_frame_id = base_link("drone")
+    transform.transform.translation.z = float(index)
+    transform.transform.rotation.w = 1.0
+    records: list[tuple[str, Any]] = [(TF_TOPIC, TFMessage(transforms=[transform]))]
+    if index % 6 == 1:
+        marker = Marker(ns="site", id=index, type=Marker.CYLINDER, action=Marker.ADD)
+        records.append((WORLD_TOPIC, MarkerArray(markers=[marker])))
+        records.append((SCIENCE_TOPIC, wire.ScienceState(score=index / 10)))
+    return records
 
 
 @pytest.fixture
@@ -186,3 +208,34 @@ def test_rosmc_watch_follows_a_replay(node: Any, journal: Path, launch_process: 
     assert watch.wait(timeout=20) == 0, watch.log()
     events = [line.split()[:2] for line in watch.log().splitlines() if line[1:2].isdigit()]
     assert len(events) == 3 and events[-1][1] == "SKILL_ADDED", watch.log()
+
+
+def test_replay_shows_the_robots_the_site_and_the_score_under_its_prefix(
+    node: Any, journal: Path
+) -> None:
+    heights: list[float] = []
+    world: list[int] = []
+    science: list[float] = []
+    subscribers = [
+        rospy.Subscriber(
+            f"/replay{TF_TOPIC}",
+            TFMessage,
+            lambda m: heights.extend(t.transform.translation.z for t in m.transforms),
+            queue_size=100,
+        ),
+        rospy.Subscriber(
+            f"/replay{WORLD_TOPIC}", MarkerArray, lambda m: world.append(m.markers[0].id)
+        ),
+        rospy.Subscriber(
+            f"/replay{SCIENCE_TOPIC}", wire.ScienceState, lambda m: science.append(m.score)
+        ),
+    ]
+    try:
+        done = replay(node.env, str(journal), "--rate", "10", "--prefix", "/replay")
+        assert done.returncode == 0, done.stderr
+        assert heights == [float(i) for i in range(1, EVENTS + 1)], "every TF record, in order"
+        assert world == [1, 7, 13, 19]
+        assert science == pytest.approx([0.1, 0.7, 1.3, 1.9])
+    finally:
+        for subscriber in subscribers:
+            subscriber.unregister()

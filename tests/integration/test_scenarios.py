@@ -26,7 +26,7 @@ import rospy
 
 from rosmc_server.core import MarkerType, Pose, SkillStatus, TaskMarker, Unavailable
 from rosmc_server.core.changes import EventKind
-from rosmc_server.interface import EVENTS_TOPIC
+from rosmc_server.interface import AGENT_STATES_TOPIC, EVENTS_TOPIC
 from rosmc_server.recording import read_journal
 from rosmc_server.ros.client import ControlCommand
 from rosmc_sim.ros.demo_operator import OPERATOR_KINDS, WIFI_SPOT_ADAPTED
@@ -116,6 +116,25 @@ def test_the_demo_mission_completes_with_a_score_and_a_full_recording(tmp_path: 
     assert expected <= made.keys(), made
     assert kinds[EventKind.SYNC_CONFIRMED] == kinds[EventKind.SYNC_REQUESTED]
     _check_adaptation(events)
+    _check_robots_recorded(journal, float(score.group(1)))
+
+
+def _check_robots_recorded(journal: Any, score: float) -> None:
+    """The recording shows the robots moving, their states, the site and the score."""
+    frames = {t.child_frame_id for m in journal.messages("/tf") for t in m.transforms}
+    assert frames == {f"{robot}/base_link" for robot in (DRONE, SCIENCE, ARM)}
+    drone_heights = [
+        t.transform.translation.z
+        for m in journal.messages("/tf")
+        for t in m.transforms
+        if t.child_frame_id == "drone/base_link"
+    ]
+    assert max(drone_heights) > 2.0, "the drone was recorded flying"
+    states = journal.messages(AGENT_STATES_TOPIC)
+    assert len(states) >= 10
+    assert {s.executor_state for m in states for s in m.agents} >= {"running"}
+    assert journal.messages("/rosmc/sim/world"), "the site"
+    assert journal.messages("/rosmc/sim/science")[-1].score == pytest.approx(score, abs=0.01)
 
 
 def _check_adaptation(events: list[Any]) -> None:

@@ -643,8 +643,23 @@ def test_journal_channels_are_the_graph_names() -> None:
         MISSION_TOPIC,
         ROBOT_REPORTS_TOPIC,
         AGENT_STATES_TOPIC,
+        "/tf",
+        "/rosmc/sim/science",
+        "/rosmc/sim/world",
     ]
     assert EVENTS_TOPIC == "/rosmc/mission_events" and MISSION_TOPIC == "/rosmc/mission"
+
+
+def test_telemetry_channels_take_their_own_types_only(tmp_path: Path) -> None:
+    from tf2_msgs.msg import TFMessage
+
+    with JournalWriter.create(tmp_path / "t.mcap", mission(0), T0) as writer:
+        writer.append_telemetry("/tf", TFMessage(), T0 + 2)
+        with pytest.raises(JournalError, match="not a telemetry channel"):
+            writer.append_telemetry(EVENTS_TOPIC, TFMessage(), 3)
+        with pytest.raises(JournalError, match="records tf2_msgs/TFMessage"):
+            writer.append_telemetry("/tf", msg.ScienceState(), 3)
+    assert [r.topic for r in read_journal(tmp_path / "t.mcap").records][-1] == "/tf"
 
 
 def test_latest_state_takes_a_late_snapshot_with_the_events_written_before_it(
