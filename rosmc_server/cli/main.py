@@ -48,7 +48,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _command(name: str) -> Callable[..., int]:
-    from . import edits, replay, views
+    from . import edits, replay, review, views
 
     read_only: dict[str, Callable[..., int]] = {
         "status": views.status,
@@ -56,7 +56,8 @@ def _command(name: str) -> Callable[..., int]:
         "markers": views.markers,
         "watch": views.watch,
     }
-    return read_only.get(name) or replay.COMMANDS.get(name) or edits.COMMANDS[name]
+    recording = {**replay.COMMANDS, **review.COMMANDS}
+    return read_only.get(name) or recording.get(name) or edits.COMMANDS[name]
 
 
 def _fail(message: str, code: int) -> int:

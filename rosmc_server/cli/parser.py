@@ -7,6 +7,7 @@ from collections.abc import Callable, Sequence
 
 from ..core.policy import DEFAULT_AFTER, LostLinkKind
 from .replay import add_commands as _add_recording
+from .review import add_commands as _add_review
 
 DEFAULT_TIMEOUT = 5.0
 
@@ -94,6 +95,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_markers(command, common)
     _add_files(command)
     _add_recording(command)
+    _add_review(command)
     return parser
 
 

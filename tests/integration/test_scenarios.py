@@ -12,6 +12,7 @@ matter (each plans from where it is, with absolute targets).
 
 from __future__ import annotations
 
+import json
 import math
 import re
 import subprocess
@@ -117,6 +118,25 @@ def test_the_demo_mission_completes_with_a_score_and_a_full_recording(tmp_path: 
     assert kinds[EventKind.SYNC_CONFIRMED] == kinds[EventKind.SYNC_REQUESTED]
     _check_adaptation(events)
     _check_robots_recorded(journal, float(score.group(1)))
+    _check_info(Path(recording.group(1)), float(score.group(1)), events[-1].revision)
+
+
+def _check_info(path: Path, score: float, revision: int) -> None:
+    """``rosmc info`` summarizes the recording from the file alone."""
+    result = subprocess.run(
+        [sys.executable, str(REPO / "scripts" / "rosmc"), "--json", "info", str(path)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=True,
+    )
+    info = json.loads(result.stdout)
+    assert info["revisions"] == [0, revision]
+    assert info["final_score"] == pytest.approx(score, abs=0.01)
+    outcomes = {robot["agent"]: robot for robot in info["robots"]}
+    assert set(outcomes) == {DRONE, SCIENCE, ARM}
+    assert all(r["succeeded"] >= 2 and r["failed"] == 0 for r in outcomes.values()), outcomes
+    assert info["records"]["/tf"] > 0 and info["changes"]["SYNC_REQUESTED"] >= 3
 
 
 def _check_robots_recorded(journal: Any, score: float) -> None:
