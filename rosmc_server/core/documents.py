@@ -15,6 +15,7 @@ from typing import Any, NoReturn
 import yaml
 
 from .errors import RosmcError
+from .validation import excerpt
 
 # libyaml's C loader and dumper when present: the same safe subset (plain data only,
 # no Python object tags), several times faster on large missions.
@@ -40,7 +41,36 @@ def load_yaml(text: str) -> Any:
     indent = max((len(m.group(1)) for m in _INDENT.finditer(text)), default=0)
     if deepest > MAX_NESTING or indent > 2 * MAX_NESTING:
         raise yaml.YAMLError(f"the document is nested more than {MAX_NESTING} levels deep")
-    return yaml.load(text, Loader=SafeLoader)  # nosec: a safe loader
+    return yaml.load(text, Loader=_UniqueKeyLoader)  # nosec: a safe loader
+
+
+class DuplicateKeyError(yaml.MarkedYAMLError):
+    """A mapping names the same key twice (``problem`` names it, ``problem_mark`` the line)."""
+
+
+def yaml_problem(error: yaml.YAMLError) -> str:
+    """The problem of a YAML error and its line, on one line (str(error) spans several)."""
+    problem = getattr(error, "problem", None) or str(error).splitlines()[0]
+    mark = getattr(error, "problem_mark", None)
+    return f"{problem} at line {mark.line + 1}" if mark is not None else str(problem)
+
+
+class _UniqueKeyLoader(SafeLoader):  # type: ignore[misc,valid-type]
+    """The safe loader, refusing a mapping that names a key twice ("last one wins" hides typos)."""
+
+    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
+        seen: set[object] = set()
+        for key_node, _ in node.value:
+            if key_node.tag == "tag:yaml.org,2002:merge":
+                continue  # "<<" merges may repeat keys on purpose
+            key = self.construct_object(key_node, deep=True)
+            if isinstance(key, (str, int, float, bool)) or key is None:
+                if key in seen:
+                    raise DuplicateKeyError(
+                        None, None, f"duplicate key {excerpt(key)}", key_node.start_mark
+                    )
+                seen.add(key)
+        return dict(super().construct_mapping(node, deep=deep))
 
 
 class DocumentReader:
@@ -71,7 +101,7 @@ class DocumentReader:
             self.fail(key, f"must be a mapping, got {type(raw).__name__}")
         for name in raw:
             if not isinstance(name, str):
-                self.fail(key, f"has a non-text key {name!r}")
+                self.fail(key, f"has a non-text key {excerpt(name)}")
         missing = sorted(required - raw.keys())
         if missing:
             self.fail(key, f"is missing {', '.join(missing)}")
@@ -90,7 +120,7 @@ class DocumentReader:
     def text(self, raw: object, key: str, empty: bool = False) -> str:
         """Text, non-empty unless ``empty``."""
         if not isinstance(raw, str) or (not empty and not raw.strip()):
-            self.fail(key, f"must be non-empty text, got {raw!r}")
+            self.fail(key, f"must be non-empty text, got {excerpt(raw)}")
         return raw
 
     def number(
@@ -98,31 +128,31 @@ class DocumentReader:
     ) -> float:
         """A finite number within the bounds given."""
         if isinstance(raw, bool) or not isinstance(raw, (int, float)):
-            self.fail(key, f"must be a number, got {raw!r}")
+            self.fail(key, f"must be a number, got {excerpt(raw)}")
         if not math.isfinite(raw):
-            self.fail(key, f"must be a finite number, got {raw!r}")
+            self.fail(key, f"must be a finite number, got {excerpt(raw)}")
         if minimum is not None and raw < minimum:
-            self.fail(key, f"must be at least {minimum:g}, got {raw!r}")
+            self.fail(key, f"must be at least {minimum:g}, got {excerpt(raw)}")
         if maximum is not None and raw > maximum:
-            self.fail(key, f"must be at most {maximum:g}, got {raw!r}")
+            self.fail(key, f"must be at most {maximum:g}, got {excerpt(raw)}")
         return float(raw)
 
     def positive(self, raw: object, key: str) -> float:
         """A finite number above zero."""
         value = self.number(raw, key)
         if value <= 0:
-            self.fail(key, f"must be positive, got {raw!r}")
+            self.fail(key, f"must be positive, got {excerpt(raw)}")
         return value
 
     def whole(self, raw: object, key: str, minimum: int) -> int:
         """A whole number of at least ``minimum``."""
         if isinstance(raw, bool) or not isinstance(raw, int) or raw < minimum:
-            self.fail(key, f"must be a whole number >= {minimum}, got {raw!r}")
+            self.fail(key, f"must be a whole number >= {minimum}, got {excerpt(raw)}")
         return raw
 
     def enum(self, kind: Any, raw: object, key: str) -> Any:
         """A member of enum ``kind``, given by name."""
         names = [member.name for member in kind]
         if raw not in names:
-            self.fail(key, f"must be one of {', '.join(names)}, got {raw!r}")
+            self.fail(key, f"must be one of {', '.join(names)}, got {excerpt(raw)}")
         return kind[raw]

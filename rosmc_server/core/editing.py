@@ -18,9 +18,7 @@ from .library import Library, SkillSpec
 from .model import SkillInstance, TaskMarker
 from .params import ParamType, Value
 from .state import MissionState
-
-MAX_LABEL = 120
-MAX_RETRIES = 100
+from .validation import MAX_LABEL, MAX_RETRIES, check_one_line, check_whole
 
 
 def plan_add_skill(
@@ -190,16 +188,8 @@ def bound_values(
 
 def check_label(label: str, default: str | None) -> str:
     """A label: stripped, not too long; ``default`` when empty (or an error if None)."""
-    if not isinstance(label, str):
-        raise InvalidRequest("a label must be text")
-    stripped = label.strip()
-    if not stripped:
-        if default is None:
-            raise InvalidRequest("a label must not be empty")
-        return default
-    if len(stripped) > MAX_LABEL or any(ch in stripped for ch in "\n\r\t"):
-        raise InvalidRequest(f"a label must be one line of at most {MAX_LABEL} characters")
-    return stripped
+    stripped = check_one_line(label, "a label", MAX_LABEL, empty=default is not None)
+    return stripped or (default or "")
 
 
 def check_timeout(timeout: float) -> float:
@@ -213,8 +203,4 @@ def check_timeout(timeout: float) -> float:
 
 def check_retries(max_retries: int) -> int:
     """An automatic retry count between 0 and MAX_RETRIES."""
-    if isinstance(max_retries, bool) or not isinstance(max_retries, int):
-        raise InvalidRequest(f"a retry count must be a whole number, got {max_retries!r}")
-    if not 0 <= max_retries <= MAX_RETRIES:
-        raise InvalidRequest(f"a retry count must be between 0 and {MAX_RETRIES}")
-    return max_retries
+    return check_whole(max_retries, "a retry count", 0, MAX_RETRIES)

@@ -39,10 +39,18 @@ class StaleRevision(RosmcError):
     """A request was made against a revision that another operator's change superseded."""
 
     def __init__(self, base_revision: int, current_revision: int) -> None:
-        super().__init__(
-            f"the mission changed since revision {base_revision} (it is now at revision "
-            f"{current_revision}); fetch the mission and try again"
-        )
+        again = "run 'rosmc status' (or look at the command GUI) to see it, then try again"
+        if base_revision > current_revision:
+            problem = (
+                f"revision {base_revision} is ahead of the mission, which is at revision "
+                f"{current_revision}: the request was made against another mission or server"
+            )
+        else:
+            problem = (
+                f"the mission changed since revision {base_revision} "
+                f"(it is now at revision {current_revision})"
+            )
+        super().__init__(f"{problem}; {again}")
         self.base_revision = base_revision
         self.current_revision = current_revision
 

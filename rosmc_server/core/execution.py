@@ -16,6 +16,7 @@ from .changes import Change, EventKind, PlacedSkill, Proposal
 from .errors import InvalidRequest, RuleViolation
 from .model import Resolution, SkillInstance, SkillStatus, Transfer
 from .state import MissionState
+from .validation import clip_status_text, excerpt
 
 S = SkillStatus
 
@@ -191,6 +192,7 @@ def plan_report(
     _check_report_fields(status, attempt, text, stamp)
     for value in (started, finished):
         _check_report_fields(status, attempt, text, value)
+    text = clip_status_text(text)  # a robot's sentence is kept, made one clean short line
     stamp = float(stamp)
     skill = state.skill(skill_id)
     agent, index = state.locate(skill_id)
@@ -234,9 +236,11 @@ def _check_report_fields(status: object, attempt: object, text: object, stamp: o
     if attempt is not None and (
         isinstance(attempt, bool) or not isinstance(attempt, int) or attempt < 1
     ):
-        raise InvalidRequest(f"an attempt must be a whole number of at least 1, got {attempt!r}")
+        raise InvalidRequest(
+            f"an attempt must be a whole number of at least 1, got {excerpt(attempt)}"
+        )
     if not isinstance(text, str):
-        raise InvalidRequest(f"a status text must be text, got {text!r}")
+        raise InvalidRequest(f"a status text must be text, got {excerpt(text)}")
     if (
         isinstance(stamp, bool)
         or not isinstance(stamp, (int, float))

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import yaml
 
-from .documents import DocumentReader, load_yaml
+from .documents import DocumentReader, load_yaml, yaml_problem
 from .errors import InvalidRequest, LibraryError, NotFound, RuleViolation
 from .params import (
     COMPATIBLE_MARKERS,
@@ -25,6 +25,7 @@ from .params import (
     Value,
     check_value,
 )
+from .validation import excerpt
 
 LIBRARY_VERSION = 1
 
@@ -84,7 +85,7 @@ class SkillSpec:
             if spec.name == name:
                 return spec
         known = ", ".join(spec.name for spec in self.parameters) or "none"
-        raise NotFound(f"skill '{self.name}' has no parameter '{name}' (it has: {known})")
+        raise NotFound(f"skill '{self.name}' has no parameter {excerpt(name)} (it has: {known})")
 
     def defaults(self) -> dict[str, Value]:
         """Every parameter's default value."""
@@ -115,7 +116,7 @@ class Library:
             if agent.name == name:
                 return agent
         known = ", ".join(agent.name for agent in self.agents)
-        raise NotFound(f"there is no agent '{name}' (agents: {known})")
+        raise NotFound(f"there is no agent {excerpt(name)} (agents: {known})")
 
     @property
     def dynamic_agents(self) -> tuple[str, ...]:
@@ -134,7 +135,9 @@ class Library:
         skills = self.models.get(spec.model, {})
         if skill not in skills:
             known = ", ".join(sorted(skills)) or "none"
-            raise NotFound(f"agent '{agent}' has no skill '{skill}' (it has: {known})")
+            raise NotFound(
+                f"agent {excerpt(agent)} has no skill {excerpt(skill)} (it has: {known})"
+            )
         return skills[skill]
 
 
@@ -163,14 +166,8 @@ def load_library(path: str | Path) -> Library:
     try:
         data = load_yaml(text)
     except yaml.YAMLError as error:
-        raise LibraryError(f"{source}: not valid YAML ({_yaml_problem(error)})") from error
+        raise LibraryError(f"{source}: not valid YAML ({yaml_problem(error)})") from error
     return library_from_dict(data, source)
-
-
-def _yaml_problem(error: yaml.YAMLError) -> str:
-    mark = getattr(error, "problem_mark", None)
-    problem = getattr(error, "problem", None) or str(error).splitlines()[0]
-    return f"{problem} at line {mark.line + 1}" if mark is not None else str(problem)
 
 
 def library_from_dict(data: object, source: str = "<library>") -> Library:

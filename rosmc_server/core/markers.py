@@ -20,16 +20,14 @@ from .library import Library
 from .model import SkillInstance, TaskMarker
 from .params import MarkerType, Pose
 from .state import MissionState
+from .validation import MAX_NAME, check_one_line
 
-MAX_NAME = 80
 _NAME_NUMBER = re.compile(r"(\d+)$")
 
 
 def check_marker(marker: TaskMarker) -> TaskMarker:
     """Check a marker's shape; return it with an AREA's pose set to its centroid."""
-    name = marker.name.strip()
-    if not name or len(name) > MAX_NAME or any(ch in name for ch in "\n\r\t"):
-        raise InvalidRequest(f"a marker name must be one line of 1 to {MAX_NAME} characters")
+    name = check_one_line(marker.name, "a marker name", MAX_NAME)
     pose = Pose.from_any(marker.pose, f"the pose of marker '{name}'")
     vertices = tuple(
         Pose.from_any(v, f"vertex {i} of marker '{name}'") for i, v in enumerate(marker.vertices)

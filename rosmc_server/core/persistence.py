@@ -17,12 +17,13 @@ from typing import Any
 import yaml
 
 from .barriers import describe_cycle, find_deadlock
-from .documents import DocumentReader, SafeDumper, load_yaml
+from .documents import DocumentReader, DuplicateKeyError, SafeDumper, load_yaml, yaml_problem
 from .errors import MissionFileError, RosmcError
 from .library import Library
 from .model import Barrier, Resolution, SkillInstance, SkillStatus, TaskMarker, Transfer
 from .params import MarkerType, Pose, value_to_data
 from .state import MissionContent
+from .validation import check_id
 
 MISSION_VERSION = 1
 
@@ -87,12 +88,14 @@ def parse_mission(text: str, library: Library, source: str) -> tuple[MissionCont
     """Parse and check a mission document; return its content and revision."""
     try:
         data = load_yaml(text)
+    except DuplicateKeyError as error:
+        raise MissionFileError(f"{source}: not valid YAML ({yaml_problem(error)})") from error
     except yaml.constructor.ConstructorError as error:
         raise MissionFileError(
             f"{source}: refused a YAML tag that is not plain data ({error.problem})"
         ) from error
     except yaml.YAMLError as error:
-        raise MissionFileError(f"{source}: not valid YAML ({_yaml_problem(error)})") from error
+        raise MissionFileError(f"{source}: not valid YAML ({yaml_problem(error)})") from error
     _refuse_alias_bombs(data, len(text), source)
     return mission_from_dict(data, library, source)
 
@@ -118,13 +121,6 @@ def _refuse_alias_bombs(data: object, length: int, source: str) -> None:
             pending.extend(item.values())
         elif isinstance(item, list):
             pending.extend(item)
-
-
-def _yaml_problem(error: yaml.YAMLError) -> str:
-    """The problem of a YAML error and its line, on one line (str(error) spans several)."""
-    problem = getattr(error, "problem", None) or str(error).splitlines()[0]
-    mark = getattr(error, "problem_mark", None)
-    return f"{problem} at line {mark.line + 1}" if mark is not None else str(problem)
 
 
 def mission_from_dict(
@@ -205,6 +201,10 @@ def _read_tasks(
         for i, entry in enumerate(reader.items(entries, f"tasks.{agent}")):
             key = f"tasks.{agent}[{i}]"
             skill = _read_skill(reader, entry, agent, key)
+            try:
+                check_loaded_skill(skill)
+            except RosmcError as error:
+                reader.fail(key, str(error))
             if skill.id in seen:
                 reader.fail(f"{key}.id", f"skill id {skill.id!r} appears twice")
             seen.add(skill.id)
@@ -220,6 +220,19 @@ def _read_tasks(
             tasks[agent].append(skill)
         _check_sections(reader, tasks[agent], f"tasks.{agent}")
     return tasks
+
+
+def check_loaded_skill(skill: SkillInstance) -> None:
+    """The checks an added or edited skill passes, for a skill read from a file."""
+    from .editing import check_label, check_retries, check_timeout
+    from .validation import MAX_ATTEMPT, MAX_STATUS_TEXT, check_one_line, check_whole
+
+    check_id(skill.id)
+    check_label(skill.label, None)
+    check_timeout(skill.timeout)
+    check_retries(skill.max_retries)
+    check_whole(skill.attempt, "an attempt", 1, MAX_ATTEMPT)
+    check_one_line(skill.status_text, "a status text", MAX_STATUS_TEXT, empty=True)
 
 
 def _marker(markers: Mapping[str, TaskMarker], name: str) -> TaskMarker:
@@ -314,6 +327,10 @@ def _read_barriers(
         key = f"barriers[{i}]"
         body = reader.mapping(entry, key, {"id", "skills"}, set())
         barrier_id = reader.text(body["id"], f"{key}.id")
+        try:
+            check_id(barrier_id, "a barrier id")
+        except RosmcError as error:
+            reader.fail(f"{key}.id", str(error))
         members = tuple(reader.text(s, f"{key}.skills") for s in reader.items(body["skills"], key))
         if barrier_id in barriers or barrier_id in agent_of:
             reader.fail(f"{key}.id", f"id {barrier_id!r} appears twice")

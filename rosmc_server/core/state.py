@@ -14,6 +14,7 @@ from .changes import Change
 from .errors import NotFound
 from .library import Library
 from .model import Barrier, SkillInstance, SkillStatus, TaskMarker, Transfer
+from .validation import excerpt
 
 
 @dataclass
@@ -96,7 +97,9 @@ class MissionState:
             return self._content.tasks[agent]
         except KeyError:
             known = ", ".join(self._content.tasks) or "none"
-            raise NotFound(f"agent '{agent}' has no task (agents with tasks: {known})") from None
+            raise NotFound(
+                f"agent {excerpt(agent)} has no task (agents with tasks: {known})"
+            ) from None
 
     def skills(self) -> Iterator[SkillInstance]:
         """Every skill of every agent, task by task."""
@@ -111,7 +114,7 @@ class MissionState:
         """The agent and index of a skill; NotFound if there is none."""
         agent = self._agent_of.get(skill_id)
         if agent is None:
-            raise NotFound(f"there is no skill '{skill_id}'")
+            raise NotFound(f"there is no skill {excerpt(skill_id)}")
         task = self._content.tasks[agent]
         for index, skill in enumerate(task):
             if skill.id == skill_id:
@@ -139,7 +142,7 @@ class MissionState:
         try:
             return self._content.barriers[barrier_id]
         except KeyError:
-            raise NotFound(f"there is no barrier '{barrier_id}'") from None
+            raise NotFound(f"there is no barrier {excerpt(barrier_id)}") from None
 
     def barrier_of(self, skill_id: str) -> Barrier | None:
         """The barrier a skill belongs to, if any."""

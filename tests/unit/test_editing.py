@@ -13,6 +13,7 @@ from rosmc_server.core import (
     MarkerType,
     NotFound,
     Pose,
+    RosmcError,
     RuleViolation,
     SkillStatus,
     TaskMarker,
@@ -162,13 +163,15 @@ def test_add_refuses_bad_requests(
     [
         ({"label": "x" * 121}, "at most 120"),
         ({"label": "two\nlines"}, "one line"),
+        ({"label": "\x1b[31mred"}, "printable"),
+        ({"label": "zero\u200bwidth"}, "printable"),
         ({"label": 5}, "text"),
         ({"timeout": -1}, "non-negative"),
         ({"timeout": math.nan}, "finite"),
         ({"timeout": math.inf}, "finite"),
         ({"timeout": "10"}, "number"),
-        ({"max_retries": -1}, "between 0"),
-        ({"max_retries": 101}, "between 0"),
+        ({"max_retries": -1}, "from 0 to 100"),
+        ({"max_retries": 101}, "from 0 to 100"),
         ({"max_retries": 1.0}, "whole number"),
     ],
 )
@@ -307,7 +310,7 @@ def test_edit_bind_and_unbind(mission: Any, drv: Any, accepted: Any, markers: No
         ({}, {"label": "   "}, InvalidRequest, "must not be empty"),
         ({}, {"label": "a\tb"}, InvalidRequest, "one line"),
         ({}, {"timeout": -0.5}, InvalidRequest, "non-negative"),
-        ({}, {"max_retries": 1000}, InvalidRequest, "between 0"),
+        ({}, {"max_retries": 1000}, InvalidRequest, "from 0 to 100"),
         ({}, {"bindings": {"target": "nowhere"}}, NotFound, "no task marker"),
         ({}, {"bindings": {"target": "field"}}, RuleViolation, "area marker"),
         ({}, {"bindings": {"speed": "spot"}}, RuleViolation, "takes no markers"),
@@ -492,3 +495,11 @@ def test_reorder_that_would_deadlock_is_refused(mission: Any, drv: Any, rejected
     z2 = drv.add("bravo")
     mission.reorder("bravo", [x2, z2, y2])  # keeps x before y: no cycle
     assert drv.ids("bravo") == [x2, z2, y2]
+
+
+def test_errors_quote_a_short_escaped_excerpt_of_huge_input(mission: Any) -> None:
+    with pytest.raises(RosmcError) as caught:
+        mission.add_skill("\x1b[2J" + "a" * 2**20, "noop")
+    message = str(caught.value)
+    assert len(message) < 300 and "\x1b" not in message, message[:300]
+    assert "(1048580 characters)" in message

@@ -33,6 +33,13 @@ def test_stale_revision_names_both_revisions() -> None:
     assert (error.base_revision, error.current_revision) == (3, 7)
     assert "revision 3" in str(error) and "revision 7" in str(error)
     assert isinstance(error, RosmcError)
+    assert "rosmc status" in str(error), "the hint names a real command"
+
+
+def test_a_revision_from_the_future_is_called_so() -> None:
+    message = str(StaleRevision(2**63, 69))
+    assert message.startswith("revision 9223372036854775808 is ahead of the mission"), message
+    assert "changed since" not in message
 
 
 @pytest.mark.parametrize("name", ["a\nb", "a\r\nb", "a\u2028b", "a\x0bb", "a\x85b", "tab\there"])

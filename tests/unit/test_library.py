@@ -230,6 +230,14 @@ def test_invalid_yaml_is_refused_with_the_line(tmp_path: Path) -> None:
     refused(path, "not valid YAML", "line")
 
 
+def test_a_key_given_twice_is_refused_with_its_name_and_line(tmp_path: Path) -> None:
+    path = tmp_path / "twice.yaml"
+    path.write_text(
+        "rosmc_library: 1\nname: team\nmodels: {}\nagents: {}\nname: other\n", encoding="utf-8"
+    )
+    refused(path, "duplicate key 'name'", "line 5")
+
+
 def test_python_tag_in_library_is_refused_not_run(tmp_path: Path) -> None:
     marker = tmp_path / "touched"
     path = tmp_path / "evil.yaml"

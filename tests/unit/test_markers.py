@@ -66,7 +66,7 @@ def test_area_gets_its_centroid(mission: Any) -> None:
         (marker("f", MarkerType.AREA, vertices=TRIANGLE[:2]), InvalidRequest, "at least 3"),
         (marker("p", MarkerType.POSE, vertices=TRIANGLE), InvalidRequest, "takes no vertices"),
         (marker("p", MarkerType.POSITION, vertices=TRIANGLE), InvalidRequest, "no vertices"),
-        (marker("x" * 81), InvalidRequest, "1 to 80"),
+        (marker("x" * 81), InvalidRequest, "at most 80"),
         (marker("two\nlines"), InvalidRequest, "one line"),
         (marker("nan", pose=Pose(math.nan)), InvalidRequest, "finite"),
         (marker("inf", pose=Pose(0.0, math.inf)), InvalidRequest, "finite"),
@@ -197,7 +197,7 @@ def test_rename_propagates_to_bindings(mission: Any, accepted: Any, bound: Any) 
         ("goal", "goal", InvalidRequest, "already has that name"),
         ("goal", " goal ", InvalidRequest, "already has that name"),
         ("goal", "spot", RuleViolation, "already exists"),
-        ("goal", "", InvalidRequest, "1 to 80"),
+        ("goal", "", InvalidRequest, "must not be empty"),
         ("goal", "a\tb", InvalidRequest, "one line"),
     ],
 )

@@ -286,6 +286,24 @@ def _mutations() -> list[tuple[str, Any, str]]:
         ),
         ("uploading-synced", skill_set("alpha", 0, "transfer", "UPLOADING"), "transfer"),
         ("resolution-on-success", skill_set("alpha", 0, "resolution", "SKIPPED"), "resolution"),
+        # what add and edit refuse, a file cannot bring in (core/validation.py)
+        ("label-1-mib", skill_set("alpha", 0, "label", "x" * 2**20), "at most 120"),
+        ("label-line-break", skill_set("alpha", 0, "label", "two\nlines"), "label"),
+        ("label-escape-code", skill_set("alpha", 0, "label", "\x1b[31mred"), "label"),
+        ("id-line-break", skill_set("alpha", 0, "id", "a\nb"), "a skill id must be"),
+        ("id-escape-code", skill_set("alpha", 0, "id", "\x1b]0;owned\x07"), "a skill id"),
+        ("id-too-long", skill_set("alpha", 0, "id", "a" * 65), "a skill id"),
+        ("retries-a-billion", skill_set("alpha", 0, "max_retries", 10**9), "from 0 to 100"),
+        ("attempt-huge", skill_set("alpha", 0, "attempt", 10**9), "an attempt"),
+        ("timeout-infinite", skill_set("alpha", 0, "timeout", float("inf")), "timeout"),
+        ("status-text-lines", skill_set("alpha", 0, "status_text", "a\nb"), "status text"),
+        ("status-text-long", skill_set("alpha", 0, "status_text", "s" * 501), "status text"),
+        (
+            "marker-name-escape",
+            lambda d: d["markers"][1].__setitem__("name", "\x1b[2Jgone"),
+            "marker name",
+        ),
+        ("barrier-id-space", lambda d: d["barriers"][0].__setitem__("id", "b 1"), "barrier id"),
         # deadlock
         (
             "deadlocking-barriers",
@@ -320,7 +338,8 @@ def test_malformed_file_is_refused(
     message = str(caught.value)
     assert message.startswith(f"{path}: "), message
     assert fragment in message, message
-    assert "\n" not in message
+    assert "\n" not in message and "\x1b" not in message
+    assert len(message) < 400, "an error quotes a short, escaped excerpt of the input"
     assert snap(mission) == before
 
 
@@ -350,6 +369,13 @@ def test_invalid_yaml_gives_one_line(library: Any, text: str) -> None:
         parse_mission(text, library, "broken.yaml")
     message = str(caught.value)
     assert message.startswith("broken.yaml: ") and "\n" not in message
+
+
+def test_a_key_given_twice_is_refused_not_overwritten(document: Any, library: Any) -> None:
+    text = yaml.safe_dump(document, sort_keys=False)
+    twice = text.replace("tasks:\n", "tasks:\n  alpha: []\n", 1)
+    with pytest.raises(MissionFileError, match=r"duplicate key 'alpha' at line \d+"):
+        parse_mission(twice, library, "twice.yaml")
 
 
 @pytest.mark.parametrize("text", ["", "just text", "[1, 2]", "42", "null"])

@@ -1,0 +1,102 @@
+"""The checks every way into the mission shares: add, edit, load, robot reports.
+
+A mission file, a robot report and an operator's request can all put text and numbers into
+the mission. Whatever the way in, the same limits hold, so that what one path accepts
+another never refuses later (a saved mission loads again) and nothing the mission holds can
+flood a terminal or a log: text is one line, free of control characters (line breaks,
+terminal escape codes), and short; ids are plain tokens; counts are bounded.
+
+Errors quote offending input through :func:`excerpt`: short and escaped.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import unicodedata
+
+from .errors import InvalidRequest
+
+MAX_LABEL = 120
+MAX_NAME = 80  # task marker and barrier names
+MAX_ID = 64
+MAX_STATUS_TEXT = 500
+MAX_RETRIES = 100
+MAX_ATTEMPT = 10_000
+EXCERPT = 40
+
+_ID = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.:-]*")
+
+
+def excerpt(value: object, limit: int = EXCERPT) -> str:
+    """``value`` quoted for an error message: escaped (repr) and cut to about ``limit``."""
+    text = repr(value) if not isinstance(value, str) else repr(value[: limit + 1])
+    if isinstance(value, str) and len(value) > limit:
+        return f"{repr(value[:limit])[:-1]}…{text[-1]} ({len(value)} characters)"
+    return text if len(text) <= limit + 2 else f"{text[:limit]}…"
+
+
+def has_control_characters(text: str) -> bool:
+    """Whether ``text`` holds a line break, tab, escape or other control/format character."""
+    return any(unicodedata.category(ch) in ("Cc", "Cf") for ch in text)
+
+
+def check_one_line(text: object, what: str, max_length: int, *, empty: bool = False) -> str:
+    """``text`` stripped, if it is one line of printable text of at most ``max_length``."""
+    if not isinstance(text, str):
+        raise InvalidRequest(f"{what} must be text, got {excerpt(text)}")
+    stripped = text.strip()
+    if not stripped and not empty:
+        raise InvalidRequest(f"{what} must not be empty")
+    if len(stripped) > max_length or has_control_characters(stripped):
+        raise InvalidRequest(
+            f"{what} must be one line of at most {max_length} printable characters, "
+            f"got {excerpt(text)}"
+        )
+    return stripped
+
+
+def check_id(value: object, what: str = "a skill id") -> str:
+    """A plain token: letters, digits and ``_ . : -``, at most MAX_ID characters."""
+    if not isinstance(value, str) or len(value) > MAX_ID or not _ID.fullmatch(value):
+        raise InvalidRequest(
+            f"{what} must be 1 to {MAX_ID} letters, digits, '_', '.', ':' or '-', "
+            f"got {excerpt(value)}"
+        )
+    return value
+
+
+def check_whole(value: object, what: str, minimum: int, maximum: int) -> int:
+    """A whole number within ``minimum..maximum``."""
+    if isinstance(value, bool) or not isinstance(value, int) or not minimum <= value <= maximum:
+        raise InvalidRequest(
+            f"{what} must be a whole number from {minimum} to {maximum}, got {excerpt(value)}"
+        )
+    return value
+
+
+def check_time(value: object, what: str) -> float:
+    """A finite, non-negative number of seconds."""
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, (int, float))
+        or not math.isfinite(value)
+        or value < 0
+    ):
+        raise InvalidRequest(
+            f"{what} must be a finite number of seconds >= 0, got {excerpt(value)}"
+        )
+    return float(value)
+
+
+def clip_status_text(text: str) -> str:
+    """A robot's status text made safe to hold: control characters become spaces, cut short.
+
+    Robots are not refused for a long or odd sentence (the report still counts); the
+    mission keeps a clean excerpt of it.
+    """
+    cleaned = "".join(
+        " " if unicodedata.category(ch) in ("Cc", "Cf") else ch
+        for ch in text[: MAX_STATUS_TEXT * 2]
+    ).strip()
+    return cleaned if len(cleaned) <= MAX_STATUS_TEXT else cleaned[: MAX_STATUS_TEXT - 1] + "…"
