@@ -660,6 +660,12 @@ def test_telemetry_channels_take_their_own_types_only(tmp_path: Path) -> None:
         with pytest.raises(JournalError, match="records tf2_msgs/TFMessage"):
             writer.append_telemetry("/tf", msg.ScienceState(), 3)
     assert [r.topic for r in read_journal(tmp_path / "t.mcap").records][-1] == "/tf"
+    # What Foxglove and the mcap tools do: decode it from the schema embedded in the file.
+    with (tmp_path / "t.mcap").open("rb") as file:
+        reader = SeekingReader(file, decoder_factories=[DecoderFactory()])
+        decoded = list(reader.iter_decoded_messages(topics=["/tf"]))
+    assert decoded[0].schema.name == "tf2_msgs/TFMessage"
+    assert decoded[0].decoded_message.transforms == []
 
 
 def test_latest_state_takes_a_late_snapshot_with_the_events_written_before_it(
