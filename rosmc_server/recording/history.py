@@ -181,7 +181,7 @@ class MissionHistory:
         since_checkpoint = 0
         for record in result.records:
             if record.topic == ROBOT_REPORTS_TOPIC:
-                self._timeline.report(record.message)
+                self._timeline.report(record.message, record.log_time)
                 continue
             if record.topic == MISSION_TOPIC:
                 revision = int(record.message.revision)

@@ -108,13 +108,17 @@ class TimelineBuilder:
         self._start = start
         self._agents: dict[str, None] = {}
         self._reports: dict[str, tuple[int, int, float]] = {}
-        self._clock: list[tuple[float, float]] = []
+        self._clock: list[tuple[float, float]] = []  # (server's event stamp, recording second)
+        self._robot_clock: list[tuple[float, float]] = []  # (robot's report stamp, second)
         self._steps: list[_Transition | float] = []  # a float: everything ends (replacement)
         self._barriers: dict[str, tuple[tuple[str, str], ...]] = {}
 
-    def report(self, msg: Any) -> None:
+    def report(self, msg: Any, log_time: int | None = None) -> None:
         """A journaled ``rosmc/RobotReport``: the robot's own stamp of its next change."""
-        self._reports[msg.skill_id] = (msg.status.value, msg.attempt, msg.stamp.to_sec())
+        stamp = msg.stamp.to_sec()
+        self._reports[msg.skill_id] = (msg.status.value, msg.attempt, stamp)
+        if log_time is not None and stamp > 0:
+            self._robot_clock.append((stamp, self._seconds(log_time)))
 
     def reset(self, state: MissionState, log_time: int) -> None:
         """The history (re)started from a snapshot: skills active in it start now."""
@@ -157,7 +161,7 @@ class TimelineBuilder:
 
     def build(self, duration: float) -> Timeline:
         """The timeline of everything collected, ending at ``duration`` seconds."""
-        to_seconds = _clock_map(self._clock)
+        to_seconds = _clock_map(self._robot_time_pairs())
         lanes: dict[str, list[Interval]] = {agent: [] for agent in self._agents}
         open_: dict[str, Interval] = {}
         latest: dict[str, float] = {}
@@ -211,6 +215,27 @@ class TimelineBuilder:
 
     def _seconds(self, log_time: int) -> float:
         return (log_time - self._start) / 1e9
+
+    def _robot_time_pairs(self) -> list[tuple[float, float]]:
+        """Pairs that map robot stamps to recording seconds.
+
+        Normally the server stamps its events on the robots' clock (both sim time, or both
+        wall time), and its events give the map. A server started before ``/use_sim_time``
+        was set stamps in wall time while the robots report sim time: the two clocks are
+        then far apart, and the robots' own reports (their stamp, when they were journaled)
+        give the map instead, so such a recording still draws right.
+        """
+        if not self._robot_clock or not self._clock:
+            return self._clock or sorted(self._robot_clock)
+        robot = sorted(stamp for stamp, _ in self._robot_clock)[len(self._robot_clock) // 2]
+        server = sorted(stamp for stamp, _ in self._clock)[len(self._clock) // 2]
+        if abs(robot - server) > CLOCKS_APART:
+            return sorted(self._robot_clock)
+        return self._clock
+
+
+CLOCKS_APART = 86_400.0
+"""Seconds between the medians of server and robot stamps that mean two different clocks."""
 
 
 def _started(skill: SkillInstance | None) -> bool:

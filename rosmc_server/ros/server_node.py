@@ -135,6 +135,7 @@ class MissionServer:
             self, config.agent_state_rate, on_published=self._recorder.agent_states
         )
         self._services = OperatorServices(self)
+        self._clock_watch = ClockWatch()
 
     # -- lifecycle -----------------------------------------------------------------
     def start(self) -> None:
@@ -162,9 +163,13 @@ class MissionServer:
                 self._journal.close()
 
     def _tick_link(self) -> None:
+        next_clock_check = 0.0
         while not rospy.is_shutdown() and not self._stopping:
             with self._lock:
                 self.link.tick()
+            if time.monotonic() >= next_clock_check:
+                next_clock_check = time.monotonic() + CLOCK_CHECK_PERIOD
+                self._clock_watch.check()
             time.sleep(0.05)
 
     # -- the one way to change the mission ------------------------------------------
@@ -247,6 +252,45 @@ class MissionServer:
         path = self.config.journal or default_journal_path(self.config.journal_dir)
         snapshot = mission_to_msg(mission.state.content(), 0, time.time())
         return mission, JournalWriter.create(path, snapshot, time.time_ns(), options)
+
+
+CLOCK_CHECK_PERIOD = 5.0  # seconds between looks at /use_sim_time
+
+
+class ClockWatch:
+    """Says which clock the server stamps with, and warns when the robots' clock differs.
+
+    rospy picks sim or wall time once, when the node starts. A simulator that sets
+    ``/use_sim_time`` after the server started (started separately, in the wrong order)
+    leaves the server on wall time while the robots report sim time: the recording then
+    holds both clocks (``rosmc timeline`` maps each on its own), and the operator should
+    know at once.
+    """
+
+    def __init__(self) -> None:
+        self.sim_time = bool(rospy.get_param("/use_sim_time", False))
+        self._warned = False
+        _log.info(
+            "mission server clock: %s",
+            "sim time (/clock)" if self.sim_time else "wall time (/use_sim_time is not set)",
+        )
+
+    def check(self) -> None:
+        """Warn once if /use_sim_time was set after the server started."""
+        if self.sim_time or self._warned:
+            return
+        try:
+            now_sim = bool(rospy.get_param("/use_sim_time", False))
+        except (OSError, KeyError):
+            return
+        if now_sim:
+            self._warned = True
+            _log.error(
+                "/use_sim_time was set after the mission server started: the server stamps "
+                "events in wall time while the robots report sim time. Start the simulator "
+                "first (or both from one launch file, e.g. operator.launch sim:=true), or "
+                "restart the server with _resume:=true."
+            )
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -36,6 +36,7 @@ from rosmc_server.core import (  # noqa: E402
     NotFound,
     SkillStatus,
     Transfer,
+    load_library,
 )
 from rosmc_server.interface import EVENTS_TOPIC, MISSION_TOPIC, ROBOT_REPORTS_TOPIC  # noqa: E402
 from rosmc_server.recording import JournalWriter, read_journal  # noqa: E402
@@ -50,6 +51,7 @@ from rosmc_server.recording.timeline_svg import (  # noqa: E402
 from rosmc_server.recording.to_rosbag import journal_to_rosbag  # noqa: E402
 
 T0 = 1_700_000_000_000_000_000
+REPO = Path(__file__).resolve().parents[2]
 SVG = "{http://www.w3.org/2000/svg}"
 S = SkillStatus
 
@@ -397,3 +399,38 @@ def test_history_and_pictures_do_not_import_rospy() -> None:
     )
     done = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr or "rospy was imported"
+
+
+def test_a_server_on_wall_time_and_robots_on_sim_time_still_draw_right(tmp_path: Path) -> None:
+    """The server started before /use_sim_time was set: its events carry wall time, the
+    robots' reports sim time. The bars must still span what the robots did."""
+    wall = iter(float(1_700_000_000 + n) for n in range(1000))
+    mission = Mission(
+        load_library(REPO / "rosmc_server" / "config" / "mars_team.yaml"), clock=lambda: next(wall)
+    )
+    path = tmp_path / "mixed.mcap"
+    with JournalWriter.create(path, mission_to_msg(mission.state.content(), 0, 0.0), T0) as writer:
+
+        def journal(event: MissionEvent, second: float) -> None:
+            state = mission.state
+            msg = event_to_msg(event, lambda s: state.locate(s)[0])
+            writer.append_event(msg, T0 + round(second * 1e9))
+
+        added = mission.add_skill("drone", "take_off", {"altitude": 5.0})
+        journal(added, 0.5)
+        skill_id = added.change.put_skills[0].skill.id
+        journal(mission.synchronize("drone"), 1.0)
+        journal(mission.confirm_synchronized("drone", [skill_id]), 2.0)
+        for status, sim_stamp, heard in ((S.RUNNING, 10.0, 10.2), (S.SUCCESS, 40.0, 40.3)):
+            report = wire.RobotReport(
+                agent="drone",
+                stamp=genpy.Time.from_sec(sim_stamp),
+                skill_id=skill_id,
+                status=wire.SkillStatus(int(status)),
+                attempt=1,
+            )
+            writer.append_report(report, T0 + round(heard * 1e9))
+            journal(mission.report_status(skill_id, status, stamp=sim_stamp), heard)
+    bar = MissionHistory.from_journal(path).timeline().lanes["drone"][0]
+    assert (bar.start, bar.end) == pytest.approx((10.0, 40.0), abs=0.5)
+    assert bar.outcome is S.SUCCESS
