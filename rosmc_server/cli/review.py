@@ -1,12 +1,17 @@
-"""Reviewing a recording: ``rosmc info FILE`` (reads the file only; no ROS master needed)."""
+"""Reviewing a recording: ``rosmc info FILE`` and ``rosmc diff FILE T1 T2`` (read the file
+only; no ROS master needed), and ``rosmc restore FILE --at T`` (see :mod:`.restore`)."""
 
 from __future__ import annotations
 
 import argparse
-from collections.abc import Callable
+import sys
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
+from . import restore as _restore
+
 if TYPE_CHECKING:
+    from ..recording.diff import FieldChange, MissionDiff
     from ..recording.summary import RecordingSummary
     from .context import Context
 
@@ -21,12 +26,22 @@ def add_commands(command: _Command) -> None:
         "Reads the journal only. --json gives the same as data for scripts.",
     )
     info.add_argument("file", metavar="FILE", help="a mission journal (.mcap)")
+    from ..recording.diff import WHEN_HELP  # pure Python, no ROS: --help stays fast
+
+    diff = command(
+        "diff",
+        "what changed in a recording between two times or revisions",
+        f"T1 and T2 are each {WHEN_HELP}.\nSkills added, removed and edited (parameter by "
+        "parameter), status changes, barriers and task markers. --json for scripts.",
+    )
+    diff.add_argument("file", metavar="FILE", help="a mission journal (.mcap)")
+    diff.add_argument("first", metavar="T1", help="the earlier moment")
+    diff.add_argument("second", metavar="T2", help="the later moment")
+    _restore.add_command(command, WHEN_HELP)
 
 
 def info(ctx: Context) -> int:
     """Print what a recording holds."""
-    import sys
-
     from ..recording.summary import summarize
 
     summary = summarize(ctx.args.file)
@@ -97,5 +112,68 @@ def _duration(seconds: float) -> str:
     return f"{int(minutes)} min {rest:.0f} s" if minutes else f"{rest:.1f} s"
 
 
-COMMANDS: dict[str, Callable[[Context], int]] = {"info": info}
+def diff(ctx: Context) -> int:
+    """Print what changed between two moments of a recording."""
+    from ..recording.diff import diff_missions, resolve_when
+    from ..recording.history import MissionHistory
+
+    history = MissionHistory.from_journal(ctx.args.file)
+    for line in history.problems:
+        print(f"rosmc: warning: {line}", file=sys.stderr)
+    changes = diff_missions(
+        resolve_when(history, ctx.args.first), resolve_when(history, ctx.args.second)
+    )
+    ctx.emit(format_diff(changes), diff_data(changes))
+    return 0
+
+
+def format_diff(changes: MissionDiff) -> str:
+    """The difference as the text ``rosmc diff`` prints."""
+    before, after = changes.before, changes.after
+    lines = [
+        f"{before.label} (r{before.state.revision}, {before.seconds:.1f} s) -> "
+        f"{after.label} (r{after.state.revision}, {after.seconds:.1f} s)"
+    ]
+    if changes.is_empty:
+        return lines[0] + "\n  no changes"
+    sections: list[tuple[str, Sequence[str]]] = [
+        ("skills added", changes.skills_added),
+        ("skills removed", changes.skills_removed),
+        ("skills edited", [_change_text(c) for c in changes.edits]),
+        ("status changes", [_change_text(c) for c in changes.statuses]),
+        ("barriers added", changes.barriers_added),
+        ("barriers removed", changes.barriers_removed),
+        ("markers added", changes.markers_added),
+        ("markers removed", changes.markers_removed),
+        ("markers changed", [_change_text(c) for c in changes.marker_changes]),
+    ]
+    for title, entries in sections:
+        if entries:
+            lines.append(f"{title} ({len(entries)})")
+            lines += [f"  {entry}" for entry in entries]
+    return "\n".join(lines)
+
+
+def diff_data(changes: MissionDiff) -> dict[str, Any]:
+    """The difference as JSON-ready data (``rosmc --json diff``)."""
+    data: dict[str, Any] = {
+        side: {"label": m.label, "revision": m.state.revision, "seconds": round(m.seconds, 3)}
+        for side, m in (("from", changes.before), ("to", changes.after))
+    }
+    for name in changes.__dataclass_fields__:
+        value = getattr(changes, name)
+        if name not in ("before", "after"):
+            data[name] = [vars(v) if hasattr(v, "subject") else v for v in value]
+    return data
+
+
+def _change_text(change: FieldChange) -> str:
+    return f"{change.subject} {change.field}: {change.before} -> {change.after}"
+
+
+COMMANDS: dict[str, Callable[[Context], int]] = {
+    "info": info,
+    "diff": diff,
+    "restore": _restore.restore,
+}
 """The review commands by name, for the dispatcher in :mod:`.main`."""

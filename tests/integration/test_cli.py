@@ -496,6 +496,49 @@ def test_sync_shows_uploading(server: Server, fresh: MissionClient) -> None:
     assert [s["transfer"] for s in drone] == ["NONE", "NONE", "NONE"], drone
 
 
+def journal_of(server: Server) -> Path:
+    """The journal the module's server writes now (the newest in its directory)."""
+    return max(server.journal_dir.glob("*.mcap"), key=lambda path: path.stat().st_mtime)
+
+
+def test_diff_and_restore_a_past_moment(server: Server, fresh: MissionClient) -> None:
+    ids = build_mission(fresh)
+    barrier = fresh.add_barrier([ids["sci"], ids["man"]]).barrier_id
+    planned = mission_to_json(fresh.get_mission())
+    fresh.edit_skill(ids["cover"], {"altitude": 4.5})
+    fresh.delete_skills([ids["land"]])
+    fresh.add_marker(TaskMarker("Late", MarkerType.POSITION, Pose(3.0, 4.0)))
+    added = fresh.add_skill("drone", "land").skill_id
+    now = fresh.revision
+    journal = str(journal_of(server))
+    text = rosmc(server, "diff", journal, f"r{planned['revision']}", f"r{now}")
+    assert text.splitlines()[0].startswith(f"r{planned['revision']} (r{planned['revision']}, ")
+    assert f"  {ids['cover']} param altitude: 9.5 -> 4.5\n" in text, text
+    assert f"skills removed (1)\n  {ids['land']} (drone land " in text, text
+    assert f"skills added (1)\n  {added} (drone land " in text, text
+    assert "markers added (1)\n  Late (POSITION)\n" in text, text
+    data = json.loads(rosmc(server, "--json", "diff", journal, "0", f"r{now}"))
+    assert data["from"]["seconds"] == 0.0 and data["to"]["revision"] == now
+    assert {b.split(":")[0] for b in data["barriers_added"]} == {barrier}, data
+    assert json.loads(rosmc(server, "--json", "diff", journal, f"r{now}", f"r{now}"))["edits"] == []
+    # The live journal has no footer yet: the reader warns on a line of its own first.
+    (bad,) = run_many(server.env, [["diff", journal, "soon", "r1"]])
+    assert bad.returncode == 1 and "rosmc: cannot read 'soon' as a time" in bad.stderr, bad
+    # A robot holding synchronized work: the server refuses and nothing changes.
+    rosmc(server, "sync", "drone")
+    (refused,) = run_many(server.env, [["restore", journal, "--at", f"r{planned['revision']}"]])
+    assert refused.returncode == 1 and "holds unfinished skill" in refused.stderr, refused
+    assert fresh.get_mission().revision == fresh.revision
+    rosmc(server, "unsync", "drone")
+    out = rosmc(server, "restore", journal, "--at", f"r{planned['revision']}")
+    assert f"restored {Path(journal).name} at r{planned['revision']} " in out, out
+    assert "blueprint of 5 skills" in out and "dropped" not in out, out
+    restored = mission_to_json(fresh.get_mission())
+    assert {key: restored[key] for key in ("agents", "barriers", "markers")} == {
+        key: planned[key] for key in ("agents", "barriers", "markers")
+    }
+
+
 def test_unreachable_master_exits_3_quickly(server: Server) -> None:
     """No master at ROS_MASTER_URI: exit 3 after --timeout, with one clear line."""
     with socket.socket() as probe:  # a port that nothing listens on
