@@ -1,0 +1,189 @@
+"""Reviewing a recording offline: ``rosmc diff`` and the blueprint ``rosmc restore`` loads.
+
+The journal is written the way the mission server writes one: a real core Mission plans,
+synchronizes, executes (a success, a failure and its retry) and edits, and every accepted
+event is journaled with JournalWriter at the mission's own stamp. No ROS master.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("rosmc.msg", reason="rosmc messages are not built (source build/devel)")
+
+from rosmc_server import demo
+from rosmc_server.cli import main as rosmc
+from rosmc_server.conversions import event_to_msg, mission_to_msg
+from rosmc_server.core import (
+    InvalidRequest,
+    MarkerType,
+    Mission,
+    MissionEvent,
+    Pose,
+    SkillStatus,
+    TaskMarker,
+    Transfer,
+    load_library,
+)
+from rosmc_server.core.persistence import dump_mission, parse_mission
+from rosmc_server.recording import JournalWriter
+from rosmc_server.recording.diff import diff_missions, resolve_when
+from rosmc_server.recording.history import MissionHistory
+from rosmc_server.recording.restore import blueprint_from
+
+T0 = 1_700_000_000_000_000_000
+S = SkillStatus
+
+
+@dataclass
+class Journal:
+    """The journal and the revisions of interest."""
+
+    path: Path
+    planned: int  # everything planned, nothing synchronized
+    retried: int  # d1 succeeded, d2 failed and was retried
+    last: int
+    ids: dict[str, str]
+
+
+@pytest.fixture(scope="module")
+def journal(tmp_path_factory: pytest.TempPathFactory) -> Journal:
+    """Plan, execute and edit a mission; journal every event at its stamp (10 s apart)."""
+    counter = itertools.count(1)
+    clock = itertools.count(0, 10)
+    mission = Mission(
+        load_library(demo.LIBRARY),
+        new_id=lambda prefix: f"{prefix}-{next(counter)}",
+        clock=lambda: float(next(clock)),
+    )
+    path = tmp_path_factory.mktemp("review") / "mission.mcap"
+    writer = JournalWriter.create(path, mission_to_msg(mission.state.content(), 0, 0.0), T0)
+
+    def do(event: MissionEvent) -> MissionEvent:
+        state = mission.state
+        message = event_to_msg(event, lambda skill_id: state.locate(skill_id)[0])
+        writer.append_event(message, T0 + round(event.stamp * 1e9))
+        return event
+
+    def added(agent: str, skill: str, **kwargs: object) -> str:
+        return do(mission.add_skill(agent, skill, **kwargs)).change.put_skills[0].skill.id  # type: ignore[arg-type]
+
+    do(mission.add_marker(TaskMarker("RSS A", MarkerType.POSITION, Pose(10.0, 6.0))))
+    ids = {
+        "d1": added("drone", "take_off", params={"altitude": 12}),
+        "d2": added("drone", "fly_over", params={"altitude": 9.5}),
+        "d3": added("drone", "land"),
+        "s4": added("science_rover", "identify_stones", bindings={"position": "RSS A"}),
+        "m5": added("manipulator_rover", "identify_stones"),
+        "s6": added("science_rover", "explore"),
+    }
+    do(mission.add_barrier([ids["s4"], ids["m5"]]))
+    do(mission.add_barrier([ids["d1"], ids["s6"]]))
+    planned = mission.revision
+    do(mission.synchronize("drone", ids["d2"]))
+    do(mission.confirm_synchronized("drone", [ids["d1"], ids["d2"]]))
+    for skill_id, outcome in ((ids["d1"], S.SUCCESS), (ids["d2"], S.FAILURE)):
+        do(mission.report_status(skill_id, S.RUNNING))
+        do(mission.report_status(skill_id, outcome))
+    ids["d2b"] = do(mission.retry(ids["d2"])).change.put_skills[1].skill.id
+    retried = mission.revision
+    do(mission.edit_skill(ids["s4"], {"radius": 4.0}, label="closer look"))
+    do(mission.add_marker(TaskMarker("Late", MarkerType.POSITION, Pose(1.0, 2.0))))
+    writer.close()
+    return Journal(path, planned, retried, mission.revision, ids)
+
+
+@pytest.fixture(scope="module")
+def history(journal: Journal) -> MissionHistory:
+    return MissionHistory.from_journal(journal.path)
+
+
+def test_restore_drops_what_ran_and_resets_the_rest(
+    journal: Journal, history: MissionHistory
+) -> None:
+    ids = journal.ids
+    state = history.at_revision(journal.retried)
+    # The retry went straight to the robot: synchronized, second attempt.
+    assert (state.skill(ids["d2b"]).status, state.skill(ids["d2b"]).attempt) == (
+        S.IDLE_SYNCHRONIZED,
+        2,
+    )
+    restored = blueprint_from(state)
+    assert restored.dropped == (ids["d1"], ids["d2"])
+    assert restored.barriers_dropped == (f"{[b.id for b in state.barriers][1]}",)
+    content = restored.content
+    assert [s.id for s in content.tasks["drone"]] == [ids["d2b"], ids["d3"]]
+    assert restored.kept == 5
+    for skill in (s for task in content.tasks.values() for s in task):
+        assert (skill.status, skill.transfer, skill.attempt) == (S.IDLE, Transfer.NONE, 1)
+        assert skill.status_text == "" and skill.started == skill.finished == 0.0
+    assert [b.skill_ids for b in content.barriers.values()] == [(ids["s4"], ids["m5"])]
+    assert [m.name for m in content.markers.values()] == ["RSS A"]
+    assert content.tasks["science_rover"][0].bindings == {"position": "RSS A"}
+    # The document is one the server's load_mission accepts, unchanged by the round trip.
+    document = dump_mission(content, state.revision)
+    parsed, revision = parse_mission(document, load_library(demo.LIBRARY), "restore")
+    assert (parsed, revision) == (content, state.revision)
+
+
+def test_diff_shows_execution_edits_and_markers(journal: Journal, history: MissionHistory) -> None:
+    ids = journal.ids
+    ran = diff_missions(
+        resolve_when(history, f"r{journal.planned}"), resolve_when(history, f"r{journal.retried}")
+    )
+    statuses = {(c.subject, c.field): (c.before, c.after) for c in ran.statuses}
+    assert statuses[(ids["d1"], "status")] == ("IDLE", "SUCCESS")
+    assert statuses[(ids["d2"], "status")] == ("IDLE", "FAILURE")
+    assert statuses[(ids["d2"], "resolution")] == ("NONE", "RETRIED")
+    assert ran.skills_added == (
+        f"{ids['d2b']} (drone fly_over '{ran.after.state.skill(ids['d2b']).label}')",
+    )
+    assert ran.edits == () and ran.skills_removed == () and ran.markers_added == ()
+    edited = diff_missions(
+        resolve_when(history, f"r{journal.retried}"), resolve_when(history, f"r{journal.last}")
+    )
+    assert {(c.subject, c.field, c.before, c.after) for c in edited.edits} == {
+        (ids["s4"], "param radius", "2", "4"),
+        (ids["s4"], "label", "identify_stones", "closer look"),
+    }
+    assert edited.markers_added == ("Late (POSITION)",) and edited.statuses == ()
+    same = diff_missions(resolve_when(history, "r3"), resolve_when(history, "r3"))
+    assert same.is_empty
+
+
+def test_every_way_to_name_a_moment(journal: Journal, history: MissionHistory) -> None:
+    # Revision n is journaled at (n - 1) * 10 s: the clock starts at 0 and ticks 10 s.
+    def revision(when: str) -> int:
+        return resolve_when(history, when).state.revision
+
+    assert revision("r5") == 5
+    assert revision("40") == revision("40s") == revision("0:40") == revision("0:00:40") == 5
+    assert revision("1:30") == 10
+    iso = datetime.fromtimestamp((T0 + 40 * 10**9) / 1e9, UTC)
+    assert revision(iso.isoformat()) == 5
+    assert revision(iso.replace(tzinfo=None).isoformat()) == 5  # no zone: UTC
+    with pytest.raises(InvalidRequest, match="cannot read 'soon' as a time"):
+        resolve_when(history, "soon")
+    with pytest.raises(InvalidRequest, match="outside the recording"):
+        resolve_when(history, "2020-01-01T00:00:00")
+
+
+def test_cli_diff_as_json(journal: Journal, capsys: pytest.CaptureFixture[str]) -> None:
+    args = ["--json", "diff", str(journal.path), f"r{journal.planned}", f"r{journal.last}"]
+    assert rosmc(args) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["from"]["revision"] == journal.planned and data["to"]["revision"] == journal.last
+    assert {
+        "subject": journal.ids["d1"],
+        "field": "status",
+        "before": "IDLE",
+        "after": "SUCCESS",
+    } in data["statuses"]
+    assert rosmc(["diff", str(journal.path), "r1", "soon"]) == 1
+    assert "cannot read 'soon' as a time" in capsys.readouterr().err
