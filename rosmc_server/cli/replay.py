@@ -127,11 +127,12 @@ def at(ctx: Context) -> int:
 
 def timeline(ctx: Context) -> int:
     """Draw the recording's per-robot timeline into an SVG or PNG file."""
-    from ..recording.history import MissionHistory
+    from ..recording.overlays import timeline_with_overlays
     from ..recording.timeline_svg import write_timeline
 
-    history = _history(MissionHistory.from_journal(ctx.args.file))
-    drawn = history.timeline()
+    # With the operator's changes, link outages and the score drawn over the lanes.
+    history, drawn = timeline_with_overlays(ctx.args.file)
+    _history(history)
     title = (
         f"{history.path.name}: {history.duration:.1f} s, revision {history.revisions[-1].revision}"
     )

@@ -8,7 +8,8 @@ import sys
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
-from . import restore as _restore
+from .restore import add_command as _add_restore
+from .restore import restore as _restore_command
 
 if TYPE_CHECKING:
     from ..recording.diff import FieldChange, MissionDiff
@@ -37,7 +38,7 @@ def add_commands(command: _Command) -> None:
     diff.add_argument("file", metavar="FILE", help="a mission journal (.mcap)")
     diff.add_argument("first", metavar="T1", help="the earlier moment")
     diff.add_argument("second", metavar="T2", help="the later moment")
-    _restore.add_command(command, WHEN_HELP)
+    _add_restore(command, WHEN_HELP)
 
 
 def info(ctx: Context) -> int:
@@ -174,6 +175,6 @@ def _change_text(change: FieldChange) -> str:
 COMMANDS: dict[str, Callable[[Context], int]] = {
     "info": info,
     "diff": diff,
-    "restore": _restore.restore,
+    "restore": _restore_command,
 }
 """The review commands by name, for the dispatcher in :mod:`.main`."""

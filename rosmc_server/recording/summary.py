@@ -93,7 +93,7 @@ def summarize(path: str | Path) -> RecordingSummary:
         last_revision=revisions[-1].revision,
         changes=dict(changes.most_common()),
         robots=[_outcomes(agent, final.task(agent)) for agent in final.agents],
-        outages=_outages(result, history),
+        outages=link_outages(result, history),
         score=[
             (history.seconds(r.log_time), float(r.message.score))
             for r in result.records
@@ -119,7 +119,8 @@ def _outcomes(agent: str, task: Sequence[SkillInstance]) -> RobotOutcomes:
     return RobotOutcomes(agent, **counts)
 
 
-def _outages(result: JournalResult, history: MissionHistory) -> list[Outage]:
+def link_outages(result: JournalResult, history: MissionHistory) -> list[Outage]:
+    """Every stretch a robot's link was DOWN in the recorded agent states, by start."""
     down_since: dict[str, float] = {}
     outages: list[Outage] = []
     for record in result.records:

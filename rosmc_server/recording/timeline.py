@@ -69,6 +69,21 @@ class BarrierRelease:
 
 
 @dataclass(frozen=True)
+class OperatorMark:
+    """An operator's change on the time axis.
+
+    Attributes:
+        time: Seconds since the recording started.
+        kind: "sync", "unsync" or "edit" (any other change the operator made).
+        summary: The event's one-sentence summary.
+    """
+
+    time: float
+    kind: str
+    summary: str
+
+
+@dataclass(frozen=True)
 class Timeline:
     """Every robot's lane of intervals and the barrier releases between them.
 
@@ -76,11 +91,17 @@ class Timeline:
         lanes: Agent name to its intervals in time order, for every agent of the mission.
         releases: Barrier releases in time order.
         duration: Seconds from the recording's first to its last record.
+        marks: The operator's changes in time order (see recording.overlays).
+        outages: ``(agent, start, end)`` seconds while a robot's link was down.
+        score: ``(seconds, score)`` as the simulator recorded it; empty without one.
     """
 
     lanes: dict[str, tuple[Interval, ...]]
     releases: tuple[BarrierRelease, ...]
     duration: float
+    marks: tuple[OperatorMark, ...] = ()
+    outages: tuple[tuple[str, float, float], ...] = ()
+    score: tuple[tuple[float, float], ...] = ()
 
     @property
     def intervals(self) -> list[Interval]:

@@ -4,7 +4,10 @@ The SVG is plain text written here (no plotting library). Bars are coloured by
 what the robot did and how it ended: teal for running and success, red for a
 failure, olive while waiting at a barrier, grey while paused; a stopped or
 unfinished execution has a dashed outline. A barrier release is a vertical line
-joining its members' lanes. PNG goes through ImageMagick's ``convert``.
+joining its members' lanes. Above the lanes, the operator's changes are marks on the
+time axis (blue: sync, orange: unsync, purple: other edits); a robot's link outages
+are shaded amber on its lane; the score is a line in a panel below the lanes.
+PNG goes through ImageMagick's ``convert``.
 """
 
 from __future__ import annotations
@@ -17,19 +20,24 @@ from pathlib import Path
 from xml.sax.saxutils import escape, quoteattr
 
 from rosmc_server.core import RosmcError, SkillStatus
-from rosmc_server.recording.timeline import BarrierRelease, Interval, Timeline
+from rosmc_server.recording.timeline import BarrierRelease, Interval, OperatorMark, Timeline
 
 TEAL = "#1b9e8f"
 RED = "#d1453b"
 OLIVE = "#8d8d2b"
 GREY = "#9a9a9a"
 INK = "#222222"
+OUTAGE = "#f9c46b"  # amber shading: the link was down
+MARK_COLOURS = {"sync": "#2b6cc4", "unsync": "#e8731a", "edit": "#7b4fa0"}
+SCORE = "#1f4e9c"
 
 LABEL_WIDTH = 170
 PLOT_WIDTH = 1000
 LANE_HEIGHT = 46
 BAR_HEIGHT = 26
 TOP = 48
+MARK_HEIGHT = 12  # operator marks sit in a strip just above the lanes
+SCORE_PANEL = 72  # the score panel's height, below the lanes, when a score was recorded
 PNG_DENSITY = 144  # dpi: twice the SVG's pixel size, sharp on high-resolution screens
 CHAR_WIDTH = 6.0  # about, in 11 px sans-serif: how much of a label fits its bar
 
@@ -52,7 +60,10 @@ def render_svg(timeline: Timeline, title: str = "") -> str:
     lanes = list(timeline.lanes)
     span = max(timeline.duration, 1e-3)
     scale = PLOT_WIDTH / span
-    height = TOP + LANE_HEIGHT * max(len(lanes), 1) + 86
+    lanes_bottom = TOP + LANE_HEIGHT * len(lanes)
+    score_room = SCORE_PANEL if timeline.score else 0
+    overlays = bool(timeline.score or timeline.marks or timeline.outages)
+    height = TOP + LANE_HEIGHT * max(len(lanes), 1) + 86 + score_room + (20 if overlays else 0)
     width = LABEL_WIDTH + PLOT_WIDTH + 30
     out = [
         f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" '
@@ -73,11 +84,23 @@ def render_svg(timeline: Timeline, title: str = "") -> str:
             f'<text x="{LABEL_WIDTH - 10}" y="{y + LANE_HEIGHT / 2 + 4}" text-anchor="end" '
             f'font-size="12" font-weight="bold">{escape(agent)}</text>'
         )
+        out += [
+            f'<rect class="outage" x="{_x(start, scale)}" y="{y}" '
+            f'width="{max(round((end - start) * scale, 2), 1.0)}" height="{LANE_HEIGHT}" '
+            f'fill="{OUTAGE}"><title>link down {start:.1f}-{end:.1f} s</title></rect>'
+            for who, start, end in timeline.outages
+            if who == agent
+        ]
         out += [_bar(interval, y, scale) for interval in timeline.lanes[agent]]
         out.append("</g>")
     row_of = {agent: row for row, agent in enumerate(lanes)}
     out += [_release(release, row_of, scale) for release in timeline.releases]
-    out += _axis(span, scale, TOP + LANE_HEIGHT * len(lanes))
+    out += [_mark(mark, scale) for mark in timeline.marks]
+    if timeline.score:
+        out += _score(timeline.score, span, scale, lanes_bottom)
+    out += _axis(span, scale, lanes_bottom + score_room)
+    if overlays:
+        out += _overlay_legend(height - 36)
     out += _legend(height - 16)
     out.append("</svg>")
     return "\n".join(out) + "\n"
@@ -179,6 +202,65 @@ def _release(release: BarrierRelease, row_of: dict[str, int], scale: float) -> s
         f'<line x1="{x}" y1="{top}" x2="{x}" y2="{bottom}" '
         f'stroke="{INK}" stroke-width="2"/>{dots}</g>'
     )
+
+
+def _mark(mark: OperatorMark, scale: float) -> str:
+    x = _x(mark.time, scale)
+    return (
+        f'<rect class="mark" data-kind="{mark.kind}" x="{x - 1.5}" y="{TOP - MARK_HEIGHT - 2}" '
+        f'width="3" height="{MARK_HEIGHT}" fill="{MARK_COLOURS[mark.kind]}">'
+        f"<title>{escape(f'{mark.time:.1f} s: {mark.summary}')}</title></rect>"
+    )
+
+
+def score_y(value: float, top: float, highest: float) -> float:
+    """Where a score value is drawn in the panel whose top is at ``top``."""
+    plot = SCORE_PANEL - 22  # 10 px margin above, 12 below
+    return round(top + 10 + plot * (1.0 - value / highest), 2) if highest > 0 else top + 10 + plot
+
+
+def _score(
+    score: tuple[tuple[float, float], ...], span: float, scale: float, top: float
+) -> list[str]:
+    """The score as a step line: it holds each value until the next record.
+
+    Drawn as separate segments, not a polyline: ImageMagick's SVG renderer joins a
+    long polyline's ends with stray diagonals.
+    """
+    highest = max(value for _, value in score)
+    style = f'stroke="{SCORE}" stroke-width="3" stroke-linecap="square"'
+    out = [
+        f'<text x="{LABEL_WIDTH - 10}" y="{top + SCORE_PANEL / 2 + 4}" text-anchor="end" '
+        f'font-size="12" font-weight="bold">score (max {highest:g})</text>',
+        f'<line x1="{LABEL_WIDTH}" y1="{score_y(0.0, top, highest)}" '
+        f'x2="{LABEL_WIDTH + PLOT_WIDTH}" y2="{score_y(0.0, top, highest)}" stroke="#cccccc"/>',
+        '<g class="score">',
+    ]
+    previous: float | None = None
+    for index, (when, value) in enumerate(score):
+        until = score[index + 1][0] if index + 1 < len(score) else span
+        x, y = _x(when, scale), score_y(value, top, highest)
+        if previous is not None:
+            out.append(f'<line x1="{x}" y1="{previous}" x2="{x}" y2="{y}" {style}/>')
+        out.append(f'<line x1="{x}" y1="{y}" x2="{_x(until, scale)}" y2="{y}" {style}/>')
+        previous = y
+    out.append("</g>")
+    return out
+
+
+def _overlay_legend(y: float) -> list[str]:
+    items = [
+        (OUTAGE, "link down"),
+        *((colour, f"operator {kind}") for kind, colour in MARK_COLOURS.items()),
+        (SCORE, "score"),
+    ]
+    out = []
+    x = float(LABEL_WIDTH)
+    for colour, text in items:
+        out.append(f'<rect x="{x}" y="{y - 10}" width="14" height="12" fill="{colour}"/>')
+        out.append(f'<text x="{x + 20}" y="{y}">{escape(text)}</text>')
+        x += 40 + len(text) * CHAR_WIDTH
+    return out
 
 
 def _axis(span: float, scale: float, y: float) -> list[str]:

@@ -9,18 +9,22 @@ from __future__ import annotations
 
 import itertools
 import json
+import re
+import shutil
+import subprocess
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
+from typing import Any
 
 import pytest
 
-pytest.importorskip("rosmc.msg", reason="rosmc messages are not built (source build/devel)")
+wire = pytest.importorskip("rosmc.msg", reason="rosmc messages are not built (source build/devel)")
 
-from rosmc_server import demo
-from rosmc_server.cli import main as rosmc
-from rosmc_server.conversions import event_to_msg, mission_to_msg
-from rosmc_server.core import (
+from rosmc_server import demo  # noqa: E402
+from rosmc_server.cli import main as rosmc  # noqa: E402
+from rosmc_server.conversions import event_to_msg, mission_to_msg  # noqa: E402
+from rosmc_server.core import (  # noqa: E402
     InvalidRequest,
     MarkerType,
     Mission,
@@ -31,14 +35,49 @@ from rosmc_server.core import (
     Transfer,
     load_library,
 )
-from rosmc_server.core.persistence import dump_mission, parse_mission
-from rosmc_server.recording import JournalWriter
-from rosmc_server.recording.diff import diff_missions, resolve_when
-from rosmc_server.recording.history import MissionHistory
-from rosmc_server.recording.restore import blueprint_from
+from rosmc_server.core.persistence import dump_mission, parse_mission  # noqa: E402
+from rosmc_server.interface import SCIENCE_TOPIC  # noqa: E402
+from rosmc_server.recording import JournalWriter  # noqa: E402
+from rosmc_server.recording.diff import diff_missions, resolve_when  # noqa: E402
+from rosmc_server.recording.history import MissionHistory  # noqa: E402
+from rosmc_server.recording.overlays import timeline_with_overlays  # noqa: E402
+from rosmc_server.recording.restore import blueprint_from  # noqa: E402
+from rosmc_server.recording.timeline_svg import (  # noqa: E402
+    LABEL_WIDTH,
+    LANE_HEIGHT,
+    MARK_COLOURS,
+    MARK_HEIGHT,
+    OUTAGE,
+    PLOT_WIDTH,
+    PNG_DENSITY,
+    SCORE,
+    TOP,
+    score_y,
+)
 
 T0 = 1_700_000_000_000_000_000
 S = SkillStatus
+
+
+def _states(drone_link: int) -> Any:
+    return wire.AgentStates(
+        agents=[
+            wire.AgentState(agent="drone", link=wire.LinkState(state=drone_link)),
+            wire.AgentState(agent="science_rover", link=wire.LinkState(state=1)),
+        ]
+    )
+
+
+# (seconds, message): the drone's link is down from 50 to 110 s; the score rises to 5
+# at 100 s and to 10 at 150 s. The mission's events are 10 s apart from 0 to 170 s.
+TELEMETRY: list[tuple[float, Any]] = [
+    (5.0, _states(1)),
+    (6.0, wire.ScienceState(score=0.0)),
+    (50.0, _states(2)),
+    (100.0, wire.ScienceState(score=5.0)),
+    (110.0, _states(1)),
+    (150.0, wire.ScienceState(score=10.0)),
+]
 
 
 @dataclass
@@ -64,8 +103,16 @@ def journal(tmp_path_factory: pytest.TempPathFactory) -> Journal:
     )
     path = tmp_path_factory.mktemp("review") / "mission.mcap"
     writer = JournalWriter.create(path, mission_to_msg(mission.state.content(), 0, 0.0), T0)
+    telemetry = list(TELEMETRY)
 
     def do(event: MissionEvent) -> MissionEvent:
+        while telemetry and telemetry[0][0] <= event.stamp:
+            seconds, message = telemetry.pop(0)
+            log_time = T0 + round(seconds * 1e9)
+            if isinstance(message, wire.ScienceState):
+                writer.append_telemetry(SCIENCE_TOPIC, message, log_time)
+            else:
+                writer.append_agent_states(message, log_time)
         state = mission.state
         message = event_to_msg(event, lambda skill_id: state.locate(skill_id)[0])
         writer.append_event(message, T0 + round(event.stamp * 1e9))
@@ -187,3 +234,69 @@ def test_cli_diff_as_json(journal: Journal, capsys: pytest.CaptureFixture[str]) 
     } in data["statuses"]
     assert rosmc(["diff", str(journal.path), "r1", "soon"]) == 1
     assert "cannot read 'soon' as a time" in capsys.readouterr().err
+
+
+# -- the timeline picture, checked by its pixels -----------------------------------------
+def pixel(png: Path, x: float, y: float) -> tuple[int, int, int]:
+    """The colour at SVG coordinates (x, y) of a PNG rendered at PNG_DENSITY dpi."""
+    zoom = PNG_DENSITY / 96  # SVG pixels are 1/96 inch
+    crop = f"1x1+{round(x * zoom)}+{round(y * zoom)}"
+    text = subprocess.run(
+        ["convert", str(png), "-crop", crop, "-depth", "8", "txt:-"],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout
+    found = re.search(r"#([0-9A-Fa-f]{6})", text)
+    assert found is not None, text
+    code = found.group(1)
+    return int(code[0:2], 16), int(code[2:4], 16), int(code[4:6], 16)
+
+
+def near(colour: tuple[int, int, int], hex_colour: str) -> bool:
+    """Whether ``colour`` is ``hex_colour`` (#rrggbb), give or take anti-aliasing."""
+    want = tuple(int(hex_colour[i : i + 2], 16) for i in (1, 3, 5))
+    return all(abs(a - b) <= 12 for a, b in zip(colour, want, strict=True))
+
+
+@pytest.mark.skipif(shutil.which("convert") is None, reason="ImageMagick is not installed")
+def test_timeline_shows_marks_outages_and_score(
+    journal: Journal, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    png = tmp_path / "timeline.png"
+    assert rosmc(["timeline", str(journal.path), "-o", str(png)]) == 0
+    capsys.readouterr()
+    history, timeline = timeline_with_overlays(journal.path)
+    assert timeline.outages == (("drone", 50.0, 110.0),)
+    assert timeline.score == ((6.0, 0.0), (100.0, 5.0), (150.0, 10.0))
+    kinds = {mark.kind for mark in timeline.marks}
+    assert kinds == {"sync", "edit"}  # nobody unsynchronized here
+    scale = PLOT_WIDTH / timeline.duration
+    lanes = list(timeline.lanes)
+
+    def x(seconds: float) -> float:
+        return LABEL_WIDTH + seconds * scale
+
+    def lane_top(agent: str) -> float:
+        return TOP + lanes.index(agent) * LANE_HEIGHT + 3  # above the bars
+
+    # The drone's lane is shaded while its link was down, and only then; not the rover's.
+    assert near(pixel(png, x(80), lane_top("drone")), OUTAGE)
+    assert not near(pixel(png, x(30), lane_top("drone")), OUTAGE)
+    assert not near(pixel(png, x(130), lane_top("drone")), OUTAGE)
+    assert not near(pixel(png, x(80), lane_top("science_rover")), OUTAGE)
+    # The score holds each value until the next: 5 at 120 s (half way up), 10 at 160 s.
+    panel = TOP + LANE_HEIGHT * len(lanes)
+    assert near(pixel(png, x(120), score_y(5.0, panel, 10.0)), SCORE)
+    assert near(pixel(png, x(160), score_y(10.0, panel, 10.0)), SCORE)
+    assert near(pixel(png, x(60), score_y(0.0, panel, 10.0)), SCORE)
+    assert not near(pixel(png, x(120), score_y(10.0, panel, 10.0)), SCORE)
+    # Operator marks in their colours above the lanes, where the changes were journaled.
+    sync = next(mark for mark in timeline.marks if mark.kind == "sync")
+    assert sync.time == history.seconds(history.revisions[journal.planned + 1].log_time)
+    strip = TOP - MARK_HEIGHT / 2 - 2
+    assert near(pixel(png, x(sync.time), strip), MARK_COLOURS["sync"])
+    last_edit = history.seconds(history.revisions[-1].log_time)
+    assert history.revisions[-1].revision == journal.last
+    assert near(pixel(png, x(last_edit), strip), MARK_COLOURS["edit"])
+    assert not near(pixel(png, x(sync.time + 5), strip), MARK_COLOURS["sync"])
