@@ -4,7 +4,7 @@ The mission at T, without the skills that had ended, is loaded through the serve
 load_mission service like ``rosmc load``. The server refuses while a robot holds
 synchronized, unfinished work (the same rule as ``rosmc load`` and ``rosmc new``), and
 there is deliberately no --force: replacing the mission under a robot that is executing
-would orphan its skills. Unsynchronize or stop the robots first.
+would orphan its skills. Stop a running skill and unsynchronize first.
 """
 
 from __future__ import annotations
