@@ -65,7 +65,8 @@ def format_summary(summary: RecordingSummary) -> str:
             for name in ("succeeded", "failed", "retried", "skipped", "unfinished", "blueprint")
             if getattr(robot, name)
         ]
-        lines.append(f"  {robot.agent:<20} {', '.join(parts) or 'no skills'}")
+        tried = f" ({robot.attempts} attempts)" if robot.attempts else ""
+        lines.append(f"  {robot.agent:<20} {', '.join(parts) or 'no skills'}{tried}")
     total = sum(summary.changes.values())
     lines.append(f"changes ({total})")
     lines.append("  " + ", ".join(f"{kind} {n}" for kind, n in summary.changes.items()))

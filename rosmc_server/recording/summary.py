@@ -51,6 +51,7 @@ class RobotOutcomes:
     skipped: int = 0
     unfinished: int = 0  # synchronized and not finished when the recording ended
     blueprint: int = 0  # never synchronized
+    attempts: int = 0  # executions the robot started (each retry is one more)
 
 
 @dataclass(frozen=True)
@@ -107,6 +108,7 @@ def summarize(path: str | Path) -> RecordingSummary:
 def _outcomes(agent: str, task: Sequence[SkillInstance]) -> RobotOutcomes:
     counts: Counter[str] = Counter()
     for skill in task:
+        counts["attempts"] += skill.status.has_started
         if skill.status is SkillStatus.SUCCESS:
             counts["succeeded"] += 1
         elif skill.status is SkillStatus.FAILURE:

@@ -300,3 +300,37 @@ def test_timeline_shows_marks_outages_and_score(
     assert history.revisions[-1].revision == journal.last
     assert near(pixel(png, x(last_edit), strip), MARK_COLOURS["edit"])
     assert not near(pixel(png, x(sync.time + 5), strip), MARK_COLOURS["sync"])
+
+
+# -- rosmc info ----------------------------------------------------------------------------
+def test_info_counts_outcomes_attempts_outages_and_score(
+    journal: Journal, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert rosmc(["--json", "info", str(journal.path)]) == 0
+    data = json.loads(capsys.readouterr().out)
+    drone = next(robot for robot in data["robots"] if robot["agent"] == "drone")
+    # d1 succeeded, d2 failed and was retried, the retry waits on the robot, d3 unsent.
+    assert (drone["succeeded"], drone["retried"], drone["unfinished"]) == (1, 1, 1)
+    assert (drone["blueprint"], drone["attempts"]) == (1, 2)
+    assert data["outages"] == [{"agent": "drone", "start_s": 50.0, "end_s": 110.0}]
+    assert data["final_score"] == 10.0
+    assert rosmc(["info", str(journal.path)]) == 0
+    text = capsys.readouterr().out
+    assert (
+        "  drone                1 succeeded, 1 retried, 1 unfinished, 1 blueprint (2 attempts)\n"
+        in text
+    )
+    assert "  drone                50.0 s to 110.0 s (60.0 s)\n" in text
+    assert "score 10.00 at the end (3 records)\n" in text
+
+
+def test_info_says_what_a_recording_lacks(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    mission = Mission(load_library(demo.LIBRARY))
+    path = tmp_path / "bare.mcap"
+    JournalWriter.create(path, mission_to_msg(mission.state.content(), 0, 0.0), T0).close()
+    assert rosmc(["info", str(path)]) == 0
+    text = capsys.readouterr().out
+    assert "link outages: no agent states recorded\n" in text
+    assert "score: not recorded (no simulator science state)\n" in text
