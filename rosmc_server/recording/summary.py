@@ -89,7 +89,7 @@ def summarize(path: str | Path) -> RecordingSummary:
     return RecordingSummary(
         path=Path(path),
         size_bytes=Path(path).stat().st_size,
-        duration=history.duration,
+        duration=_span(result),
         first_revision=revisions[0].revision,
         last_revision=revisions[-1].revision,
         changes=dict(changes.most_common()),
@@ -137,3 +137,9 @@ def link_outages(result: JournalResult, history: MissionHistory) -> list[Outage]
                 outages.append(Outage(state.agent, down_since.pop(state.agent), now))
     outages += [Outage(agent, start, None) for agent, start in down_since.items()]
     return sorted(outages, key=lambda outage: (outage.start, outage.agent))
+
+
+def _span(result: JournalResult) -> float:
+    """Seconds from the first to the last record of any channel (what the timeline shows)."""
+    times = [record.log_time for record in result.records]
+    return (max(times) - min(times)) / 1e9 if times else 0.0
