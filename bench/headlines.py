@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from fnmatch import fnmatchcase
 from typing import Any
 
-MAX_ROWS = 30
+MAX_ROWS = 40
 
 # Names that label the items of a list of results better than their index.
 LIST_LABELS = ("name", "size", "label", "skills", "robots", "agents")
@@ -36,12 +36,20 @@ EXCLUDED_PATTERNS = ("target*", "*.target*", "*.n", "*samples*")
 
 HEADLINES: dict[str, tuple[str, ...]] = {
     "server": (
-        "sizes.*.latency.*.p50",
-        "sizes.*.latency.*.p95",
-        "sizes.*.event_bytes.*",
+        "sizes.20x500.latency.*.p50_ms",
+        "sizes.20x500.latency.*.p95_ms",
+        "sizes.*.event_bytes.add",
+        "sizes.20x500.event_bytes.*",
         "sizes.*.snapshot_bytes",
         "sizes.*.journal_bytes_per_change",
         "sizes.*.server_peak_rss_mib",
+    ),
+    "journal": (
+        "append.*.p50_us",
+        "append.*.p95_us",
+        "append.chunked.bytes_per_event",
+        "recovery.*_ms",
+        "snapshot_20x500.*bytes",
     ),
     "executor": ("*sync_to_start*median_ms", "*barrier_skew*median_ms", "*barrier_skew*max_ms"),
     "sim": ("*.rtf", "*cpu_share"),

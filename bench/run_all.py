@@ -145,13 +145,28 @@ def update_readme(text: str, table: str) -> str:
     return f"{head}{BEGIN}\n{table}{END}{tail}"
 
 
+def _write_tables(results: dict[str, Any], readme: bool) -> int:
+    """Write results.md (and the README's table) from ``results``; print the tables."""
+    table = markdown(results)
+    (BENCH_DIR / "results.md").write_text(table)
+    if readme:
+        README.write_text(update_readme(README.read_text(), table))
+    print(table)
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the benchmarks, write results.json and results.md (and README.md with --readme)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", default="", help="comma-separated names, e.g. server,scale")
     parser.add_argument("--timeout", type=float, default=900.0, help="seconds per benchmark")
     parser.add_argument("--readme", action="store_true", help="also update README.md")
+    parser.add_argument(
+        "--render", action="store_true", help="run nothing: redo the tables from results.json"
+    )
     args = parser.parse_args(argv)
+    if args.render:
+        return _write_tables(json.loads((BENCH_DIR / "results.json").read_text()), args.readme)
     wanted = {name.strip() for name in args.only.split(",") if name.strip()}
     scripts = sorted(BENCH_DIR.glob("bench_*.py"))
     if wanted:
@@ -168,11 +183,7 @@ def main(argv: list[str] | None = None) -> int:
         state = "ok" if bench["returncode"] == 0 and bench["figures"] is not None else "FAILED"
         print(f"run_all: {name} {state} in {bench['seconds']:.0f} s", file=sys.stderr, flush=True)
     (BENCH_DIR / "results.json").write_text(json.dumps(results, indent=2) + "\n")
-    table = markdown(results)
-    (BENCH_DIR / "results.md").write_text(table)
-    if args.readme:
-        README.write_text(update_readme(README.read_text(), table))
-    print(table)
+    _write_tables(results, args.readme)
     failed = [n for n, b in results["benchmarks"].items() if b["returncode"] or not b["figures"]]
     if failed:
         print(f"run_all: failed: {', '.join(failed)}", file=sys.stderr)
