@@ -4,10 +4,12 @@
 ``/rosmc/mission`` (rosmc/Mission). Under a burst of changes it coalesces:
 it waits until changes pause (``quiet``) or a burst has lasted ``max_delay``,
 so a multi-megabyte snapshot is not built per change, yet the latched
-snapshot is always current shortly after a burst ends. During a long burst it
-publishes at most every ``cost_factor`` times what the last snapshot cost, so
-building and serializing a large mission takes a bounded share of the server's
-time (the service threads share one interpreter with it).
+snapshot is always current shortly after a burst ends. The snapshot is for late joiners,
+not a stream (clients follow ``/rosmc/mission_events``): after one is published the next
+waits at least ``min_period``, and during a long burst at least ``cost_factor`` times
+what the last one cost, so building and serializing a large mission takes a bounded share
+of the server's time (the service threads share one interpreter with it). A replaced
+mission (new or loaded) is published at once: its content is only in the snapshot.
 """
 
 from __future__ import annotations
@@ -32,7 +34,8 @@ class SnapshotPublisher:
         build: Callable[[], wire.Mission],
         quiet: float = 0.05,
         max_delay: float = 0.25,
-        cost_factor: float = 10.0,
+        cost_factor: float = 20.0,
+        min_period: float = 2.0,
         on_published: Callable[[wire.Mission], None] | None = None,
     ) -> None:
         self._publisher = rospy.Publisher(topic, wire.Mission, queue_size=1, latch=True)
@@ -41,6 +44,9 @@ class SnapshotPublisher:
         self._quiet = quiet
         self._max_delay = max_delay
         self._cost_factor = cost_factor
+        self._min_period = min_period
+        self._published = 0.0  # monotonic time of the last publish
+        self._urgent = False
         self._cost = 0.0  # seconds the last snapshot took to build and publish
         self._changed = threading.Condition()
         self._dirty_since: float | None = None
@@ -53,10 +59,11 @@ class SnapshotPublisher:
         self._publisher.publish(self._build())
         self._thread.start()
 
-    def changed(self) -> None:
-        """The mission changed; a new snapshot will follow."""
+    def changed(self, urgent: bool = False) -> None:
+        """The mission changed; a new snapshot will follow (``urgent``: as soon as it can)."""
         with self._changed:
             now = time.monotonic()
+            self._urgent = self._urgent or urgent
             self._last_change = now
             if self._dirty_since is None:
                 self._dirty_since = now
@@ -78,7 +85,7 @@ class SnapshotPublisher:
                 if self._stopped:
                     return
                 self._wait_for_pause()
-                self._dirty_since = None
+                self._dirty_since, self._urgent = None, False
             started = time.monotonic()
             try:
                 snapshot = self._build()
@@ -87,7 +94,8 @@ class SnapshotPublisher:
                     self._on_published(snapshot)
             except Exception:  # keep publishing later snapshots whatever happened
                 _log.exception("could not publish the mission snapshot")
-            self._cost = time.monotonic() - started
+            self._published = time.monotonic()
+            self._cost = self._published - started
 
     def _wait_for_pause(self) -> None:
         """Wait (lock held) until changes pause or the burst is old enough."""
@@ -96,6 +104,9 @@ class SnapshotPublisher:
             now = time.monotonic()
             longest = max(self._max_delay, self._cost_factor * self._cost)
             deadline = min(self._last_change + self._quiet, self._dirty_since + longest)
+            if not self._urgent:
+                spacing = max(self._min_period, self._cost_factor * self._cost)
+                deadline = max(deadline, self._published + spacing)
             if now >= deadline:
                 return
             self._changed.wait(deadline - now)

@@ -207,7 +207,7 @@ class MissionServer:
             rospy.signal_shutdown("journal write failed")
             raise
         self._events.publish(msg)
-        self._snapshots.changed()
+        self._snapshots.changed(urgent=event.kind is EventKind.MISSION_REPLACED)
         for spec in commands_for_event(event, state):
             self.link.send(spec)
 

@@ -30,7 +30,7 @@ pytestmark = pytest.mark.integration
 
 E = wire.ErrorCode
 PV = wire.ParameterValue
-NOW_AT = re.compile(r"revision (\d+)\)?; fetch")
+NOW_AT = re.compile(r"now at revision (\d+)\)")
 
 
 def current_revision_named(error: str) -> int:
