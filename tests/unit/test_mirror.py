@@ -80,9 +80,10 @@ class View:
             case SkillRemoved(skill, index):
                 assert self.tasks[skill.agent].pop(index) == skill.id
                 del self.skills[skill.id]
-            case SkillsMoved(agent, order):
-                assert sorted(order) == sorted(self.tasks[agent])
-                self.tasks[agent] = list(order)
+            case SkillsMoved(agent, moves):
+                for move in moves:  # one after the other, each index as it is once moved
+                    self.tasks[agent].remove(move.skill_id)
+                    self.tasks[agent].insert(move.index, move.skill_id)
             case BarrierPut(old, new):
                 assert self.barriers.get(new.id) == (old.skill_ids if old else None)
                 self.barriers[new.id] = new.skill_ids
