@@ -83,6 +83,7 @@ class MissionState:
         self._keys: dict[str, list[int]] = {}  # per agent, parallel to its task
         self._member_keys: dict[str, list[int]] = {}  # per agent, its barrier members' keys
         self._member_ids: dict[str, list[str]] = {}  # ... and their ids, in task order
+        self._in_transfer: dict[str, set[str]] = {}  # per agent, skills awaiting the robot
         self._reindex()
 
     # -- queries ---------------------------------------------------------
@@ -147,6 +148,13 @@ class MissionState:
         """The skill with this id; NotFound if there is none."""
         agent, index = self.locate(skill_id)
         return self._content.tasks[agent][index]
+
+    def pending(self, agent: str, transfer: Transfer) -> list[SkillInstance]:
+        """``agent``'s skills awaiting the robot's answer to ``transfer``, in task order."""
+        task = self.task(agent)
+        waiting = sorted(self._in_transfer.get(agent, ()), key=self._key_of.__getitem__)
+        skills = (task[self.locate(skill_id)[1]] for skill_id in waiting)
+        return [skill for skill in skills if skill.transfer is transfer]
 
     def sections(self, agent: str) -> Sections:
         """Where ``agent``'s task splits into synchronized, uploading and editable parts."""
@@ -271,6 +279,7 @@ class MissionState:
             _, current = self.locate(skill.id)
             self._unbind(task[current])
             task[current] = skill
+            self._note_transfer(skill)
         else:
             self._insert(skill.agent, index, skill)
         self._bind(skill)
@@ -289,6 +298,7 @@ class MissionState:
         keys.insert(index, key)
         self._key_of[skill.id] = key
         self._agent_of[skill.id] = agent
+        self._note_transfer(skill)
 
     def _remove_skill(self, skill_id: str) -> SkillInstance:
         agent, index = self.locate(skill_id)
@@ -297,6 +307,7 @@ class MissionState:
         self._keys[agent].pop(index)
         del self._key_of[skill_id]
         del self._agent_of[skill_id]
+        self._in_transfer.get(agent, set()).discard(skill_id)
         self._unbind(skill)
         return skill
 
@@ -344,6 +355,13 @@ class MissionState:
             del keys[at]
             del self._member_ids[agent][at]
 
+    def _note_transfer(self, skill: SkillInstance) -> None:
+        waiting = self._in_transfer.setdefault(skill.agent, set())
+        if skill.transfer is Transfer.NONE:
+            waiting.discard(skill.id)
+        else:
+            waiting.add(skill.id)
+
     def _bind(self, skill: SkillInstance) -> None:
         for marker in skill.bindings.values():
             self._bound.setdefault(marker, set()).add(skill.id)
@@ -360,12 +378,15 @@ class MissionState:
         self._keys.clear()
         self._member_keys.clear()
         self._member_ids.clear()
+        self._in_transfer.clear()
         for agent, task in self._content.tasks.items():
             self._keys[agent] = []
             self._spread_keys(agent)
             self._agent_of.update(dict.fromkeys(map(_skill_id, task), agent))
             for skill in task:
                 self._bind(skill)
+                if skill.transfer is not Transfer.NONE:
+                    self._note_transfer(skill)
         for barrier in self._content.barriers.values():
             for skill_id in barrier.skill_ids:
                 self._barrier_of[skill_id] = barrier.id

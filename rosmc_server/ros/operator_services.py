@@ -285,7 +285,7 @@ class OperatorServices:
         state = self._server.mission.state
         if agent not in state.agents:
             return False
-        return any(s.transfer is Transfer.UPLOADING for s in state.task(agent))
+        return bool(state.pending(agent, Transfer.UPLOADING))
 
     def _control(self, req: Any, resp: Any) -> None:
         if req.command not in _CONTROL:
