@@ -127,6 +127,7 @@ def ros_master(home: Path) -> Iterator[dict[str, str]]:
         PYTHONUNBUFFERED="1",
     )
     os.environ.update({k: env[k] for k in ("ROS_MASTER_URI", "ROS_IP", "ROS_HOME", "ROS_LOG_DIR")})
+    (home / "log").mkdir(parents=True, exist_ok=True)
     with (home / "rosmaster.log").open("wb") as log:
         master = subprocess.Popen(
             ["rosmaster", "--core", "-p", str(port)],
@@ -135,12 +136,13 @@ def ros_master(home: Path) -> Iterator[dict[str, str]]:
             stderr=subprocess.STDOUT,
             start_new_session=True,
         )
+    master_api = xmlrpc.client.ServerProxy(env["ROS_MASTER_URI"])
     try:
         deadline = time.monotonic() + 20
         while True:
-            with contextlib.suppress(OSError):
-                xmlrpc.client.ServerProxy(env["ROS_MASTER_URI"]).getSystemState("/bench")
-                break
+            with contextlib.suppress(OSError, xmlrpc.client.Error):
+                if master_api.getSystemState("/bench")[0] == 1:
+                    break
             if time.monotonic() > deadline:
                 raise RuntimeError("rosmaster did not start")
             time.sleep(0.05)
