@@ -66,16 +66,21 @@ def run_demo(factor: float, timeout: float) -> dict[str, Any]:
             str(timeout),
         ]
         started = time.monotonic()
-        result = subprocess.run(
-            argv,
-            cwd=REPO,
-            env=dict(os.environ),
-            stdin=subprocess.DEVNULL,
-            capture_output=True,
-            text=True,
-            timeout=timeout + 120,
-            check=False,
-        )
+        try:
+            result = subprocess.run(
+                argv,
+                cwd=REPO,
+                env=dict(os.environ),
+                stdin=subprocess.DEVNULL,
+                capture_output=True,
+                text=True,
+                timeout=timeout + 120,
+                check=False,
+            )
+        except subprocess.TimeoutExpired as expired:  # the run's figures are missing, not all
+            output = expired.stdout or ""
+            text = output.decode(errors="replace") if isinstance(output, bytes) else output
+            result = subprocess.CompletedProcess(argv, -9, text, f"killed after {timeout + 120} s")
         wall = time.monotonic() - started
     figures: dict[str, Any] = {"real_time_factor": factor, **parse_summary(result.stdout)}
     sim, mission_wall = figures["mission_sim_s"], figures["mission_wall_s"]

@@ -24,19 +24,15 @@ CPU contention between 20 executors, the server and the benchmark itself.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import json
 import os
 import platform
 import shutil
-import socket
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
-import xmlrpc.client
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -45,6 +41,9 @@ import yaml
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
+sys.path.insert(0, str(REPO / "bench"))
+
+from _server_harness import ros_master  # noqa: E402
 
 from rosmc_server.core import SkillStatus  # noqa: E402
 from tests.integration.executor_fixtures import (  # noqa: E402
@@ -52,7 +51,6 @@ from tests.integration.executor_fixtures import (  # noqa: E402
     Operator,
     RosmcSystem,
     running_stamps,
-    stop_process,
 )
 
 S = SkillStatus
@@ -68,38 +66,6 @@ def team_library(directory: Path, robots: int) -> Path:
     path = directory / f"team_{robots}.yaml"
     path.write_text(yaml.safe_dump(data))
     return path
-
-
-@contextlib.contextmanager
-def ros_master(home: Path) -> Iterator[dict[str, str]]:
-    """A private ``rosmaster --core``; yields the environment for nodes (and sets ours)."""
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        port = sock.getsockname()[1]
-    uri = f"http://127.0.0.1:{port}/"
-    env = dict(os.environ, ROS_MASTER_URI=uri, ROS_IP="127.0.0.1", ROS_HOME=str(home))
-    env.update(ROS_LOG_DIR=str(home / "log"), PYTHONUNBUFFERED="1")
-    env.pop("ROS_HOSTNAME", None)
-    os.environ.update({k: env[k] for k in ("ROS_MASTER_URI", "ROS_IP", "ROS_HOME", "ROS_LOG_DIR")})
-    master = subprocess.Popen(
-        ["rosmaster", "--core", "-p", str(port)],
-        env=env,
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-        start_new_session=True,
-    )
-    try:
-        deadline = time.monotonic() + 20.0
-        while True:
-            with contextlib.suppress(OSError, xmlrpc.client.Error):
-                if xmlrpc.client.ServerProxy(uri).getSystemState("/bench")[0] == 1:
-                    break
-            if time.monotonic() > deadline:
-                raise RuntimeError("rosmaster did not start")
-            time.sleep(0.05)
-        yield env
-    finally:
-        stop_process(master)
 
 
 def summary(values: Sequence[float], scale: float = 1e3) -> dict[str, Any]:

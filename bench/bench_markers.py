@@ -24,8 +24,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
-import signal
 import statistics
 import subprocess
 import sys
@@ -40,7 +38,7 @@ import yaml
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from bench_server import REPO, Server, ros_master
+from _server_harness import REPO, Server, ros_master, stop_process
 
 ROBOTS = 20
 MARKERS = 200
@@ -178,8 +176,7 @@ def main() -> int:
             try:
                 return run(args, work)
             finally:
-                os.killpg(node.pid, signal.SIGINT)
-                node.wait(10)
+                stop_process(node)  # never raises: the figures are printed already
                 server.stop()
 
 

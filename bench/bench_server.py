@@ -17,309 +17,53 @@ and adds the top functions by internal time to the output.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import io
-import json
-import os
 import pstats
 import random
-import signal
-import socket
-import statistics
-import subprocess
 import sys
 import tempfile
-import threading
 import time
-import xmlrpc.client
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-import yaml
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # also when imported as bench.bench_server
 
-REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))
+from _server_harness import (
+    REPO,
+    Server,
+    ServerClient,
+    agent_name,
+    figures_printed,
+    library_yaml,
+    mission_yaml,
+    percentiles,
+    ros_master,
+    serialized_size,
+)
 
-LOOPBACK = "127.0.0.1"
+__all__ = [  # other benchmarks and tools take these from here
+    "REPO",
+    "Server",
+    "agent_name",
+    "library_yaml",
+    "mission_yaml",
+    "percentiles",
+    "ros_master",
+]
+
 TARGET = {"p50_ms": 2.0, "p95_ms": 5.0}
 
-# Runs the server script with a cProfile profiler in every thread (rospy serves each
-# connection on its own thread); SIGUSR1 writes the merged statistics and exits.
-PROFILED_SERVER = """
-import cProfile, os, pstats, runpy, signal, sys, threading
-profiles = [cProfile.Profile()]
-def start_thread_profile(frame, event, arg):
-    sys.setprofile(None)
-    profile = cProfile.Profile()
-    profiles.append(profile)
-    profile.enable()
-def dump(*_):
-    stats = pstats.Stats(profiles[0])
-    for profile in profiles[1:]:
-        stats.add(profile)
-    stats.dump_stats(os.environ["BENCH_PROFILE"])
-    os._exit(0)
-signal.signal(signal.SIGUSR1, dump)
-threading.setprofile(start_thread_profile)
-sys.argv = sys.argv[1:]
-profiles[0].enable()
-runpy.run_path(sys.argv[0], run_name="__main__")
-"""
 
-
-# -- processes ---------------------------------------------------------------------------------
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind((LOOPBACK, 0))
-        return int(sock.getsockname()[1])
-
-
-@contextlib.contextmanager
-def ros_master(home: Path) -> Iterator[dict[str, str]]:
-    """A private rosmaster; yields the environment for nodes (this process uses it too)."""
-    port = free_port()
-    env = dict(os.environ)
-    env.pop("ROS_HOSTNAME", None)
-    env.update(
-        ROS_MASTER_URI=f"http://{LOOPBACK}:{port}/",
-        ROS_IP=LOOPBACK,
-        ROS_HOME=str(home),
-        ROS_LOG_DIR=str(home / "log"),
-        PYTHONUNBUFFERED="1",
-    )
-    os.environ.update({k: env[k] for k in ("ROS_MASTER_URI", "ROS_IP", "ROS_HOME", "ROS_LOG_DIR")})
-    log = (home / "rosmaster.log").open("wb")
-    master = subprocess.Popen(
-        ["rosmaster", "--core", "-p", str(port)],
-        env=env,
-        stdout=log,
-        stderr=subprocess.STDOUT,
-        start_new_session=True,
-    )
-    try:
-        deadline = time.monotonic() + 20
-        while True:
-            with contextlib.suppress(OSError):
-                xmlrpc.client.ServerProxy(env["ROS_MASTER_URI"]).getSystemState("/bench")
-                break
-            if time.monotonic() > deadline:
-                raise RuntimeError("rosmaster did not start")
-            time.sleep(0.05)
-        yield env
-    finally:
-        # SIGINT may be ignored where the benchmark runs (a CI shell, nohup): then SIGKILL,
-        # so that the figures are still printed.
-        os.killpg(master.pid, signal.SIGINT)
-        try:
-            master.wait(5)
-        except subprocess.TimeoutExpired:
-            os.killpg(master.pid, signal.SIGKILL)
-            master.wait(5)
-
-
-class Server:
-    """A mission_server process (optionally under cProfile)."""
-
-    def __init__(self, env: dict[str, str], work: Path, library: Path, profile: Path | None):
-        self.journal_dir = work / "journal"
-        argv = [
-            str(REPO / "scripts" / "mission_server"),
-            f"_library:={library}",
-            f"_journal_dir:={self.journal_dir}",
-        ]
-        env = dict(env)
-        if profile is not None:
-            env["BENCH_PROFILE"] = str(profile)
-            argv = ["-c", PROFILED_SERVER, *argv]
-        self.log_path = work / "server.log"
-        with self.log_path.open("wb") as log:
-            self.process = subprocess.Popen(
-                [sys.executable, *argv],
-                env=env,
-                cwd=REPO,
-                stdout=log,
-                stderr=subprocess.STDOUT,
-                start_new_session=True,
-            )
-        deadline = time.monotonic() + 60
-        while "mission server ready" not in self.log_path.read_text(errors="replace"):
-            if self.process.poll() is not None or time.monotonic() > deadline:
-                raise RuntimeError(f"server did not start:\n{self.log_path.read_text()[-3000:]}")
-            time.sleep(0.05)
-
-    def peak_rss_mib(self) -> float:
-        for line in Path(f"/proc/{self.process.pid}/status").read_text().splitlines():
-            if line.startswith("VmHWM:"):
-                return round(int(line.split()[1]) / 1024, 1)
-        return -1.0
-
-    def journal_bytes(self) -> int:
-        return sum(p.stat().st_size for p in self.journal_dir.glob("*.mcap"))
-
-    def stop(self, profiled: bool = False) -> None:
-        os.killpg(self.process.pid, signal.SIGUSR1 if profiled else signal.SIGINT)
-        try:
-            self.process.wait(30)
-        except subprocess.TimeoutExpired:
-            os.killpg(self.process.pid, signal.SIGKILL)
-            self.process.wait(10)
-
-
-# -- the benchmark mission ------------------------------------------------------------------------
-def agent_name(index: int) -> str:
-    return f"robot_{index:02d}"
-
-
-def library_yaml(agents: int) -> str:
-    """A library of ``agents`` dynamic agents of one model with typical skills."""
-    skills = {
-        "move": {
-            "duration": 60,
-            "parameters": {
-                "target": {"type": "pose", "default": {"x": 0.0, "y": 0.0}, "marker": "pose"},
-                "speed": {"type": "float", "default": 0.5, "min": 0.05, "max": 2.0},
-            },
-        },
-        "inspect": {
-            "duration": 30,
-            "parameters": {
-                "radius": {"type": "float", "default": 2.0, "min": 0.5, "max": 10.0},
-                "mode": {
-                    "type": "string",
-                    "default": "standard",
-                    "choices": ["quick", "standard", "detailed"],
-                },
-                "tries": {"type": "int", "default": 1, "min": 1, "max": 5},
-            },
-        },
-        "wait": {"duration": 10, "parameters": {"seconds": {"type": "float", "default": 5.0}}},
-    }
-    return yaml.safe_dump(
-        {
-            "rosmc_library": 1,
-            "name": f"bench_{agents}",
-            "models": {"robot": {"skills": skills}},
-            "agents": {agent_name(i): {"kind": "dynamic", "model": "robot"} for i in range(agents)},
-        },
-        sort_keys=False,
-    )
-
-
-def mission_yaml(agents: int, skills: int) -> str:
-    """A mission document: ``skills`` blueprint skills per agent and one task marker."""
-    kinds = ["move", "inspect", "wait"]
-    params = {
-        "move": {
-            "target": {"x": 1.0, "y": 2.0, "z": 0.0, "roll": 0.0, "pitch": 0.0, "yaw": 0.5},
-            "speed": 0.8,
-        },
-        "inspect": {"radius": 3.0, "mode": "quick", "tries": 2},
-        "wait": {"seconds": 5.0},
-    }
-    tasks = {}
-    for a in range(agents):
-        name = agent_name(a)
-        tasks[name] = [
-            {
-                "id": f"{name}-s{k:05d}",
-                "skill": kinds[k % 3],
-                "label": f"step {k}",
-                "params": params[kinds[k % 3]],
-                "status": "IDLE",
-            }
-            for k in range(skills)
-        ]
-    marker = {"name": "Site", "type": "POSE", "pose": {"x": 3.0, "y": 4.0}}
-    return yaml.safe_dump(
-        {
-            "rosmc_mission": 1,
-            "library": f"bench_{agents}",
-            "revision": 0,
-            "tasks": tasks,
-            "barriers": [],
-            "markers": [marker],
-        },
-        sort_keys=False,
-    )
-
-
-# -- measuring -------------------------------------------------------------------------------------
-def percentiles(samples: list[float]) -> dict[str, float]:
-    ordered = sorted(samples)
-    p95 = ordered[min(len(ordered) - 1, round(0.95 * (len(ordered) - 1)))]
-    return {
-        "p50_ms": round(statistics.median(ordered) * 1000, 3),
-        "p95_ms": round(p95 * 1000, 3),
-        "n": len(ordered),
-    }
-
-
-def serialized_size(msg: Any) -> int:
-    buffer = io.BytesIO()
-    msg.serialize(buffer)
-    return len(buffer.getvalue())
-
-
-class Bench:
+class Bench(ServerClient):
     """Times operations against one running server."""
 
     def __init__(self, agents: int, skills: int, samples: int, seed: int = 1) -> None:
-        import rosmc.msg as wire
-        import rosmc.srv as srv
-        import rospy
-
-        from rosmc_server import interface
-
-        self.wire, self.rospy = wire, rospy
+        super().__init__()
         self.agents = [agent_name(i) for i in range(agents)]
         self.skills = skills
         self.samples = samples
         self.rng = random.Random(seed)
-        self.proxies: dict[str, Any] = {}
-        for operation, type_name in interface.SERVICES.items():
-            rospy.wait_for_service(interface.service_name(operation), 30)
-            self.proxies[operation] = rospy.ServiceProxy(
-                interface.service_name(operation), getattr(srv, type_name), persistent=True
-            )
-        self.events: list[Any] = []
-        self._lock = threading.Lock()
-        self.subscriber = rospy.Subscriber(
-            interface.EVENTS_TOPIC, wire.MissionEvent, self._on_event, queue_size=100000
-        )
-        self.rev = self.call("get_mission").mission.revision
-        self.changes = 0
-
-    def _on_event(self, msg: Any) -> None:
-        with self._lock:
-            self.events.append(msg)
-
-    def call(self, operation: str, **fields: Any) -> Any:
-        response = self.proxies[operation](**fields)
-        if getattr(response, "error_code", 0):
-            raise RuntimeError(f"{operation} failed: {response.error}")
-        if hasattr(response, "revision") and response.revision != self.rev:
-            self.rev = response.revision
-            self.changes += 1
-        return response
-
-    def timed(self, operation: str, **fields: Any) -> tuple[float, Any]:
-        proxy = self.proxies[operation]
-        request = proxy.request_class(**fields)
-        started = time.perf_counter()
-        response = proxy.call(request)
-        elapsed = time.perf_counter() - started
-        if getattr(response, "error_code", 0):
-            raise RuntimeError(f"{operation} failed: {response.error}")
-        if hasattr(response, "revision") and response.revision != self.rev:
-            self.rev = response.revision
-            self.changes += 1
-        return elapsed, response
-
-    def close(self) -> None:
-        self.subscriber.unregister()
-        for proxy in self.proxies.values():
-            proxy.close()
 
     def run(self) -> dict[str, dict[str, float]]:
         wire, n = self.wire, self.samples
@@ -404,8 +148,9 @@ class Bench:
             record("get_mission", elapsed)
         return {name: percentiles(values) for name, values in times.items()}
 
-    def event_bytes(self) -> dict[str, int]:
-        kinds = {
+    def kind_names(self) -> dict[int, str]:
+        """The event kinds this benchmark causes, by the name of the operation."""
+        return {
             self.wire.MissionEvent.SKILL_ADDED: "add",
             self.wire.MissionEvent.SKILL_EDITED: "edit",
             self.wire.MissionEvent.SKILL_DELETED: "delete",
@@ -414,13 +159,6 @@ class Bench:
             self.wire.MissionEvent.MARKER_MOVED: "marker_move",
             self.wire.MissionEvent.SYNC_REQUESTED: "sync",
         }
-        sizes: dict[str, list[int]] = {}
-        with self._lock:
-            events = list(self.events)
-        for event in events:
-            if event.kind in kinds:
-                sizes.setdefault(kinds[event.kind], []).append(serialized_size(event))
-        return {name: int(statistics.median(values)) for name, values in sizes.items()}
 
 
 def bench_size(
@@ -432,7 +170,11 @@ def bench_size(
     library = work / "library.yaml"
     library.write_text(library_yaml(agents))
     server = Server(env, work, library, profile)
-    bench = Bench(agents, skills, samples)
+    try:
+        bench = Bench(agents, skills, samples)
+    except BaseException:
+        server.stop()
+        raise
     try:
         document = mission_yaml(agents, skills)
         started = time.perf_counter()
@@ -450,7 +192,7 @@ def bench_size(
             "total_skills": sum(len(t.skills) for t in snapshot.tasks),
             "load_document_s": round(load_s, 3),
             "latency": latencies,
-            "event_bytes": bench.event_bytes(),
+            "event_bytes": bench.event_bytes(bench.kind_names()),
             "snapshot_bytes": serialized_size(snapshot),
             "journal_bytes_per_change": round((server.journal_bytes() - journal_start) / changes),
             "changes": changes,
@@ -458,7 +200,7 @@ def bench_size(
         }
     finally:
         bench.close()
-        server.stop(profiled=profile is not None)
+        server.stop()
     return result
 
 
@@ -476,24 +218,22 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--profile", action="store_true", help="cProfile the largest size")
     args = parser.parse_args(argv)
     sizes = [tuple(int(x) for x in size.split("x")) for size in args.sizes.split(",")]
-    with tempfile.TemporaryDirectory(prefix="bench_server_") as tmp:
+    output: dict[str, Any] = {"target_at_20x500": TARGET, "sizes": []}
+    with figures_printed(output), tempfile.TemporaryDirectory(prefix="bench_server_") as tmp:
         base = Path(tmp)
         (base / "log").mkdir()
         with ros_master(base) as env:
             import rospy
 
             rospy.init_node("bench_server", anonymous=True, disable_signals=True)
-            results = [
-                bench_size(env, base / f"{a}x{s}", a, s, args.samples, None) for a, s in sizes
-            ]
-            output: dict[str, Any] = {"target_at_20x500": TARGET, "sizes": results}
+            for a, s in sizes:
+                output["sizes"].append(bench_size(env, base / f"{a}x{s}", a, s, args.samples, None))
             if args.profile:
                 a, s = max(sizes, key=lambda size: size[0] * size[1])
                 stats = base / "server.prof"
                 bench_size(env, base / "profiled", a, s, args.samples, stats)
                 output["profile_top_tottime"] = profile_summary(stats)
             rospy.signal_shutdown("done")
-    print(json.dumps(output, indent=2))
     return 0
 
 

@@ -24,6 +24,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import signal
 import socket
 import subprocess
 import sys
@@ -38,9 +39,11 @@ from typing import Any
 import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import rosmc.msg as wire
 import rospy
+from _server_harness import stop_process
 from rosgraph_msgs.msg import Clock
 
 from rosmc_server.conversions import param_to_msg
@@ -78,8 +81,7 @@ def private_master(home: Path) -> Iterator[dict[str, str]]:
         time.sleep(1.5)
         yield env
     finally:
-        master.terminate()
-        master.wait(10)
+        stop_process(master, signal.SIGTERM)
 
 
 def cpu_seconds(pid: int) -> float:
@@ -198,8 +200,7 @@ def measure(
         cpu = cpu_seconds(node.pid) - cpu0
     finally:
         driver.close()
-        node.terminate()
-        node.wait(20)
+        stop_process(node, signal.SIGTERM, grace=20.0)
     return {
         "robots": robots,
         "real_time_factor_param": rtf,

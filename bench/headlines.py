@@ -3,11 +3,13 @@
 A benchmark's JSON is flattened to dotted keys (``sizes.20x500.latency.add.p50``). Its
 headline rows are the keys matching the glob patterns listed for it in :data:`HEADLINES`, or,
 for a benchmark not listed, the keys whose last part looks like a figure (percentiles,
-maxima, sizes, rates, memory), at most :data:`MAX_ROWS` of them.
+maxima, sizes, rates, memory), at most :data:`MAX_ROWS` of them. A benchmark listed in
+:data:`CURVES` is shown as its own table instead (``scale``: operations x mission sizes).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from fnmatch import fnmatchcase
 from typing import Any
@@ -115,3 +117,48 @@ def _format(value: float) -> str:
     if abs(value) >= 100:
         return f"{value:,.0f}"
     return f"{value:.3g}"
+
+
+def scale_curves(figures: dict[str, Any]) -> list[str]:
+    """bench_scale.py's figures as Markdown: per operation, p50 (p95) ms at each size."""
+    sizes = {int(n): size for n, size in figures.get("sizes", {}).items() if "latency" in size}
+    if not sizes:
+        return []
+    order = sorted(sizes)
+    ratio = next((v for k, v in figures.items() if k.startswith("ratio_p50_")), {})
+    names = list(dict.fromkeys(n for size in sizes.values() for n in size["latency"]))
+    head = ["operation", *(f"{n:,}" for n in order), "p50 ratio", "event bytes"]
+    lines = [
+        f"p50 (p95) ms per mission size in skills (2 robots); ratio = p50 at the largest over "
+        f"p50 at 100, target <= {figures.get('target_ratio', 1.5)}; event bytes at the "
+        "smallest / largest size.",
+        "",
+        "| " + " | ".join(head) + " |",
+        "|" + " --- |" * len(head),
+    ]
+    for name in names:
+        cells = []
+        for n in order:
+            got = sizes[n]["latency"].get(name)
+            cells.append(_p50_p95(got) if got else "")
+        event = [sizes[n].get("event_bytes", {}).get(name) for n in (order[0], order[-1])]
+        shown = " / ".join(f"{b:,}" for b in event) if None not in event else ""
+        lines.append(f"| {name} | " + " | ".join([*cells, str(ratio.get(name, "")), shown]) + " |")
+    spaced = [
+        f"{int(n):,}: {_p50_p95(size['spaced_edit'])}"
+        for n, size in sorted(figures.get("sizes", {}).items(), key=lambda item: int(item[0]))
+        if "spaced_edit" in size
+    ]
+    if spaced:
+        lines += ["", "Edits 60 ms apart, p50 (p95) ms at " + ", ".join(spaced) + "."]
+    if figures.get("over_target"):
+        lines += ["", "Over the ratio target: " + ", ".join(figures["over_target"]) + "."]
+    return lines
+
+
+def _p50_p95(figure: dict[str, float]) -> str:
+    return f"{_format(figure['p50_ms'])} ({_format(figure['p95_ms'])})"
+
+
+CURVES: dict[str, Callable[[dict[str, Any]], list[str]]] = {"scale": scale_curves}
+"""Benchmarks shown as their own table (the figures in, Markdown lines out)."""

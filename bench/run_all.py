@@ -1,7 +1,7 @@
 """Run every benchmark in bench/ and collect its figures: ``make bench``.
 
 Each ``bench/bench_*.py`` prints one JSON object. This runs them one after another (each in
-its own process group, killed whole if it overruns), then writes
+its own process group; one that overruns gets SIGTERM, then SIGKILL), then writes
 
 * ``bench/results.json``: the machine it ran on, and per benchmark its wall time, exit code
   and figures;
@@ -30,12 +30,13 @@ import time
 from pathlib import Path
 from typing import Any
 
-from headlines import flatten, headline_rows
+from headlines import CURVES, flatten, headline_rows
 
 BENCH_DIR = Path(__file__).resolve().parent
 REPO = BENCH_DIR.parent
 README = REPO / "README.md"
 BEGIN, END = "<!-- bench:begin -->", "<!-- bench:end -->"
+TERM_GRACE = 60.0  # seconds a benchmark stopped for its timeout has to print and clean up
 
 
 def machine() -> dict[str, Any]:
@@ -99,9 +100,15 @@ def run_one(script: Path, timeout: float) -> dict[str, Any]:
     try:
         output, _ = process.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
-        os.killpg(process.pid, signal.SIGKILL)
-        output, _ = process.communicate()
-        output += f"\n(run_all: killed after {timeout:.0f} s)"
+        # SIGTERM first: a benchmark then stops the processes it started and prints the
+        # figures it has (see _server_harness.figures_printed); SIGKILL if it does not end.
+        os.killpg(process.pid, signal.SIGTERM)
+        try:
+            output, _ = process.communicate(timeout=TERM_GRACE)
+        except subprocess.TimeoutExpired:
+            os.killpg(process.pid, signal.SIGKILL)
+            output, _ = process.communicate()
+        output += f"\n(run_all: stopped after {timeout:.0f} s)"
     figures = last_json(output)
     result: dict[str, Any] = {
         "seconds": round(time.monotonic() - began, 1),
@@ -126,6 +133,9 @@ def markdown(results: dict[str, Any]) -> str:
         title = f"**{name}** ({bench['seconds']:.0f} s, commit {bench.get('commit', '?')})"
         if bench["figures"] is None:
             lines += [f"{title}: failed (exit {bench['returncode']}), no figures.", ""]
+            continue
+        if name in CURVES:
+            lines += [title, "", *CURVES[name](bench["figures"]), ""]
             continue
         rows = headline_rows(name, flatten(bench["figures"]))
         if not rows:

@@ -116,7 +116,7 @@ def view_update(update: MirrorUpdate, state: MissionState | None) -> ViewUpdate:
             changed.add(change.new.id)
         elif isinstance(change, SkillsMoved):
             _add_once(agents, change.agent)
-            changed.update(change.order)
+            changed.update(move.skill_id for move in change.moves)
         elif isinstance(change, (BarrierPut, BarrierRemoved)):
             barriers = True
         elif isinstance(change, (MarkerPut, MarkerRemoved)):

@@ -36,6 +36,8 @@ from .mission import (
     marker_to_msg,
     mission_from_msg,
     mission_to_msg,
+    moves_from_msgs,
+    moves_to_msgs,
     skill_from_msg,
     skill_to_msg,
 )
@@ -66,6 +68,8 @@ __all__ = [
     "marker_to_msg",
     "mission_from_msg",
     "mission_to_msg",
+    "moves_from_msgs",
+    "moves_to_msgs",
     "param_from_msg",
     "param_to_msg",
     "parameter_spec_to_msg",

@@ -8,7 +8,7 @@ input, so service handlers can answer with an error). Round trips are exact.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import rosmc.msg as wire
@@ -27,6 +27,7 @@ from ..core import (
     TaskMarker,
     Transfer,
 )
+from ..core.changes import SkillMove
 from .values import (
     enum_from_number,
     param_from_msg,
@@ -201,11 +202,26 @@ def event_to_msg(event: MissionEvent, agent_of: Callable[[str], str]) -> wire.Mi
         removed_barrier_ids=list(change.removed_barrier_ids),
         put_markers=[marker_to_msg(m) for m in change.put_markers],
         removed_marker_names=list(change.removed_marker_names),
+        moves=moves_to_msgs(change.moves),
     )
 
 
+def moves_to_msgs(moves: Sequence[SkillMove]) -> list[wire.SkillMove]:
+    """Core moves as ``rosmc/SkillMove`` messages."""
+    return [wire.SkillMove(skill_id=m.skill_id, index=m.index) for m in moves]
+
+
+def moves_from_msgs(msgs: Sequence[wire.SkillMove]) -> tuple[SkillMove, ...]:
+    """``rosmc/SkillMove`` messages as core moves."""
+    return tuple(SkillMove(m.skill_id, m.index) for m in msgs)
+
+
 def event_from_msg(msg: wire.MissionEvent) -> MissionEvent:
-    """``rosmc/MissionEvent`` as a core event (a replacement has no content)."""
+    """``rosmc/MissionEvent`` as a core event (a replacement has no content).
+
+    An event recorded before reorders carried moves has no ``moves`` field and
+    gives the whole new order in ``blueprint_order``; the core applies either.
+    """
     change = Change(
         put_skills=tuple(PlacedSkill(p.index, skill_from_msg(p.skill)) for p in msg.put_skills),
         removed_skill_ids=tuple(msg.removed_skill_ids),
@@ -215,6 +231,7 @@ def event_from_msg(msg: wire.MissionEvent) -> MissionEvent:
         removed_barrier_ids=tuple(msg.removed_barrier_ids),
         put_markers=tuple(marker_from_msg(m) for m in msg.put_markers),
         removed_marker_names=tuple(msg.removed_marker_names),
+        moves=moves_from_msgs(getattr(msg, "moves", ())),
     )
     return MissionEvent(
         msg.revision,

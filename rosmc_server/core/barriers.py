@@ -9,10 +9,10 @@ A:[x1, y1], B:[y2, x2] with barriers {x1, x2} and {y1, y2}.
 from __future__ import annotations
 
 import itertools
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 
-from .changes import Change, EventKind, Proposal
+from .changes import Change, EventKind, Proposal, SkillMove
 from .errors import InvalidRequest, RuleViolation
 from .model import Barrier, SkillInstance, SkillStatus, Transfer
 from .state import MissionState
@@ -93,18 +93,109 @@ def check_no_deadlock(
     """Raise RuleViolation if the barriers (plus ``extra_group``) would deadlock.
 
     ``order`` replaces one agent's editable blueprint order, to check a reorder.
+    The barriers in ``state`` never deadlock, so only cycles through what is new
+    are looked for (see :func:`check_new_barrier` and :func:`check_moves`).
     """
-    groups = [barrier.skill_ids for barrier in state.barriers]
     if extra_group:
-        groups.append(tuple(extra_group))
-    members = {skill_id for group in groups for skill_id in group}
-    tasks: dict[str, list[str]] = {}
-    for agent in state.agents:
-        ids = [skill.id for skill in state.task(agent)]
-        if order is not None and order[0] == agent:
-            ids[len(ids) - len(order[1]) :] = order[1]
-        tasks[agent] = [skill_id for skill_id in ids if skill_id in members]
-    cycle = find_deadlock(tasks, groups)
+        check_new_barrier(state, extra_group)
+    if order is not None:
+        check_moves(state, order[0], state.moves_for_order(order[0], order[1]))
+
+
+def check_new_barrier(state: MissionState, skill_ids: Sequence[str]) -> None:
+    """Raise RuleViolation if a barrier over ``skill_ids`` (existing non-members) deadlocks.
+
+    The new barrier sits between the members just before and just after its
+    skills; any new cycle passes through it. The search follows "runs before"
+    edges from it among barrier members only: its cost is the number of barriers
+    after the new one, not the mission's size (none for a barrier at the tasks' ends).
+    """
+    graph = _BarrierGraph(state)
+    for skill_id in skill_ids:
+        before, after = state.members_around(skill_id)
+        graph.next_member[skill_id] = after
+        if before is not None:
+            graph.next_member[before] = skill_id
+        graph.barrier_of[skill_id] = _NEW_BARRIER
+    graph.members[_NEW_BARRIER] = tuple(skill_ids)
+    _refuse_cycle(graph.cycle_through(_NEW_BARRIER))
+
+
+def check_moves(state: MissionState, agent: str, moves: Sequence[SkillMove]) -> None:
+    """Raise RuleViolation if moving skills within ``agent``'s task makes the barriers deadlock.
+
+    Moving a skill that is in no barrier never changes the barriers' order; a moved
+    member's barrier is on any new cycle, so the search starts from those only.
+    """
+    moved = {move.skill_id for move in moves}
+    starts = {b.id for b in map(state.barrier_of, moved) if b is not None}
+    if not starts:
+        return
+    graph = _BarrierGraph(state)
+    members = state.members_after_moves(agent, moves)
+    graph.next_member.update(zip(members, [*members[1:], None], strict=True))
+    for start in sorted(starts):
+        _refuse_cycle(graph.cycle_through(start))
+
+
+_NEW_BARRIER = ""  # the barrier being checked, before it has an id (ids are never empty)
+
+
+class _BarrierGraph:
+    """The barriers of a state as a graph, with a change laid over it.
+
+    A node is a barrier; an edge goes from a member to the next member on the
+    same task. ``next_member``, ``barrier_of`` and ``members`` hold what the
+    change makes different; everything else is read from the state's indexes.
+    """
+
+    def __init__(self, state: MissionState) -> None:
+        self.state = state
+        self.next_member: dict[str, str | None] = {}
+        self.barrier_of: dict[str, str] = {}
+        self.members: dict[str, tuple[str, ...]] = {}
+
+    def edges_from(self, barrier_id: str) -> Iterator[tuple[str, OrderEdge]]:
+        """(next barrier, the task-order edge to it) for each member of ``barrier_id``."""
+        members = self.members.get(barrier_id)
+        if members is None:
+            members = self.state.barrier(barrier_id).skill_ids
+        for skill_id in members:
+            if skill_id in self.next_member:
+                after = self.next_member[skill_id]
+            else:
+                after = self.state.members_around(skill_id)[1]
+            if after is None:
+                continue
+            target = self.barrier_of.get(after)
+            if target is None:
+                barrier = self.state.barrier_of(after)
+                assert barrier is not None, f"member {after} without a barrier"
+                target = barrier.id
+            yield target, OrderEdge(self.state.agent_of(skill_id), skill_id, after)
+
+    def cycle_through(self, start: str) -> list[OrderEdge] | None:
+        """The edges of a cycle from ``start`` back to it, or None (depth-first search)."""
+        came_by: dict[str, tuple[str, OrderEdge]] = {}
+        stack = [start]
+        seen = {start}
+        while stack:
+            node = stack.pop()
+            for target, edge in self.edges_from(node):
+                if target == start:
+                    path = [edge]
+                    while node != start:
+                        node, back = came_by[node]
+                        path.append(back)
+                    return path[::-1]
+                if target not in seen:
+                    seen.add(target)
+                    came_by[target] = (node, edge)
+                    stack.append(target)
+        return None
+
+
+def _refuse_cycle(cycle: list[OrderEdge] | None) -> None:
     if cycle is not None:
         raise RuleViolation(
             "the barriers would deadlock, because each waits for another: " + describe_cycle(cycle)
@@ -130,7 +221,7 @@ def plan_add_barrier(state: MissionState, skill_ids: Sequence[str], barrier_id: 
         existing = state.barrier_of(skill.id)
         if existing is not None:
             raise RuleViolation(f"skill '{skill.id}' is already in barrier '{existing.id}'")
-    check_no_deadlock(state, extra_group=skill_ids)
+    check_new_barrier(state, skill_ids)
     barrier = Barrier(barrier_id, tuple(skill_ids))
     agents = ", ".join(skill.agent for skill in members)
     return Proposal(

@@ -11,7 +11,7 @@ import enum
 from dataclasses import dataclass
 
 from .changes import EventKind, MissionEvent
-from .model import Barrier, SkillInstance, SkillStatus
+from .model import Barrier, SkillInstance
 from .state import MissionState
 
 
@@ -61,8 +61,8 @@ def barriers_for(state: MissionState, skill_ids: set[str]) -> tuple[Barrier, ...
 
 def queued_barriers(state: MissionState, agent: str) -> tuple[Barrier, ...]:
     """Barriers of the skills ``agent``'s robot holds or is being sent."""
-    held = {s.id for s in state.task(agent) if s.status is not SkillStatus.IDLE or s.transfer}
-    return barriers_for(state, held)
+    held = state.task(agent)[: state.sections(agent).editable_start]  # synchronized, uploading
+    return barriers_for(state, {s.id for s in held})
 
 
 def commands_for_event(event: MissionEvent, state: MissionState) -> list[CommandSpec]:

@@ -11,8 +11,8 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 
-from .barriers import barrier_without, check_no_deadlock
-from .changes import Change, EventKind, PlacedSkill, Proposal
+from .barriers import barrier_without, check_moves
+from .changes import Change, EventKind, PlacedSkill, Proposal, SkillMove, moves_between
 from .errors import InvalidRequest, RuleViolation
 from .library import Library, SkillSpec
 from .model import SkillInstance, TaskMarker
@@ -137,20 +137,50 @@ def plan_delete_skills(state: MissionState, skill_ids: Sequence[str]) -> Proposa
 
 
 def plan_reorder(state: MissionState, agent: str, order: Sequence[str]) -> Proposal:
-    """Reorder ``agent``'s editable blueprint; ``order`` is a permutation of its ids."""
+    """Reorder ``agent``'s editable blueprint; ``order`` is a permutation of its ids.
+
+    The change carries the fewest moves that give the new order, not the order.
+    """
     task = state.task(agent)
-    editable = [skill.id for skill in task[state.sections(agent).editable_start :]]
+    start = state.sections(agent).editable_start
+    editable = [skill.id for skill in task[start:]]
     if len(order) != len(editable) or set(order) != set(editable):
         raise InvalidRequest(
             f"the new order must list each of {agent}'s {len(editable)} editable blueprint "
             f"skills exactly once (got {len(order)} ids)"
         )
-    check_no_deadlock(state, order=(agent, order))
+    return _reordered(state, agent, moves_between(editable, order, start))
+
+
+def plan_move_skills(state: MissionState, agent: str, moves: Sequence[SkillMove]) -> Proposal:
+    """Move skills within ``agent``'s editable blueprint, one move after the other.
+
+    Each move names a skill and its index in the task once moved; both the skill
+    and the index must be in the editable blueprint. The cost is the moves', not
+    the task's.
+    """
+    task = state.task(agent)
+    if not moves:
+        raise InvalidRequest(f"no moves within {agent}'s blueprint were given")
+    start = state.sections(agent).editable_start
+    for move in moves:
+        skill = state.skill(move.skill_id)
+        if skill.agent != agent:
+            raise InvalidRequest(f"skill '{skill.id}' is on {skill.agent}, not on {agent}")
+        require_editable(skill, "moved")
+        check_whole(move.index, f"the index to move '{skill.id}' to", start, len(task) - 1)
+    return _reordered(state, agent, tuple(moves))
+
+
+def _reordered(state: MissionState, agent: str, moves: tuple[SkillMove, ...]) -> Proposal:
+    check_moves(state, agent, moves)
+    shown = ", ".join(f"'{move.skill_id}' to {move.index}" for move in moves[:3])
+    more = f" and {len(moves) - 3} more" if len(moves) > 3 else ""
     return Proposal(
         EventKind.SKILLS_REORDERED,
         agent,
-        f"{agent}'s blueprint reordered",
-        Change(order_agent=agent, blueprint_order=tuple(order)),
+        f"{agent}'s blueprint reordered: moved {shown or 'nothing'}{more}",
+        Change(order_agent=agent, moves=moves),
     )
 
 

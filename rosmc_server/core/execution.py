@@ -34,19 +34,19 @@ def plan_synchronize(state: MissionState, agent: str, upto_id: str | None) -> Pr
     """Mark ``agent``'s editable blueprint up to ``upto_id`` (all if None) as uploading."""
     task = state.task(agent)
     sections = state.sections(agent)
-    if _pending(task, Transfer.REMOVING):
+    if state.pending(agent, Transfer.REMOVING):
         raise RuleViolation(
             f"an unsynchronize on {agent} awaits the robot's answer; synchronize after it"
         )
-    editable = task[sections.editable_start :]
-    if not editable:
+    if sections.editable_start == len(task):
         raise RuleViolation(f"{agent} has no blueprint skills to synchronize")
+    end = len(task)
     if upto_id:
-        ids = [skill.id for skill in editable]
-        if upto_id not in ids:
-            state.skill(upto_id)  # NotFound for an unknown id
+        owner, index = state.locate(upto_id)  # NotFound for an unknown id
+        if owner != agent or index < sections.editable_start:
             raise RuleViolation(f"skill '{upto_id}' is not in {agent}'s editable blueprint")
-        editable = editable[: ids.index(upto_id) + 1]
+        end = index + 1
+    editable = task[sections.editable_start : end]
     start = sections.editable_start
     puts = tuple(
         PlacedSkill(start + offset, replace(skill, transfer=Transfer.UPLOADING))
@@ -62,7 +62,7 @@ def plan_synchronize(state: MissionState, agent: str, upto_id: str | None) -> Pr
 
 def plan_confirm_sync(state: MissionState, agent: str, skill_ids: Sequence[str]) -> Proposal:
     """The robot stored these uploading skills: they become IDLE_SYNCHRONIZED."""
-    uploading = _pending(state.task(agent), Transfer.UPLOADING)
+    uploading = state.pending(agent, Transfer.UPLOADING)
     _require_run(uploading, skill_ids, agent, "uploads", from_front=True)
     puts = _placed(
         state,
@@ -83,7 +83,7 @@ def plan_decline_sync(
     state: MissionState, agent: str, skill_ids: Sequence[str], reason: str
 ) -> Proposal:
     """The robot refused these uploads (or cannot be reached): back to the blueprint."""
-    uploading = _pending(state.task(agent), Transfer.UPLOADING)
+    uploading = state.pending(agent, Transfer.UPLOADING)
     _require_run(uploading, skill_ids, agent, "uploads", from_front=False)
     declined = uploading[len(uploading) - len(skill_ids) :]
     text = reason.strip() or "declined by the robot"
@@ -101,7 +101,7 @@ def plan_cancel_uploads(state: MissionState, agent: str) -> Proposal:
 
     The robot is told to drop them (see commands), in case it got them after all.
     """
-    uploading = _pending(state.task(agent), Transfer.UPLOADING)
+    uploading = state.pending(agent, Transfer.UPLOADING)
     if not uploading:
         raise RuleViolation(f"no upload to {agent} awaits an answer")
     text = "upload cancelled by the operator"
@@ -118,11 +118,11 @@ def plan_request_unsync(state: MissionState, agent: str, from_id: str | None) ->
     """Ask the robot to give back ``from_id`` and every later synchronized skill."""
     task = state.task(agent)
     sections = state.sections(agent)
-    if _pending(task, Transfer.UPLOADING):
+    if state.pending(agent, Transfer.UPLOADING):
         raise RuleViolation(
             f"an upload to {agent} awaits the robot's answer; unsynchronize after it"
         )
-    if _pending(task, Transfer.REMOVING):
+    if state.pending(agent, Transfer.REMOVING):
         raise RuleViolation(f"an unsynchronize on {agent} already awaits the robot's answer")
     synced = task[: sections.synced_end]
     start = len(synced)
@@ -155,7 +155,7 @@ def plan_request_unsync(state: MissionState, agent: str, from_id: str | None) ->
 
 def plan_confirm_unsync(state: MissionState, agent: str, removed_ids: Sequence[str]) -> Proposal:
     """The robot removed ``removed_ids``; they return to the blueprint, the rest stay."""
-    removing = _pending(state.task(agent), Transfer.REMOVING)
+    removing = state.pending(agent, Transfer.REMOVING)
     if not removing:
         raise RuleViolation(f"no unsynchronize on {agent} awaits an answer")
     _require_run(removing, removed_ids, agent, "removals", from_front=False, allow_empty=True)
@@ -319,10 +319,6 @@ def _require_turn(state: MissionState, agent: str, index: int, skill_id: str) ->
                 f"skill '{skill_id}' cannot progress before '{earlier.id}' "
                 f"({earlier.status.name}) on {agent} is done"
             )
-
-
-def _pending(task: Sequence[SkillInstance], transfer: Transfer) -> list[SkillInstance]:
-    return [skill for skill in task if skill.transfer is transfer]
 
 
 def _require_run(

@@ -14,7 +14,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 
 from . import barriers, editing, execution, markers
-from .changes import Change, EventKind, MissionEvent, Proposal
+from .changes import Change, EventKind, MissionEvent, Proposal, SkillMove
 from .errors import RuleViolation, StaleRevision
 from .library import Library
 from .model import SkillStatus, TaskMarker, Transfer
@@ -137,6 +137,13 @@ class Mission:
         """Give an agent's editable blueprint a new order."""
         self._check_revision(base_revision)
         return self._commit(editing.plan_reorder(self.state, agent, order))
+
+    def move_skills(
+        self, agent: str, moves: Sequence[SkillMove], *, base_revision: int | None = None
+    ) -> MissionEvent:
+        """Move skills within an agent's editable blueprint, one after the other."""
+        self._check_revision(base_revision)
+        return self._commit(editing.plan_move_skills(self.state, agent, moves))
 
     # -- synchronization and execution ------------------------------------------
     def synchronize(
@@ -365,12 +372,9 @@ class Mission:
     def _unique_id(self, prefix: str) -> str:
         for _ in range(100):
             candidate = self._new_id(prefix)
-            if not self.state.has_skill(candidate) and not self._is_barrier(candidate):
+            if not self.state.has_skill(candidate) and not self.state.has_barrier(candidate):
                 return candidate
         raise RuleViolation("could not find a free id; the id factory keeps repeating itself")
-
-    def _is_barrier(self, candidate: str) -> bool:
-        return any(barrier.id == candidate for barrier in self.state.barriers)
 
     def _require_robots_idle(self, action: str) -> None:
         for skill in self.state.skills():

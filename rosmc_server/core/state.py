@@ -7,14 +7,22 @@ that can be journaled and replayed.
 
 from __future__ import annotations
 
+import bisect
+import operator
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field, replace
+from fractions import Fraction
 
-from .changes import Change
+from .changes import Change, SkillMove, moves_between
 from .errors import NotFound
 from .library import Library
 from .model import Barrier, SkillInstance, SkillStatus, TaskMarker, Transfer
 from .validation import excerpt
+
+# Spacing of the position keys given to a task's skills: room for 32 insertions at one
+# place before the task's keys are spread again.
+_KEY_SPACING = 1 << 32
+_skill_id = operator.attrgetter("id")
 
 
 @dataclass
@@ -54,7 +62,14 @@ class Sections:
 
 
 class MissionState:
-    """Mission content plus lookup indexes; mutated only by :meth:`apply`."""
+    """Mission content plus lookup indexes; mutated only by :meth:`apply`.
+
+    Every skill has a position key: the keys of a task increase along it, so a
+    skill's index is a binary search away and the order of any two skills is a
+    comparison. The barrier members of each task are kept sorted by key too, so
+    the deadlock check looks at barrier members only. A change updates these
+    indexes where it touched the task: its cost does not grow with the mission.
+    """
 
     def __init__(self, content: MissionContent, revision: int = 0) -> None:
         self.revision = revision
@@ -64,6 +79,11 @@ class MissionState:
         self._agent_of: dict[str, str] = {}
         self._barrier_of: dict[str, str] = {}
         self._bound: dict[str, set[str]] = {}
+        self._key_of: dict[str, int] = {}
+        self._keys: dict[str, list[int]] = {}  # per agent, parallel to its task
+        self._member_keys: dict[str, list[int]] = {}  # per agent, its barrier members' keys
+        self._member_ids: dict[str, list[str]] = {}  # ... and their ids, in task order
+        self._in_transfer: dict[str, set[str]] = {}  # per agent, skills awaiting the robot
         self._reindex()
 
     # -- queries ---------------------------------------------------------
@@ -115,16 +135,26 @@ class MissionState:
         agent = self._agent_of.get(skill_id)
         if agent is None:
             raise NotFound(f"there is no skill {excerpt(skill_id)}")
-        task = self._content.tasks[agent]
-        for index, skill in enumerate(task):
-            if skill.id == skill_id:
-                return agent, index
-        raise AssertionError(f"index out of date for skill {skill_id}")  # pragma: no cover
+        return agent, bisect.bisect_left(self._keys[agent], self._key_of[skill_id])
+
+    def agent_of(self, skill_id: str) -> str:
+        """The agent whose task holds the skill; NotFound if there is none."""
+        agent = self._agent_of.get(skill_id)
+        if agent is None:
+            raise NotFound(f"there is no skill {excerpt(skill_id)}")
+        return agent
 
     def skill(self, skill_id: str) -> SkillInstance:
         """The skill with this id; NotFound if there is none."""
         agent, index = self.locate(skill_id)
         return self._content.tasks[agent][index]
+
+    def pending(self, agent: str, transfer: Transfer) -> list[SkillInstance]:
+        """``agent``'s skills awaiting the robot's answer to ``transfer``, in task order."""
+        task = self.task(agent)
+        waiting = sorted(self._in_transfer.get(agent, ()), key=self._key_of.__getitem__)
+        skills = (task[self.locate(skill_id)[1]] for skill_id in waiting)
+        return [skill for skill in skills if skill.transfer is transfer]
 
     def sections(self, agent: str) -> Sections:
         """Where ``agent``'s task splits into synchronized, uploading and editable parts."""
@@ -144,10 +174,53 @@ class MissionState:
         except KeyError:
             raise NotFound(f"there is no barrier {excerpt(barrier_id)}") from None
 
+    def has_barrier(self, barrier_id: str) -> bool:
+        """Whether a barrier with this id exists."""
+        return barrier_id in self._content.barriers
+
     def barrier_of(self, skill_id: str) -> Barrier | None:
         """The barrier a skill belongs to, if any."""
         barrier_id = self._barrier_of.get(skill_id)
         return None if barrier_id is None else self._content.barriers[barrier_id]
+
+    def members_around(self, skill_id: str) -> tuple[str | None, str | None]:
+        """The barrier members just before and just after a skill on its agent's task.
+
+        The skill itself, if a member, is neither. None where there is no such member.
+        """
+        agent = self.agent_of(skill_id)
+        keys, ids = self._member_keys.get(agent, []), self._member_ids.get(agent, [])
+        key = self._key_of[skill_id]
+        at = bisect.bisect_left(keys, key)
+        before = ids[at - 1] if at else None
+        if at < len(keys) and keys[at] == key:
+            at += 1
+        return before, ids[at] if at < len(ids) else None
+
+    def members_after_moves(self, agent: str, moves: Sequence[SkillMove]) -> list[str]:
+        """``agent``'s barrier members in task order as they would be after ``moves``.
+
+        Nothing changes: the moves are played on a copy of the task's keys.
+        """
+        keys: list[int | Fraction] = list(self._keys[agent])
+        moved: dict[str, int | Fraction] = {}
+        for move in moves:
+            key = moved.get(move.skill_id, self._key_of[move.skill_id])
+            keys.pop(bisect.bisect_left(keys, key))
+            index = min(max(move.index, 0), len(keys))
+            # An exact key between the neighbours: a copy never needs spreading out.
+            low = keys[index - 1] if index else (keys[0] - 2 if keys else 0)
+            high = keys[index] if index < len(keys) else low + 2
+            moved[move.skill_id] = Fraction(low + high, 2)
+            keys.insert(index, moved[move.skill_id])
+        members = self._member_ids.get(agent, [])
+        return sorted(members, key=lambda skill_id: moved.get(skill_id, self._key_of[skill_id]))
+
+    def moves_for_order(self, agent: str, order: Sequence[str]) -> tuple[SkillMove, ...]:
+        """The moves that give the last ``len(order)`` skills of ``agent``'s task ``order``."""
+        task = self.task(agent)
+        start = len(task) - len(order)
+        return moves_between([skill.id for skill in task[start:]], order, start)
 
     def marker(self, name: str) -> TaskMarker:
         """The task marker called ``name``; NotFound if there is none."""
@@ -180,23 +253,23 @@ class MissionState:
         for barrier_id in change.removed_barrier_ids:
             self._drop_barrier(barrier_id)
         for skill_id in change.removed_skill_ids:
-            agent, index = self.locate(skill_id)
-            self._unindex_skill(content.tasks[agent].pop(index))
+            self._remove_skill(skill_id)
         for name in change.removed_marker_names:
             del content.markers[name]
         for placed in change.put_skills:
             self._put_skill(placed.index, placed.skill)
         if change.order_agent:
-            task = content.tasks[change.order_agent]
-            by_id = {skill.id: skill for skill in task[len(task) - len(change.blueprint_order) :]}
-            task[len(task) - len(change.blueprint_order) :] = [
-                by_id[skill_id] for skill_id in change.blueprint_order
-            ]
+            moves = change.moves
+            if not moves and change.blueprint_order:  # old journals: the whole new order
+                moves = self.moves_for_order(change.order_agent, change.blueprint_order)
+            for move in moves:
+                self._move_skill(move.skill_id, move.index)
         for barrier in change.put_barriers:
             self._drop_barrier(barrier.id)
             content.barriers[barrier.id] = barrier
             for skill_id in barrier.skill_ids:
                 self._barrier_of[skill_id] = barrier.id
+                self._add_member(skill_id)
         for marker in change.put_markers:
             content.markers[marker.name] = marker
 
@@ -204,25 +277,96 @@ class MissionState:
         task = self._content.tasks[skill.agent]
         if skill.id in self._agent_of:
             _, current = self.locate(skill.id)
-            self._unindex_skill(task[current])
+            self._unbind(task[current])
             task[current] = skill
+            self._note_transfer(skill)
         else:
-            task.insert(index, skill)
-        self._index_skill(skill)
+            self._insert(skill.agent, index, skill)
+        self._bind(skill)
+
+    def _insert(self, agent: str, index: int, skill: SkillInstance) -> None:
+        task, keys = self._content.tasks[agent], self._keys[agent]
+        index = min(max(index, 0), len(task))
+        low = keys[index - 1] if index else 0
+        high = keys[index] if index < len(keys) else low + 2 * _KEY_SPACING
+        if high - low < 2:  # no key left between the neighbours: spread the task's keys
+            self._spread_keys(agent)
+            low = keys[index - 1] if index else 0
+            high = keys[index]
+        key = (low + high) // 2
+        task.insert(index, skill)
+        keys.insert(index, key)
+        self._key_of[skill.id] = key
+        self._agent_of[skill.id] = agent
+        self._note_transfer(skill)
+
+    def _remove_skill(self, skill_id: str) -> SkillInstance:
+        agent, index = self.locate(skill_id)
+        self._remove_member(skill_id)
+        skill = self._content.tasks[agent].pop(index)
+        self._keys[agent].pop(index)
+        del self._key_of[skill_id]
+        del self._agent_of[skill_id]
+        self._in_transfer.get(agent, set()).discard(skill_id)
+        self._unbind(skill)
+        return skill
+
+    def _move_skill(self, skill_id: str, index: int) -> None:
+        member = skill_id in self._barrier_of
+        skill = self._remove_skill(skill_id)
+        self._insert(skill.agent, index, skill)
+        self._bind(skill)
+        if member:
+            self._add_member(skill_id)
+
+    def _spread_keys(self, agent: str) -> None:
+        """Give ``agent``'s skills evenly spaced keys again (same order)."""
+        task, keys = self._content.tasks[agent], self._keys[agent]
+        keys[:] = range(_KEY_SPACING, _KEY_SPACING * (len(task) + 1), _KEY_SPACING)
+        self._key_of.update(zip(map(_skill_id, task), keys, strict=True))
+        self._member_keys[agent] = [self._key_of[i] for i in self._member_ids.get(agent, [])]
 
     def _drop_barrier(self, barrier_id: str) -> None:
         old = self._content.barriers.pop(barrier_id, None)
         if old is not None:
             for skill_id in old.skill_ids:
+                self._remove_member(skill_id)
                 self._barrier_of.pop(skill_id, None)
 
-    def _index_skill(self, skill: SkillInstance) -> None:
-        self._agent_of[skill.id] = skill.agent
+    def _add_member(self, skill_id: str) -> None:
+        agent = self._agent_of.get(skill_id)
+        if agent is None:
+            return  # a barrier naming a skill that is not there (only a bad snapshot does)
+        keys = self._member_keys.setdefault(agent, [])
+        ids = self._member_ids.setdefault(agent, [])
+        key = self._key_of[skill_id]
+        at = bisect.bisect_left(keys, key)
+        if at == len(keys) or keys[at] != key:
+            keys.insert(at, key)
+            ids.insert(at, skill_id)
+
+    def _remove_member(self, skill_id: str) -> None:
+        agent = self._agent_of.get(skill_id)
+        if agent is None:
+            return
+        keys = self._member_keys.get(agent, [])
+        at = bisect.bisect_left(keys, self._key_of[skill_id])
+        if at < len(keys) and keys[at] == self._key_of[skill_id]:
+            del keys[at]
+            del self._member_ids[agent][at]
+
+    def _note_transfer(self, skill: SkillInstance) -> None:
+        waiting = self._in_transfer.setdefault(skill.agent, set())
+        if skill.transfer is Transfer.NONE:
+            waiting.discard(skill.id)
+        else:
+            waiting.add(skill.id)
+
+    def _bind(self, skill: SkillInstance) -> None:
         for marker in skill.bindings.values():
             self._bound.setdefault(marker, set()).add(skill.id)
 
-    def _unindex_skill(self, skill: SkillInstance) -> None:
-        self._agent_of.pop(skill.id, None)
+    def _unbind(self, skill: SkillInstance) -> None:
         for marker in skill.bindings.values():
             self._bound.get(marker, set()).discard(skill.id)
 
@@ -230,11 +374,23 @@ class MissionState:
         self._agent_of.clear()
         self._barrier_of.clear()
         self._bound.clear()
-        for skill in self.skills():
-            self._index_skill(skill)
+        self._key_of.clear()
+        self._keys.clear()
+        self._member_keys.clear()
+        self._member_ids.clear()
+        self._in_transfer.clear()
+        for agent, task in self._content.tasks.items():
+            self._keys[agent] = []
+            self._spread_keys(agent)
+            self._agent_of.update(dict.fromkeys(map(_skill_id, task), agent))
+            for skill in task:
+                self._bind(skill)
+                if skill.transfer is not Transfer.NONE:
+                    self._note_transfer(skill)
         for barrier in self._content.barriers.values():
             for skill_id in barrier.skill_ids:
                 self._barrier_of[skill_id] = barrier.id
+                self._add_member(skill_id)
 
 
 def with_status(skill: SkillInstance, status: SkillStatus, **changes: object) -> SkillInstance:

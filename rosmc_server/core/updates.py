@@ -13,7 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from .agent_status import AgentStatus
-from .changes import Change, EventKind, MissionEvent
+from .changes import Change, EventKind, MissionEvent, SkillMove
 from .errors import NotFound, RosmcError, RuleViolation
 from .model import Barrier, SkillInstance, TaskMarker
 from .state import MissionState
@@ -76,10 +76,13 @@ class SkillRemoved:
 
 @dataclass(frozen=True)
 class SkillsMoved:
-    """An agent's task has a new order: ``order`` is every skill id, in task order."""
+    """Skills moved within an agent's task, one after the other (see :class:`SkillMove`).
+
+    An old journal's reorder (the whole new order) is described by its moves too.
+    """
 
     agent: str
-    order: tuple[str, ...]
+    moves: tuple[SkillMove, ...]
 
 
 @dataclass(frozen=True)
@@ -185,9 +188,9 @@ def apply_and_describe(state: MissionState, event: MissionEvent) -> tuple[Mirror
         else:
             changes.append(SkillChanged(old, placed.skill, index))
     if change.order_agent:
-        state.apply(Change(order_agent=change.order_agent, blueprint_order=change.blueprint_order))
-        order = tuple(skill.id for skill in state.task(change.order_agent))
-        changes.append(SkillsMoved(change.order_agent, order))
+        moves = change.moves or state.moves_for_order(change.order_agent, change.blueprint_order)
+        state.apply(Change(order_agent=change.order_agent, moves=moves))
+        changes.append(SkillsMoved(change.order_agent, moves))
     for barrier in change.put_barriers:
         changes.append(BarrierPut(_barrier_or_none(state, barrier.id), barrier))
         state.apply(Change(put_barriers=(barrier,)))

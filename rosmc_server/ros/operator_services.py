@@ -25,6 +25,7 @@ from .. import interface
 from ..conversions import (
     library_to_msg,
     marker_from_msg,
+    moves_from_msgs,
     params_from_msgs,
     policy_from_request,
     pose_from_msg,
@@ -226,7 +227,13 @@ class OperatorServices:
 
     def _reorder_skills(self, req: Any, resp: Any) -> MissionEvent:
         agent = _text(req.agent, "the agent name")
-        return self._apply(lambda m: m.reorder(agent, req.order, base_revision=req.base_revision))
+        base = req.base_revision
+        if req.moves:
+            if req.order:
+                raise InvalidRequest("give either a new order or moves, not both")
+            moves = moves_from_msgs(req.moves)
+            return self._apply(lambda m: m.move_skills(agent, moves, base_revision=base))
+        return self._apply(lambda m: m.reorder(agent, req.order, base_revision=base))
 
     # -- synchronization and execution ---------------------------------------------
     def _synchronize(self, req: Any, resp: Any) -> MissionEvent:
@@ -278,7 +285,7 @@ class OperatorServices:
         state = self._server.mission.state
         if agent not in state.agents:
             return False
-        return any(s.transfer is Transfer.UPLOADING for s in state.task(agent))
+        return bool(state.pending(agent, Transfer.UPLOADING))
 
     def _control(self, req: Any, resp: Any) -> None:
         if req.command not in _CONTROL:

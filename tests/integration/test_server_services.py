@@ -391,6 +391,24 @@ def test_reorder_skills_applies_the_permutation(scene: Scene) -> None:
     assert skill_ids(c.mission(), "drone") == [scene.d3, scene.d1, scene.d2]
 
 
+def test_reorders_travel_as_moves(scene: Scene, events: Any) -> None:
+    """A whole new order and a list of moves both publish only the moves."""
+    c, recorder = scene.client, events()
+    first = do(c, "reorder_skills", agent="drone", order=[scene.d2, scene.d3, scene.d1]).revision
+    second = do(c, "reorder_skills", agent="drone", moves=[move(scene.d2, 2), move(scene.d1, 0)])
+    assert skill_ids(c.mission(), "drone") == [scene.d1, scene.d3, scene.d2]
+    got = recorder.wait_for(lambda m: bool(m) and m[-1].revision >= second.revision)
+    by_revision = {e.revision: e for e in got}
+    for revision, moves in (
+        (first, [(scene.d1, 2)]),
+        (second.revision, [(scene.d2, 2), (scene.d1, 0)]),
+    ):
+        event = by_revision[revision]
+        assert event.kind == wire.MissionEvent.SKILLS_REORDERED and event.order_agent == "drone"
+        assert not event.blueprint_order
+        assert [(m.skill_id, m.index) for m in event.moves] == moves
+
+
 REORDER_REJECTIONS: list[Case] = [
     ("empty-agent", lambda s: {"agent": "", "order": [s.d1, s.d2, s.d3]}, E.INVALID),
     ("unknown-agent", lambda s: {"agent": "rover", "order": [s.d1, s.d2, s.d3]}, E.NOT_FOUND),
@@ -406,7 +424,19 @@ REORDER_REJECTIONS: list[Case] = [
         lambda s: {"agent": "drone", "order": [s.d3, s.d2, s.d1], "base_revision": s.rev - 1},
         E.CONFLICT,
     ),
+    (
+        "order-and-moves",
+        lambda s: {"agent": "drone", "order": [s.d1], "moves": [move(s.d1, 0)]},
+        E.INVALID,
+    ),
+    ("move-other-agents", lambda s: {"agent": "drone", "moves": [move(s.s1, 0)]}, E.INVALID),
+    ("move-unknown", lambda s: {"agent": "drone", "moves": [move("x", 0)]}, E.NOT_FOUND),
+    ("move-past-the-end", lambda s: {"agent": "drone", "moves": [move(s.d1, 3)]}, E.INVALID),
 ]
+
+
+def move(skill_id: str, index: int) -> wire.SkillMove:
+    return wire.SkillMove(skill_id=skill_id, index=index)
 
 
 @rejections(REORDER_REJECTIONS)
@@ -425,6 +455,9 @@ def test_reorder_that_would_deadlock_a_barrier_is_refused(scene: Scene) -> None:
     scene.rev = c.revision()
     order = {"agent": "manipulator_rover", "order": [scene.m1, scene.m2]}
     response = check_rejection(scene, "reorder_skills", order, E.RULE)
+    assert "deadlock" in response.error
+    moves = {"agent": "manipulator_rover", "moves": [move(scene.m1, 0)]}
+    response = check_rejection(scene, "reorder_skills", moves, E.RULE)
     assert "deadlock" in response.error
 
 

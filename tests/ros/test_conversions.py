@@ -65,6 +65,7 @@ from rosmc_server.core import (
     TaskMarker,
     Transfer,
 )
+from rosmc_server.core.changes import SkillMove
 from rosmc_server.core.commands import CommandKind
 from rosmc_server.executor.core import Signal, SignalKind
 
@@ -188,6 +189,7 @@ def test_an_event_survives_with_every_part_of_its_change() -> None:
         removed_barrier_ids=("b0",),
         put_markers=(content.markers["survey"],),
         removed_marker_names=("old",),
+        moves=(SkillMove("rover-3", 4), SkillMove("rover-2", 5)),
     )
     event = MissionEvent(43, EventKind.SKILL_EDITED, "rover", "edited rover-1", 1234.5, change)
     agents = {"drone-1": "drone", "rover-1": "rover"}

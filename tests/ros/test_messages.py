@@ -234,6 +234,7 @@ def test_mission_event_round_trips() -> None:
         removed_barrier_ids=["b0"],
         put_markers=[mission.markers[2]],
         removed_marker_names=["old"],
+        moves=[m.SkillMove(skill_id="r4", index=2), m.SkillMove(skill_id="r3", index=3)],
     )
     assert round_trip(event) == event
     replaced = E(revision=44, stamp=stamp(2), kind=E.MISSION_REPLACED, summary="Loaded.")

@@ -69,3 +69,37 @@ def test_a_failed_benchmark_is_reported_without_figures() -> None:
         "benchmarks": {"broken": {"seconds": 3.0, "returncode": 1, "figures": None}},
     }
     assert "**broken** (3 s, commit ?): failed (exit 1), no figures." in run_all.markdown(results)
+
+
+def test_the_scale_benchmark_is_shown_as_operations_by_mission_size() -> None:
+    def size(p50: float, bytes_: int) -> dict[str, object]:
+        return {
+            "latency": {
+                "add": {"p50_ms": p50, "p95_ms": p50 * 2, "n": 3},
+                "get_mission": {"p50_ms": p50 * 100, "p95_ms": p50 * 200, "n": 3},
+            },
+            "event_bytes": {"add": bytes_},
+            "spaced_edit": {"p50_ms": 0.9, "p95_ms": 2.5, "n": 3},
+        }
+
+    figures = {
+        "target_ratio": 1.5,
+        "sizes": {
+            "100": size(0.3, 498),
+            "10000": size(0.33, 498),
+            "700": {"spaced_edit": {"p50_ms": 1.0, "p95_ms": 3.0}},
+        },
+        "ratio_p50_10000_vs_100": {"add": 1.1},
+        "over_target": [],
+    }
+    results = {
+        "machine": run_all.machine(),
+        "benchmarks": {"scale": {"seconds": 60.0, "returncode": 0, "figures": figures}},
+    }
+    table = run_all.markdown(results)
+    assert "| operation | 100 | 10,000 | p50 ratio | event bytes |" in table
+    assert "| add | 0.3 (0.6) | 0.33 (0.66) | 1.1 | 498 / 498 |" in table
+    assert "| get_mission | 30 (60) | 33 (66) |  |  |" in table
+    assert (
+        "Edits 60 ms apart, p50 (p95) ms at 100: 0.9 (2.5), 700: 1 (3), 10,000: 0.9 (2.5)." in table
+    )

@@ -9,6 +9,7 @@ A view kept only from the typed change callbacks must end equal to the mission t
 from __future__ import annotations
 
 import itertools
+import random
 from dataclasses import replace
 from pathlib import Path
 
@@ -16,6 +17,7 @@ import pytest
 
 from rosmc_server.core import (
     AgentStatus,
+    EventKind,
     MarkerType,
     Mission,
     MissionEvent,
@@ -26,7 +28,7 @@ from rosmc_server.core import (
     TaskMarker,
     load_library,
 )
-from rosmc_server.core.changes import Change
+from rosmc_server.core.changes import Change, SkillMove, moves_between
 from rosmc_server.core.mirror import MissionMirror
 from rosmc_server.core.updates import (
     AgentStatusChanged,
@@ -46,6 +48,7 @@ from rosmc_server.core.updates import (
 
 REPO = Path(__file__).resolve().parents[2]
 LIBRARY = load_library(REPO / "rosmc_server" / "config" / "mars_team.yaml")
+AGENTS = LIBRARY.dynamic_agents
 
 
 class View:
@@ -80,9 +83,10 @@ class View:
             case SkillRemoved(skill, index):
                 assert self.tasks[skill.agent].pop(index) == skill.id
                 del self.skills[skill.id]
-            case SkillsMoved(agent, order):
-                assert sorted(order) == sorted(self.tasks[agent])
-                self.tasks[agent] = list(order)
+            case SkillsMoved(agent, moves):
+                for move in moves:  # one after the other, each index as it is once moved
+                    self.tasks[agent].remove(move.skill_id)
+                    self.tasks[agent].insert(move.index, move.skill_id)
             case BarrierPut(old, new):
                 assert self.barriers.get(new.id) == (old.skill_ids if old else None)
                 self.barriers[new.id] = new.skill_ids
@@ -330,3 +334,82 @@ def test_a_lost_last_event_is_noticed_from_the_servers_revision() -> None:
     mirror.on_server_revision(2)
     mirror.on_server_revision(0)  # a server that started anew: its restart is seen elsewhere
     assert asked == [1]
+
+
+# -- reorders travel as moves --------------------------------------------------------------
+def test_reorders_reach_every_follower_as_the_server_has_them() -> None:
+    """Moves and whole new orders, with barriers in the way: the server's order everywhere."""
+    mission = make_mission()
+    for agent in AGENTS:
+        for _ in range(8):
+            mission.add_skill(agent, "navigate_to")
+    mission.synchronize("drone", mission.state.task("drone")[1].id)  # 2 skills uploading
+    tasks = {a: [s.id for s in mission.state.task(a)] for a in AGENTS}
+    mission.add_barrier([tasks["drone"][3], tasks["science_rover"][2]])
+    mission.add_barrier(
+        [tasks["drone"][6], tasks["science_rover"][5], tasks["manipulator_rover"][4]]
+    )
+    replayed = snapshot_of(mission)
+    mirror = MissionMirror()
+    view = View()
+    mirror.subscribe(view)
+    mirror.on_snapshot(snapshot_of(mission))
+    rng = random.Random(12)
+    accepted = refused = 0
+    for step in range(80):
+        agent = rng.choice(AGENTS)
+        start = mission.state.sections(agent).editable_start
+        ids = [s.id for s in mission.state.task(agent)[start:]]
+        try:
+            if step % 2:
+                picks = rng.sample(ids, rng.randint(1, 3))
+                moves = [SkillMove(s, rng.randrange(start, start + len(ids))) for s in picks]
+                event = mission.move_skills(agent, moves)
+            else:
+                event = mission.reorder(agent, rng.sample(ids, len(ids)))
+        except RuleViolation as error:
+            assert "deadlock" in str(error)
+            refused += 1
+            continue
+        accepted += 1
+        assert not event.change.blueprint_order and len(event.change.moves) <= len(ids)
+        apply_event(replayed, event)
+        mirror.on_event(event)
+        assert mirror.state is not None
+        for follower in (replayed, mirror.state):
+            assert [s.id for s in follower.task(agent)] == [s.id for s in mission.state.task(agent)]
+    assert accepted > 20 and refused > 5, (accepted, refused)
+    assert replayed.content() == mission.state.content()
+    assert view.matches(mission.state)
+
+
+def test_an_old_reorder_with_the_whole_order_still_applies() -> None:
+    """Journals written before moves carry the agent's whole editable blueprint in order."""
+    mission = make_mission()
+    for _ in range(6):
+        mission.add_skill("drone", "navigate_to")
+    mission.synchronize("drone", mission.state.task("drone")[0].id)  # the first is uploading
+    ids = [s.id for s in mission.state.task("drone")]
+    new = [ids[4], ids[1], ids[5], ids[2], ids[3]]
+    old = MissionEvent(
+        mission.revision + 1,
+        EventKind.SKILLS_REORDERED,
+        "drone",
+        "drone's blueprint reordered",
+        2.0,
+        Change(order_agent="drone", blueprint_order=tuple(new)),
+    )
+    state = snapshot_of(mission)
+    apply_event(state, old)
+    assert [s.id for s in state.task("drone")] == [ids[0], *new]
+    mirror = MissionMirror()
+    view = View()
+    mirror.subscribe(view)
+    mirror.on_snapshot(snapshot_of(mission))
+    mirror.on_event(old)
+    assert mirror.state is not None and mirror.state.content() == state.content()
+    assert view.matches(state)
+    (moved,) = view.updates[-1].changes
+    assert isinstance(moved, SkillsMoved) and moved.moves == moves_between(ids[1:], new, 1)
+    mission.replay(old)  # the server resuming from such a journal
+    assert mission.state.content() == state.content()

@@ -55,6 +55,7 @@ from rosmc_server.core import (
     parse_mission,
 )
 from rosmc_server.core.barriers import find_deadlock
+from rosmc_server.core.changes import SkillMove
 from rosmc_server.core.persistence import mission_from_dict
 
 S = SkillStatus
@@ -78,6 +79,7 @@ KIND = {
     "edit_skill": EventKind.SKILL_EDITED,
     "delete_skills": EventKind.SKILL_DELETED,
     "reorder": EventKind.SKILLS_REORDERED,
+    "move_skills": EventKind.SKILLS_REORDERED,
     "synchronize": EventKind.SYNC_REQUESTED,
     "confirm_synchronized": EventKind.SYNC_CONFIRMED,
     "decline_synchronize": EventKind.SYNC_DECLINED,
@@ -362,6 +364,18 @@ class MissionMachine(RuleBasedStateMachine):
         elif corruption == "foreign":
             order = [*order[1:], self.any_skill(data)]
         self.attempt("reorder", agent, order)
+
+    @rule(data=st.data())
+    def move_skills(self, data: Any) -> None:
+        agent = self.agent(data)
+        task = self.mission.state.task(agent)
+        start = self.mission.state.sections(agent).editable_start
+        ids = [s.id for s in task[start:]] or ["ghost"]
+        indexes = st.integers(start, max(start, len(task) - 1))
+        if self.rarely(data):  # another robot's skill, a started one, an index outside
+            ids, indexes = [*ids, self.any_skill(data)], st.integers(-1, len(task) + 1)
+        moves = st.builds(SkillMove, st.sampled_from(ids), indexes)
+        self.attempt("move_skills", agent, data.draw(st.lists(moves, max_size=3)))
 
     # -- synchronization -----------------------------------------------------------------
     @rule(data=st.data())
@@ -661,6 +675,18 @@ class MissionMachine(RuleBasedStateMachine):
         groups = [b.skill_ids for b in state.barriers]
         assert not deadlocks(tasks, groups)
         assert find_deadlock(tasks, groups) is None
+
+    @invariant()
+    def indexes_match_the_tasks(self) -> None:
+        """Positions and each task's barrier members, as the state keeps them, match a scan."""
+        state = self.mission.state
+        members = {s for barrier in state.barriers for s in barrier.skill_ids}
+        for agent in state.agents:
+            ids = [s.id for s in state.task(agent)]
+            assert [state.locate(s) for s in ids] == [(agent, i) for i in range(len(ids))]
+            ordered = [None, *(s for s in ids if s in members), None]
+            for before, member, after in zip(ordered, ordered[1:-1], ordered[2:], strict=False):
+                assert member is not None and state.members_around(member) == (before, after)
 
     @invariant()
     def save_and_load_reproduce_the_mission(self) -> None:

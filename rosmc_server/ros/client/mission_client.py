@@ -5,13 +5,14 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from ...conversions import marker_to_msg, policy_to_request, pose_to_msg
+from ...conversions import marker_to_msg, moves_to_msgs, policy_to_request, pose_to_msg
 from ...core import (
     InvalidRequest,
     LostLinkPolicy,
     Pose,
     TaskMarker,
 )
+from ...core.changes import SkillMove
 from ...core.editing import check_retries, check_timeout
 from .base import ClientBase
 from .connection import raise_for
@@ -168,6 +169,24 @@ class MissionClient(ClientBase):
         return Result(
             self._mutate(
                 "reorder_skills", base_revision, retry_on_conflict, agent=agent, order=list(order)
+            ).revision
+        )
+
+    def move_skills(
+        self,
+        agent: str,
+        moves: Sequence[tuple[str, int]],
+        *,
+        base_revision: int | None = None,
+        retry_on_conflict: bool = False,
+    ) -> Result:
+        """Move skills within ``agent``'s editable blueprint: (skill id, index once moved)
+        pairs, applied one after the other; the request's size is the moves', not the task's.
+        """
+        wire_moves = moves_to_msgs([SkillMove(skill_id, index) for skill_id, index in moves])
+        return Result(
+            self._mutate(
+                "reorder_skills", base_revision, retry_on_conflict, agent=agent, moves=wire_moves
             ).revision
         )
 
