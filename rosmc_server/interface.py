@@ -29,6 +29,9 @@ TELEMETRY_TOPIC = "/{agent}/telemetry"  # rosmc/Telemetry
 TF_TOPIC = "/tf"  # tf2_msgs/TFMessage: map -> <agent>/base_link
 SCIENCE_TOPIC = f"{NAMESPACE}/sim/science"  # rosmc/ScienceState, latched: regions and score
 WORLD_TOPIC = f"{NAMESPACE}/sim/world"  # visualization_msgs/MarkerArray, latched: the site
+# Published latched by the site's map provider (the simulator, or a real site's mapping); the
+# mission server checks skill targets against the newest one.
+SITE_TOPIC = f"{NAMESPACE}/site"  # rosmc/SiteMap
 
 # Operator services of the mission server: name -> srv type name.
 SERVICES = {

@@ -16,6 +16,7 @@ Modules:
 * :mod:`.library`: the skill library, both ways;
 * :mod:`.agents`: agent states (``rosmc/AgentStates``) as core ``AgentStatus``;
 * :mod:`.policy`: the lost-link policy <-> ``rosmc/SetRobotOptions`` request fields;
+* :mod:`.site`: the site map (``rosmc/SiteMap``) the server checks skill targets against;
 * :mod:`.robot_link`: the executor's protocol (commands, acks, reports, barrier
   signals, snapshots); import it from the module (it needs the executor core).
 
@@ -42,6 +43,7 @@ from .mission import (
     skill_to_msg,
 )
 from .policy import policy_from_request, policy_to_request
+from .site import site_from_msg, site_to_msg
 from .values import (
     MAX_JSON_NESTING,
     param_from_msg,
@@ -78,6 +80,8 @@ __all__ = [
     "policy_to_request",
     "pose_from_msg",
     "pose_to_msg",
+    "site_from_msg",
+    "site_to_msg",
     "skill_from_msg",
     "skill_to_msg",
     "time_to_msg",

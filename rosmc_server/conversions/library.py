@@ -20,6 +20,7 @@ from ..core import (
     SkillSpec,
     Value,
 )
+from ..core.site import SiteCheck
 from .values import param_from_msg, param_to_msg
 
 
@@ -37,6 +38,7 @@ def parameter_spec_to_msg(spec: ParameterSpec) -> wire.ParameterSpec:
         unit=spec.unit,
         description=spec.description,
         marker_type=spec.marker_type.name if spec.marker_type is not None else "",
+        check=spec.check_target.value if spec.check_target is not None else "",
     )
 
 
@@ -101,7 +103,16 @@ def _parameter_spec_from_msg(msg: wire.ParameterSpec) -> ParameterSpec:
         unit=msg.unit,
         description=msg.description,
         marker_type=MarkerType[msg.marker_type.upper()] if msg.marker_type else None,
+        check_target=_check(msg.check),
     )
+
+
+def _check(text: str) -> SiteCheck | None:
+    # The server runs the checks; a client that does not know a newer one only cannot show it.
+    try:
+        return SiteCheck(text) if text else None
+    except ValueError:
+        return None
 
 
 def _choice(ptype: ParamType, text: str) -> Value:

@@ -279,3 +279,65 @@ def barrier_without(state: MissionState, removed: set[str]) -> Change:
         else:
             dropped.append(barrier.id)
     return Change(put_barriers=tuple(put), removed_barrier_ids=tuple(dropped))
+
+
+# -- a failed member's retry or skip ---------------------------------------------------------
+def has_released(state: MissionState, barrier: Barrier) -> bool:
+    """Whether the barrier's members have started together, as far as the ground can tell.
+
+    A member reported RUNNING or SUCCESS has run, and a barrier member runs only once its
+    barrier released. A paused, stopped or failed member may or may not have run, so it
+    does not count: a robot that saw the release runs a rejoining member at once anyway.
+    """
+    return any(
+        state.skill(skill_id).status in (SkillStatus.RUNNING, SkillStatus.SUCCESS)
+        for skill_id in barrier.skill_ids
+    )
+
+
+def after_retry(state: MissionState, failed_id: str, fresh_id: str) -> tuple[Change, str]:
+    """The barrier patch for retrying ``failed_id`` as ``fresh_id``, and what to say of it.
+
+    Before the release the fresh instance takes the failed one's place, so the partners
+    wait for the new attempt. After it the barrier stays the log of who started together
+    and the new attempt runs alone.
+    """
+    barrier = state.barrier_of(failed_id)
+    if barrier is None:
+        return Change(), ""
+    if has_released(state, barrier):
+        return Change(), (
+            f"its barrier '{barrier.id}' had released (the members started together), "
+            "so the new attempt runs alone"
+        )
+    members = tuple(fresh_id if s == failed_id else s for s in barrier.skill_ids)
+    partners = _agents(state, (s for s in members if s != fresh_id))
+    return Change(put_barriers=(Barrier(barrier.id, members),)), (
+        f"barrier '{barrier.id}' now waits for '{fresh_id}' (its partners on {partners} wait "
+        "for the new attempt)"
+    )
+
+
+def after_skip(state: MissionState, failed_id: str) -> tuple[Change, str]:
+    """The barrier patch for skipping ``failed_id``, and what to say of it.
+
+    Before the release the partners would otherwise wait for ever: the skipped member
+    leaves the barrier, and a barrier left with one member is dissolved.
+    """
+    barrier = state.barrier_of(failed_id)
+    if barrier is None or has_released(state, barrier):
+        return Change(), ""
+    remaining = tuple(s for s in barrier.skill_ids if s != failed_id)
+    partners = _agents(state, remaining)
+    if len(remaining) >= 2:
+        return Change(put_barriers=(Barrier(barrier.id, remaining),)), (
+            f"it leaves barrier '{barrier.id}', whose other members ({partners}) still start "
+            "together"
+        )
+    return Change(removed_barrier_ids=(barrier.id,)), (
+        f"barrier '{barrier.id}' is dissolved, so {partners} goes on alone"
+    )
+
+
+def _agents(state: MissionState, skill_ids: Iterable[str]) -> str:
+    return ", ".join(state.skill(skill_id).agent for skill_id in skill_ids)

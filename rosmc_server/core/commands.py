@@ -77,19 +77,24 @@ def commands_for_event(event: MissionEvent, state: MissionState) -> list[Command
         # A cancelled upload may have reached the robot after all: have it dropped.
         ids = tuple(placed.skill.id for placed in change.put_skills)
         return [CommandSpec(event.agent, CommandKind.UNSYNC, skill_ids=ids)]
-    if kind is EventKind.SKILL_RETRIED:
-        failed, fresh = change.put_skills[0].skill, change.put_skills[1].skill
-        return [CommandSpec(event.agent, CommandKind.RETRY, (fresh,), (failed.id,))]
-    if kind is EventKind.SKILL_SKIPPED:
-        failed_id = change.put_skills[0].skill.id
-        return [CommandSpec(event.agent, CommandKind.SKIP, skill_ids=(failed_id,))]
-    if change.put_barriers or change.removed_barrier_ids:
-        return [
+    # New barrier sets go first: a retried robot must know the barrier its fresh
+    # instance joined before the RETRY lets it start that instance.
+    barrier_sets = (
+        [
             CommandSpec(agent, CommandKind.BARRIERS, barriers=queued_barriers(state, agent))
             for agent in state.agents
             if synced_ids(state, agent)
         ]
-    return []
+        if change.put_barriers or change.removed_barrier_ids
+        else []
+    )
+    if kind is EventKind.SKILL_RETRIED:
+        failed, fresh = change.put_skills[0].skill, change.put_skills[1].skill
+        return [*barrier_sets, CommandSpec(event.agent, CommandKind.RETRY, (fresh,), (failed.id,))]
+    if kind is EventKind.SKILL_SKIPPED:
+        failed_id = change.put_skills[0].skill.id
+        return [*barrier_sets, CommandSpec(event.agent, CommandKind.SKIP, skill_ids=(failed_id,))]
+    return barrier_sets
 
 
 def repair_command(state: MissionState, agent: str) -> CommandSpec:

@@ -12,6 +12,7 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 
+from .barriers import after_retry, after_skip
 from .changes import Change, EventKind, PlacedSkill, Proposal
 from .errors import InvalidRequest, RuleViolation
 from .model import Resolution, SkillInstance, SkillStatus, Transfer
@@ -265,7 +266,11 @@ def plan_stop(state: MissionState, agent: str) -> Proposal:
 
 
 def plan_retry(state: MissionState, skill_id: str, new_id: str) -> Proposal:
-    """A fresh synchronized instance of a failed skill, right after it (attempt + 1)."""
+    """A fresh synchronized instance of a failed skill, right after it (attempt + 1).
+
+    A barrier member that failed before its barrier released hands its place to the
+    fresh instance (see :func:`~rosmc_server.core.barriers.after_retry`).
+    """
     failed = _unresolved_failure(state, skill_id, "retried")
     agent, index = state.locate(skill_id)
     fresh = replace(
@@ -278,23 +283,33 @@ def plan_retry(state: MissionState, skill_id: str, new_id: str) -> Proposal:
         finished=0.0,
     )
     resolved = replace(failed, resolution=Resolution.RETRIED)
+    barrier, said = after_retry(state, skill_id, new_id)
     return Proposal(
         EventKind.SKILL_RETRIED,
         agent,
-        f"'{skill_id}' on {agent} retried as '{new_id}' (attempt {fresh.attempt})",
-        Change(put_skills=(PlacedSkill(index, resolved), PlacedSkill(index + 1, fresh))),
+        f"'{skill_id}' on {agent} retried as '{new_id}' (attempt {fresh.attempt})"
+        + (f"; {said}" if said else ""),
+        replace(barrier, put_skills=(PlacedSkill(index, resolved), PlacedSkill(index + 1, fresh))),
     )
 
 
 def plan_skip(state: MissionState, skill_id: str) -> Proposal:
-    """Leave a failed skill behind; the robot goes on with the next one."""
+    """Leave a failed skill behind; the robot goes on with the next one.
+
+    A barrier member that failed before its barrier released leaves the barrier, so its
+    partners do not wait for ever (see :func:`~rosmc_server.core.barriers.after_skip`).
+    """
     failed = _unresolved_failure(state, skill_id, "skipped")
     agent, index = state.locate(skill_id)
+    barrier, said = after_skip(state, skill_id)
     return Proposal(
         EventKind.SKILL_SKIPPED,
         agent,
-        f"failed '{skill_id}' on {agent} skipped",
-        Change(put_skills=(PlacedSkill(index, replace(failed, resolution=Resolution.SKIPPED)),)),
+        f"failed '{skill_id}' on {agent} skipped" + (f"; {said}" if said else ""),
+        replace(
+            barrier,
+            put_skills=(PlacedSkill(index, replace(failed, resolution=Resolution.SKIPPED)),),
+        ),
     )
 
 

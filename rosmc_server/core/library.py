@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import enum
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import yaml
@@ -25,6 +25,7 @@ from .params import (
     Value,
     check_value,
 )
+from .site import SiteCheck
 from .validation import excerpt
 
 LIBRARY_VERSION = 1
@@ -50,6 +51,7 @@ class ParameterSpec:
     unit: str = ""
     description: str = ""
     marker_type: MarkerType | None = None
+    check_target: SiteCheck | None = None
 
     def check(self, raw: object, skill: str) -> Value:
         """Check a value for this parameter of ``skill``; return it normalized.
@@ -240,7 +242,7 @@ def _read_parameter(
         raw,
         key,
         required={"type", "default"},
-        optional={"min", "max", "choices", "unit", "description", "marker"},
+        optional={"min", "max", "choices", "unit", "description", "marker", "check"},
     )
     types = {ptype.name.lower(): ptype for ptype in ParamType}
     if body["type"] not in types:
@@ -272,7 +274,7 @@ def _read_parameter(
         spec.check(spec.default, skill)
     except InvalidRequest as error:
         reader.fail(f"{key}.default", str(error))
-    return spec
+    return replace(spec, check_target=_read_check(reader, body.get("check"), spec, key))
 
 
 def _read_marker_type(
@@ -288,3 +290,21 @@ def _read_marker_type(
         expected = MARKER_PARAM_TYPE[marker].name.lower()
         reader.fail(key, f"a {marker.name.lower()} marker fills {expected} parameters only")
     return marker
+
+
+def _read_check(
+    reader: DocumentReader, raw: object, spec: ParameterSpec, key: str
+) -> SiteCheck | None:
+    """A target check: on a pose, or on an area (a list an area marker fills)."""
+    if raw is None:
+        return None
+    names = {check.value: check for check in SiteCheck}
+    if raw not in names:
+        reader.fail(f"{key}.check", f"must be one of {', '.join(names)}, got {raw!r}")
+    check = names[str(raw)]
+    area = spec.type is ParamType.LIST and spec.marker_type is MarkerType.AREA
+    if spec.type is not ParamType.POSE and not area:
+        reader.fail(f"{key}.check", "applies to pose parameters and areas (marker: area) only")
+    if area and check is SiteCheck.REACHABLE_GROUND:
+        reader.fail(f"{key}.check", "reachable_ground checks one point; an area takes on_site")
+    return check

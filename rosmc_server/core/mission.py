@@ -20,6 +20,7 @@ from .library import Library
 from .model import SkillStatus, TaskMarker, Transfer
 from .params import Pose
 from .reconcile import Reconciliation, RobotSkill, plan_reconcile
+from .site import SiteGuard
 from .state import MissionContent, MissionState
 from .updates import apply_event
 
@@ -61,6 +62,8 @@ class Mission:
         self._clock = clock
         self._new_id = new_id
         self.operator_revision = revision
+        # The site skill targets are checked against (the server hands it each new map).
+        self.site = SiteGuard()
 
     @property
     def revision(self) -> int:
@@ -96,7 +99,7 @@ class Mission:
             timeout,
             max_retries,
         )
-        return self._commit(proposal)
+        return self._commit(self._on_site(proposal))
 
     def edit_skill(
         self,
@@ -111,18 +114,17 @@ class Mission:
     ) -> MissionEvent:
         """Change a blueprint skill's parameters, bindings, label or options."""
         self._check_revision(base_revision)
-        return self._commit(
-            editing.plan_edit_skill(
-                self.state,
-                self.library,
-                skill_id,
-                params or {},
-                bindings or {},
-                label,
-                timeout,
-                max_retries,
-            )
+        proposal = editing.plan_edit_skill(
+            self.state,
+            self.library,
+            skill_id,
+            params or {},
+            bindings or {},
+            label,
+            timeout,
+            max_retries,
         )
+        return self._commit(self._on_site(proposal))
 
     def delete_skills(
         self, skill_ids: Sequence[str], *, base_revision: int | None = None
@@ -263,9 +265,8 @@ class Mission:
     ) -> MissionEvent:
         """Move a task marker; bound parameters follow."""
         self._check_revision(base_revision)
-        return self._commit(
-            markers.plan_move_marker(self.state, self.library, name, pose, vertices)
-        )
+        proposal = markers.plan_move_marker(self.state, self.library, name, pose, vertices)
+        return self._commit(self._on_site(proposal))
 
     def rename_marker(
         self, name: str, new_name: str, *, base_revision: int | None = None
@@ -328,11 +329,13 @@ class Mission:
             content.library, tasks, dict(content.barriers), dict(content.markers)
         )
         return self._commit(
-            Proposal(
-                EventKind.MISSION_REPLACED,
-                "",
-                f"mission loaded from {source}",
-                Change(replacement=loaded),
+            self._on_site(
+                Proposal(
+                    EventKind.MISSION_REPLACED,
+                    "",
+                    f"mission loaded from {source}",
+                    Change(replacement=loaded),
+                )
             )
         )
 
@@ -356,6 +359,11 @@ class Mission:
             self._clock(),
             proposal.change,
         )
+
+    def _on_site(self, proposal: Proposal) -> Proposal:
+        """``proposal`` if the targets it sets suit the known site; RuleViolation if not."""
+        self.site.check(self.library, self.state, proposal.change)
+        return proposal
 
     def _check_revision(self, base_revision: int | None) -> None:
         """Refuse a request made before another operator's change (or from the future).

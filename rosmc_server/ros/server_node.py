@@ -16,7 +16,9 @@ simulator's science state and world markers on change (see :mod:`.recorder`).
 
 Subscribes:
     ``/<agent>/telemetry`` (rosmc/Telemetry) and the robot links' ack, report and
-    snapshot topics; ``/tf``, ``/rosmc/sim/science`` and ``/rosmc/sim/world`` (to journal).
+    snapshot topics; ``/tf``, ``/rosmc/sim/science`` and ``/rosmc/sim/world`` (to journal);
+    ``/rosmc/site`` (rosmc/SiteMap, latched): the site skill targets are checked against
+    (see :mod:`.site_listener`).
 
 Parameters (private):
     ``~library`` (str): skill library YAML (default: the shipped Mars team library).
@@ -68,6 +70,7 @@ from .logging_bridge import bridge_logging_to_rosout
 from .operator_services import OperatorServices
 from .publishing import SnapshotPublisher
 from .recorder import TelemetryRecorder
+from .site_listener import SiteListener
 
 _log = logging.getLogger(__name__)
 
@@ -146,6 +149,7 @@ class MissionServer:
         self._agent_states.start()
         self._recorder.start()
         self._services.advertise()
+        self._site = SiteListener(self)
         threading.Thread(target=self._tick_link, name="link", daemon=True).start()
         _log.info(
             "mission server ready: library %s, %d agents, revision %d, journal %s",

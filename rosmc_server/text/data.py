@@ -142,6 +142,7 @@ def _parameter_to_json(param: ParameterSpec) -> dict[str, Any]:
         "unit": param.unit,
         "description": param.description,
         "marker": param.marker_type.name.lower() if param.marker_type is not None else None,
+        "check": param.check_target.value if param.check_target is not None else None,
     }
 
 

@@ -194,6 +194,8 @@ def _skill_spec_lines(skill: SkillSpec) -> list[str]:
             text += f", one of {'|'.join(format_value(c) for c in param.choices)}"
         if param.marker_type is not None:
             text += f", marker {param.marker_type.name.lower()}"
+        if param.check_target is not None:
+            text += f", check {param.check_target.value}"
         if param.description:
             text += f"  # {param.description}"
         lines.append(text)

@@ -25,14 +25,7 @@ class NoPath(Exception):
 
 def obstacle_distance(obstacle: Obstacle, x: float, y: float) -> float:
     """Distance from a point to an obstacle's footprint (0 inside)."""
-    dx, dy = x - obstacle.x, y - obstacle.y
-    if obstacle.shape == "cylinder":
-        return max(0.0, math.hypot(dx, dy) - obstacle.radius)
-    cos, sin = math.cos(-obstacle.yaw), math.sin(-obstacle.yaw)
-    lx, ly = dx * cos - dy * sin, dx * sin + dy * cos
-    ox = max(0.0, abs(lx) - obstacle.size_x / 2)
-    oy = max(0.0, abs(ly) - obstacle.size_y / 2)
-    return math.hypot(ox, oy)
+    return obstacle.footprint().distance(x, y)
 
 
 @dataclass
@@ -60,11 +53,12 @@ class Grid:
         height = math.ceil((y_max - y_min) / resolution)
         blocked = [bytearray(height) for _ in range(width)]
         grid = cls(x_min, y_min, resolution, width, height, blocked)
+        footprints = [o.footprint() for o in obstacles]
         for i in range(width):
             for j in range(height):
                 x, y = grid.center(i, j)
                 near_edge = min(x - x_min, x_max - x, y - y_min, y_max - y) < clearance / 2
-                if near_edge or any(obstacle_distance(o, x, y) < clearance for o in obstacles):
+                if near_edge or any(f.distance(x, y) < clearance for f in footprints):
                     blocked[i][j] = 1
         return grid
 

@@ -15,6 +15,7 @@ import yaml
 
 from rosmc_server.core.documents import DocumentReader, load_yaml
 from rosmc_server.core.errors import RosmcError
+from rosmc_server.core.site import Footprint, Shape
 
 SCENARIO_VERSION = 1
 ROBOT_KINDS = ("drone", "science_rover", "manipulator_rover")
@@ -38,6 +39,12 @@ class Obstacle:
     size_x: float = 0.0
     size_y: float = 0.0
     yaw: float = 0.0
+
+    def footprint(self) -> Footprint:
+        """Its footprint on the ground, as sites describe obstacles."""
+        shape = Shape.CYLINDER if self.shape == "cylinder" else Shape.BOX
+        sizes = (self.radius, self.size_x, self.size_y, self.yaw, self.height)
+        return Footprint(self.name, shape, self.x, self.y, *sizes)
 
 
 @dataclass(frozen=True)

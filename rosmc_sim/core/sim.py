@@ -128,11 +128,13 @@ class Simulation:
                 self.stones[name] = stone
                 if world is not None:
                     world.add_stone(name, stone.x, stone.y)
-        clearance = max(max(ROBOT_SIZE[k][:2]) for k in ROBOT_SIZE) / 2 + 0.4
+        # How far a rover's path keeps from obstacles, and half of it from the site's edge.
+        self.clearance = max(max(ROBOT_SIZE[k][:2]) for k in ROBOT_SIZE) / 2 + 0.4
         # The lander is an obstacle too: rovers drive around it, never across it.
         side = 2 * scenario.lander_radius
         lander = Obstacle("lander", "box", 0.0, 0.0, 1.2, size_x=side, size_y=side)
-        self.grid = Grid.build(scenario.bounds, (*scenario.obstacles, lander), clearance)
+        self.ground_obstacles = (*scenario.obstacles, lander)
+        self.grid = Grid.build(scenario.bounds, self.ground_obstacles, self.clearance)
 
     # -- motion --------------------------------------------------------------------
     def plan(self, robot: Robot, x: float, y: float) -> list[tuple[float, float]]:

@@ -5,8 +5,9 @@ public operator services only (like the ``rosmc`` CLI would):
 
 1. plan: the drone surveys an area; the manipulator rover fetches the Wi-Fi box
    for a spot; the science rover heads out; synchronize and start;
-2. adapt: the planned Wi-Fi spot lies on the ridge, so the not-yet-run
-   ``place_box`` is unsynchronized, its marker moved, and re-synchronized;
+2. adapt: the planned Wi-Fi spot at the foot of the ridge lies in its radio shadow,
+   so the not-yet-run ``place_box`` is unsynchronized, its marker moved, and
+   re-synchronized (a spot on the ridge itself the server would refuse at once);
 3. once the drone has discovered a region, both rovers identify its stones
    together (a skill barrier), the manipulator picks the best stone and brings
    it to the lander;
@@ -39,7 +40,7 @@ from .topics import SCIENCE_TOPIC
 T = TypeVar("T")
 
 SURVEY = ((9.0, 3.0), (23.0, 3.0), (23.0, 15.0), (9.0, 15.0))
-WIFI_SPOT_PLANNED = Pose(21.5, -8.0)  # on the ridge: not traversable
+WIFI_SPOT_PLANNED = Pose(19.0, -8.0)  # at the foot of the ridge, in its radio shadow
 WIFI_SPOT_ADAPTED = Pose(15.0, -13.0, 0.0, 0.0, 0.0, -0.6)
 OPERATOR_KINDS = {
     EventKind.SKILL_ADDED,
@@ -104,7 +105,7 @@ class DemoOperator:
             client.synchronize(agent)
         self._wait("the robots stored their skills", self._nothing_uploading)
         client.control(ControlCommand.START)
-        say("started; the planned Wi-Fi spot lies on the ridge: adapting")
+        say("started; the planned Wi-Fi spot lies in the ridge's radio shadow: adapting")
         client.unsynchronize("manipulator_rover", place)
         self._wait("the manipulator rover gave place_box back", lambda: self._editable(place))
         client.move_marker("Wi-Fi spot", WIFI_SPOT_ADAPTED)

@@ -15,7 +15,9 @@ Topics (names in :mod:`rosmc_sim.ros.topics`; stamps are sim time):
   (:mod:`rosmc_sim.ros.robot_state`);
 * ``/rosmc/sim/science`` (rosmc/ScienceState, latched) (:mod:`rosmc_sim.ros.science`);
 * ``/rosmc/sim/world`` (visualization_msgs/MarkerArray, latched)
-  (:mod:`rosmc_sim.ros.world_markers`).
+  (:mod:`rosmc_sim.ros.world_markers`);
+* ``/rosmc/site`` (rosmc/SiteMap, latched, once): the site the mission server checks skill
+  targets against (:mod:`rosmc_sim.ros.site_publisher`).
 
 Private parameters: ``~scenario`` (path, relative ones resolved against the
 ``rosmc_sim`` package; default ``rosmc_sim/scenarios/mars_sample_return.yaml``),
@@ -49,6 +51,7 @@ from ..core.sim import Simulation
 from ..core.world import World
 from .robot_state import RobotStatePublisher
 from .science import SciencePublisher
+from .site_publisher import SitePublisher
 from .task_channel import TaskChannel
 from .task_desk import TaskDesk
 from .timing import Pacer
@@ -146,6 +149,7 @@ class SimNode:
         self.state = RobotStatePublisher(self.sim)
         self.science = SciencePublisher(self.sim)
         self.world_markers = WorldPublisher(self.sim)
+        self.site = SitePublisher(self.sim)
         self._clock = ClockSource()
         self.steps = 0
 

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-# The science state and world markers are journaled by the server: their names live in the
-# shared table.
-from rosmc_server.interface import SCIENCE_TOPIC, WORLD_TOPIC
+# The science state and world markers are journaled by the server, and the server checks
+# skill targets against the site: their names live in the shared table.
+from rosmc_server.interface import SCIENCE_TOPIC, SITE_TOPIC, WORLD_TOPIC
 
-__all__ = ["SCIENCE_TOPIC", "SIM_NODE", "WORLD_TOPIC"]
+__all__ = ["SCIENCE_TOPIC", "SIM_NODE", "SITE_TOPIC", "WORLD_TOPIC"]
 
 SIM_NODE = "/rosmc/sim"
 

@@ -214,6 +214,7 @@ def test_library_as_text_and_json(server: Server) -> None:
     text, data = run_many(server.env, [["library", "drone"], ["--json", "library"]])
     assert text.stdout.startswith("library mars_sample_return\ndrone (dynamic, model drone_scout)")
     assert "    altitude: float = 5 m, range 1..30" in text.stdout
+    assert "    target: pose = 0,0,0,0,0,0, marker pose, check on_site" in text.stdout
     assert "science_rover" not in text.stdout
     agents = json.loads(data.stdout)["agents"]
     assert [a["name"] for a in agents][:4] == [
@@ -241,6 +242,7 @@ def test_library_as_text_and_json(server: Server) -> None:
         "unit": "m",
         "description": "Height above the ground to climb to.",
         "marker": None,
+        "check": None,
     }
 
 

@@ -72,7 +72,12 @@ LEGAL: dict[tuple[SkillStatus, Transfer], set[tuple[SkillStatus, Transfer]]] = {
         (S.FAILURE, _N),
     },
     (S.IDLE_SYNCHRONIZED, _R): {(S.IDLE, _N), (S.IDLE_SYNCHRONIZED, _N)},
-    (S.SYNCWAITING, _N): {(S.RUNNING, _N), (S.PAUSED, _N), (S.IDLE_SYNCHRONIZED, _N)},
+    (S.SYNCWAITING, _N): {
+        (S.RUNNING, _N),
+        (S.PAUSED, _N),
+        (S.IDLE_SYNCHRONIZED, _N),
+        (S.FAILURE, _N),  # gave up waiting (its timeout)
+    },
     (S.RUNNING, _N): {(S.PAUSED, _N), (S.SUCCESS, _N), (S.FAILURE, _N), (S.IDLE_SYNCHRONIZED, _N)},
     (S.PAUSED, _N): {(S.RUNNING, _N), (S.SYNCWAITING, _N), (S.IDLE_SYNCHRONIZED, _N)},
     (S.SUCCESS, _N): set(),
@@ -348,6 +353,68 @@ def test_pause_and_resume_at_a_barrier(rosmc: Start) -> None:
         S.SUCCESS,
     ]
     assert skew(running_stamps(system.journal), [early, late]) <= BARRIER_SKEW
+
+
+def failed_at_the_barrier(op: Operator) -> tuple[str, str, str]:
+    """r1's member gives up waiting (its 1 s timeout) before r2 arrives; r2 then waits for r1.
+
+    Returns (r1's failed member, r2's waiting member, the barrier).
+    """
+    member = op.add("r1", "wait", {"duration": 0.2}, timeout=1.0)
+    partner = op.add("r2", "wait", {"duration": 0.2})
+    barrier = op.add_barrier([member, partner])
+    op.sync("r1")
+    op.sync("r2")
+    wait_all_synced(op, [member, partner])
+    op.start("r1")
+    state = op.wait_status([member], S.FAILURE)
+    assert state.skill(member).status_text == (
+        f"timed out after 1 s waiting at barrier '{barrier}' for r2"
+    )
+    op.start("r2")
+    state = op.wait_status([partner], S.SYNCWAITING)
+    assert state.skill(partner).status_text == "waiting for r1"
+    time.sleep(0.5)  # r1 holds at its failure: r2 keeps waiting
+    assert op.mission().skill(partner).status is S.SYNCWAITING
+    return member, partner, barrier
+
+
+def test_a_member_that_failed_at_its_barrier_is_retried_and_starts_with_its_partner(
+    rosmc: Start,
+) -> None:
+    system, op = rosmc(agents=("r1", "r2"))
+    member, partner, barrier = failed_at_the_barrier(op)
+    mark = len(op.events)
+    fresh = op.retry(member)
+    state = op.wait_status([fresh, partner], S.SUCCESS)
+    assert state.barrier(barrier).skill_ids == (fresh, partner)
+    retried = next(m for _, m in op.events.since(mark) if m.kind == wire.MissionEvent.SKILL_RETRIED)
+    assert f"barrier '{barrier}' now waits for '{fresh}'" in retried.summary
+    system.stop("server")
+    lines = journal_timelines(system.journal)
+    assert timeline(lines, fresh) == [
+        (S.IDLE_SYNCHRONIZED, _N),
+        (S.SYNCWAITING, _N),
+        (S.RUNNING, _N),
+        (S.SUCCESS, _N),
+    ]
+    assert [t.status for t in lines[partner]][-3:] == [S.SYNCWAITING, S.RUNNING, S.SUCCESS]
+    for skill_id in (member, fresh, partner):
+        assert_legal(lines, skill_id)
+    started = skew(running_stamps(system.journal), [fresh, partner])
+    print(f"start skew of a retried member and its waiting partner: {started * 1000:.1f} ms")
+    assert started <= BARRIER_SKEW
+
+
+def test_skipping_a_member_that_failed_at_its_barrier_lets_its_partner_go_on(
+    rosmc: Start,
+) -> None:
+    _, op = rosmc(agents=("r1", "r2"))
+    member, partner, _ = failed_at_the_barrier(op)
+    op.skip(member)
+    state = op.wait_status([partner], S.SUCCESS)
+    assert state.barriers == ()
+    assert state.skill(member).resolution is Resolution.SKIPPED
 
 
 def test_failure_retry_skip_and_a_retry_that_succeeds(rosmc: Start) -> None:

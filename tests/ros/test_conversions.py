@@ -35,6 +35,8 @@ from rosmc_server.conversions import (
     param_to_msg,
     pose_from_msg,
     pose_to_msg,
+    site_from_msg,
+    site_to_msg,
     skill_from_msg,
     skill_to_msg,
 )
@@ -50,6 +52,7 @@ from rosmc_server.core import (
     Barrier,
     Change,
     EventKind,
+    InvalidRequest,
     Library,
     MarkerType,
     MissionContent,
@@ -67,6 +70,7 @@ from rosmc_server.core import (
 )
 from rosmc_server.core.changes import SkillMove
 from rosmc_server.core.commands import CommandKind
+from rosmc_server.core.site import Footprint, GroundRobot, Shape, SiteCheck, SiteModel
 from rosmc_server.executor.core import Signal, SignalKind
 
 
@@ -218,7 +222,13 @@ def test_the_library_survives_with_every_parameter_attribute() -> None:
         unit="m/s",
         description="Cruise speed.",
     )
-    target = ParameterSpec("target", ParamType.POSE, POSE, marker_type=MarkerType.POSE)
+    target = ParameterSpec(
+        "target",
+        ParamType.POSE,
+        POSE,
+        marker_type=MarkerType.POSE,
+        check_target=SiteCheck.REACHABLE_GROUND,
+    )
     mode = ParameterSpec("mode", ParamType.STRING, "quick", choices=("quick", "deep"))
     tries = ParameterSpec("tries", ParamType.INT, 2, minimum=1, maximum=5, choices=(1, 2, 5))
     assert_no_default_field(speed, target, mode, tries)
@@ -235,6 +245,44 @@ def test_the_library_survives_with_every_parameter_attribute() -> None:
     back = library_from_msg(over_the_wire(library_to_msg(library)))
     assert back.name == library.name and back.agents == library.agents
     assert back.skills_of("rover") == library.skills_of("rover")
+
+
+def test_the_site_map_survives_with_every_field() -> None:
+    rock = Footprint("rock", Shape.CYLINDER, 9.0, 6.0, radius=1.6, height=1.8)
+    ridge = Footprint("ridge", Shape.BOX, 22.0, -9.0, 0.5, 2.0, 14.0, 0.25, 3.0)
+    rover = GroundRobot("science_rover", "science_rover", 1.45, 0.9)
+    site = SiteModel("mars", (-40.0, 40.0, -30.0, 30.0), (rock, ridge), (rover,))
+    assert_no_default_field(rock, ridge)
+    assert_no_default_field(rover)
+    assert_no_default_field(site)
+    msg = over_the_wire(site_to_msg(site, 12.5))
+    assert (msg.frame_id, msg.stamp.to_sec()) == ("map", 12.5)
+    assert site_from_msg(msg) == site
+
+
+@pytest.mark.parametrize(
+    ("change", "fragment"),
+    [
+        ({"frame_id": "odom"}, "is in frame 'odom', not 'map'"),
+        ({"x_max": -50.0}, "bounds with no area"),
+        ({"y_min": float("nan")}, "not finite"),
+    ],
+)
+def test_a_site_map_the_server_cannot_check_against_is_refused(
+    change: dict[str, Any], fragment: str
+) -> None:
+    msg = site_to_msg(SiteModel("mars", (-40.0, 40.0, -30.0, 30.0)), 0.0)
+    for name, value in change.items():
+        setattr(msg, name, value)
+    with pytest.raises(InvalidRequest, match=fragment):
+        site_from_msg(msg)
+
+
+def test_an_obstacle_of_unknown_shape_is_refused() -> None:
+    msg = site_to_msg(SiteModel("mars", (-40.0, 40.0, -30.0, 30.0)), 0.0)
+    msg.obstacles = [wire.SiteObstacle(name="blob", shape=7)]
+    with pytest.raises(InvalidRequest, match="unknown shape"):
+        site_from_msg(msg)
 
 
 def test_every_agent_state_field_reaches_the_agent_status() -> None:

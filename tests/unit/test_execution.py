@@ -12,6 +12,7 @@ from rosmc_server.core import (
     EventKind,
     InvalidRequest,
     MarkerType,
+    MissionState,
     NotFound,
     Pose,
     Resolution,
@@ -21,6 +22,8 @@ from rosmc_server.core import (
     TaskMarker,
     Transfer,
 )
+from rosmc_server.core.commands import CommandKind, commands_for_event
+from rosmc_server.core.updates import BarrierPut, BarrierRemoved, apply_and_describe, apply_event
 
 S = SkillStatus
 
@@ -295,17 +298,169 @@ def test_retry_of_running_skill_refused(
     rejected(mission, RuleViolation, mission.skip, synced[0], match="RUNNING")
 
 
-def test_retry_leaves_the_barrier_with_the_original(mission: Any, drv: Any) -> None:
+# -- a failed barrier member: retry and skip ------------------------------------------
+
+
+@pytest.fixture
+def waiting_pair(mission: Any, drv: Any) -> tuple[str, str, str]:
+    """alpha's ``a`` and bravo's ``b`` in one barrier, synchronized; returns (a, b, barrier)."""
     a, b = drv.add("alpha"), drv.add("bravo")
-    barrier = mission.add_barrier([a, b]).change.put_barriers[0]
+    barrier = mission.add_barrier([a, b]).change.put_barriers[0].id
     drv.sync("alpha")
     drv.sync("bravo")
-    mission.report_status(a, S.SYNCWAITING)
+    return a, b, barrier
+
+
+def fail_waiting(mission: Any, skill_id: str) -> None:
+    """The robot reaches the barrier, then gives up waiting (its timeout)."""
+    mission.report_status(skill_id, S.SYNCWAITING)
+    mission.report_status(skill_id, S.FAILURE, text="timed out after 5 s waiting at barrier")
+
+
+def test_a_member_that_failed_before_the_release_hands_its_place_to_the_retry(
+    mission: Any, drv: Any, accepted: Any, waiting_pair: tuple[str, str, str]
+) -> None:
+    a, b, barrier = waiting_pair
     mission.report_status(b, S.SYNCWAITING)
-    drv.finish(a, S.FAILURE)
+    fail_waiting(mission, a)
+    event = accepted(mission, EventKind.SKILL_RETRIED, mission.retry, a)
+    fresh = event.change.put_skills[1].skill.id
+    assert mission.state.barrier(barrier).skill_ids == (fresh, b)  # the order is kept
+    assert mission.state.barrier_of(fresh).id == barrier
+    assert mission.state.barrier_of(a) is None  # the failure stays as a log, outside
+    assert event.change.put_barriers == (mission.state.barrier(barrier),)
+    assert f"barrier '{barrier}' now waits for '{fresh}' (its partners on bravo" in event.summary
+    # The robots hear the new barrier sets first, then the retry.
+    specs = commands_for_event(event, mission.state)
+    assert [(c.agent, c.kind) for c in specs] == [
+        ("alpha", CommandKind.BARRIERS),
+        ("bravo", CommandKind.BARRIERS),
+        ("alpha", CommandKind.RETRY),
+    ]
+    assert specs[1].barriers == (mission.state.barrier(barrier),)
+    # The partner waits on; the new attempt starts with it.
+    mission.report_status(fresh, S.SYNCWAITING)
+    mission.report_status(fresh, S.RUNNING)
+    mission.report_status(b, S.RUNNING)
+
+
+def test_a_member_that_failed_before_reaching_the_barrier_rejoins_too(
+    mission: Any, waiting_pair: tuple[str, str, str]
+) -> None:
+    a, b, barrier = waiting_pair
+    mission.report_status(a, S.FAILURE, text="could not reach the start point")
     fresh = mission.retry(a).change.put_skills[1].skill.id
-    assert mission.state.barrier(barrier.id).skill_ids == (a, b)
+    assert mission.state.barrier(barrier).skill_ids == (fresh, b)
+
+
+def test_a_retry_after_the_release_runs_alone(
+    mission: Any, drv: Any, waiting_pair: tuple[str, str, str]
+) -> None:
+    a, b, barrier = waiting_pair
+    for member in (a, b):
+        mission.report_status(member, S.SYNCWAITING)
+        mission.report_status(member, S.RUNNING)
+    mission.report_status(a, S.FAILURE)
+    event = mission.retry(a)
+    fresh = event.change.put_skills[1].skill.id
+    assert mission.state.barrier(barrier).skill_ids == (a, b)  # the log of who started together
     assert mission.state.barrier_of(fresh) is None
+    assert event.change.put_barriers == () and event.change.removed_barrier_ids == ()
+    assert f"its barrier '{barrier}' had released" in event.summary
+    assert "the new attempt runs alone" in event.summary
+    kinds = [c.kind for c in commands_for_event(event, mission.state)]
+    assert kinds == [CommandKind.RETRY]
+    drv.finish(b)  # the partner finishing counts as released as well
+    drv.finish(fresh)
+
+
+def test_a_second_failure_of_the_fresh_instance_passes_the_place_on(
+    mission: Any, waiting_pair: tuple[str, str, str]
+) -> None:
+    a, b, barrier = waiting_pair
+    fail_waiting(mission, a)
+    fresh = mission.retry(a).change.put_skills[1].skill.id
+    fail_waiting(mission, fresh)
+    third = mission.retry(fresh).change.put_skills[1].skill
+    assert third.attempt == 3
+    assert mission.state.barrier(barrier).skill_ids == (third.id, b)
+
+
+def test_skipping_a_failed_member_dissolves_a_two_member_barrier(
+    mission: Any, accepted: Any, waiting_pair: tuple[str, str, str]
+) -> None:
+    a, b, barrier = waiting_pair
+    mission.report_status(b, S.SYNCWAITING)
+    fail_waiting(mission, a)
+    event = accepted(mission, EventKind.SKILL_SKIPPED, mission.skip, a)
+    assert mission.state.barriers == ()
+    assert event.change.removed_barrier_ids == (barrier,)
+    assert f"barrier '{barrier}' is dissolved, so bravo goes on alone" in event.summary
+    specs = commands_for_event(event, mission.state)
+    assert [(c.agent, c.kind, c.barriers) for c in specs] == [
+        ("alpha", CommandKind.BARRIERS, ()),
+        ("bravo", CommandKind.BARRIERS, ()),
+        ("alpha", CommandKind.SKIP, ()),
+    ]
+    mission.report_status(b, S.RUNNING)  # the partner is free to go
+
+
+def test_skipping_a_failed_member_of_three_leaves_the_others_together(
+    mission: Any, drv: Any, waiting_pair: tuple[str, str, str]
+) -> None:
+    a, b, _ = waiting_pair
+    mission.delete_barrier(mission.state.barrier_of(a).id)
+    c = drv.add("charlie")
+    drv.sync("charlie")
+    barrier = mission.add_barrier([a, b, c]).change.put_barriers[0].id
+    fail_waiting(mission, a)
+    event = mission.skip(a)
+    assert mission.state.barrier(barrier).skill_ids == (b, c)
+    assert "whose other members (bravo, charlie) still start together" in event.summary
+
+
+def test_skipping_a_member_that_failed_after_the_release_keeps_the_barrier(
+    mission: Any, drv: Any, waiting_pair: tuple[str, str, str]
+) -> None:
+    a, b, barrier = waiting_pair
+    drv.run(a)
+    drv.run(b)
+    drv.finish(a, S.FAILURE)
+    event = mission.skip(a)
+    assert mission.state.barrier(barrier).skill_ids == (a, b)
+    assert event.change.put_barriers == () and event.summary.endswith("skipped")
+
+
+def test_the_barrier_change_of_a_retry_and_a_skip_replays_identically(
+    mission: Any, waiting_pair: tuple[str, str, str]
+) -> None:
+    a, b, _ = waiting_pair
+    start = MissionState(mission.state.content(), mission.revision)
+    described = MissionState(mission.state.content(), mission.revision)
+    events = [
+        mission.report_status(a, S.SYNCWAITING),
+        mission.report_status(a, S.FAILURE),
+    ]
+    events.append(mission.retry(a))
+    fresh = events[-1].change.put_skills[1].skill.id
+    events += [
+        mission.report_status(fresh, S.SYNCWAITING),
+        mission.report_status(fresh, S.FAILURE),
+        mission.skip(fresh),
+    ]
+    puts, removed = [], []
+    for event in events:
+        apply_event(start, event)
+        for change in apply_and_describe(described, event):
+            if isinstance(change, BarrierPut):
+                puts.append((change.old.skill_ids if change.old else None, change.new.skill_ids))
+            if isinstance(change, BarrierRemoved):
+                removed.append(change.barrier.skill_ids)
+    for state in (start, described):
+        assert state.content() == mission.state.content()
+        assert state.revision == mission.revision
+    assert puts == [((a, b), (fresh, b))]
+    assert removed == [(fresh, b)]
 
 
 def test_retry_on_stale_revision(mission: Any, drv: Any, rejected: Any, synced: list[str]) -> None:

@@ -953,6 +953,111 @@ def test_a_barrier_with_a_stopped_peer_never_releases(pair: Team) -> None:
     assert pair["r1"].status("b1") is S.SYNCWAITING
 
 
+# -- a member that fails at its barrier: the wait timeout, retry and skip -------------------
+def waiting_team(timeout: float = 2.0) -> Team:
+    """r1 holds b1 (its wait bounded by ``timeout``), r2 holds a2 (3 s) then b2; one barrier."""
+    team = Team("r1", "r2")
+    barrier = barrier_of(("b1", "r1"), ("b2", "r2"))
+    team["r1"].upload(make_skill("b1", agent="r1", timeout=timeout), barriers=(barrier,))
+    team["r2"].upload(
+        make_skill("a2", agent="r2", params={"duration": 3.0}),
+        make_skill("b2", agent="r2"),
+        barriers=(barrier,),
+    )
+    return team
+
+
+def retry_b1(team: Team, barriers_first: bool) -> None:
+    """The ground's retry of b1 as b1x: new barrier sets for both robots and the RETRY."""
+    rejoined = barrier_of(("b1x", "r1"), ("b2", "r2"))
+    fresh = replace(make_skill("b1x", agent="r1"), attempt=2)
+    if barriers_first:
+        team["r1"].send(K.BARRIERS, barriers=(rejoined,))
+    team["r1"].send(K.RETRY, skill_ids=("b1",), skills=(fresh,))
+    team.deliver()
+    team["r2"].send(K.BARRIERS, barriers=(rejoined,))
+    team.deliver()
+
+
+def test_a_member_gives_up_waiting_after_its_timeout_and_withdraws() -> None:
+    team = waiting_team(timeout=2.0)
+    r1 = team["r1"]
+    r1.send(K.START)
+    team.tick(1.9)
+    assert r1.status("b1") is S.SYNCWAITING
+    team.tick(0.1)
+    assert r1.status("b1") is S.FAILURE
+    assert r1.skill("b1").status_text == "timed out after 2 s waiting at barrier 'B' for r2"
+    assert r1.out.signals[-1].kind is SignalKind.WITHDRAWN
+    assert r1.out.trail("b1") == [S.SYNCWAITING, S.FAILURE]
+    assert r1.engine.state_name() == "holding"  # no automatic retry of a wait
+
+
+def test_paused_time_does_not_count_against_the_wait_timeout() -> None:
+    team = waiting_team(timeout=2.0)
+    r1 = team["r1"]
+    r1.send(K.START)
+    team.tick(1.5)
+    r1.send(K.PAUSE)
+    team.tick(10.0)
+    r1.send(K.RESUME)
+    team.tick(0.4)
+    assert r1.status("b1") is S.SYNCWAITING
+    team.tick(0.1)
+    assert r1.status("b1") is S.FAILURE
+
+
+@pytest.mark.parametrize("barriers_first", [True, False], ids=["barriers-first", "retry-first"])
+def test_a_retried_member_rejoins_and_starts_with_the_waiting_partner(
+    barriers_first: bool,
+) -> None:
+    team = waiting_team(timeout=2.0)
+    r1, r2 = team["r1"], team["r2"]
+    r1.send(K.START)
+    r2.send(K.START)
+    team.tick(3.5)  # r1 gave up at 2 s; r2 reached b2 at 3 s and waits for r1
+    assert r1.status("b1") is S.FAILURE
+    assert r2.status("b2") is S.SYNCWAITING and r2.skill("b2").status_text == "waiting for r1"
+    retry_b1(team, barriers_first)
+    assert r1.status("b1x") is S.RUNNING and r2.status("b2") is S.RUNNING
+    assert r1.skill("b1x").started == r2.skill("b2").started
+    assert r1.out.trail("b1x") == [S.SYNCWAITING, S.RUNNING]
+    assert r1.engine.board.barrier_of("b1") is None
+
+
+def test_a_retry_after_the_release_runs_alone() -> None:
+    team = Team("r1", "r2")
+    r1, r2 = team["r1"], team["r2"]
+    barrier = barrier_of(("b1", "r1"), ("b2", "r2"))
+    probe = make_skill("b1", "probe", agent="r1", params={"duration": 0.5, "fail": True})
+    r1.upload(probe, barriers=(barrier,))
+    r2.upload(make_skill("b2", agent="r2"), barriers=(barrier,))
+    r2.send(K.START)
+    team.deliver()
+    r1.send(K.START)  # r2 is ready: r1 releases the barrier itself
+    team.deliver(lose=frozenset({"r2"}))  # and never hears r2's RELEASED
+    assert r1.status("b1") is S.RUNNING and r2.status("b2") is S.RUNNING
+    team.tick(1.0)
+    assert r1.status("b1") is S.FAILURE and r2.status("b2") is S.SUCCESS
+    signals = len(r1.out.signals)
+    fresh = replace(probe, id="b1x", attempt=2, params={"duration": 0.5})
+    r1.send(K.RETRY, skill_ids=("b1",), skills=(fresh,))  # the ground leaves the barrier be
+    assert r1.status("b1x") is S.RUNNING  # at once: it released once, it waits for nobody
+    assert r1.out.signals[signals:] == []
+
+
+def test_a_waiting_partner_goes_on_when_the_failed_member_is_skipped() -> None:
+    team = waiting_team(timeout=1.0)
+    r1, r2 = team["r1"], team["r2"]
+    r1.send(K.START)
+    r2.send(K.START)
+    team.tick(3.5)
+    assert r1.status("b1") is S.FAILURE and r2.status("b2") is S.SYNCWAITING
+    r2.send(K.BARRIERS, barriers=())  # the ground dissolved the barrier
+    r1.send(K.SKIP, skill_ids=("b1",))
+    assert r2.status("b2") is S.RUNNING
+
+
 # -- lost-link policy ------------------------------------------------------------------------
 def hold_after(seconds: float) -> str:
     return json.dumps({"lost_link": {"policy": "hold", "after": seconds}})

@@ -20,6 +20,7 @@ from rosmc_server.core import (
     load_library,
 )
 from rosmc_server.core.library import library_from_dict
+from rosmc_server.core.site import SiteCheck
 
 
 def write(tmp_path: Path, data: Any, name: str = "team.yaml") -> Path:
@@ -54,7 +55,10 @@ def test_shipped_library_loads(shipped_library: Any) -> None:
     mode = shipped_library.skill("science_rover", "identify_stones").parameter("mode")
     assert mode.choices == ("quick", "standard", "detailed")
     target = shipped_library.skill("manipulator_rover", "navigate_to").parameter("target")
-    assert target.type is ParamType.POSE and target.default == Pose(0.0, 0.0)
+    # Beside the lander, not on it: a rover's target must be ground it can stand on.
+    assert target.type is ParamType.POSE and target.default == Pose(5.0, 0.0)
+    assert target.check_target is SiteCheck.REACHABLE_GROUND
+    assert fly_over.parameter("area").check_target is SiteCheck.ON_SITE
 
 
 def test_shipped_library_every_dynamic_agent_has_skills(shipped_library: Any) -> None:

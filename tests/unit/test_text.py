@@ -204,6 +204,7 @@ def test_library_json(library: Library) -> None:
         "unit": "m/s",
         "description": "",
         "marker": None,
+        "check": None,
     }
     assert data["agents"][3]["skills"] == []
 

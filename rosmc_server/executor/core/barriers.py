@@ -3,8 +3,10 @@
 Each robot waiting at a barrier skill announces READY and keeps re-announcing
 until released (messages may be lost). It starts as soon as it knows every
 other member is ready, or hears that a member already started (RELEASED),
-which can only happen once everybody was ready. A member that pauses, stops
-or is unsynchronized while waiting sends WITHDRAWN.
+which can only happen once everybody was ready. A member that pauses, stops,
+gives up waiting (its timeout) or is unsynchronized while waiting sends WITHDRAWN.
+A member retried after failing before the release hands its place to the fresh
+instance (:meth:`BarrierBoard.member_retried`), as the ground does.
 
 Readiness is soft state: a READY counts for :data:`READY_LEASE` seconds (of
 the hearing robot's clock) unless repeated, so a member that crashed or
@@ -41,6 +43,25 @@ class BarrierBoard:
             if any(member == skill_id for member, _ in barrier.members):
                 return barrier
         return None
+
+    def released(self, barrier_id: str) -> None:
+        """This robot released the barrier itself: it stays released for this robot."""
+        self._released.add(barrier_id)
+
+    def member_retried(self, failed_id: str, fresh_id: str) -> None:
+        """A failed member is retried: before the release its fresh instance takes its place.
+
+        The ground makes the same change and sends the new set; doing it here too keeps a
+        fresh instance from starting alone should that set arrive after the retry.
+        """
+        barrier = self.barrier_of(failed_id)
+        if barrier is None or barrier.id in self._released:
+            return
+        members = tuple(
+            (fresh_id if skill_id == failed_id else skill_id, agent)
+            for skill_id, agent in barrier.members
+        )
+        self.barriers[barrier.id] = BarrierInfo(barrier.id, members)
 
     def hear(self, signal: Signal, now: float) -> None:
         """Record a peer's signal heard at ``now`` (own signals are ignored)."""

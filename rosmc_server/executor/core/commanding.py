@@ -106,6 +106,8 @@ def _retry(engine: Engine, cmd: Command) -> Ack:
     if not cmd.skill_ids or not cmd.skills:
         return ack(engine, cmd.seq, error="a retry names the failed skill and its new instance")
     answer = queueing.retry(engine.queue, cmd.skill_ids[0], cmd.skills[0])
+    if answer.accepted:
+        engine.board.member_retried(cmd.skill_ids[0], cmd.skills[0].id)
     return _queue_changed(engine, cmd.seq, answer)
 
 

@@ -161,11 +161,11 @@ class Engine:
             return
         if active.behavior is not None and self._status(active.skill_id) is S.RUNNING:
             self._update_running(active, now)
-        elif (
-            self._status(active.skill_id) is S.SYNCWAITING
-            and now - active.last_announce >= ANNOUNCE_PERIOD
-        ):
-            self._announce(active, SignalKind.READY)
+        elif self._status(active.skill_id) is S.SYNCWAITING:
+            if active.deadline and now >= active.deadline:
+                self._give_up_waiting(active)
+            elif now - active.last_announce >= ANNOUNCE_PERIOD:
+                self._announce(active, SignalKind.READY)
 
     def _update_running(self, active: _Active, now: float) -> None:
         assert active.behavior is not None
@@ -226,6 +226,8 @@ class Engine:
         if active.barrier is None:
             self._run(active)
             return
+        if upcoming.timeout > 0:  # the timeout bounds the wait too: partners may never come
+            active.deadline = self.clock() + upcoming.timeout
         self._set(upcoming.id, S.SYNCWAITING, text=self._waiting_text(active.barrier))
         self._announce(active, SignalKind.READY)
         self._try_release(active)
@@ -242,8 +244,25 @@ class Engine:
             # Still waiting. Who for is in the snapshot (waiting_on); a report per peer
             # arrival would cost n^2 reports over the ground link for an n-robot barrier.
             return
+        self.board.released(barrier.id)
         self._announce(active, SignalKind.RELEASED)
         self._run(active)
+
+    def _give_up_waiting(self, active: _Active) -> None:
+        """The wait at the barrier outlasted the skill's timeout: it fails, partners are told.
+
+        No automatic retry: those re-run a skill that failed running. The robot holds
+        until the operator retries (the fresh instance takes this one's place in the
+        barrier) or skips (the barrier goes on without it).
+        """
+        skill = self._find(active.skill_id)
+        assert skill is not None and active.barrier is not None
+        missing = ", ".join(self.board.missing(active.barrier, self.clock()))
+        self._announce(active, SignalKind.WITHDRAWN)
+        self._active = None
+        text = f"timed out after {skill.timeout:g} s waiting at barrier '{active.barrier.id}'"
+        self._set(skill.id, S.FAILURE, text=text + (f" for {missing}" if missing else ""),
+                  finished=self.clock())  # fmt: skip
 
     def _waiting_text(self, barrier: BarrierInfo) -> str:
         missing = self.board.missing(barrier, self.clock())
@@ -317,19 +336,19 @@ class Engine:
         status = self._status(active.skill_id)
         if status is S.RUNNING and active.behavior is not None:
             active.behavior.pause()
-            active.paused_at = self.clock()
         elif status is S.SYNCWAITING:
             self._announce(active, SignalKind.WITHDRAWN)
         else:
             return
+        active.paused_at = self.clock()
         active.paused_from = status
         self._set(active.skill_id, S.PAUSED, text=why)
 
     def _resume_active(self, active: _Active) -> None:
+        if active.deadline:  # time spent paused counts against no timeout, running or waiting
+            active.deadline += self.clock() - active.paused_at
         if active.paused_from is S.RUNNING and active.behavior is not None:
             active.behavior.resume()
-            if active.deadline:  # time spent paused does not count against the timeout
-                active.deadline += self.clock() - active.paused_at
             self._set(active.skill_id, S.RUNNING, text="")
         else:
             if active.barrier is not None:

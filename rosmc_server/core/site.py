@@ -1,0 +1,234 @@
+"""The site the robots work on, and the checks of skill targets against it.
+
+A map provider (the simulator, or a real site's mapping) publishes the site: its bounds,
+the ground footprints of its obstacles, and how far each ground robot keeps from them and
+from the edge. A skill parameter (a pose, or an area's corners) may declare a named check
+with ``check:`` in the library:
+
+* ``on_site``: the point, or every corner of the area, lies within the site's bounds
+  (what a flying robot, which crosses obstacles, or an area to survey needs);
+* ``reachable_ground``: a point a ground robot can stand on: on the site, at least its edge
+  margin inside the edge, and at least its clearance away from every obstacle footprint.
+
+The mission runs the checks through :class:`SiteGuard` when a skill is added or edited,
+when a task marker bound to it moves, and when a mission is loaded, and refuses a bad
+target with one sentence that says where it lies and what to pick instead. With no site
+known the checks are skipped, and the first skipped check says so once in the log.
+"""
+
+from __future__ import annotations
+
+import enum
+import logging
+import math
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from .errors import InvalidRequest, RuleViolation
+from .model import SkillInstance, SkillStatus
+from .params import Pose, Value
+
+if TYPE_CHECKING:
+    from .changes import Change
+    from .library import Library, ParameterSpec
+    from .state import MissionState
+
+_log = logging.getLogger(__name__)
+
+
+class SiteCheck(enum.Enum):
+    """A named check of a target against the site (the library's ``check:`` values)."""
+
+    ON_SITE = "on_site"
+    REACHABLE_GROUND = "reachable_ground"
+
+
+class Shape(enum.IntEnum):
+    """The shape of an obstacle's footprint (numbers match ``rosmc/SiteObstacle``)."""
+
+    CYLINDER = 0
+    BOX = 1
+
+
+@dataclass(frozen=True)
+class Footprint:
+    """An obstacle's footprint on the ground: a circle, or a rectangle turned by ``yaw``."""
+
+    name: str
+    shape: Shape
+    x: float
+    y: float
+    radius: float = 0.0
+    size_x: float = 0.0
+    size_y: float = 0.0
+    yaw: float = 0.0
+    height: float = 0.0
+
+    def distance(self, x: float, y: float) -> float:
+        """Distance from a point to the footprint (0 on or inside it)."""
+        dx, dy = x - self.x, y - self.y
+        if self.shape is Shape.CYLINDER:
+            return max(0.0, math.hypot(dx, dy) - self.radius)
+        cos, sin = math.cos(-self.yaw), math.sin(-self.yaw)
+        along, across = dx * cos - dy * sin, dx * sin + dy * cos
+        return math.hypot(
+            max(0.0, abs(along) - self.size_x / 2), max(0.0, abs(across) - self.size_y / 2)
+        )
+
+
+@dataclass(frozen=True)
+class GroundRobot:
+    """How far a ground robot's targets must keep from obstacles and from the site's edge."""
+
+    agent: str
+    kind: str = ""
+    clearance: float = 0.0
+    edge_margin: float = 0.0
+
+
+@dataclass(frozen=True)
+class SiteModel:
+    """A site as its map provider describes it; every coordinate is in the map frame."""
+
+    name: str
+    bounds: tuple[float, float, float, float]  # x_min, x_max, y_min, y_max
+    obstacles: tuple[Footprint, ...] = ()
+    robots: tuple[GroundRobot, ...] = ()
+
+    def robot(self, agent: str) -> GroundRobot:
+        """What ``agent`` keeps clear of (nothing beyond the footprints if the site omits it)."""
+        return next((r for r in self.robots if r.agent == agent), GroundRobot(agent))
+
+    def problem(self, check: SiteCheck, agent: str, x: float, y: float) -> str:
+        """What is wrong with (x, y) as ``agent``'s target under ``check``; "" if nothing."""
+        x_min, x_max, y_min, y_max = self.bounds
+        if not (x_min <= x <= x_max and y_min <= y <= y_max):
+            return (
+                f"lies off the site '{self.name}' (x {x_min:g} to {x_max:g} m, "
+                f"y {y_min:g} to {y_max:g} m); pick a point on it"
+            )
+        if check is SiteCheck.ON_SITE:
+            return ""
+        robot = self.robot(agent)
+        edge = min(x - x_min, x_max - x, y - y_min, y_max - y)
+        if edge < robot.edge_margin:
+            return (
+                f"lies {edge:.1f} m from the site's edge, closer than {agent} keeps "
+                f"({robot.edge_margin:.1f} m); pick a point farther inside"
+            )
+        distances = sorted((o.distance(x, y), o.name) for o in self.obstacles)
+        if distances and distances[0][0] <= 0.0:
+            return f"lies inside obstacle '{distances[0][1]}'; pick a point outside it"
+        if distances and distances[0][0] < robot.clearance:
+            distance, name = distances[0]
+            return (
+                f"lies {distance:.1f} m from obstacle '{name}', closer than {agent} keeps "
+                f"({robot.clearance:.1f} m); pick a point farther from it"
+            )
+        return ""
+
+
+def check_site(site: SiteModel) -> SiteModel:
+    """Return ``site`` if a mission can check targets against it; InvalidRequest otherwise."""
+    x_min, x_max, y_min, y_max = site.bounds
+    numbers = [*site.bounds]
+    for o in site.obstacles:
+        numbers += [o.x, o.y, o.radius, o.size_x, o.size_y, o.yaw, o.height]
+        if min(o.radius, o.size_x, o.size_y, o.height) < 0:
+            raise InvalidRequest(f"obstacle '{o.name}' of site '{site.name}' has a negative size")
+    for r in site.robots:
+        numbers += [r.clearance, r.edge_margin]
+        if min(r.clearance, r.edge_margin) < 0:
+            raise InvalidRequest(
+                f"robot '{r.agent}' of site '{site.name}' keeps a negative distance"
+            )
+    if not all(math.isfinite(n) for n in numbers):
+        raise InvalidRequest(f"site '{site.name}' holds a number that is not finite")
+    if not (x_min < x_max and y_min < y_max):
+        raise InvalidRequest(f"site '{site.name}' has bounds with no area")
+    return site
+
+
+class SiteGuard:
+    """The newest site the mission knows, and the target checks it runs against it.
+
+    The mission owns one; the server hands it each site its map provider publishes.
+    """
+
+    def __init__(self) -> None:
+        self.site: SiteModel | None = None
+        self._said_unchecked = False
+
+    def update(self, site: SiteModel) -> None:
+        """Check targets against ``site`` from now on (skills already added stay as they are)."""
+        self.site = check_site(site)
+
+    def check(self, library: Library, state: MissionState, change: Change) -> None:
+        """Refuse ``change`` if a blueprint skill it puts has a target the site rules out.
+
+        Only checked parameters whose value the change sets anew count: editing a label
+        never fails for a target that was fine when the site was unknown.
+        """
+        for skill, is_new in _blueprint_skills(state, change):
+            old = None if is_new or change.replacement else state.skill(skill.id)
+            spec = library.skill(skill.agent, skill.skill)
+            for param in spec.parameters:
+                value = skill.params.get(param.name)
+                if param.check_target is None or value is None:
+                    continue
+                if old is not None and old.params.get(param.name) == value:
+                    continue
+                if self.site is None:
+                    self._say_unchecked()
+                    return
+                self._check_value(self.site, skill, is_new, param, value)
+
+    def _check_value(
+        self,
+        site: SiteModel,
+        skill: SkillInstance,
+        is_new: bool,
+        param: ParameterSpec,
+        value: Value,
+    ) -> None:
+        assert param.check_target is not None
+        for what, x, y in _points(param.name, value):
+            problem = site.problem(param.check_target, skill.agent, x, y)
+            if problem:
+                owner = f"{skill.agent}'s '{skill.skill}'" + ("" if is_new else f" ({skill.id})")
+                marker = skill.bindings.get(param.name)
+                bound = f", bound to marker '{marker}'," if marker else ""
+                raise RuleViolation(f"{what} of {owner}{bound} {problem}")
+
+    def _say_unchecked(self) -> None:
+        if not self._said_unchecked:
+            self._said_unchecked = True
+            _log.info(
+                "skill targets are not checked against the site: no site map is known yet "
+                "(the simulator or a map provider publishes one)"
+            )
+
+
+def _blueprint_skills(state: MissionState, change: Change) -> Iterator[tuple[SkillInstance, bool]]:
+    """The blueprint skills a change puts, each with whether it is new to the operator."""
+    if change.replacement is not None:
+        for task in change.replacement.tasks.values():
+            yield from ((s, False) for s in task if s.status is SkillStatus.IDLE)
+        return
+    for placed in change.put_skills:
+        if placed.skill.status is SkillStatus.IDLE:
+            yield placed.skill, not state.has_skill(placed.skill.id)
+
+
+def _points(name: str, value: Value) -> Sequence[tuple[str, float, float]]:
+    """The points of a pose or an area value, each with how a sentence names it."""
+    if isinstance(value, Pose):
+        return [(f"{name} ({value.x:.1f}, {value.y:.1f})", value.x, value.y)]
+    if isinstance(value, list):
+        corners = [(float(p["x"]), float(p["y"])) for p in value if isinstance(p, dict)]
+        return [
+            (f"corner {i} ({x:.1f}, {y:.1f}) of {name}", x, y)
+            for i, (x, y) in enumerate(corners, 1)
+        ]
+    return []
