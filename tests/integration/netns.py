@@ -262,6 +262,17 @@ class RadioLab:
         robot_end = run_ip(show[0], "-n", host.namespace, *show[1:], ROBOT_RADIO)
         return ground_end.stdout + robot_end.stdout
 
+    def tune_tcp(self, rto_max_ms: int, retries: int = 100) -> None:
+        """Cap TCP's retransmission backoff at ``rto_max_ms`` on every host of the lab.
+
+        (``net.ipv4.tcp_rto_max_ms``, Linux 6.11 and later, a per-namespace setting.) With a
+        lower cap a connection gives up after fewer seconds of ``tcp_retries2`` attempts, so
+        ``retries`` raises that too: a long outage must not close the robots' connections.
+        """
+        for host in self.hosts.values():
+            settings = (f"net.ipv4.tcp_rto_max_ms={rto_max_ms}", f"net.ipv4.tcp_retries2={retries}")
+            run_ip(*self.command(host.name, ["sysctl", "-q", "-w", *settings]))
+
     # -- processes ------------------------------------------------------------------------
     def master_uri(self, port: int = 11311) -> str:
         """The URI of a master that runs on the ground at ``port``."""
