@@ -80,7 +80,10 @@ _rosmc_default_ros_ip() {
     host="${ROS_MASTER_URI#*://}"
     host="${host%%/*}"
     host="${host%:*}"
-    address="$(getent ahostsv4 "$host" 2>/dev/null | awk 'NR == 1 { print $1 }')"
+    case "$host" in
+        localhost | 127.*) address="127.0.0.1" ;;
+        *) address="$(getent ahostsv4 "$host" 2>/dev/null | awk 'NR == 1 { print $1 }')" ;;
+    esac
     if [[ "$address" == 127.* ]]; then
         export ROS_IP="127.0.0.1"
         return 0
@@ -90,8 +93,8 @@ _rosmc_default_ros_ip() {
             sed -n 's/.* src \([0-9.]*\).*/\1/p')"
     fi
     if [[ -z "${src:-}" ]]; then
-        echo "env.sh: no route to the master's host '$host' (ROS_MASTER_URI); set ROS_IP" \
-            "to this machine's address that the other machines reach" >&2
+        echo "env.sh: no address of this machine towards the master's host '$host'" \
+            "(ROS_MASTER_URI); set ROS_IP to the address the other machines reach" >&2
         return 0
     fi
     export ROS_IP="$src"

@@ -11,7 +11,9 @@ ground; no link emulator). Measured at full speed, then with every radio limited
   ``/rosmc/mission_events`` (``bench_executor.sync_to_start``, run by the operator on the
   ground);
 * ``barrier_skew``: max - min of the members' RUNNING stamps, per barrier of all robots,
-  which arrive 20 ms apart (``bench_executor.barrier_rounds``).
+  which arrive 20 ms apart (``bench_executor.barrier_rounds``);
+* ``idle_radio``: bytes per second each way on every robot's radio while nothing happens
+  (heartbeats and the robot's periodic snapshot), with the number of skills it holds.
 
 Then, still at ``--rate``, ``after_outage_of_every_radio`` / ``_of_one_radio``: every
 radio (or the first robot's) goes down (``ip link set down``) while the robots run towards
@@ -40,6 +42,7 @@ import shutil
 import sys
 import tempfile
 import time
+from collections import Counter
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
@@ -50,7 +53,7 @@ sys.path.insert(0, str(REPO))
 from bench_executor import print_figures, summary, team_library  # noqa: E402
 
 from tests.integration.multihost_fixtures import LabSystem, lab_base_env  # noqa: E402
-from tests.integration.netns import RadioLab, unavailable  # noqa: E402
+from tests.integration.netns import RadioLab, can_cap_tcp_backoff, unavailable  # noqa: E402
 from tests.integration.remote_operator import RemoteOperator  # noqa: E402
 
 MEASURES = "bench.bench_executor"  # run by the operator, next to the server
@@ -70,6 +73,24 @@ def link_figures(
     if stall:
         figures["stalled"] = stall
     return figures
+
+
+def idle_radio(
+    op: RemoteOperator, lab: RadioLab, agents: Sequence[str], seconds: float
+) -> dict[str, Any]:
+    """What every idle robot's radio carries per second, and how many skills the robot holds."""
+    before = {agent: lab.sent_bytes(agent) for agent in agents}
+    time.sleep(seconds)
+    after = {agent: lab.sent_bytes(agent) for agent in agents}
+    held = Counter(agent for _, _, agent in op("statuses").values())
+    return {
+        agent: {
+            "skills_on_robot": held[agent],
+            "downlink_bytes_per_s": round((after[agent][0] - before[agent][0]) / seconds),
+            "uplink_bytes_per_s": round((after[agent][1] - before[agent][1]) / seconds),
+        }
+        for agent in agents
+    }
 
 
 def outage_round(
@@ -157,10 +178,11 @@ def measure(args: argparse.Namespace, work: Path) -> dict[str, Any]:
         }
         lab.shape(args.rate)
         figures[f"tbf_{args.rate}"] = link_figures(op, agents, args.samples, args.rounds)
+        figures["idle_radio"] = idle_radio(op, lab, agents, 5.0)
         outages = (op, lab, agents, args.outages, args.outage)
         figures["after_outage_of_every_radio"] = outage_figures(*outages, agents)
         figures["after_outage_of_one_radio"] = outage_figures(*outages, agents[:1])
-    if not Path("/proc/sys/net/ipv4/tcp_rto_max_ms").exists():
+    if not can_cap_tcp_backoff():
         figures["rto_max"] = "net.ipv4.tcp_rto_max_ms needs Linux 6.11 or later"
         return figures
     with team(args, work / "rto_max", args.rto_max_ms) as (lab, op, _):

@@ -61,6 +61,7 @@ HEADLINES: dict[str, tuple[str, ...]] = {
         "*.barrier_skew.max_ms",
         "after_outage*.restore_to_last_start.median_ms",
         "after_outage*.restore_to_last_start.max_ms",
+        "idle_radio.*.uplink_bytes_per_s",
     ),
 }
 

@@ -78,6 +78,11 @@ def unavailable() -> str:
     return ""
 
 
+def can_cap_tcp_backoff() -> bool:
+    """Whether this kernel has ``net.ipv4.tcp_rto_max_ms`` (Linux 6.11 and later)."""
+    return os.path.exists("/proc/sys/net/ipv4/tcp_rto_max_ms")
+
+
 def namespace_pids(namespace: str) -> list[int]:
     """The processes running in ``namespace``."""
     result = run_ip("ip", "netns", "pids", namespace, check=False)
@@ -272,6 +277,13 @@ class RadioLab:
         for host in self.hosts.values():
             settings = (f"net.ipv4.tcp_rto_max_ms={rto_max_ms}", f"net.ipv4.tcp_retries2={retries}")
             run_ip(*self.command(host.name, ["sysctl", "-q", "-w", *settings]))
+
+    def sent_bytes(self, robot: str) -> tuple[int, int]:
+        """Bytes a robot's radio has sent since it was shaped: (to the robot, from the robot)."""
+        counts = [int(n) for n in re.findall(r"Sent (\d+) bytes", self.qdisc(robot))]
+        if len(counts) != 2:
+            raise LabError(f"{robot}'s radio is not shaped: {self.qdisc(robot)}")
+        return counts[0], counts[1]
 
     # -- processes ------------------------------------------------------------------------
     def master_uri(self, port: int = 11311) -> str:
