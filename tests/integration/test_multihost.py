@@ -71,8 +71,9 @@ OPERATOR_BOUND = 1.0
 # retransmission, then what queued meanwhile drains through the 256 kbit/s radios. The
 # hosts run as the README advises (TCP's backoff capped at TCP_RTO_MAX_MS): every
 # connection resumes within a second, the drain takes well under one. Without the cap the
-# wait grows with the outage (bench_multihost.py: up to 1.2 s after 15 s of every radio
-# out, 7 s after 15 s of one); where the kernel cannot cap it, the bound is the outage.
+# wait depends on the backoff reached (bench_multihost.py, 15 s outages: the last member
+# started up to 1.6 s after every radio returned, 8.3 s after one radio did); where the
+# kernel cannot cap it, the bound is the outage itself.
 TCP_RTO_MAX_MS = 1000
 SKEW_FULL_SPEED = 0.050
 SKEW_AFTER_OUTAGE = 1.5 if can_cap_tcp_backoff() else OUTAGE
