@@ -57,18 +57,47 @@ _rosmc_env_main() {
     unset -f _rosmc_prepend
 
     # Devel setup.bash defaults the master to localhost; ours is explicit loopback unless the
-    # caller chose one. ROS_IP defaults to loopback unless the caller set ROS_IP or
-    # ROS_HOSTNAME (for a team spread over several machines, set them before sourcing).
+    # caller chose one. Unless the caller set ROS_IP or ROS_HOSTNAME, ROS_IP is loopback for
+    # a master on this machine and, for a master on another machine, this machine's address
+    # on the way there: nodes advertise it, and the other machines connect to it (loopback
+    # there would send every peer to itself).
     if [[ -n "$had_master_uri" ]]; then
         export ROS_MASTER_URI="$had_master_uri"
     else
         export ROS_MASTER_URI="http://127.0.0.1:11311"
     fi
     if [[ -z "${ROS_IP:-}" && -z "${ROS_HOSTNAME:-}" ]]; then
-        export ROS_IP="127.0.0.1"
+        _rosmc_default_ros_ip
     fi
     export ROSMC_ROOT="$root"
     return "$status"
+}
+
+# Set ROS_IP for ROS_MASTER_URI's host: 127.0.0.1 for a loopback master, else the source
+# address of this machine's route to it. Without a route it says what to do and sets nothing.
+_rosmc_default_ros_ip() {
+    local host address src
+    host="${ROS_MASTER_URI#*://}"
+    host="${host%%/*}"
+    host="${host%:*}"
+    case "$host" in
+        localhost | 127.*) address="127.0.0.1" ;;
+        *) address="$(getent ahostsv4 "$host" 2>/dev/null | awk 'NR == 1 { print $1 }')" ;;
+    esac
+    if [[ "$address" == 127.* ]]; then
+        export ROS_IP="127.0.0.1"
+        return 0
+    fi
+    if [[ -n "$address" ]]; then
+        src="$(ip -4 -o route get "$address" 2>/dev/null |
+            sed -n 's/.* src \([0-9.]*\).*/\1/p')"
+    fi
+    if [[ -z "${src:-}" ]]; then
+        echo "env.sh: no address of this machine towards the master's host '$host'" \
+            "(ROS_MASTER_URI); set ROS_IP to the address the other machines reach" >&2
+        return 0
+    fi
+    export ROS_IP="$src"
 }
 
 # Run with the caller's -e/-u switched off (catkin's setup.bash and venv's activate are not
@@ -79,7 +108,7 @@ _rosmc_env_main
 _rosmc_env_status=$?
 if [[ "$_rosmc_env_opts" == *e* ]]; then set -e; fi
 if [[ "$_rosmc_env_opts" == *u* ]]; then set -u; fi
-unset -f _rosmc_env_main
+unset -f _rosmc_env_main _rosmc_default_ros_ip
 unset _rosmc_env_opts
 # The status is expanded before the unset runs. 1 means `make setup` has not run yet.
 eval "unset _rosmc_env_status; return $_rosmc_env_status"

@@ -278,6 +278,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     finally:
         if not args.keep:
             shutil.rmtree(work, ignore_errors=True)
+    print_figures(figures, began)
+    return 0
+
+
+def print_figures(figures: dict[str, Any], began: float) -> None:
+    """Print ``figures`` as JSON with the machine and the wall time since ``began``."""
     figures["machine"] = {
         "cpus": os.cpu_count(),
         "python": platform.python_version(),
@@ -285,7 +291,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     }
     figures["wall_time_s"] = round(time.monotonic() - began, 1)
     print(json.dumps(figures, indent=2))
-    return 0
 
 
 if __name__ == "__main__":

@@ -56,6 +56,15 @@ HEADLINES: dict[str, tuple[str, ...]] = {
     "executor": ("*sync_to_start*median_ms", "*barrier_skew*median_ms", "*barrier_skew*max_ms"),
     "sim": ("*.rtf", "*cpu_share"),
     "demo": ("runs.*.score", "runs.*.mission_sim_s", "runs.*.mission_wall_s"),
+    "multihost": (
+        "*.sync_to_start.robot_running_after_return.median_ms",
+        "*.sync_to_start.operator_sees_running_after_return.median_ms",
+        "*.barrier_skew.median_ms",
+        "*.barrier_skew.max_ms",
+        "after_outage*.restore_to_last_start.median_ms",
+        "after_outage*.restore_to_last_start.max_ms",
+        "idle_radio.*.uplink_bytes_per_s",
+    ),
 }
 
 

@@ -13,7 +13,8 @@ Usage::
     python bench/run_all.py [--only server,scale] [--timeout 900] [--readme]
 
 A benchmark that fails or prints no JSON is recorded with its exit code and the tail of its
-output; the run goes on with the next one and exits 1 at the end.
+output; the run goes on with the next one and exits 1 at the end. One that cannot run here
+prints ``{"skipped": reason}`` (``bench_multihost.py`` needs root); the tables say so.
 """
 
 from __future__ import annotations
@@ -133,6 +134,10 @@ def markdown(results: dict[str, Any]) -> str:
         title = f"**{name}** ({bench['seconds']:.0f} s, commit {bench.get('commit', '?')})"
         if bench["figures"] is None:
             lines += [f"{title}: failed (exit {bench['returncode']}), no figures.", ""]
+            continue
+        if isinstance(bench["figures"], dict) and "skipped" in bench["figures"]:
+            # e.g. bench_multihost.py without root: say so instead of leaving it out
+            lines += [f"{title}: skipped: {bench['figures']['skipped']}", ""]
             continue
         if name in CURVES:
             lines += [title, "", *CURVES[name](bench["figures"]), ""]

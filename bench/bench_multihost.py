@@ -1,0 +1,227 @@
+"""Benchmark of the robot link across hosts (network namespaces); prints one JSON object.
+
+Builds a :class:`~tests.integration.netns.RadioLab`: ``rosmaster``, the mission server and
+the operator in a ground namespace, every robot's executor in a namespace of its own,
+talking to the server and to each other over its "radio" (a veth pair into a bridge on the
+ground; no link emulator). Measured at full speed, then with every radio limited to
+``--rate`` by ``tc tbf`` (both directions):
+
+* ``sync_to_start``: from the operator's Synchronize call returning to the skill RUNNING
+  on a started, idle robot (the robot's RUNNING stamp), and to the operator seeing it on
+  ``/rosmc/mission_events`` (``bench_executor.sync_to_start``, run by the operator on the
+  ground);
+* ``barrier_skew``: max - min of the members' RUNNING stamps, per barrier of all robots,
+  which arrive 20 ms apart (``bench_executor.barrier_rounds``);
+* ``idle_radio``: bytes per second each way on every robot's radio while nothing happens
+  (heartbeats and the robot's periodic snapshot), with the number of skills it holds.
+
+Then, still at ``--rate``, ``after_outage_of_every_radio`` / ``_of_one_radio``: every
+radio (or the first robot's) goes down (``ip link set down``) while the robots run towards
+a barrier, and comes back ``--outage`` seconds later; the time from the radios' return to
+the first and the last member starting, and the skew. A robot's connections resume with
+their next TCP retransmission, whose timer backs off while the radio is down; the last
+figures repeat the one-radio outage in a second lab whose hosts cap that backoff
+(``net.ipv4.tcp_rto_max_ms=--rto-max-ms``, Linux 6.11 and later).
+
+All namespaces share one kernel, hence one clock: the robots' stamps, the operator's and
+this script's are directly comparable. Needs root; without it (or where namespaces are
+refused) it prints ``{"skipped": reason}``. Run from the repository root after
+``source env.sh``::
+
+    python bench/bench_multihost.py [--robots 3] [--samples 20] [--rounds 10]
+                                    [--rate 256kbit] [--outages 3] [--outage 15]
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import os
+import shutil
+import sys
+import tempfile
+import time
+from collections import Counter
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
+
+from bench_executor import print_figures, summary, team_library  # noqa: E402
+
+from tests.integration.multihost_fixtures import LabSystem, lab_base_env  # noqa: E402
+from tests.integration.netns import RadioLab, can_cap_tcp_backoff, unavailable  # noqa: E402
+from tests.integration.remote_operator import RemoteOperator  # noqa: E402
+
+MEASURES = "bench.bench_executor"  # run by the operator, next to the server
+
+
+def link_figures(
+    op: RemoteOperator, agents: Sequence[str], samples: int, rounds: int
+) -> dict[str, Any]:
+    """Sync-to-start latency on the first robot and barrier skew across all of them."""
+    latency = op(f"{MEASURES}:sync_to_start", agents[0], samples, timeout=30.0 + samples * 5.0)
+    barriers, stall = op(f"{MEASURES}:barrier_rounds", list(agents), rounds, timeout=40.0 * rounds)
+    started = op("started")
+    skews = [max(started[m] for m in b) - min(started[m] for m in b) for b in barriers]
+    figures: dict[str, Any] = {"sync_to_start": latency}
+    if skews:
+        figures["barrier_skew"] = summary(skews)
+    if stall:
+        figures["stalled"] = stall
+    return figures
+
+
+def idle_radio(
+    op: RemoteOperator, lab: RadioLab, agents: Sequence[str], seconds: float
+) -> dict[str, Any]:
+    """What every idle robot's radio carries per second, and how many skills the robot holds."""
+    before = {agent: lab.sent_bytes(agent) for agent in agents}
+    time.sleep(seconds)
+    after = {agent: lab.sent_bytes(agent) for agent in agents}
+    held = Counter(agent for _, _, agent in op("statuses").values())
+    return {
+        agent: {
+            "skills_on_robot": held[agent],
+            "downlink_bytes_per_s": round((after[agent][0] - before[agent][0]) / seconds),
+            "uplink_bytes_per_s": round((after[agent][1] - before[agent][1]) / seconds),
+        }
+        for agent in agents
+    }
+
+
+def outage_round(
+    op: RemoteOperator, lab: RadioLab, agents: Sequence[str], outage: float, cut: Sequence[str]
+) -> tuple[float, float, float]:
+    """One barrier reached while the radios of ``cut`` are down: (first start, last start, skew).
+
+    The starts are seconds after the radios came back.
+    """
+    ahead = [op("add", agent, "wait", {"duration": 1.5}) for agent in agents]
+    members = [op("add", agent, "wait", {"duration": 0.05}) for agent in agents]
+    op("add_barrier", members)
+    for agent in agents:
+        op("sync", agent)
+    op("wait_status", ahead, "RUNNING", 30.0)
+    lab.cut(cut)
+    time.sleep(outage)
+    restored = time.time()
+    lab.restore(cut)
+    op("wait_status", members, "SUCCESS", 60.0, timeout=70.0)
+    started = op("started")
+    stamps = [started[m] - restored for m in members]
+    if min(stamps) < 0:
+        raise RuntimeError(f"a member started before the radios came back: {stamps}")
+    return min(stamps), max(stamps), max(stamps) - min(stamps)
+
+
+def outage_figures(
+    op: RemoteOperator,
+    lab: RadioLab,
+    agents: Sequence[str],
+    rounds: int,
+    outage: float,
+    cut: Sequence[str],
+) -> dict[str, Any]:
+    """Barrier release after an outage of the radios of ``cut``, over ``rounds`` rounds."""
+    results = [outage_round(op, lab, agents, outage, cut) for _ in range(rounds)]
+    return {
+        "outage_s": outage,
+        "restore_to_first_start": summary([r[0] for r in results]),
+        "restore_to_last_start": summary([r[1] for r in results]),
+        "barrier_skew": summary([r[2] for r in results]),
+    }
+
+
+@contextlib.contextmanager
+def team(
+    args: argparse.Namespace, work: Path, rto_max_ms: int = 0
+) -> Iterator[tuple[RadioLab, RemoteOperator, float]]:
+    """A lab of ``args.robots`` robots, linked and executing: (lab, operator, start-up seconds).
+
+    ``rto_max_ms`` caps TCP's retransmission backoff on every host before any node starts
+    (a socket keeps the setting it was made with).
+    """
+    agents = [f"a{i:02d}" for i in range(1, args.robots + 1)]
+    work.mkdir(parents=True)
+    library = team_library(work, args.robots)
+    with RadioLab(agents, subnet=os.getpid() % 250) as lab:
+        if rto_max_ms:
+            lab.tune_tcp(rto_max_ms)
+        system = LabSystem(lab_base_env(work / "home"), work / "team", library=library, lab=lab)
+        try:
+            system.start_master()
+            system.start_server("_link_timeout:=2.0")
+            began = time.monotonic()
+            for agent in agents:
+                system.start_executor(agent)
+            op = system.operator()
+            op("wait_links", agents, 120.0, timeout=130.0)
+            startup = time.monotonic() - began
+            op("start", "")
+            yield lab, op, startup
+        finally:
+            system.close()
+
+
+def measure(args: argparse.Namespace, work: Path) -> dict[str, Any]:
+    """Every figure: one lab with the kernel's TCP settings, one with the backoff capped."""
+    with team(args, work / "default") as (lab, op, startup):
+        agents = list(lab.robots)
+        figures: dict[str, Any] = {
+            "robots": args.robots,
+            "executors_started_s": round(startup, 1),
+            "full_speed": link_figures(op, agents, args.samples, args.rounds),
+        }
+        lab.shape(args.rate)
+        figures[f"tbf_{args.rate}"] = link_figures(op, agents, args.samples, args.rounds)
+        figures["idle_radio"] = idle_radio(op, lab, agents, 5.0)
+        outages = (op, lab, agents, args.outages, args.outage)
+        figures["after_outage_of_every_radio"] = outage_figures(*outages, agents)
+        figures["after_outage_of_one_radio"] = outage_figures(*outages, agents[:1])
+    if not can_cap_tcp_backoff():
+        figures["rto_max"] = "net.ipv4.tcp_rto_max_ms needs Linux 6.11 or later"
+        return figures
+    with team(args, work / "rto_max", args.rto_max_ms) as (lab, op, _):
+        lab.shape(args.rate)
+        outages = (op, lab, list(lab.robots), args.outages, args.outage)
+        figures[f"after_outage_of_one_radio_rto_max_{args.rto_max_ms}ms"] = outage_figures(
+            *outages, lab.robots[:1]
+        )
+    return figures
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the benchmark and print its JSON."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--robots", type=int, default=3, help="robots, one namespace each")
+    parser.add_argument("--samples", type=int, default=20, help="sync-to-start samples")
+    parser.add_argument("--rounds", type=int, default=10, help="barrier rounds")
+    parser.add_argument("--rate", default="256kbit", help="tbf rate of every radio")
+    parser.add_argument("--outages", type=int, default=3, help="outage rounds")
+    parser.add_argument("--outage", type=float, default=15.0, help="seconds each outage lasts")
+    parser.add_argument(
+        "--rto-max-ms", type=int, default=1000, help="net.ipv4.tcp_rto_max_ms of the last rounds"
+    )
+    parser.add_argument("--keep", action="store_true", help="keep the work directory")
+    args = parser.parse_args(argv)
+    reason = unavailable()
+    if reason:
+        print(json.dumps({"skipped": reason}))
+        return 0
+    work = Path(tempfile.mkdtemp(prefix="bench_multihost_"))
+    began = time.monotonic()
+    try:
+        figures = measure(args, work)
+    finally:
+        if not args.keep:
+            shutil.rmtree(work, ignore_errors=True)
+    print_figures(figures, began)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
