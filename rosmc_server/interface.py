@@ -30,6 +30,10 @@ TF_TOPIC = "/tf"  # tf2_msgs/TFMessage: map -> <agent>/base_link
 SCIENCE_TOPIC = f"{NAMESPACE}/sim/science"  # rosmc/ScienceState, latched: regions and score
 WORLD_TOPIC = f"{NAMESPACE}/sim/world"  # visualization_msgs/MarkerArray, latched: the site
 
+# A replay (``rosmc replay``) is steered through one service and says where it is.
+REPLAY_CONTROL_SERVICE = f"{NAMESPACE}/replay/control"  # rosmc/ReplayControl
+REPLAY_STATE_TOPIC = f"{NAMESPACE}/replay/state"  # rosmc/ReplayState, latched
+
 # Operator services of the mission server: name -> srv type name.
 SERVICES = {
     "add_skill": "AddSkill",
