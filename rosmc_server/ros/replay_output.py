@@ -7,7 +7,7 @@ after a seek back are shifted forward (:class:`~rosmc_server.recording.playback.
 since TF listeners drop transforms older than the ones they hold.
 
 Publishes (each name behind the prefix): every topic of :data:`TYPES`, latched as the live
-publishers latch them (:data:`LATCHED`).
+publishers latch them (:data:`~rosmc_server.recording.channels.LATCHED_TOPICS`).
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import Marker, MarkerArray
 
 from .. import interface
+from ..recording.channels import LATCHED_TOPICS
 from ..recording.playback import Playlist, StampShift
 
 TYPES: dict[str, Any] = {
@@ -35,9 +36,6 @@ TYPES: dict[str, Any] = {
     interface.WORLD_TOPIC: MarkerArray,
 }
 """Every recorded topic with its message class."""
-
-LATCHED = (interface.MISSION_TOPIC, interface.SCIENCE_TOPIC, interface.WORLD_TOPIC)
-"""Latched as their publishers latch them: a late rviz still gets the site and the score."""
 
 CURRENT_AT_START = (
     interface.AGENT_STATES_TOPIC,
@@ -69,7 +67,7 @@ class ReplayOutput:
                 interface.prefixed(topic, prefix),
                 msg_type,
                 queue_size=1000,
-                latch=topic in LATCHED,
+                latch=topic in LATCHED_TOPICS,  # a late rviz still gets the site
             )
             for topic, msg_type in TYPES.items()
         }
