@@ -69,7 +69,7 @@ class MissionFollower:
         self._server_uri: str | None = None  # who answers now (None: nobody)
         self._known_uri: str | None = None  # who answered last
         self._restarted = False
-        self._seeks: int | None = None  # of the replay followed (None: none heard yet)
+        self._seeks: int | None = None  # moves of the replay followed (None: none heard yet)
         self._closed = threading.Event()
         self._retry: threading.Timer | None = None
         self._library: Library | None = None
@@ -159,7 +159,8 @@ class MissionFollower:
     def _on_replay_state(self, msg: wire.ReplayState) -> None:
         seeks = int(msg.seeks)
         before, self._seeks = self._seeks, seeks
-        if before is None or seeks == before or self._closed.is_set():
+        # The first state heard may tell of seeks made before the first fetch answered.
+        if seeks == (before or 0) or self._closed.is_set():
             return
         # A replay moved back publishes revisions the mirror has seen, with other content:
         # its mission is taken whatever its revision, as a restarted server's is.
