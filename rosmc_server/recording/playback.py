@@ -115,7 +115,7 @@ class PlaybackClock:
         """Stop the position where it is (nothing happens if paused already)."""
         with self._changed:
             if not self._paused:
-                self._anchor, self._since = self._position(), self._monotonic()
+                self._rebase()
                 self._paused = True
                 self._changed_now()
             return self._status()
@@ -151,7 +151,7 @@ class PlaybackClock:
         """
         rate = _checked_rate(rate)
         with self._changed:
-            self._anchor, self._since = self._position(), self._monotonic()
+            self._rebase()
             self._rate = rate
             self._changed_now()
             return self._status()
@@ -201,6 +201,10 @@ class PlaybackClock:
         if self._paused or not self._started or self._position() >= self._duration:
             return None
         return ahead / self._rate
+
+    def _rebase(self) -> None:
+        """Count on from the position now (before the rate or the pausing changes)."""
+        self._anchor, self._since = self._position(), self._monotonic()
 
     def _move(self, seconds: float) -> None:
         self._anchor, self._since = self._clamp(seconds), self._monotonic()

@@ -1,18 +1,14 @@
 """Republishing a recorded mission onto the ROS graph, as the mission server published it.
 
-:class:`RecordingReplayer` plays a journal back at a chosen rate: what the server
-recorded at log time ``t`` is published when the replay's position (seconds since the
-recording started, advancing ``rate`` seconds per second) reaches ``t``, so rviz, the
-command GUI and ``rosmc watch`` show the mission evolving. The replay can be paused,
-resumed, moved (seek, backwards too) and sped up while it runs, from the terminal
-(``rosmc replay``) or through its control service. It refuses to play onto names another
-node publishes on (a live mission server); a topic prefix moves the replay out of their way.
-
-After every seek (and at the start) subscribers get the state at the new position: the
-mission then (a snapshot, then the events from there on), the robots' agent states, TF,
-the site and the score as last recorded before it. TF stamps after a seek back are
-shifted forward (:class:`~rosmc_server.recording.playback.StampShift`), so TF listeners
-keep taking them.
+:class:`RecordingReplayer` publishes what the server recorded at log time ``t`` when the
+replay's position (seconds since the recording started, advancing ``rate`` seconds per
+second) reaches ``t``, so rviz, the command GUI and ``rosmc watch`` show the mission
+evolving. It can be paused, resumed, moved (backwards too) and sped up while it runs
+(keys of ``rosmc replay``, or its control service). After every seek, and at the start,
+subscribers get the state at the position: the mission then (a snapshot, then the events
+from there on), the robots' agent states, TF, the site and the score as last recorded.
+It refuses to play onto names another node uses (a live mission server); a topic prefix
+moves the replay out of their way.
 
 Publishes (each name behind ``prefix``):
     ``/rosmc/mission`` (rosmc/Mission, latched): the mission at the start time (and after
@@ -33,10 +29,9 @@ Services (behind ``prefix``):
     a live server.
     ``/rosmc/replay/control`` (rosmc/ReplayControl): pause, resume, seek, rate.
 
-The replayer serves clients and is driven by ``rosmc replay``; it ranks with the client
-(``rosmc_server.ros.client``) in the layers, above the server's adapters. Its callers need
-no rospy: :meth:`RecordingReplayer.run` makes the process a node itself and hands each
-event over as a core :class:`~rosmc_server.core.MissionEvent`.
+The replayer serves clients and ranks with the client in the layers. Its callers need no
+rospy: :meth:`RecordingReplayer.run` makes the process a node itself and hands each event
+over as a core :class:`~rosmc_server.core.MissionEvent`.
 """
 
 from __future__ import annotations
