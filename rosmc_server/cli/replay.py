@@ -78,12 +78,12 @@ def replay(ctx: Context) -> int:
     from ..recording.history import MissionHistory
     from ..ros.replayer import RecordingReplayer, ReplayConfig
     from .replay_session import ReplaySession
-    from .terminal import is_terminal
+    from .terminal import is_terminal, keys_from
 
     args = ctx.args
     result = read_journal(args.file)
     history = _history(MissionHistory(result))
-    keys = sys.stdin if not ctx.json and is_terminal(sys.stdin) else None
+    keys = sys.stdin if not ctx.json and keys_from(sys.stdin) else None
     config = ReplayConfig(
         rate=args.rate, start=args.start, prefix=args.prefix, hold=args.hold or keys is not None
     )

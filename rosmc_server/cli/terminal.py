@@ -39,6 +39,20 @@ def is_terminal(stream: TextIO) -> bool:
         return False
 
 
+def keys_from(stream: TextIO) -> bool:
+    """Whether keys can be read from ``stream``: a terminal whose foreground we run in.
+
+    A job in the background of its terminal (``rosmc replay ... &``) must leave the terminal
+    alone: changing its mode would stop the job (SIGTTOU), and the keys are the shell's.
+    """
+    if not is_terminal(stream):
+        return False
+    try:
+        return os.tcgetpgrp(stream.fileno()) == os.getpgrp()
+    except OSError:  # not this process's controlling terminal: no job control applies
+        return True
+
+
 def key_names(data: bytes) -> list[str]:
     """The keys in bytes read from a terminal: ``space``, ``left``, ``q``, ``[``, ...
 

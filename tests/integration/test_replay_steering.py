@@ -11,6 +11,7 @@ its mode back however the replay ends.
 
 from __future__ import annotations
 
+import fcntl
 import io
 import os
 import pty
@@ -368,3 +369,41 @@ def test_the_terminal_gets_its_mode_back_when_the_replay_is_stopped(
     code = term.close()
     assert code in (0, 130), term.output[-2000:]
     assert termios.tcgetattr(term.slave) == term.mode, "the terminal's mode is back"
+
+
+def test_in_the_background_of_a_terminal_it_leaves_the_terminal_alone(
+    client_node: Any, tmp_path: Path
+) -> None:
+    # `rosmc replay ... &` in an interactive shell: changing the terminal's mode from the
+    # background would stop the job (SIGTTOU); it must play to the end without keys.
+    master, slave = pty.openpty()
+    log = tmp_path / "replay.log"
+    command = (
+        f"set -m; {sys.executable} {ROSMC} replay {SAMPLE} --rate 10 --prefix /bg "
+        f"> {log} 2>&1 & wait %1; jobs -l"
+    )
+
+    def controlling_terminal() -> None:  # as a login shell gets its terminal
+        fcntl.ioctl(0, termios.TIOCSCTTY, 0)
+
+    shell = subprocess.Popen(
+        ["bash", "-c", command],
+        env=dict(client_node.env),
+        stdin=slave,
+        stdout=slave,
+        stderr=slave,
+        start_new_session=True,
+        preexec_fn=controlling_terminal,
+    )
+    try:
+        assert shell.wait(60.0) == 0
+        jobs = b""
+        while select.select([master], [], [], 0.1)[0]:
+            jobs += os.read(master, 65536)
+        assert b"Stopped" not in jobs, jobs
+        assert "replay done at revision" in log.read_text(), log.read_text()[-2000:]
+    finally:
+        if shell.poll() is None:
+            os.killpg(shell.pid, signal.SIGKILL)
+        os.close(master)
+        os.close(slave)
