@@ -85,9 +85,10 @@ class ReplaySession:
             if self._progress:
                 ticker = threading.Thread(target=self._tick, name="rosmc-progress", daemon=True)
                 ticker.start()
+                # Undone last to first: stop the ticker, then erase its line.
+                stack.callback(self._line.close)
                 stack.callback(ticker.join, 2.0)
                 stack.callback(self._done.set)
-                stack.callback(self._line.close)
             return player.run()
 
     def _tick(self) -> None:
@@ -104,7 +105,10 @@ class ReplaySession:
         try:
             if name == "space":
                 status = player.status()
-                _ = player.resume() if status.paused or status.ended else player.pause()
+                if status.paused or status.ended:
+                    player.resume()
+                else:
+                    player.pause()
             elif name in ("left", "right"):
                 player.seek(SEEK_STEP if name == "right" else -SEEK_STEP, relative=True)
             elif name in ("[", "]"):

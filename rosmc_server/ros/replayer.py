@@ -140,8 +140,6 @@ class RecordingReplayer:
         config: ReplayConfig,
         on_event: EventCallback | None = None,
     ) -> None:
-        if not config.rate > 0:
-            raise InvalidRequest(f"the rate must be a positive number, got {config.rate}")
         if not 0 <= config.start <= history.duration:
             raise InvalidRequest(
                 f"the start must be between 0 and {history.duration:.2f} s (the recording's "
