@@ -7,6 +7,7 @@
 #   make test    setup, lint, then pytest over tests/; PYTEST_ARGS=... passes options
 #   make bench   setup, then every bench/ script: bench/results.json, bench/results.md and the
 #                README's figures table; BENCH=server,scale runs only those
+#   make sample  setup, then record bags/samples/demo.mcap anew (after a message change)
 #   make lint    ruff check, ruff format --check, mypy --strict on every rosmc_* package
 #   make format  ruff format and the safe ruff fixes, in place
 #   make clean   remove build/ and the tool caches (keeps .venv)
@@ -44,7 +45,7 @@ PACKAGES = $(patsubst %/__init__.py,%,$(wildcard rosmc_*/__init__.py))
 # Run a command inside the environment of env.sh.
 IN_ENV := source ./env.sh &&
 
-.PHONY: help setup apt venv requirements msgs demo test pytest bench lint format clean
+.PHONY: help setup apt venv requirements msgs demo sample test pytest bench lint format clean
 
 help:
 	@sed -n '1,/^$$/s/^# \{0,1\}//p' Makefile
@@ -89,6 +90,10 @@ $(BUILD)/rosmc.stamp: $(BUILD_INPUTS) | apt
 
 demo: setup
 	$(IN_ENV) rosmc_demo $(if $(filter 1 yes true,$(GUI)),--gui) $(DEMO_ARGS)
+
+# The committed sample recording the replay tests use (tools/record_sample.py says more).
+sample: setup
+	$(IN_ENV) python tools/record_sample.py
 
 test: setup lint pytest
 

@@ -33,6 +33,10 @@ WORLD_TOPIC = f"{NAMESPACE}/sim/world"  # visualization_msgs/MarkerArray, latche
 # mission server checks skill targets against the newest one.
 SITE_TOPIC = f"{NAMESPACE}/site"  # rosmc/SiteMap
 
+# A replay (``rosmc replay``) is steered through one service and says where it is.
+REPLAY_CONTROL_SERVICE = f"{NAMESPACE}/replay/control"  # rosmc/ReplayControl
+REPLAY_STATE_TOPIC = f"{NAMESPACE}/replay/state"  # rosmc/ReplayState, latched
+
 # Operator services of the mission server: name -> srv type name.
 SERVICES = {
     "add_skill": "AddSkill",

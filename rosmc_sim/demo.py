@@ -76,6 +76,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         default=str(PACKAGE_ROOT / "bags"),
         help="where the mission recording goes (default: bags/)",
     )
+    parser.add_argument(
+        "--snapshot-every",
+        type=int,
+        default=500,
+        metavar="N",
+        help="mission events between two full snapshots in the recording (default 500)",
+    )
     args = parser.parse_args(
         [a for a in (argv if argv is not None else sys.argv[1:]) if ":=" not in a]
     )
@@ -97,6 +104,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         f"real_time_factor:={args.real_time_factor}",
         f"latency:={args.latency}",
         f"journal_dir:={journal_dir}",
+        f"snapshot_every:={max(1, args.snapshot_every)}",
         f"timeout:={args.timeout}",
         f"result_file:={result}",
     ]

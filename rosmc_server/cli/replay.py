@@ -18,6 +18,17 @@ if TYPE_CHECKING:  # the commands import ROS late, so that --help stays fast
 
 _Command = Callable[..., argparse.ArgumentParser]
 
+REPLAY_HELP = """\
+rviz, the command GUI and 'rosmc watch' then show the mission evolving.
+Refuses to publish where a live mission server does, unless --prefix
+moves the replay aside.
+
+In a terminal: space pauses and resumes, left/right arrows seek 10 s back
+and forth, [ and ] halve and double the rate, q quits; a progress line
+shows time / duration, revision, rate and whether it is paused. Programs
+steer it through the service <prefix>/rosmc/replay/control
+(rosmc/ReplayControl) and follow it on <prefix>/rosmc/replay/state."""
+
 AT_HELP = """\
 WHEN is seconds since the recording started (12.5) or a revision (r42).
 The mission shown is the one the mission server held then."""
@@ -26,11 +37,7 @@ The mission shown is the one the mission server held then."""
 def add_commands(command: _Command) -> None:
     """Add the recording subcommands through the parser's ``command`` helper."""
     replay = command(
-        "replay",
-        "republish a recording onto the ROS graph (needs a ROS master)",
-        "rviz, the command GUI and 'rosmc watch' then show the mission evolving.\n"
-        "Refuses to publish where a live mission server does, unless --prefix\n"
-        "moves the replay aside.",
+        "replay", "republish a recording onto the ROS graph (needs a ROS master)", REPLAY_HELP
     )
     replay.add_argument("file", metavar="FILE", help="a mission journal (.mcap)")
     replay.add_argument(
@@ -44,6 +51,11 @@ def add_commands(command: _Command) -> None:
         default="",
         metavar="P",
         help="put P before every name, e.g. /replay (default: the live names)",
+    )
+    replay.add_argument(
+        "--hold",
+        action="store_true",
+        help="stay at the end until stopped (always so when keys steer it from a terminal)",
     )
     at = command("at", "print the mission as it was at a time or revision of a recording", AT_HELP)
     at.add_argument("file", metavar="FILE", help="a mission journal (.mcap)")
@@ -61,23 +73,22 @@ def add_commands(command: _Command) -> None:
 
 
 def replay(ctx: Context) -> int:
-    """Republish the recording onto the graph, timed by log time over the rate."""
-    from ..core import MissionEvent
+    """Republish the recording onto the graph, steered from the terminal or the service."""
     from ..recording import read_journal
     from ..recording.history import MissionHistory
     from ..ros.replayer import RecordingReplayer, ReplayConfig
-    from ..text import format_event
+    from .replay_session import ReplaySession
+    from .terminal import is_terminal, keys_from
 
     args = ctx.args
     result = read_journal(args.file)
     history = _history(MissionHistory(result))
-    config = ReplayConfig(rate=args.rate, start=args.start, prefix=args.prefix)
-
-    def show(revision: int, event: MissionEvent | None, seconds: float) -> None:
-        line = format_event(event) if event else f"r{revision} (an event that does not decode)"
-        print(f"[{seconds:8.2f} s] {line}", file=ctx.out, flush=True)
-
-    player = RecordingReplayer(history, result.records, config, None if ctx.json else show)
+    keys = sys.stdin if not ctx.json and keys_from(sys.stdin) else None
+    config = ReplayConfig(
+        rate=args.rate, start=args.start, prefix=args.prefix, hold=args.hold or keys is not None
+    )
+    session = ReplaySession(ctx.out, is_terminal(ctx.out), keys, progress=not ctx.json)
+    player = RecordingReplayer(history, result.records, config, session.event)
     player.check_names()  # refuse before saying anything
     where = f"under {config.topic('')}" if config.topic("") else "on the live topic names"
     ctx.emit(
@@ -86,7 +97,7 @@ def replay(ctx: Context) -> int:
         f"{args.start:g} s at {args.rate:g}x {where}",
         None,
     )
-    revision = player.run()
+    revision = session.run(player)
     ctx.emit(f"replay done at revision {revision}", {"revision": revision})
     return 0
 

@@ -41,6 +41,9 @@ TELEMETRY_TOPICS: Final = (
 )
 """Channels of what the robots and the site did: written, never fsynced on their own."""
 
+LATCHED_TOPICS: Final = (MISSION_TOPIC, SCIENCE_TOPIC, WORLD_TOPIC)
+"""Channels whose live publishers latch them (a replay and a converted bag latch them too)."""
+
 PROFILE: Final = "ros1"
 MESSAGE_ENCODING: Final = "ros1"
 SCHEMA_ENCODING: Final = "ros1msg"

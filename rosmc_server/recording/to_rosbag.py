@@ -1,8 +1,9 @@
 """Converting a mission journal (MCAP) to a rosbag1 file for ``rosbag play``.
 
-Every recorded message keeps its topic and log time; the mission snapshots are
-marked latched, as the mission server publishes them, so a late subscriber to
-a ``rosbag play`` gets the last snapshot played.
+Every recorded message keeps its topic, its log time and its recorded definition
+(type, md5sum and full text, as the journal embeds it); the mission snapshots, the
+site and the score are marked latched, as the mission server and the simulator
+publish them, so a late subscriber to a ``rosbag play`` gets the last one played.
 """
 
 from __future__ import annotations
@@ -15,7 +16,8 @@ from pathlib import Path
 import genpy
 import rosbag
 
-from rosmc_server.interface import MISSION_TOPIC, SERVER_NODE
+from rosmc_server.interface import SERVER_NODE
+from rosmc_server.recording.channels import LATCHED_TOPICS
 from rosmc_server.recording.errors import JournalError
 from rosmc_server.recording.reader import read_journal
 
@@ -69,7 +71,7 @@ def journal_to_rosbag(
                     "md5sum": message._md5sum,
                     "message_definition": message._full_text,
                     "callerid": CALLER_ID,
-                    "latching": "1" if record.topic == MISSION_TOPIC else "0",
+                    "latching": "1" if record.topic in LATCHED_TOPICS else "0",
                 }
                 stamp = genpy.Time(record.log_time // 10**9, record.log_time % 10**9)
                 bag.write(record.topic, message, stamp, connection_header=header)

@@ -1,31 +1,37 @@
 """Republishing a recorded mission onto the ROS graph, as the mission server published it.
 
-:class:`RecordingReplayer` plays a journal back at a chosen rate: what the
-server recorded at log time ``t`` is published ``(t - start) / rate`` seconds
-after the replay began, so rviz, the command GUI and ``rosmc watch`` show the
-mission evolving. It refuses to play onto names another node publishes on
-(a live mission server); a topic prefix moves the replay out of their way.
+:class:`RecordingReplayer` publishes what the server recorded at log time ``t`` when the
+replay's position (seconds since the recording started, advancing ``rate`` seconds per
+second) reaches ``t``, so rviz, the command GUI and ``rosmc watch`` show the mission
+evolving. It can be paused, resumed, moved (backwards too) and sped up while it runs
+(keys of ``rosmc replay``, or its control service). After every seek, and at the start,
+subscribers get the state at the position: the mission then (a snapshot, then the events
+from there on), the robots' agent states, TF, the site and the score as last recorded.
+It refuses to play onto names another node uses (a live mission server); a topic prefix
+moves the replay out of their way.
 
 Publishes (each name behind ``prefix``):
-    ``/rosmc/mission`` (rosmc/Mission, latched): the mission at the start time, then the
-    mission after every burst of events (rebuilt from the recording, as the server
-    coalesces its snapshots).
-    ``/rosmc/mission_events`` (rosmc/MissionEvent): every recorded event after the start.
+    ``/rosmc/mission`` (rosmc/Mission, latched): the mission at the start time (and after
+    every seek), then the mission after every burst of events (rebuilt from the
+    recording, as the server coalesces its snapshots).
+    ``/rosmc/mission_events`` (rosmc/MissionEvent): every recorded event after the position.
     ``/rosmc/agent_states`` (rosmc/AgentStates): as recorded (the latest one at once).
     ``/rosmc/robot_reports`` (rosmc/RobotReport): as recorded.
     ``/tf`` (tf2_msgs/TFMessage): the robots' recorded transforms (``<prefix>/tf`` with a
     prefix: ``roslaunch rosmc rviz.launch ns:=/replay`` remaps rviz's ``/tf`` to it).
     ``/rosmc/sim/science`` (rosmc/ScienceState, latched), ``/rosmc/sim/world``
     (visualization_msgs/MarkerArray, latched): the site and the score, as recorded.
+    ``/rosmc/replay/state`` (rosmc/ReplayState, latched): see :mod:`.replay_control`.
 
 Services (behind ``prefix``):
-    ``/rosmc/get_mission`` (rosmc/GetMission): the mission as replayed so far, so clients that
-    start from it (``rosmc watch``, the GUIs) follow the replay as they follow a live server.
+    ``/rosmc/get_mission`` (rosmc/GetMission): the mission at the replay's position, so
+    clients that start from it (``rosmc watch``, the GUIs) follow the replay as they follow
+    a live server.
+    ``/rosmc/replay/control`` (rosmc/ReplayControl): pause, resume, seek, rate.
 
-The replayer serves clients and is driven by ``rosmc replay``; it ranks with the client
-(``rosmc_server.ros.client``) in the layers, above the server's adapters. Its callers need
-no rospy: :meth:`RecordingReplayer.run` makes the process a node itself and hands each
-event over as a core :class:`~rosmc_server.core.MissionEvent`.
+The replayer serves clients and ranks with the client in the layers. Its callers need no
+rospy: :meth:`RecordingReplayer.run` makes the process a node itself and hands each event
+over as a core :class:`~rosmc_server.core.MissionEvent`.
 """
 
 from __future__ import annotations
@@ -35,22 +41,22 @@ import os
 import threading
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import rosgraph
-import rosmc.msg as wire
 import rosmc.srv as wire_srv
 import rospy
-from tf2_msgs.msg import TFMessage
-from visualization_msgs.msg import MarkerArray
 
 from .. import interface
 from ..conversions import event_from_msg, mission_to_msg
 from ..core import EventKind, InvalidRequest, MissionEvent, NotFound, RosmcError
 from ..recording import JournalRecord
 from ..recording.history import MissionHistory
+from ..recording.playback import PlaybackClock, PlaybackStatus, Playlist
 from .client import ServerUnavailable, init_node
+from .replay_control import ReplayControl
+from .replay_output import TYPES, ReplayOutput
 
 _log = logging.getLogger(__name__)
 
@@ -62,30 +68,10 @@ WARM_UP = 0.5
 """Seconds for subscribers to connect before the first message."""
 LINGER = 1.0
 """Seconds the last messages get to reach their subscribers before the node leaves."""
+SEEK_ANSWER = 10.0
+"""Longest a seek request waits for the replay to publish the state at its new position."""
 
 GET_MISSION = interface.service_name("get_mission")
-
-TYPES: dict[str, Any] = {
-    interface.MISSION_TOPIC: wire.Mission,
-    interface.EVENTS_TOPIC: wire.MissionEvent,
-    interface.AGENT_STATES_TOPIC: wire.AgentStates,
-    interface.ROBOT_REPORTS_TOPIC: wire.RobotReport,
-    interface.TF_TOPIC: TFMessage,
-    interface.SCIENCE_TOPIC: wire.ScienceState,
-    interface.WORLD_TOPIC: MarkerArray,
-}
-
-LATCHED = (interface.MISSION_TOPIC, interface.SCIENCE_TOPIC, interface.WORLD_TOPIC)
-"""Latched as their publishers latch them: a late rviz still gets the site and the score."""
-
-CURRENT_AT_START = (
-    interface.AGENT_STATES_TOPIC,
-    interface.TF_TOPIC,
-    interface.SCIENCE_TOPIC,
-    interface.WORLD_TOPIC,
-)
-"""Topics whose newest message before the start time is published at once."""
-
 
 EventCallback = Callable[[int, MissionEvent | None, float], None]
 """Called with each replayed event: its revision, the event (None if it does not decode)
@@ -104,18 +90,17 @@ class ReplayConfig:
         rate: Speed-up: 2.0 plays twice as fast as recorded.
         start: Seconds since the recording started to begin at.
         prefix: Put before every topic name ("" = the live names, e.g. ``/replay``).
+        hold: At the end, stay (and keep serving) until stopped, instead of leaving.
     """
 
     rate: float = 1.0
     start: float = 0.0
     prefix: str = ""
+    hold: bool = False
 
     def topic(self, name: str) -> str:
         """A recorded topic's name in this replay."""
-        prefix = self.prefix.strip().rstrip("/")
-        if prefix and not prefix.startswith("/"):
-            prefix = "/" + prefix
-        return prefix + name
+        return interface.prefixed(name, self.prefix)
 
 
 def taken_names(names: Sequence[str], caller_id: str = "/rosmc_replay") -> dict[str, list[str]]:
@@ -139,12 +124,12 @@ def taken_names(names: Sequence[str], caller_id: str = "/rosmc_replay") -> dict[
 
 
 class RecordingReplayer:
-    """Plays one recording onto the graph with :meth:`run`.
+    """Plays one recording onto the graph with :meth:`run`; steer it from any thread.
 
     Args:
         history: The recording's history (rebuilds the snapshots).
         records: The recording's records (:attr:`JournalResult.records`).
-        config: Rate, start time and topic prefix.
+        config: Rate, start time, topic prefix, hold.
         on_event: Called with each event as it is published (see :data:`EventCallback`).
     """
 
@@ -155,8 +140,6 @@ class RecordingReplayer:
         config: ReplayConfig,
         on_event: EventCallback | None = None,
     ) -> None:
-        if not config.rate > 0:
-            raise InvalidRequest(f"the rate must be a positive number, got {config.rate}")
         if not 0 <= config.start <= history.duration:
             raise InvalidRequest(
                 f"the start must be between 0 and {history.duration:.2f} s (the recording's "
@@ -165,25 +148,81 @@ class RecordingReplayer:
         self._history = history
         self._config = config
         self._on_event = on_event
-        start_ns = history.start + round(config.start * 1e9)
-        self._before = [r for r in records if r.log_time <= start_ns]
-        self._records = sorted((r for r in records if r.log_time > start_ns), key=_log_time)
+        self._playlist = Playlist(records, history.start)
+        self._clock = PlaybackClock(history.duration, config.start, config.rate)
         self._stop = threading.Event()
-        self._publishers: dict[str, rospy.Publisher] = {}
-        self._revision = -1  # of the last snapshot published
-        self._latest = -1  # of the last event published
-        events = [r.message for r in self._before if r.topic == interface.EVENTS_TOPIC]
-        self._stamp = events[-1].stamp.to_sec() if events else 0.0  # mission clock of _latest
-        self._snapshot: Any = None  # the last snapshot published, for get_mission
+        self._lock = threading.RLock()  # the history, and what was published
+        self._handled = threading.Condition(self._lock)  # a seek's state is out
+        self._handled_seeks = 0
+        self._playing = False
+        self._output: ReplayOutput | None = None
+        self._control: ReplayControl | None = None
+        self._revision = -1  # of the last snapshot published on /rosmc/mission
+        self._current = history.revision_at(config.start).revision  # of the replay's mission
+        self._stamp = self._mission_stamp(config.start)  # mission clock of _current
+        self._built: tuple[int, Any] | None = None  # the last snapshot built, for get_mission
 
+    # -- steering (any thread) -------------------------------------------------------------
+    def status(self) -> PlaybackStatus:
+        """Where the replay is: position, rate, paused, seeks and the mission revision there."""
+        with self._lock:
+            return replace(self._clock.status(), revision=self._current)
+
+    def pause(self) -> PlaybackStatus:
+        """Stop where it is."""
+        self._clock.pause()
+        return self.status()
+
+    def resume(self) -> PlaybackStatus:
+        """Go on; at the end of the recording, play it again from the start."""
+        moved = self._clock.resume()
+        self._await_seek(moved.seeks)
+        return self.status()
+
+    def seek(self, seconds: float, *, relative: bool = False) -> PlaybackStatus:
+        """Move to ``seconds`` since the start (or from the position; clamped to the recording).
+
+        Returns once subscribers have been sent the state at the new position (while the
+        replay plays; at once before :meth:`run` or after it).
+
+        Raises:
+            InvalidRequest: ``seconds`` is not a number.
+        """
+        moved = self._clock.seek(seconds, relative=relative)
+        self._await_seek(moved.seeks)
+        return self.status()
+
+    def set_rate(self, rate: float) -> PlaybackStatus:
+        """Play ``rate`` times as fast as recorded from now on.
+
+        Raises:
+            InvalidRequest: The rate is not a sensible speed-up.
+        """
+        self._clock.set_rate(rate)
+        return self.status()
+
+    def stop(self) -> None:
+        """End :meth:`run` early (thread-safe)."""
+        self._stop.set()
+        self._clock.close()
+
+    # -- running --------------------------------------------------------------------------
     def check_names(self) -> None:
-        """Refuse to play if any node publishes the replay's topics or serves its service.
+        """Refuse to play if any node publishes the replay's topics or serves its services.
 
         Raises:
             ReplayRefused: Another node uses one of the names (the message names it).
             ServerUnavailable: The ROS master does not answer.
         """
-        names = [self._config.topic(topic) for topic in (*TYPES, GET_MISSION)]
+        names = [
+            self._config.topic(name)
+            for name in (
+                *TYPES,
+                GET_MISSION,
+                interface.REPLAY_CONTROL_SERVICE,
+                interface.REPLAY_STATE_TOPIC,
+            )
+        ]
         caller = rospy.get_name() if rospy.core.is_initialized() else "/rosmc_replay"
         taken = taken_names(names, caller)
         if taken:
@@ -193,10 +232,6 @@ class RecordingReplayer:
                 "replay under a prefix (--prefix /replay)"
             )
 
-    def stop(self) -> None:
-        """End :meth:`run` early (thread-safe)."""
-        self._stop.set()
-
     def run(self) -> int:
         """Check the names, publish everything on time and return the last revision shown.
 
@@ -205,83 +240,157 @@ class RecordingReplayer:
         """
         self.check_names()
         init_node(f"rosmc_replay_{os.getpid()}")
-        for topic, msg_type in TYPES.items():
-            name = self._config.topic(topic)
-            self._publishers[topic] = rospy.Publisher(
-                name, msg_type, queue_size=1000, latch=topic in LATCHED
-            )
-        self._publish_snapshot(self._history.at_time(self._config.start).revision)
-        for topic in CURRENT_AT_START:
-            before = [r for r in self._before if r.topic == topic]
-            if before:
-                self._publishers[topic].publish(before[-1].message)
+        self._output = ReplayOutput(self._config.prefix)
         service = rospy.Service(
             self._config.topic(GET_MISSION), wire_srv.GetMission, self._on_get_mission
         )
-        rospy.on_shutdown(self._stop.set)
+        self._control = ReplayControl(self, self._config.prefix)
+        rospy.on_shutdown(self.stop)
         try:
             return self._play()
         finally:
+            with self._handled:
+                self._playing = False
+                self._handled.notify_all()
+            self._control.close()
             service.shutdown()
+            self._clock.close()
 
     def _play(self) -> int:
+        with self._handled:
+            self._playing = True
         if self._stop.wait(WARM_UP):
-            return self._revision
-        began = time.monotonic()
-        last_snapshot = began
-        for index, record in enumerate(self._records):
-            due = began + (self._offset(record) - self._config.start) / self._config.rate
-            if self._stop.wait(max(0.0, due - time.monotonic())):
-                break
-            replaced = self._publish(record)
-            following = self._records[index + 1] if index + 1 < len(self._records) else None
+            return self._current
+        self._clock.start()
+        playlist, seen, index = self._playlist, -1, 0
+        last_snapshot = time.monotonic()
+        while not self._stop.is_set():
+            changes = self._clock.changes
+            status = self._clock.status()
+            if status.seeks != seen:
+                seen = status.seeks
+                index = self._jump(status)
+                continue
+            if index >= len(playlist):
+                if not self._config.hold:
+                    self._announce()
+                    break
+                self._announce()
+                self._clock.wait(None, changes)
+                continue
+            if not self._clock.wait(playlist.offset(index), changes):
+                if self._clock.status().seeks == seen:  # paused, resumed, rate: say so
+                    self._flush_snapshot()
+                    self._announce()
+                continue
+            replaced = self._publish(playlist.records[index])
+            index += 1
             now = time.monotonic()
             quiet = (
-                following is None
-                or (self._offset(following) - self._offset(record)) / self._config.rate >= QUIET
+                index == len(playlist)
+                or (playlist.offset(index) - playlist.offset(index - 1)) / status.rate >= QUIET
             )
             if replaced or quiet or now - last_snapshot >= MAX_DELAY:
-                if self._latest > self._revision:
-                    self._publish_snapshot(self._latest)
+                self._flush_snapshot()
                 last_snapshot = now
         self._stop.wait(LINGER)
-        return self._revision
+        return self._current
 
-    def _offset(self, record: JournalRecord) -> float:
-        return self._history.seconds(record.log_time)
+    def _await_seek(self, seeks: int) -> None:
+        """Wait until the state at seek number ``seeks`` is out (while the replay plays)."""
+        deadline = time.monotonic() + SEEK_ANSWER
+        with self._handled:
+            while self._playing and self._handled_seeks < seeks and not self._stop.is_set():
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    _log.warning("the replay took longer than %g s to seek", SEEK_ANSWER)
+                    return
+                self._handled.wait(left)
+
+    # -- publishing -----------------------------------------------------------------------
+    def _jump(self, status: PlaybackStatus) -> int:
+        """Publish the state at ``status.position``; return the index of the record after it."""
+        position = status.position
+        with self._handled:
+            self._current = self._history.revision_at(position).revision
+            self._stamp = self._mission_stamp(position)
+            self._publish_snapshot(self._current, position)
+            self._out().publish_state_at(self._playlist, position, moved=status.seeks > 0)
+            self._handled_seeks = status.seeks
+            self._handled.notify_all()
+        self._announce()
+        _log.debug("replay: at %.2f s, revision %d", position, self._current)
+        return self._playlist.index_after(position)
 
     def _publish(self, record: JournalRecord) -> bool:
         """Publish one record; True if it replaced the mission (publish its snapshot now)."""
-        msg = record.message
-        if record.topic == interface.MISSION_TOPIC:
-            if int(msg.revision) > self._revision:  # a revision the history could not rebuild
-                self._publishers[interface.MISSION_TOPIC].publish(msg)
-                self._revision, self._snapshot = int(msg.revision), msg
-            return False
-        if record.topic == interface.EVENTS_TOPIC:
+        msg, topic = record.message, record.topic
+        with self._lock:
+            if topic not in (interface.MISSION_TOPIC, interface.EVENTS_TOPIC):
+                self._out().publish(topic, msg)
+                return False
             revision = int(msg.revision)
-            if revision <= self._revision:
-                return False  # part of the snapshot already published
-            self._publishers[interface.EVENTS_TOPIC].publish(msg)
-            self._latest, self._stamp = max(self._latest, revision), msg.stamp.to_sec()
-            if self._on_event is not None:
-                self._on_event(revision, _decoded(msg), self._offset(record))
-            return bool(msg.kind == EventKind.MISSION_REPLACED)
-        self._publishers[record.topic].publish(msg)
-        return False
+            if revision <= self._current:
+                return False  # part of the mission published already
+            self._out().publish(topic, msg)
+            self._current = revision
+            if topic == interface.MISSION_TOPIC:  # a revision the history could not rebuild
+                self._revision = revision
+                return False
+            self._stamp = msg.stamp.to_sec()
+        if self._on_event is not None:
+            self._on_event(revision, _decoded(msg), self._history.seconds(record.log_time))
+        return bool(msg.kind == EventKind.MISSION_REPLACED)
 
-    def _publish_snapshot(self, revision: int) -> None:
-        try:
-            state = self._history.at_revision(revision)
-        except NotFound:
-            return  # not rebuilt (a gap in the recording): its recorded snapshot follows
-        msg = mission_to_msg(state.content(), revision, self._stamp)
-        self._publishers[interface.MISSION_TOPIC].publish(msg)
-        self._revision, self._snapshot = revision, msg
-        _log.debug("replay: snapshot of revision %d", revision)
+    def _flush_snapshot(self) -> None:
+        with self._lock:
+            if self._current > self._revision:
+                self._publish_snapshot(self._current)
+
+    def _publish_snapshot(self, revision: int, position: float | None = None) -> None:
+        msg = self._mission_msg(revision, position)
+        if msg is not None:
+            self._out().publish(interface.MISSION_TOPIC, msg)
+            self._revision = revision
+            _log.debug("replay: snapshot of revision %d", revision)
+
+    def _mission_msg(self, revision: int, position: float | None = None) -> Any:
+        """The mission at ``revision`` as a message (None if the history lacks it)."""
+        with self._lock:
+            if self._built is not None and self._built[0] == revision:
+                return self._built[1]
+            try:
+                state = self._history.at_revision(revision)
+            except NotFound:  # a gap in the recording: its recorded snapshot follows
+                if position is None:
+                    return None
+                recorded = self._playlist.latest(interface.MISSION_TOPIC, position)
+                return None if recorded is None else recorded.message
+            msg = mission_to_msg(state.content(), revision, self._stamp)
+            self._built = (revision, msg)
+            return msg
+
+    def _mission_stamp(self, position: float) -> float:
+        """The mission clock of the last change recorded at or before ``position``."""
+        records = [
+            self._playlist.latest(topic, position)
+            for topic in (interface.EVENTS_TOPIC, interface.MISSION_TOPIC)
+        ]
+        latest = max((r for r in records if r is not None), key=lambda r: r.log_time, default=None)
+        return 0.0 if latest is None else float(latest.message.stamp.to_sec())
+
+    def _out(self) -> ReplayOutput:
+        assert self._output is not None, "the replay publishes only while it runs"
+        return self._output
+
+    def _announce(self) -> None:
+        if self._control is not None:
+            self._control.publish(self.status())
 
     def _on_get_mission(self, _request: Any) -> Any:
-        return wire_srv.GetMissionResponse(mission=self._snapshot)
+        with self._lock:
+            msg = self._mission_msg(self._current, self._clock.status().position)
+        return wire_srv.GetMissionResponse(mission=msg)
 
 
 def _decoded(msg: Any) -> MissionEvent | None:
@@ -289,7 +398,3 @@ def _decoded(msg: Any) -> MissionEvent | None:
         return event_from_msg(msg)
     except RosmcError:
         return None
-
-
-def _log_time(record: JournalRecord) -> int:
-    return record.log_time

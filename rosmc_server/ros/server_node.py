@@ -28,6 +28,7 @@ Parameters (private):
     ``~link_timeout`` (float, s): silence after which a robot link is DOWN (3.0).
     ``~agent_state_rate`` (float, Hz): rate of ``/rosmc/agent_states`` (2.0).
     ``~fsync`` (bool): fsync the journal on every change (survives power loss).
+    ``~snapshot_every`` (int): mission events between two full snapshots in the journal (500).
     ``~mission_dir`` (str): the only directory (with its subdirectories) where SaveMission
         and LoadMission read or write files on the server's host (default ``missions/``);
         elsewhere, clients pass the document itself.
@@ -92,6 +93,7 @@ class ServerConfig:
     agent_state_rate: float = 2.0
     fsync: bool = False
     mission_dir: Path = DEFAULT_MISSION_DIR
+    snapshot_every: int = JournalOptions.snapshot_every
 
     @classmethod
     def from_params(cls) -> ServerConfig:
@@ -115,6 +117,7 @@ class ServerConfig:
             agent_state_rate=float(rospy.get_param("~agent_state_rate", 2.0)),
             fsync=bool(rospy.get_param("~fsync", False)),
             mission_dir=Path(str(rospy.get_param("~mission_dir", str(DEFAULT_MISSION_DIR)))),
+            snapshot_every=max(1, int(rospy.get_param("~snapshot_every", cls.snapshot_every))),
         )
 
 
@@ -238,7 +241,7 @@ class MissionServer:
 
     # -- journal -------------------------------------------------------------------
     def _open_journal(self) -> tuple[Mission, JournalWriter]:
-        options = JournalOptions(fsync=self.config.fsync)
+        options = JournalOptions(fsync=self.config.fsync, snapshot_every=self.config.snapshot_every)
         clock = rospy.get_time
         if self.config.resume:
             if self.config.journal is None:

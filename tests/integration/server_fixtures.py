@@ -474,6 +474,19 @@ class FakeRobot:
             )
         )
 
+    def report(self, seq: int, skill_id: str, status: int, attempt: int = 1) -> None:
+        """Publish the robot's report number ``seq``: ``skill_id`` is now ``status``."""
+        self._report.publish(
+            wire.RobotReport(
+                agent=self.agent,
+                seq=seq,
+                stamp=rospy.Time.now(),
+                skill_id=skill_id,
+                status=wire.SkillStatus(status),
+                attempt=attempt,
+            )
+        )
+
     def close(self) -> None:
         """Stop listening and publishing."""
         self.commands.close()

@@ -4,10 +4,12 @@ Subscribes (each name behind ``prefix``, e.g. ``/replay``):
     ``/rosmc/mission_events`` (rosmc/MissionEvent): one message per accepted change.
     ``/rosmc/agent_states`` (rosmc/AgentStates): every robot's link and telemetry, and the
     server's revision (an event lost at the end of a burst shows there).
+    ``/rosmc/replay/state`` (rosmc/ReplayState): only a replay publishes it; when the replay
+    was moved (a seek, backwards too) the mirror starts again from the replay's mission.
 
 Calls (on its own worker thread, never the caller's):
     ``/rosmc/get_mission`` (rosmc/GetMission): the snapshot, at start, after a revision gap,
-    after a replaced mission and after the server restarted.
+    after a replaced mission, after the server restarted and after a replay was moved.
 
 Watches ``/rosmc/get_mission`` on the master once per ``check_period`` to tell when the
 server went away or came back as a new process (then the mirror starts from its snapshot).
@@ -67,6 +69,7 @@ class MissionFollower:
         self._server_uri: str | None = None  # who answers now (None: nobody)
         self._known_uri: str | None = None  # who answered last
         self._restarted = False
+        self._seeks: int | None = None  # moves of the replay followed (None: none heard yet)
         self._closed = threading.Event()
         self._retry: threading.Timer | None = None
         self._library: Library | None = None
@@ -82,6 +85,12 @@ class MissionFollower:
                 wire.AgentStates,
                 self._on_states,
                 queue_size=1,
+            ),
+            rospy.Subscriber(
+                interface.prefixed(interface.REPLAY_STATE_TOPIC, prefix),
+                wire.ReplayState,
+                self._on_replay_state,
+                queue_size=10,
             ),
         ]
         self._watcher = threading.Thread(target=self._watch, name="rosmc-follow", daemon=True)
@@ -146,6 +155,23 @@ class MissionFollower:
             return
         self.mirror.on_agent_statuses(statuses)
         self.mirror.on_server_revision(int(msg.revision))
+
+    def _on_replay_state(self, msg: wire.ReplayState) -> None:
+        seeks = int(msg.seeks)
+        before, self._seeks = self._seeks, seeks
+        # The first state heard may tell of seeks made before the first fetch answered.
+        if seeks == (before or 0) or self._closed.is_set():
+            return
+        # A replay moved back publishes revisions the mirror has seen, with other content:
+        # its mission is taken whatever its revision, as a restarted server's is.
+        _log.info("the replay moved; fetching its mission")
+        self._fetcher.submit(lambda client: client.fetch_mission(), self._on_moved_snapshot)
+
+    def _on_moved_snapshot(self, outcome: Outcome[MissionState]) -> None:
+        if outcome.value is not None:
+            self.mirror.on_snapshot(outcome.value, restarted=True)
+        else:
+            self._on_snapshot(outcome)  # says so and tries again
 
     # -- is the server there, and the same process? ----------------------------------------------
     def _watch(self) -> None:
