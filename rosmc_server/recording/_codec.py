@@ -69,39 +69,64 @@ class Decoder:
         self.notes: list[str] = []
 
     def decode(self, schema: fmt.SchemaRecord, data: bytes) -> RosMessage:
-        """Decode ``data``; raise JournalError if the schema or the bytes do not fit."""
+        """Decode ``data``; raise JournalError if the schema or the bytes do not fit.
+
+        Data that the recorded definition cannot decode gets a second chance with the
+        installed definition of that name: the recorded text may be what is damaged.
+        """
         decoder = self._decoders.get(schema.id)
         if decoder is None:
             decoder = self._decoders[schema.id] = self._make(schema)
         try:
             return decoder(data)
         except MessageException as err:
+            installed = self._installed(schema)
+            if installed is not None and installed is not decoder:
+                try:
+                    return installed(data)
+                except MessageException:
+                    pass
             raise JournalError(f"a {schema.name} message does not decode: {err}") from err
+
+    def _installed(self, schema: fmt.SchemaRecord) -> Callable[[bytes], RosMessage] | None:
+        """A decoder with the installed class of the schema's name, if there is one."""
+        try:
+            cls = installed_class(schema.name)
+        except JournalError:
+            return None
+        decoder: Callable[[bytes], RosMessage] = lambda data: cls().deserialize(data)  # noqa: E731
+        return decoder
 
     def _make(self, schema: fmt.SchemaRecord) -> Callable[[bytes], RosMessage]:
         if schema.encoding != SCHEMA_ENCODING:
             raise JournalError(
                 f"schema {schema.name} has encoding {schema.encoding!r}, not ros1msg"
             )
-        try:
-            cls = installed_class(schema.name)
-        except JournalError:
-            cls = None
-        if cls is not None and str(cls._full_text).encode() == schema.data:
-            return lambda data: cls().deserialize(data)
-        self.notes.append(
-            f"the recorded definition of {schema.name} differs from the installed one "
-            "(or none is installed); its messages were decoded with the recorded definition"
-        )
+        installed = self._installed(schema)
+        if (
+            installed is not None
+            and str(installed_class(schema.name)._full_text).encode() == schema.data
+        ):
+            return installed
         mcap_schema = Schema(
             id=schema.id, name=schema.name, encoding=schema.encoding, data=schema.data
         )
         try:
             decoder = self._dynamic.decoder_for("ros1", mcap_schema)
         except DefinitionErrors as err:
-            raise JournalError(
-                f"the recorded definition of {schema.name} is invalid: {err}"
-            ) from err
+            if installed is None:
+                raise JournalError(
+                    f"the recorded definition of {schema.name} is invalid: {err}"
+                ) from err
+            self.notes.append(
+                f"the recorded definition of {schema.name} is invalid ({err}); its messages "
+                "were decoded with the installed one"
+            )
+            return installed
         if decoder is None:
             raise JournalError(f"no ROS 1 decoder for schema {schema.name}")
+        self.notes.append(
+            f"the recorded definition of {schema.name} differs from the installed one "
+            "(or none is installed); its messages were decoded with the recorded definition"
+        )
         return decoder

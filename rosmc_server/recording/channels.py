@@ -41,6 +41,9 @@ TELEMETRY_TOPICS: Final = (
 )
 """Channels of what the robots and the site did: written, never fsynced on their own."""
 
+LIBRARY: Final = "rosmc-journal/1"
+"""The library field of a journal's MCAP header: a file with it was written by JournalWriter."""
+
 PROFILE: Final = "ros1"
 MESSAGE_ENCODING: Final = "ros1"
 SCHEMA_ENCODING: Final = "ros1msg"
