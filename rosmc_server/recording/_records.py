@@ -42,7 +42,7 @@ class Declarations:
         self.channels = channels
         self._journal = journal
         self._fixed: DataSection | None = None
-        self._sequences: dict[int, int] = {}  # the last sequence number per channel
+        self._taken: dict[int, int] = {}  # messages taken per channel
         self._rebuilt: list[str] = []
 
     def take(self, opcode: int, body: bytes, messages: list[fmt.MessageRecord]) -> bool:
@@ -59,7 +59,7 @@ class Declarations:
                     f"a message on channel {msg.channel_id}, which was never declared"
                 )
             messages.append(msg)
-            self._sequences[msg.channel_id] = msg.sequence
+            self._taken[msg.channel_id] = self._taken.get(msg.channel_id, 0) + 1
             return True
         if opcode == Opcode.SCHEMA:
             schema = fmt.parse_schema(body)
@@ -76,22 +76,25 @@ class Declarations:
             raise RecordDamage(f"channel {chan.id} is declared twice with different content")
         return False
 
+    def forget(self, message: fmt.MessageRecord) -> None:
+        """Take back the last message taken (it turned out to be damaged)."""
+        self._taken[message.channel_id] -= 1
+
     def fits(self, channel_id: int, sequence: int) -> bool:
         """Whether a bare message with this channel and sequence number could be next.
 
-        A journal numbers the messages of each channel 0, 1, 2, ...: after damage, a
-        message can only come later, never earlier.
+        A journal numbers the messages of each channel 0, 1, 2, ... in its file: after
+        damage, a message's number is at least the count of those taken before it.
         """
         if channel_id not in self.channels and channel_id not in self._fixed_channels():
             return False
-        last = self._sequences.get(channel_id)
-        return not self._journal or last is None or sequence > last
+        return not self._journal or sequence >= self._taken.get(channel_id, 0)
 
     @contextmanager
     def staged(self) -> Iterator[None]:
         """Undo every declaration made inside the block if it raises (a damaged chunk)."""
         schemas, channels = dict(self.schemas), dict(self.channels)
-        sequences, rebuilt = dict(self._sequences), list(self._rebuilt)
+        taken, rebuilt = dict(self._taken), list(self._rebuilt)
         try:
             yield
         except BaseException:
@@ -99,7 +102,7 @@ class Declarations:
             self.schemas.update(schemas)
             self.channels.clear()
             self.channels.update(channels)
-            self._sequences, self._rebuilt = sequences, rebuilt
+            self._taken, self._rebuilt = taken, rebuilt
             raise
 
     def notes(self, path: Path) -> list[str]:

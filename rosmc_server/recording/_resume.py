@@ -102,7 +102,7 @@ def _reopen(
     while earlier and _needs_earlier(results):
         results.insert(0, decode_scan(_scan.scan(earlier.pop()[1])))
     recovered = join_results(base, results)
-    if scan.damage:
+    if results[-1].damage:  # found by the scan, or as messages that do not decode
         os.close(fd)  # left as it is: its damage stays there to be looked at
         new = part_path(base, number + 1)
         return Reopened(base, PartFile.create(new, number + 1, chunked, durable), recovered, True)

@@ -267,7 +267,7 @@ class _Walker:
         if last_bare is not None:  # the message before may have a wrong length
             inside = self._resync.find(last_bare + _HEAD + 22, pos, "bare")
             if inside is not None:
-                r.messages.pop()
+                self._records.forget(r.messages.pop())
                 r.spans.pop()
                 r.top_level_messages -= 1
                 return self._salvage_message(last_bare, inside, "length field")

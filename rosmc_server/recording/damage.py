@@ -59,5 +59,9 @@ def skipped_line(
         count = sum(r.count for r in missing)
         names = ", ".join(str(r) for r in missing[:SHOWN])
         more = ", ..." if len(missing) > SHOWN else ""
-        parts.append(f"{count} revisions have no event ({names}{more})")
+        parts.append(
+            f"revision {names} has no event"
+            if count == 1
+            else f"{count} revisions have no event ({names}{more})"
+        )
     return f"journal {path}: " + "; ".join(parts) if parts else ""

@@ -126,6 +126,7 @@ class RevisionWalk(Generic[S, E]):
                 self._broken = (self.current + 1, "is missing")
             return
         self._apply(revision, replaced, item)
+        self._advance()
 
     def finish(self) -> None:
         """Close the walk: a trailing replacement is left out, a trailing gap recorded."""
@@ -133,6 +134,8 @@ class RevisionWalk(Generic[S, E]):
             self.unacknowledged = self._pending[0]
             self.highest = max((r for r in self._top if r != self.unacknowledged), default=-1)
             self._pending = None
+        if self._broken is None and self.current is not None and self._waiting:
+            self._broken = (self.current + 1, "is missing")
         if self._broken is not None:
             first, cause = self._broken
             self.gaps.append(Gap(RevisionRange(first, max(first, self.highest)), None, cause))
@@ -174,7 +177,11 @@ class RevisionWalk(Generic[S, E]):
             self._broken = (revision, "does not apply")
 
     def _advance(self) -> None:
-        """Apply the waiting events that now follow; note the gap before the rest."""
+        """Apply the waiting events that now follow.
+
+        The rest keep waiting without marking a gap yet: the events after a snapshot
+        in the file may still bring the revision they need.
+        """
         while self._broken is None and self._pending is None and self.current is not None:
             waiting = self._waiting.pop(self.current + 1, None)
             if waiting is None:
@@ -182,11 +189,6 @@ class RevisionWalk(Generic[S, E]):
             self._apply(self.current + 1, *waiting)
         current = -1 if self.current is None else self.current
         self._waiting = {r: e for r, e in self._waiting.items() if r > current}
-        if self._waiting and self._pending is not None:
-            self._broken = (self._pending[0], "replaced the mission, but its snapshot is missing")
-            self._pending = None
-        elif self._waiting and self._broken is None:
-            self._broken = (current + 1, "is missing")
 
 
 def missing_revisions(revisions: Iterable[int]) -> list[RevisionRange]:
