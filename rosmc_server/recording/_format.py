@@ -311,7 +311,7 @@ def read_chunk(data: bytes, start: int) -> tuple[ChunkRecord, int]:
     if len(records) != size:
         raise FormatError(f"a chunk holds {len(records)} bytes, its header says {size}")
     if crc and zlib.crc32(records) != crc:
-        raise FormatError("a chunk's CRC does not match its content")
+        raise FormatError("its CRC does not match its content")
     return ChunkRecord(begin, end, size, crc, compression, records), cur.pos
 
 

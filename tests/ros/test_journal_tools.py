@@ -68,7 +68,7 @@ def test_at_timeline_info_and_tobag_say_what_they_skipped_in_one_line(
     assert gap.revisions.first == DAMAGED and resumed is not None
     line = (
         f"rosmc: warning: journal {path}: skipped damaged bytes {start}..{end - 1} of "
-        f"mission.mcap (a damaged chunk record (a chunk's CRC does not match its content)); "
+        f"mission.mcap (a damaged chunk record (its CRC does not match its content)); "
         f"{resumed - DAMAGED} revisions r{DAMAGED}..r{resumed - 1} cannot be rebuilt; the "
         f"mission continues from the snapshot of r{resumed}"
     )
@@ -96,7 +96,7 @@ def test_at_timeline_info_and_tobag_say_what_they_skipped_in_one_line(
     out, err = capsys.readouterr()
     assert warnings(err) == [
         f"rosmc: warning: journal {path}: skipped damaged bytes {start}..{end - 1} of "
-        f"mission.mcap (a damaged chunk record (a chunk's CRC does not match its content)); "
+        f"mission.mcap (a damaged chunk record (its CRC does not match its content)); "
         f"revision r{DAMAGED} has no event"
     ]
     with rosbag.Bag(str(bag)) as reader:
