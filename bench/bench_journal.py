@@ -2,22 +2,25 @@
 
 Measures append latency (p50/p95, with and without fsync, chunked and bare
 layouts), bytes per small event, bytes and time per snapshot of a 20-agent x
-500-skill mission, and recovery time of a 10,000-event journal killed before
-closing. Run from the repository root with the messages built::
+500-skill mission, recovery time of a 10,000-event journal killed before
+closing, and the memory the writer keeps as a journal grows (tracemalloc over
+100,000 changes). Run from the repository root with the messages built::
 
     source build/devel/setup.bash
-    python bench/bench_journal.py [--dir DIR] [--events N]
+    python bench/bench_journal.py [--dir DIR] [--events N] [--changes N] [--only memory]
 
 ``--dir`` should be on the disk the server journals to: fsync figures depend on it.
 """
 
 import argparse
+import gc
 import json
 import logging
 import statistics
 import sys
 import tempfile
 import time
+import tracemalloc
 from collections.abc import Callable, Sequence
 from functools import partial
 from io import BytesIO
@@ -183,6 +186,57 @@ def bench_recovery(directory: Path, events: int, chunked: bool) -> dict[str, Any
     }
 
 
+def bench_memory(directory: Path, changes: int, traced: int = 5_000) -> dict[str, Any]:
+    """What the writer keeps in memory while a journal grows by ``changes`` events.
+
+    A snapshot of a 4 x 50 mission every 500 events, as the server writes them. The
+    process's resident memory is read at ten points along the way (a bound shows as a
+    figure that stops growing); the memory each change leaves behind is measured exactly
+    (tracemalloc, which slows appends 30x) over the first ``traced`` changes.
+    """
+    path = directory / "memory.mcap"
+    mission = big_mission(0, agents=4, skills=50)
+    writer = JournalWriter.create(path, mission, 0, JournalOptions())
+    step = max(changes // 10, 1)
+    rss: dict[str, int] = {}
+    gc.collect()
+    base = _rss_kib()
+    for rev in range(1, changes + 1):
+        if rev == 1:
+            tracemalloc.start()
+        writer.append_event(small_event(rev), rev)
+        if writer.snapshot_due:
+            mission.revision = rev
+            writer.append_snapshot(mission, rev)
+        if rev == traced:
+            gc.collect()
+            per_change = tracemalloc.get_traced_memory()[0] / traced
+            tracemalloc.stop()
+        if rev % step == 0:
+            gc.collect()
+            rss[str(rev)] = _rss_kib() - base
+    writer.close()
+    files = [path, *directory.glob("memory.part*.mcap")]
+    return {
+        "changes": changes,
+        "files": len(files),
+        "journal_mib": round(sum(f.stat().st_size for f in files) / 2**20, 1),
+        "retained_bytes_per_change": round(per_change, 1),
+        "rss_growth_kib": rss,
+        "rss_growth_max_kib": max(rss.values()),
+        "rss_growth_last_half_kib": rss[str(changes)]
+        - rss[str(changes // 2 - (changes // 2) % step)],
+    }
+
+
+def _rss_kib() -> int:
+    """This process's resident set size (KiB)."""
+    for line in Path("/proc/self/status").read_text().splitlines():
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1])
+    raise RuntimeError("no VmRSS in /proc/self/status")
+
+
 def _serialized(message: Any) -> bytes:
     buffer = BytesIO()
     message.serialize(buffer)
@@ -197,11 +251,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     parser.add_argument("--events", type=int, default=10_000, help="events in the recovery journal")
     parser.add_argument("--appends", type=int, default=2_000, help="appends per latency run")
+    parser.add_argument("--changes", type=int, default=100_000, help="changes of the memory run")
+    parser.add_argument("--only", choices=["memory"], help="run only this measurement")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.ERROR)  # recovery warnings are expected here
     with tempfile.TemporaryDirectory(dir=args.dir) as tmp:
         directory = Path(tmp)
-        figures: dict[str, Any] = {"append": {}, "recovery": {}}
+        if args.only == "memory":
+            print(json.dumps({"memory": bench_memory(directory, args.changes)}, indent=2))
+            return 0
+        # First: the resident memory it reads must not include the other runs' heap.
+        figures: dict[str, Any] = {"memory": bench_memory(directory, args.changes)}
+        figures.update(append={}, recovery={})
         for chunked in (True, False):
             layout = "chunked" if chunked else "bare"
             figures["append"][layout] = bench_appends(directory, chunked, False, args.appends)

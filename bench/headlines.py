@@ -50,6 +50,8 @@ HEADLINES: dict[str, tuple[str, ...]] = {
         "append.chunked.bytes_per_event",
         "recovery.*_ms",
         "snapshot_20x500.*bytes",
+        "memory.retained_bytes_per_change",
+        "memory.rss_growth_*_kib",
     ),
     "executor": ("*sync_to_start*median_ms", "*barrier_skew*median_ms", "*barrier_skew*max_ms"),
     "sim": ("*.rtf", "*cpu_share"),
