@@ -34,7 +34,7 @@ from rosmc_server.core.updates import apply_event
 from rosmc_server.interface import EVENTS_TOPIC, MISSION_TOPIC, ROBOT_REPORTS_TOPIC
 from rosmc_server.recording.damage import skipped_line
 from rosmc_server.recording.errors import JournalError
-from rosmc_server.recording.reader import JournalRecord, JournalResult, read_journal
+from rosmc_server.recording.reader import JournalRecord, JournalResult, feed, read_journal
 from rosmc_server.recording.revisions import Gap, RevisionWalk
 from rosmc_server.recording.timeline import Timeline, TimelineBuilder
 
@@ -186,16 +186,12 @@ class MissionHistory:
 
     def _build(self, result: JournalResult) -> None:
         walk: RevisionWalk[JournalRecord, JournalRecord] = RevisionWalk(self._restart, self._apply)
-        self._walk = walk
         self._since_checkpoint = 0
         for record in result.records:
             if record.topic == ROBOT_REPORTS_TOPIC:
                 self._timeline.report(record.message, record.log_time)
-            elif record.topic == MISSION_TOPIC:
-                walk.snapshot(int(record.message.revision), record)
-            elif record.topic == EVENTS_TOPIC:
-                replaced = record.message.kind == record.message.MISSION_REPLACED
-                walk.event(int(record.message.revision), replaced, record)
+            else:
+                feed(walk, record)
         walk.finish()
         if walk.unacknowledged is not None:
             self._problems.append(

@@ -236,11 +236,7 @@ def latest_state(result: JournalResult) -> LatestState:
 
     walk: RevisionWalk[JournalRecord, JournalRecord] = RevisionWalk(restart, apply, covered)
     for record in result.records:
-        if record.topic == MISSION_TOPIC:
-            walk.snapshot(int(record.message.revision), record)
-        elif record.topic == EVENTS_TOPIC:
-            replaced = record.message.kind == record.message.MISSION_REPLACED
-            walk.event(int(record.message.revision), replaced, record)
+        feed(walk, record)
     walk.finish()
     if not base:
         raise JournalError(f"journal {result.path} holds no mission snapshot to start from")
@@ -260,3 +256,12 @@ def latest_state(result: JournalResult) -> LatestState:
         tuple(walk.gaps),
         walk.highest,
     )
+
+
+def feed(walk: RevisionWalk[JournalRecord, JournalRecord], record: JournalRecord) -> None:
+    """Hand a snapshot or event record to ``walk``; records of other topics are ignored."""
+    if record.topic == MISSION_TOPIC:
+        walk.snapshot(int(record.message.revision), record)
+    elif record.topic == EVENTS_TOPIC:
+        replaced = record.message.kind == record.message.MISSION_REPLACED
+        walk.event(int(record.message.revision), replaced, record)
