@@ -51,6 +51,8 @@ HEADLINES: dict[str, tuple[str, ...]] = {
         "recovery.*_ms",
         "snapshot_20x500.*bytes",
         "memory.retained_bytes_per_change",
+        "damage.*.resumed_at",
+        "damage.*.events_kept",
         "memory.rss_growth_*_kib",
     ),
     "executor": ("*sync_to_start*median_ms", "*barrier_skew*median_ms", "*barrier_skew*max_ms"),
