@@ -22,7 +22,9 @@ Parameters (private):
     ``~library`` (str): skill library YAML (default: the shipped Mars team library).
     ``~journal`` (str): journal file; "" = a new timestamped file in ``~journal_dir``.
     ``~journal_dir`` (str): where new journals go (default: ``bags/`` of the package).
-    ``~resume`` (bool): continue from ``~journal`` (recovering a damaged tail).
+    ``~resume`` (bool): continue from ``~journal`` (its last part file), recovering what a
+        crash cut short; damage is skipped, said once as an ERROR and kept for GetMission's
+        ``journal_alert`` (``rosmc status``).
     ``~link_timeout`` (float, s): silence after which a robot link is DOWN (3.0).
     ``~agent_state_rate`` (float, Hz): rate of ``/rosmc/agent_states`` (2.0).
     ``~fsync`` (bool): fsync the journal on every change (survives power loss).
