@@ -44,7 +44,7 @@ def default_journal_path(directory: str | Path, now: Callable[[], datetime] = da
     stem = now().strftime("mission_%Y%m%d_%H%M%S")
     path = directory / f"{stem}.mcap"
     number = 1
-    while path.exists():
+    while path.exists() or len(journal_parts(path)[1]) > 1:  # parts of a journal moved away
         number += 1
         path = directory / f"{stem}_{number}.mcap"
     return path

@@ -174,7 +174,8 @@ def decode_scan(scan: _scan.ScanResult, topics: Collection[str] | None = None) -
                 JournalRecord(channel.topic, msg.log_time, decoder.decode(schema, msg.data))
             )
         except JournalError as err:
-            if schema is not None and scan.library == LIBRARY:  # its own bytes are damaged
+            # A journal's bare message (no CRC) that does not decode: its bytes are damaged.
+            if schema is not None and scan.library == LIBRARY and not scan.chunk_indexes:
                 what = f"a {schema.name} message that does not decode"
                 damage.append(Damage(scan.path, start, end, what))
             else:
