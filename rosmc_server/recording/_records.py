@@ -122,7 +122,10 @@ class Declarations:
 
     def _rebuild(self, channel_id: int) -> bool:
         chan = self._fixed_channels().get(channel_id)
-        if chan is None or chan.topic in {c.topic for c in self.channels.values()}:
+        # Unless the topic is declared under another id that carries messages (a damaged
+        # id declares it under a number nothing uses).
+        used = {c.topic for c in self.channels.values() if self._taken.get(c.id)}
+        if chan is None or chan.topic in used:
             return False
         if chan.schema_id not in self.schemas and not self._rebuild_schema(chan.schema_id):
             return False

@@ -277,6 +277,24 @@ def test_a_damaged_declaration_is_rebuilt_from_the_journal_channels(tmp_path: Pa
     assert any("rebuilt from the journal's fixed channel list" in w for w in result.warnings)
 
 
+@pytest.mark.parametrize("layout", LAYOUTS)
+def test_a_flipped_byte_anywhere_in_the_declarations_loses_nothing(
+    tmp_path: Path, layout: str
+) -> None:
+    """Every 37th byte of the 20 kB of schemas and channels after the header: a damaged
+    definition text, type name, id, topic or length; every record is still read."""
+    path = tmp_path / "j.mcap"
+    rows = write(path, layout, events=30)
+    clean = path.read_bytes()
+    header_end = len(MAGIC) + HEAD + clean[len(MAGIC) + 1]
+    for offset in range(header_end, rows[0].start, 37):
+        path.write_bytes(clean)
+        flip(path, offset, 0x10)
+        result = read_journal(path)
+        assert revisions(result) == list(range(1, 31)), offset
+        assert latest_state(result).revision == 30, offset
+
+
 # -- resume -------------------------------------------------------------------------------
 @pytest.mark.parametrize("layout", LAYOUTS)
 def test_resume_after_damage_goes_on_in_a_new_part(tmp_path: Path, layout: str) -> None:
