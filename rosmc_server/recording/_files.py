@@ -1,5 +1,4 @@
-"""File-system helpers of the journal: its chain of part files, exclusive opening, tails,
-directory sync.
+"""File-system helpers of the journal: its chain of part files, exclusive opening, tails.
 
 A journal is one file, ``mission_X.mcap``, until it grows past
 :attr:`JournalOptions.part_bytes`; then the writer continues in
@@ -18,17 +17,7 @@ from collections.abc import Callable
 from datetime import datetime
 from pathlib import Path
 
-from rosmc_server.core.durable import fsync_directory
 from rosmc_server.recording.errors import JournalError
-
-__all__ = [
-    "default_journal_path",
-    "fsync_directory",
-    "journal_parts",
-    "open_locked",
-    "part_path",
-    "save_tail",
-]
 
 _log = logging.getLogger(__name__)
 

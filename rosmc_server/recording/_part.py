@@ -6,8 +6,9 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
+from rosmc_server.core.durable import fsync_directory
 from rosmc_server.recording import _format as fmt
-from rosmc_server.recording._files import fsync_directory, open_locked
+from rosmc_server.recording._files import open_locked
 from rosmc_server.recording._section import DataSection
 from rosmc_server.recording.channels import JOURNAL_TOPICS, LIBRARY, PROFILE
 from rosmc_server.recording.errors import JournalError
