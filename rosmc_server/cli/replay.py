@@ -162,6 +162,8 @@ def tobag(ctx: Context) -> int:
     from ..recording.to_rosbag import journal_to_rosbag
 
     summary = journal_to_rosbag(ctx.args.file, ctx.args.bag, overwrite=ctx.args.force)
+    if summary.skipped:
+        print(f"rosmc: warning: {summary.skipped}", file=sys.stderr)
     counts = ", ".join(f"{topic} {count}" for topic, count in summary.counts.items())
     ctx.emit(
         f"wrote {summary.path}: {summary.total} messages ({counts})",

@@ -24,14 +24,17 @@ from .context import Context
 
 
 def status(ctx: Context) -> int:
-    """Every robot's schedule, plus its link and telemetry line."""
+    """Every robot's schedule, plus its link and telemetry line (and a journal alert first)."""
     state = ctx.client.get_mission()
     library = ctx.client.library()
     statuses = None if ctx.args.no_states else ctx.agent_states()
+    alert = ctx.client.journal_alert
     if ctx.json:
-        ctx.emit("", mission_to_json(state, library, statuses))
+        ctx.emit("", {**mission_to_json(state, library, statuses), "journal_alert": alert})
         return 0
     text = format_schedule(state, statuses=statuses, verbose=ctx.args.verbose)
+    if alert:  # first, where nobody misses it
+        text = f"{alert}\n{text}"
     if state.markers:
         markers = format_markers(state.markers).splitlines()
         text += "\n  task markers\n" + "\n".join(f"    {line}" for line in markers)

@@ -18,6 +18,7 @@ import yaml
 
 from .barriers import describe_cycle, find_deadlock
 from .documents import DocumentReader, DuplicateKeyError, SafeDumper, load_yaml, yaml_problem
+from .durable import write_durably
 from .errors import MissionFileError, RosmcError
 from .library import Library
 from .model import Barrier, Resolution, SkillInstance, SkillStatus, TaskMarker, Transfer
@@ -62,14 +63,11 @@ def dump_mission(content: MissionContent, revision: int) -> str:
 
 
 def save_mission(path: str | Path, content: MissionContent, revision: int) -> None:
-    """Write the mission to ``path`` atomically (write a temporary file, then rename)."""
-    target = Path(path)
-    temporary = target.with_name(f".{target.name}.tmp")
+    """Write the mission to ``path`` atomically and durably (see :func:`write_durably`)."""
     try:
-        temporary.write_text(dump_mission(content, revision), encoding="utf-8")
-        temporary.replace(target)
+        write_durably(Path(path), dump_mission(content, revision))
     except OSError as error:
-        raise MissionFileError(f"{target}: cannot write the mission ({error.strerror})") from error
+        raise MissionFileError(f"{path}: cannot write the mission ({error.strerror})") from error
 
 
 def load_mission(path: str | Path, library: Library) -> tuple[MissionContent, int]:

@@ -1,11 +1,13 @@
 """The MCAP mission journal: every accepted change, durably, for crash recovery and replay.
 
 The mission server appends each accepted change (``rosmc/MissionEvent``) and
-periodic full snapshots (``rosmc/Mission``) to one MCAP file in ROS 1 encoding
+periodic full snapshots (``rosmc/Mission``) to an MCAP file in ROS 1 encoding
 with the ``rosmc`` message definitions embedded, so Foxglove and the ``mcap``
-tools read it. After a crash, :meth:`JournalWriter.resume` recovers every intact
-record and continues the same file; :func:`latest_state` gives the snapshot and
-events to rebuild the mission from.
+tools read it; a long journal goes on in part files beside the first (see
+:mod:`._files`), which every reader follows. After a crash,
+:meth:`JournalWriter.resume` recovers every intact record (skipping damaged
+bytes, see :mod:`._scan`) and continues the journal; :func:`latest_state` gives
+the snapshot and events to rebuild the mission from, and the revisions lost.
 
 Typical use::
 

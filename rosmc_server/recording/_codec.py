@@ -17,7 +17,7 @@ from mcap.records import Schema
 from mcap_ros1.decoder import DecoderFactory
 
 from rosmc_server.recording import _format as fmt
-from rosmc_server.recording.channels import SCHEMA_ENCODING
+from rosmc_server.recording.channels import JOURNAL_TOPICS, SCHEMA_ENCODING
 from rosmc_server.recording.errors import JournalError
 
 RosMessage = Any
@@ -60,6 +60,26 @@ def installed_class(type_name: str) -> Any:
     return cls
 
 
+# genpy generates Python source from a recorded definition and imports it, so a damaged
+# definition fails in whatever way that source fails; so may decoding with it.
+_GENERATION_ERRORS: tuple[type[Exception], ...] = (
+    *DefinitionErrors,
+    SyntaxError,
+    ValueError,
+    KeyError,
+    IndexError,
+    AttributeError,
+    TypeError,
+)
+_DECODING_ERRORS: tuple[type[Exception], ...] = (
+    MessageException,
+    ValueError,
+    IndexError,
+    TypeError,
+    AttributeError,
+)
+
+
 class Decoder:
     """Decodes message payloads per schema; collects notes about how it had to decode."""
 
@@ -69,39 +89,95 @@ class Decoder:
         self.notes: list[str] = []
 
     def decode(self, schema: fmt.SchemaRecord, data: bytes) -> RosMessage:
-        """Decode ``data``; raise JournalError if the schema or the bytes do not fit."""
+        """Decode ``data``; raise JournalError if the schema or the bytes do not fit.
+
+        Data that the recorded definition cannot decode gets a second chance with the
+        installed definition of that name: the recorded text may be what is damaged.
+        """
         decoder = self._decoders.get(schema.id)
         if decoder is None:
             decoder = self._decoders[schema.id] = self._make(schema)
         try:
             return decoder(data)
-        except MessageException as err:
+        except _DECODING_ERRORS as err:
+            installed = self._installed(schema)
+            if installed is not None and installed is not decoder:
+                try:
+                    return installed(data)
+                except MessageException:
+                    pass
             raise JournalError(f"a {schema.name} message does not decode: {err}") from err
 
+    def _installed(self, schema: fmt.SchemaRecord) -> Callable[[bytes], RosMessage] | None:
+        """A decoder with the installed class of the schema's name, if there is one."""
+        cls = _installed_class_of(schema.name)
+        if cls is None:
+            return None
+        decoder: Callable[[bytes], RosMessage] = lambda data: cls().deserialize(data)  # noqa: E731
+        return decoder
+
     def _make(self, schema: fmt.SchemaRecord) -> Callable[[bytes], RosMessage]:
+        installed = self._installed(schema)
+        cls = _installed_class_of(schema.name)
+        text = b"" if cls is None else str(cls._full_text).encode()
+        if installed is not None and text == schema.data and cls._type == schema.name:
+            return installed
+        if installed is not None and (
+            schema.encoding != SCHEMA_ENCODING or _damaged_copy(schema.data, text)
+        ):
+            self.notes.append(
+                f"the recorded schema of {schema.name} is damaged (a few bytes differ from the "
+                "installed definition); its messages were decoded with the installed one"
+            )
+            return installed
         if schema.encoding != SCHEMA_ENCODING:
             raise JournalError(
                 f"schema {schema.name} has encoding {schema.encoding!r}, not ros1msg"
             )
-        try:
-            cls = installed_class(schema.name)
-        except JournalError:
-            cls = None
-        if cls is not None and str(cls._full_text).encode() == schema.data:
-            return lambda data: cls().deserialize(data)
-        self.notes.append(
-            f"the recorded definition of {schema.name} differs from the installed one "
-            "(or none is installed); its messages were decoded with the recorded definition"
-        )
         mcap_schema = Schema(
             id=schema.id, name=schema.name, encoding=schema.encoding, data=schema.data
         )
         try:
             decoder = self._dynamic.decoder_for("ros1", mcap_schema)
-        except DefinitionErrors as err:
-            raise JournalError(
-                f"the recorded definition of {schema.name} is invalid: {err}"
-            ) from err
+        except _GENERATION_ERRORS as err:
+            if installed is None:
+                raise JournalError(
+                    f"the recorded definition of {schema.name} is invalid: {err}"
+                ) from err
+            self.notes.append(
+                f"the recorded definition of {schema.name} is invalid ({err}); its messages "
+                "were decoded with the installed one"
+            )
+            return installed
         if decoder is None:
             raise JournalError(f"no ROS 1 decoder for schema {schema.name}")
+        self.notes.append(
+            f"the recorded definition of {schema.name} differs from the installed one "
+            "(or none is installed); its messages were decoded with the recorded definition"
+        )
         return decoder
+
+
+DAMAGE_LIMIT = 8
+"""Bytes in which a recorded definition may differ from the installed one of the same length
+and still count as a damaged copy of it (an edited definition changes its length)."""
+
+
+def _damaged_copy(recorded: bytes, installed: bytes, limit: int = DAMAGE_LIMIT) -> bool:
+    """Whether ``recorded`` is ``installed`` with at most ``limit`` bytes damaged."""
+    if len(recorded) != len(installed):
+        return False
+    return sum(a != b for a, b in zip(recorded, installed, strict=True)) <= limit
+
+
+def _installed_class_of(name: str) -> Any:
+    """The installed class of the type ``name``, or of the journal type whose name it is
+    a damaged copy of (one or two characters differ); None if there is none."""
+    try:
+        return installed_class(name)
+    except JournalError:
+        pass
+    for journal_type in set(JOURNAL_TOPICS.values()):
+        if _damaged_copy(name.encode(), journal_type.encode(), limit=2):
+            return installed_class(journal_type)
+    return None

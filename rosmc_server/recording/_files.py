@@ -1,9 +1,18 @@
-"""File-system helpers of the journal writer: exclusive opening, tails, directory sync."""
+"""File-system helpers of the journal: its chain of part files, exclusive opening, tails.
+
+A journal is one file, ``mission_X.mcap``, until it grows past
+:attr:`JournalOptions.part_bytes`; then the writer continues in
+``mission_X.part002.mcap``, ``mission_X.part003.mcap``, ... (and after a resume
+that found damage, in the next part too). Each part is a complete MCAP file of
+its own. The first file's name stands for the whole chain: every reader and
+resume follow it.
+"""
 
 import errno
 import fcntl
 import logging
 import os
+import re
 from collections.abc import Callable
 from datetime import datetime
 from pathlib import Path
@@ -24,10 +33,45 @@ def default_journal_path(directory: str | Path, now: Callable[[], datetime] = da
     stem = now().strftime("mission_%Y%m%d_%H%M%S")
     path = directory / f"{stem}.mcap"
     number = 1
-    while path.exists():
+    while path.exists() or len(journal_parts(path)[1]) > 1:  # parts of a journal moved away
         number += 1
         path = directory / f"{stem}_{number}.mcap"
     return path
+
+
+_PART = re.compile(r"^(?P<stem>.+)\.part(?P<number>\d{3,})(?P<suffix>\.[^.]*)?$")
+
+
+def part_path(base: Path, number: int) -> Path:
+    """The file of part ``number`` (1 is ``base`` itself) of the journal ``base``."""
+    if number == 1:
+        return base
+    return base.with_name(f"{base.stem}.part{number:03d}{base.suffix}")
+
+
+def journal_parts(path: str | Path) -> tuple[Path, list[tuple[int, Path]]]:
+    """The journal a file belongs to and its parts that exist, as (number, file), in order.
+
+    ``path`` may name the first file or any part; a part whose first file is gone is
+    read on its own.
+    """
+    path = Path(path)
+    match = _PART.match(path.name)
+    base = path
+    if match is not None:
+        first = path.with_name(match["stem"] + (match["suffix"] or ""))
+        if first.exists():
+            base = first
+    parts = [(1, base)]
+    for candidate in base.parent.glob(f"{_glob_escape(base.stem)}.part*{base.suffix}"):
+        found = _PART.match(candidate.name)
+        if found is not None and part_path(base, int(found["number"])) == candidate:
+            parts.append((int(found["number"]), candidate))
+    return base, sorted(parts)
+
+
+def _glob_escape(text: str) -> str:
+    return re.sub(r"([*?\[])", r"[\1]", text)
 
 
 def open_locked(path: Path, flags: int) -> int:
@@ -60,12 +104,3 @@ def save_tail(path: Path, start: int) -> Path:
         "journal %s: saved the %d bytes cut off at byte %d to %s", path, len(tail), start, saved
     )
     return saved
-
-
-def fsync_directory(directory: Path) -> None:
-    """Make a new directory entry durable (after creating a journal with fsync on)."""
-    fd = os.open(directory, os.O_RDONLY | os.O_DIRECTORY)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)

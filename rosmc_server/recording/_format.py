@@ -209,17 +209,25 @@ def decompress(compression: str, data: bytes, size: int) -> bytes:
 
 
 class Cursor:
-    """Reads little-endian fields from a record body; raises FormatError past its end."""
+    """Reads little-endian fields from ``data[start:end]``; raises FormatError past its end."""
 
-    def __init__(self, data: bytes) -> None:
+    def __init__(self, data: bytes, start: int = 0, end: int | None = None) -> None:
         self._data = data
-        self._pos = 0
+        self._start = self._pos = start
+        self._end = len(data) if end is None else end
+
+    @property
+    def pos(self) -> int:
+        """Offset in ``data`` of the next field."""
+        return self._pos
 
     def take(self, size: int) -> bytes:
         """Return the next ``size`` bytes."""
         end = self._pos + size
-        if end > len(self._data):
-            raise FormatError(f"a field needs {end} bytes, the record has {len(self._data)}")
+        if end > self._end:
+            raise FormatError(
+                f"a field needs {end - self._start} bytes, the record has {self._end - self._start}"
+            )
         chunk_ = self._data[self._pos : end]
         self._pos = end
         return chunk_
@@ -249,6 +257,15 @@ def parse_header(body: bytes) -> str:
     return Cursor(body).string()
 
 
+def read_header(data: bytes, start: int) -> tuple[str, str, int]:
+    """Decode a Header body at ``start`` by its own fields: (profile, library, where it ends).
+
+    Does not trust the record's length field, so a damaged one can be told apart.
+    """
+    cur = Cursor(data, start)
+    return cur.string(), cur.string(), cur.pos
+
+
 def parse_schema(body: bytes) -> SchemaRecord:
     """Decode a Schema record."""
     cur = Cursor(body)
@@ -272,15 +289,48 @@ def parse_message(body: bytes) -> MessageRecord:
 
 def parse_chunk(body: bytes) -> ChunkRecord:
     """Decode a Chunk record and check its size and CRC; return it with its records."""
-    cur = Cursor(body)
-    start, end, size, crc = cur.u64(), cur.u64(), cur.u64(), cur.u32()
-    compression = cur.string()
-    data = decompress(compression, cur.take(cur.u64()), size)
-    if len(data) != size:
-        raise FormatError(f"a chunk holds {len(data)} bytes, its header says {size}")
-    if crc and zlib.crc32(data) != crc:
-        raise FormatError("a chunk's CRC does not match its content")
-    return ChunkRecord(start, end, size, crc, compression, data)
+    rec, end = read_chunk(body, 0)
+    if end != len(body):
+        raise FormatError(f"its length field says {len(body)} bytes, its content takes {end}")
+    return rec
+
+
+def read_chunk(data: bytes, start: int) -> tuple[ChunkRecord, int]:
+    """Decode a Chunk body at ``start`` by its own fields; return it and where it ends.
+
+    Does not trust the record's length field: a chunk whose content passes its CRC is
+    intact even when the length (or opcode) in front of it is damaged.
+    """
+    cur = Cursor(data, start)
+    begin, end, size, crc = cur.u64(), cur.u64(), cur.u64(), cur.u32()
+    name_length = cur.u32()
+    if name_length > 8:  # no compression has a longer name: refuse before reading garbage
+        raise FormatError("a chunk names an impossible compression")
+    compression = cur.take(name_length).decode(errors="replace")
+    records = decompress(compression, cur.take(cur.u64()), size)
+    if len(records) != size:
+        raise FormatError(f"a chunk holds {len(records)} bytes, its header says {size}")
+    if crc and zlib.crc32(records) != crc:
+        raise FormatError("its CRC does not match its content")
+    return ChunkRecord(begin, end, size, crc, compression, records), cur.pos
+
+
+def read_message_index(data: bytes, start: int) -> tuple[int, list[tuple[int, int]], int]:
+    """Decode a Message Index body at ``start``: (channel id, entries, where it ends)."""
+    cur = Cursor(data, start)
+    channel_id, length = cur.u16(), cur.u32()
+    if length % 16:
+        raise FormatError(f"a message index of {length} bytes is not a list of entries")
+    entries = [struct.unpack_from("<QQ", cur.take(16)) for _ in range(length // 16)]
+    return channel_id, [(int(t), int(o)) for t, o in entries], cur.pos
+
+
+def record_head(data: bytes, pos: int) -> tuple[int, int] | None:
+    """(opcode, body length) of the record at ``pos``, or None if its head is cut off."""
+    if pos + RECORD_HEAD.size > len(data):
+        return None
+    opcode, length = RECORD_HEAD.unpack_from(data, pos)
+    return int(opcode), int(length)
 
 
 def iter_records(data: bytes, start: int = 0) -> Iterator[tuple[int, int, bytes]]:

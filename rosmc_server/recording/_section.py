@@ -2,19 +2,26 @@
 
 The writer hands every record to the file as soon as it exists; this class
 encodes the records that need bookkeeping (schemas, channels, chunks) and
-remembers what the summary written on close must list.
+remembers what the summary written on close must list. The chunk indexes are
+kept already encoded (about 90 bytes per chunk, not a Python object each): they
+are the only thing that grows with every append.
 """
+
+from __future__ import annotations
 
 import zlib
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 from mcap.opcode import Opcode
 
 from rosmc_server.recording import _format as fmt
 from rosmc_server.recording._codec import schema_of
-from rosmc_server.recording._scan import ScanResult
-from rosmc_server.recording.channels import MESSAGE_ENCODING, SCHEMA_ENCODING
+from rosmc_server.recording.channels import JOURNAL_TOPICS, MESSAGE_ENCODING, SCHEMA_ENCODING
+
+if TYPE_CHECKING:
+    from rosmc_server.recording._scan import ScanResult
 
 
 @dataclass
@@ -23,18 +30,40 @@ class DataSection:
 
     schemas: dict[int, fmt.SchemaRecord] = field(default_factory=dict)
     channels: dict[int, fmt.ChannelRecord] = field(default_factory=dict)
-    chunk_indexes: list[fmt.ChunkIndexRecord] = field(default_factory=list)
     counts: dict[int, int] = field(default_factory=dict)
     start_time: int = 0
     end_time: int = 0
+    chunks: int = 0
+    _indexes: bytearray = field(default_factory=bytearray)  # encoded, all but the last
+    _last_index: fmt.ChunkIndexRecord | None = None  # kept whole: resume may extend it
 
     @classmethod
-    def from_scan(cls, scan: ScanResult) -> "DataSection":
+    def from_scan(cls, scan: ScanResult) -> DataSection:
         """Rebuild the state of the data section a scan found."""
-        section = cls(dict(scan.schemas), dict(scan.channels), list(scan.chunk_indexes))
+        section = cls(dict(scan.schemas), dict(scan.channels))
+        for index in scan.chunk_indexes:
+            section.add_index(index)
         for msg in scan.messages:
             section.count(msg.channel_id, msg.log_time)
         return section
+
+    @classmethod
+    def journal(cls) -> DataSection:
+        """The section of a new journal: every journal channel declared, in the fixed order.
+
+        A journal's channel and schema ids follow from :data:`JOURNAL_TOPICS` alone, so
+        a reader can still tell a channel whose declaration was damaged.
+        """
+        section = cls()
+        section.declare(JOURNAL_TOPICS)
+        return section
+
+    def add_index(self, index: fmt.ChunkIndexRecord) -> None:
+        """Remember a written chunk for the summary."""
+        if self._last_index is not None:
+            self._indexes += fmt.chunk_index(self._last_index)
+        self._last_index = index
+        self.chunks += 1
 
     def channel_ids(self) -> dict[str, int]:
         """Channel id of each topic."""
@@ -66,7 +95,7 @@ class DataSection:
     ) -> None:
         """Count one more message written on a channel (in the chunk ``chunk_index`` lists)."""
         if chunk_index is not None:
-            self.chunk_indexes.append(chunk_index)
+            self.add_index(chunk_index)
         if not self.counts:
             self.start_time = self.end_time = log_time
         self.start_time = min(self.start_time, log_time)
@@ -108,15 +137,15 @@ class DataSection:
 
     def restore_indexes(self, offset: int, missing: Mapping[int, list[tuple[int, int]]]) -> bytes:
         """Return the message indexes the last chunk lost, to go at ``offset`` right after it."""
-        if not self.chunk_indexes or not missing:
+        last = self._last_index
+        if last is None or not missing:
             return b""
-        last = self.chunk_indexes[-1]
         offsets = list(last.message_index_offsets)
         records = b""
         for channel_id, entries in missing.items():
             offsets.append((channel_id, offset + len(records)))
             records += fmt.message_index(channel_id, entries)
-        self.chunk_indexes[-1] = replace(
+        self._last_index = replace(
             last,
             message_index_offsets=tuple(offsets),
             message_index_length=last.message_index_length + len(records),
@@ -135,7 +164,7 @@ class DataSection:
             (Opcode.SCHEMA, b"".join(fmt.schema(s) for s in self.schemas.values())),
             (Opcode.CHANNEL, b"".join(fmt.channel(c) for c in self.channels.values())),
             (Opcode.STATISTICS, self._statistics()),
-            (Opcode.CHUNK_INDEX, b"".join(fmt.chunk_index(c) for c in self.chunk_indexes)),
+            (Opcode.CHUNK_INDEX, self._chunk_indexes()),
         ]
         summary = b""
         offsets = b""
@@ -152,8 +181,12 @@ class DataSection:
         return fmt.statistics(
             schemas=len(self.schemas),
             channels=len(self.channels),
-            chunks=len(self.chunk_indexes),
+            chunks=self.chunks,
             counts=self.counts,
             start=self.start_time,
             end=self.end_time,
         )
+
+    def _chunk_indexes(self) -> bytes:
+        last = b"" if self._last_index is None else fmt.chunk_index(self._last_index)
+        return bytes(self._indexes) + last

@@ -44,6 +44,9 @@ TELEMETRY_TOPICS: Final = (
 LATCHED_TOPICS: Final = (MISSION_TOPIC, SCIENCE_TOPIC, WORLD_TOPIC)
 """Channels whose live publishers latch them (a replay and a converted bag latch them too)."""
 
+LIBRARY: Final = "rosmc-journal/1"
+"""The library field of a journal's MCAP header: a file with it was written by JournalWriter."""
+
 PROFILE: Final = "ros1"
 MESSAGE_ENCODING: Final = "ros1"
 SCHEMA_ENCODING: Final = "ros1msg"

@@ -32,8 +32,10 @@ from rosmc_server.core import (
 )
 from rosmc_server.core.updates import apply_event
 from rosmc_server.interface import EVENTS_TOPIC, MISSION_TOPIC, ROBOT_REPORTS_TOPIC
+from rosmc_server.recording.damage import skipped_line
 from rosmc_server.recording.errors import JournalError
-from rosmc_server.recording.reader import JournalResult, read_journal
+from rosmc_server.recording.reader import JournalRecord, JournalResult, feed, read_journal
+from rosmc_server.recording.revisions import Gap, RevisionWalk
 from rosmc_server.recording.timeline import Timeline, TimelineBuilder
 
 CHECKPOINT_EVERY = 256
@@ -80,10 +82,18 @@ class MissionHistory:
         """Log time (ns) of the last record."""
         self._entries: list[_Entry] = []
         self._problems: list[str] = []
+        self._mission: MissionState | None = None
         self._timeline = TimelineBuilder(self.start)
+        self.gaps: tuple[Gap, ...] = ()
+        """The revisions that cannot be rebuilt (damaged or missing records)."""
+        self.damage = result.damage
+        """The damaged byte ranges reading skipped."""
         self._build(result)
-        self.problems = tuple(f"journal {self.path}: {text}" for text in self._problems)
-        """Revisions that could not be rebuilt and why (empty for an intact journal)."""
+        skipped = skipped_line(self.path, self.damage, self.gaps)
+        self.problems: tuple[str, ...] = (skipped,) if skipped else ()
+        self.problems += tuple(f"journal {self.path}: {text}" for text in self._problems)
+        """What was skipped (one line: damaged bytes and the revisions they cost) and any
+        other revision that could not be rebuilt, one sentence each (empty when intact)."""
         self._revisions = [entry.info.revision for entry in self._entries]
         self._times = [entry.info.log_time for entry in self._entries]
         self._cache: tuple[int, MissionState] | None = None
@@ -175,86 +185,60 @@ class MissionHistory:
         return MissionState(state.content(), state.revision)
 
     def _build(self, result: JournalResult) -> None:
-        mission: MissionState | None = None
-        pending: tuple[MissionEvent, int] | None = None  # a replacement awaiting its snapshot
-        broken_at: int | None = None  # first revision that could not be applied
-        since_checkpoint = 0
+        walk: RevisionWalk[JournalRecord, JournalRecord] = RevisionWalk(self._restart, self._apply)
+        self._since_checkpoint = 0
         for record in result.records:
             if record.topic == ROBOT_REPORTS_TOPIC:
                 self._timeline.report(record.message, record.log_time)
-                continue
-            if record.topic == MISSION_TOPIC:
-                revision = int(record.message.revision)
-                current = -1 if mission is None else mission.revision
-                if pending is not None and revision == pending[0].revision:
-                    event, log_time = pending
-                    info = Revision(revision, log_time, event.kind, event.summary)
-                    pending = None
-                elif revision > current:
-                    if mission is not None:
-                        self._gap(current, revision, broken_at)
-                    info = Revision(revision, record.log_time, None, "")
-                else:
-                    continue  # a periodic snapshot of a revision already rebuilt
-                content, _ = mission_from_msg(record.message)
-                mission = _state(content, revision)
-                self._entries.append(_Entry(info, None, content))
-                self._timeline.reset(mission, info.log_time)
-                broken_at, since_checkpoint = None, 0
-                continue
-            if mission is None or record.topic != EVENTS_TOPIC:
-                continue
-            revision = int(record.message.revision)
-            if revision <= mission.revision or broken_at is not None:
-                continue  # already in the snapshot, or after a gap: wait for a snapshot
-            if pending is not None:
-                self._problems.append(
-                    f"revision {pending[0].revision} replaced the mission but its snapshot is "
-                    f"missing; revisions from {pending[0].revision} on are left out"
-                )
-                broken_at = pending[0].revision
-                pending = None
-                continue
-            if revision != mission.revision + 1:
-                broken_at = mission.revision + 1
-                continue
-            try:
-                event = event_from_msg(record.message)
-                if event.kind is EventKind.MISSION_REPLACED:
-                    pending = (event, record.log_time)
-                    continue
-                self._timeline.event(mission, event, record.log_time)
-                apply_event(mission, event)
-            except RosmcError as err:
-                self._problems.append(f"revision {revision} does not apply ({err}); skipped")
-                broken_at = revision
-                continue
-            since_checkpoint += 1
-            checkpoint = None
-            if since_checkpoint >= CHECKPOINT_EVERY:
-                checkpoint, since_checkpoint = mission.content(), 0
-            info = Revision(revision, record.log_time, event.kind, event.summary)
-            self._entries.append(_Entry(info, event if checkpoint is None else None, checkpoint))
-        if broken_at is not None:
+            else:
+                feed(walk, record)
+        walk.finish()
+        if walk.unacknowledged is not None:
             self._problems.append(
-                f"revision {broken_at} is missing; the revisions after it are left out"
-            )
-        if pending is not None:
-            self._problems.append(
-                f"revision {pending[0].revision} replaced the mission, but the journal ends "
+                f"revision {walk.unacknowledged} replaced the mission, but the journal ends "
                 "before the new mission's snapshot; it is left out"
             )
+        self.gaps = tuple(walk.gaps)
         if not self._entries:
             raise JournalError(f"journal {self.path} holds no mission snapshot to start from")
 
-    def _gap(self, current: int, revision: int, broken_at: int | None) -> None:
-        first = current + 1 if broken_at is None else broken_at
-        if revision > first:
-            missing = f"{first}" if revision == first + 1 else f"{first} to {revision - 1}"
-            self._problems.append(
-                f"revision {missing} cannot be rebuilt; the history continues from the "
-                f"snapshot of revision {revision}"
-            )
+    def _restart(self, record: JournalRecord, replacing: JournalRecord | None) -> None:
+        """(Re)start the history from a snapshot (of a replacement, if given)."""
+        revision = int(record.message.revision)
+        info = Revision(revision, self._next_time(record.log_time), None, "")
+        if replacing is not None:
+            kind, summary = EventKind.MISSION_REPLACED, str(replacing.message.summary)
+            info = Revision(revision, self._next_time(replacing.log_time), kind, summary)
+        content, _ = mission_from_msg(record.message)
+        self._mission = _state(content, revision)
+        self._entries.append(_Entry(info, None, content))
+        self._timeline.reset(self._mission, info.log_time)
+        self._since_checkpoint = 0
+
+    def _apply(self, record: JournalRecord) -> bool:
+        """Apply the next event; False (and a problem) if it does not apply."""
+        mission = self._mission
+        assert mission is not None
+        revision = int(record.message.revision)
+        try:
+            event = event_from_msg(record.message)
+            self._timeline.event(mission, event, record.log_time)
+            apply_event(mission, event)
+        except RosmcError as err:
+            self._problems.append(f"revision {revision} does not apply ({err}); skipped")
+            return False
+        self._since_checkpoint += 1
+        checkpoint = None
+        if self._since_checkpoint >= CHECKPOINT_EVERY:
+            checkpoint, self._since_checkpoint = mission.content(), 0
+        info = Revision(revision, self._next_time(record.log_time), event.kind, event.summary)
+        self._entries.append(_Entry(info, event if checkpoint is None else None, checkpoint))
+        return True
+
+    def _next_time(self, log_time: int) -> int:
+        """``log_time``, or the previous revision's if later: an event journaled before a
+        late snapshot is shown right after it, so times never go back."""
+        return max(log_time, self._entries[-1].info.log_time) if self._entries else log_time
 
 
 def _state(content: MissionContent | None, revision: int) -> MissionState:

@@ -1,14 +1,18 @@
 """Reading a mission journal back, including one whose writer was killed mid-write."""
 
 import logging
-from collections.abc import Collection
-from dataclasses import dataclass
+from collections.abc import Collection, Sequence
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from rosmc_server.interface import EVENTS_TOPIC, MISSION_TOPIC
 from rosmc_server.recording import _scan
 from rosmc_server.recording._codec import Decoder, RosMessage
+from rosmc_server.recording._files import journal_parts
+from rosmc_server.recording.channels import LIBRARY
+from rosmc_server.recording.damage import Damage
 from rosmc_server.recording.errors import JournalError
+from rosmc_server.recording.revisions import Gap, RevisionWalk
 
 _log = logging.getLogger(__name__)
 
@@ -24,15 +28,17 @@ class JournalRecord:
 
 @dataclass(frozen=True)
 class JournalResult:
-    """Everything recovered from a journal file.
+    """Everything recovered from a journal (all its part files, or one file).
 
     Attributes:
-        path: The file that was read.
+        path: The journal that was read (its first file).
         records: Every intact message in file order.
-        dropped_bytes: Bytes at the end that were not used: a record cut short, a damaged
-            record and everything after it, or an unfinished summary. 0 for a clean file.
-        complete: Whether the file ended with a footer (its writer closed it).
-        warnings: One sentence per problem found, each naming the file.
+        dropped_bytes: Bytes at the end that were not used: a record cut short, damage
+            that runs to the end, or an unfinished summary. 0 for a clean file.
+        complete: Whether every file ended with a footer (its writer closed it).
+        warnings: One sentence per problem found other than damage, each naming the file.
+        damage: The damaged byte ranges that were skipped (see :func:`.skipped_line`).
+        files: The files read, in order.
     """
 
     path: Path
@@ -40,11 +46,18 @@ class JournalResult:
     dropped_bytes: int
     complete: bool
     warnings: tuple[str, ...]
+    damage: tuple[Damage, ...] = ()
+    files: tuple[Path, ...] = ()
 
     @property
     def clean(self) -> bool:
         """True for a closed journal read without any problem."""
-        return self.complete and not self.warnings
+        return self.complete and not self.warnings and not self.damage
+
+    @property
+    def size(self) -> int:
+        """Bytes of all the files read."""
+        return sum(file.stat().st_size for file in self.files if file.exists())
 
     def messages(self, topic: str) -> list[RosMessage]:
         """Return the messages recorded on ``topic``, in file order."""
@@ -53,15 +66,17 @@ class JournalResult:
 
 @dataclass(frozen=True)
 class LatestState:
-    """The last mission snapshot of a journal and the events recorded after it.
+    """The snapshot and events to rebuild the newest mission a journal holds.
 
     Attributes:
-        snapshot: The last ``rosmc/Mission`` snapshot.
+        snapshot: The ``rosmc/Mission`` snapshot to start from.
         snapshot_time: Its log time (ns).
-        events: The ``rosmc/MissionEvent`` messages after it with a higher revision, in order.
-        problems: Error-level findings (missing revisions, a replaced mission without its
-            snapshot); a state with problems is not a faithful copy of the last mission.
+        events: The ``rosmc/MissionEvent`` messages to apply on it, in order.
+        problems: Error-level findings, one sentence each (revisions that cannot be
+            rebuilt); a state with problems is not a faithful copy of the last mission.
         notes: What was left out on purpose (a change recorded but never acknowledged).
+        gaps: The revisions that cannot be rebuilt (see :attr:`lost`).
+        highest: The highest revision the journal holds (-1 for none).
     """
 
     snapshot: RosMessage
@@ -69,15 +84,31 @@ class LatestState:
     events: tuple[RosMessage, ...]
     problems: tuple[str, ...]
     notes: tuple[str, ...] = ()
+    gaps: tuple[Gap, ...] = ()
+    highest: int = -1
 
     @property
     def revision(self) -> int:
         """The revision the mission reaches once the events are applied to the snapshot."""
         return int(self.events[-1].revision if self.events else self.snapshot.revision)
 
+    @property
+    def lost(self) -> Gap | None:
+        """Recorded revisions that are not in the rebuilt mission: no snapshot follows them."""
+        last = self.gaps[-1] if self.gaps else None
+        return last if last is not None and last.resumed_at is None else None
+
+    @property
+    def next_revision(self) -> int:
+        """The revision the next change must get: above every revision the journal holds."""
+        return max(self.revision, self.highest) + 1
+
 
 def read_journal(path: str | Path, topics: Collection[str] | None = None) -> JournalResult:
     """Read every intact record of a journal, closed or not, and say what was lost.
+
+    A journal that grew past one file is read whole: ``path`` names its first file
+    (or any part) and every part follows in order.
 
     Args:
         path: The ``.mcap`` journal.
@@ -86,15 +117,52 @@ def read_journal(path: str | Path, topics: Collection[str] | None = None) -> Jou
     Raises:
         JournalError: The file is missing, empty, not MCAP, or ends before its header.
     """
-    return decode_scan(_scan.scan(Path(path)), topics)
+    base, parts = journal_parts(path)
+    results = [decode_scan(_scan.scan(parts[0][1]), topics)]
+    warnings: list[str] = []
+    expected = parts[0][0] + 1
+    for number, part in parts[1:]:
+        if number != expected:
+            missing = f"{expected}" if number == expected + 1 else f"{expected} to {number - 1}"
+            warnings.append(f"journal {base}: part {missing} is missing")
+        expected = number + 1
+        try:
+            results.append(decode_scan(_scan.scan(part), topics))
+        except JournalError as err:  # e.g. a part created just before a crash
+            warnings.append(f"skipped {part.name}: {err}")
+    for text in warnings:
+        _log.warning("%s", text)
+    return join_results(base, results, warnings)
+
+
+def join_results(
+    path: Path, results: Sequence[JournalResult], warnings: Sequence[str] = ()
+) -> JournalResult:
+    """One result of the parts of a journal read one by one, in order."""
+    if len(results) == 1 and not warnings:
+        return replace(results[0], path=path)
+    return JournalResult(
+        path,
+        tuple(record for result in results for record in result.records),
+        sum(result.dropped_bytes for result in results),
+        all(result.complete for result in results),
+        tuple(w for result in results for w in result.warnings) + tuple(warnings),
+        tuple(d for result in results for d in result.damage),
+        tuple(f for result in results for f in result.files),
+    )
 
 
 def decode_scan(scan: _scan.ScanResult, topics: Collection[str] | None = None) -> JournalResult:
-    """Decode the messages a scan found into a JournalResult and log its warnings."""
+    """Decode the messages a scan found into a JournalResult and log its warnings.
+
+    Damage is not logged here: whoever reads the journal reports it in one line (with
+    the revisions it cost, which only they know).
+    """
     decoder = Decoder()
     records: list[JournalRecord] = []
     failures: dict[str, list[str]] = {}
-    for msg in scan.messages:
+    damage = list(scan.damage)
+    for msg, (start, end) in zip(scan.messages, scan.spans, strict=True):
         channel = scan.channels[msg.channel_id]
         if topics is not None and channel.topic not in topics:
             continue
@@ -106,7 +174,12 @@ def decode_scan(scan: _scan.ScanResult, topics: Collection[str] | None = None) -
                 JournalRecord(channel.topic, msg.log_time, decoder.decode(schema, msg.data))
             )
         except JournalError as err:
-            failures.setdefault(channel.topic, []).append(str(err))
+            # A journal's bare message (no CRC) that does not decode: its bytes are damaged.
+            if schema is not None and scan.library == LIBRARY and not scan.chunk_indexes:
+                what = f"a {schema.name} message that does not decode"
+                damage.append(Damage(scan.path, start, end, what))
+            else:
+                failures.setdefault(channel.topic, []).append(str(err))
     warnings = list(scan.warnings)
     warnings += [f"journal {scan.path}: {note}" for note in decoder.notes]
     for topic, reasons in failures.items():
@@ -117,16 +190,24 @@ def decode_scan(scan: _scan.ScanResult, topics: Collection[str] | None = None) -
     for text in warnings:
         _log.warning("%s", text)
     return JournalResult(
-        scan.path, tuple(records), scan.dropped_bytes, scan.complete, tuple(warnings)
+        scan.path,
+        tuple(records),
+        scan.dropped_bytes,
+        scan.complete,
+        tuple(warnings),
+        tuple(sorted(damage, key=lambda d: d.start)),
+        (scan.path,),
     )
 
 
 def latest_state(result: JournalResult) -> LatestState:
-    """Pick the newest snapshot and the events after it, to rebuild the mission from.
+    """Pick the snapshot and the events to rebuild the newest mission from.
 
-    Events at or below the snapshot's revision are already part of it and left out.
-    A missing revision, a revision that goes backwards, or a mission replacement
-    whose snapshot is missing is reported in ``problems`` and logged as an error.
+    The mission starts from the newest snapshot that the events before it reach (or
+    that a gap makes necessary) and takes every event that follows it one by one;
+    events journaled before a late periodic snapshot count too. A missing revision (a
+    damaged record) stops the events: what follows it is in :attr:`LatestState.gaps`
+    and, if no snapshot follows, in :attr:`LatestState.lost`.
 
     A ``MISSION_REPLACED`` event carries no content, so the writer must append the new
     mission's snapshot right after it and acknowledge the change only then. A journal
@@ -136,58 +217,52 @@ def latest_state(result: JournalResult) -> LatestState:
     Raises:
         JournalError: The journal holds no snapshot.
     """
-    last = None
-    for index, record in enumerate(result.records):
-        # The newest snapshot by revision: a periodic one built off the service path
-        # can land in the file after a newer one (e.g. after a mission replacement).
-        if record.topic == MISSION_TOPIC and (
-            last is None
-            or int(record.message.revision) >= int(result.records[last].message.revision)
-        ):
-            last = index
-    if last is None:
-        raise JournalError(f"journal {result.path} holds no mission snapshot to start from")
-    snapshot = result.records[last]
-    expected = int(snapshot.message.revision) + 1
+    base: list[JournalRecord] = []
     events: list[RosMessage] = []
-    problems: list[str] = []
-    # A periodic snapshot may be written a moment after the events that followed the
-    # revision it shows (the server builds it off the service path), so events with a
-    # higher revision count wherever they stand in the file.
-    after = int(snapshot.message.revision)
-    tail = [
-        r.message
-        for r in result.records
-        if r.topic == EVENTS_TOPIC and int(r.message.revision) > after
-    ]
-    notes: list[str] = []
-    if tail and tail[-1].kind == tail[-1].MISSION_REPLACED:
+
+    def restart(snapshot: JournalRecord, _replacing: JournalRecord | None) -> None:
+        base[:] = [snapshot]
+        events.clear()
+
+    def apply(event: JournalRecord) -> bool:
+        events.append(event.message)
+        return True
+
+    def covered(snapshot: JournalRecord) -> None:
+        # A newer periodic snapshot saves replaying the events it already holds.
+        revision = int(snapshot.message.revision)
+        if base and revision >= int(base[0].message.revision):
+            base[:] = [snapshot]
+            events[:] = [e for e in events if int(e.revision) > revision]
+
+    walk: RevisionWalk[JournalRecord, JournalRecord] = RevisionWalk(restart, apply, covered)
+    for record in result.records:
+        feed(walk, record)
+    walk.finish()
+    if not base:
+        raise JournalError(f"journal {result.path} holds no mission snapshot to start from")
+    notes = []
+    if walk.unacknowledged is not None:
         notes.append(
-            f"revision {tail.pop().revision} replaced the mission, but the journal ends before "
-            "the new mission's snapshot: that change was never acknowledged and is left out"
+            f"journal {result.path}: revision {walk.unacknowledged} replaced the mission, but "
+            "the journal ends before the new mission's snapshot: that change was never "
+            "acknowledged and is left out"
         )
-    for event in tail:
-        revision = int(event.revision)
-        if revision < expected:
-            if events:  # only a repeat *after* the snapshot is suspicious
-                problems.append(f"event revision {revision} repeats or goes backwards; ignored")
-            continue
-        if revision > expected:
-            missing = f"{expected}" if revision == expected + 1 else f"{expected} to {revision - 1}"
-            problems.append(f"revision {missing} is missing before revision {revision}")
-        if event.kind == event.MISSION_REPLACED:
-            problems.append(
-                f"revision {revision} replaced the mission but no snapshot of the new mission "
-                "follows it"
-            )
-        events.append(event)
-        expected = revision + 1
-    problems = [f"journal {result.path}: {text}" for text in problems]
-    notes = [f"journal {result.path}: {text}" for text in notes]
-    for text in problems:
-        _log.error("%s", text)
-    for text in notes:
-        _log.warning("%s", text)
     return LatestState(
-        snapshot.message, snapshot.log_time, tuple(events), tuple(problems), tuple(notes)
+        base[0].message,
+        base[0].log_time,
+        tuple(events),
+        tuple(f"journal {result.path}: {gap}" for gap in walk.gaps),
+        tuple(notes),
+        tuple(walk.gaps),
+        walk.highest,
     )
+
+
+def feed(walk: RevisionWalk[JournalRecord, JournalRecord], record: JournalRecord) -> None:
+    """Hand a snapshot or event record to ``walk``; records of other topics are ignored."""
+    if record.topic == MISSION_TOPIC:
+        walk.snapshot(int(record.message.revision), record)
+    elif record.topic == EVENTS_TOPIC:
+        replaced = record.message.kind == record.message.MISSION_REPLACED
+        walk.event(int(record.message.revision), replaced, record)

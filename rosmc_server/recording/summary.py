@@ -88,7 +88,7 @@ def summarize(path: str | Path) -> RecordingSummary:
     changes = Counter(info.kind.name for info in revisions if info.kind is not None)
     return RecordingSummary(
         path=Path(path),
-        size_bytes=Path(path).stat().st_size,
+        size_bytes=result.size,
         duration=_span(result),
         first_revision=revisions[0].revision,
         last_revision=revisions[-1].revision,

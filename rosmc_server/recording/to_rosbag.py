@@ -16,10 +16,12 @@ from pathlib import Path
 import genpy
 import rosbag
 
-from rosmc_server.interface import SERVER_NODE
+from rosmc_server.interface import EVENTS_TOPIC, SERVER_NODE
 from rosmc_server.recording.channels import LATCHED_TOPICS
+from rosmc_server.recording.damage import skipped_line
 from rosmc_server.recording.errors import JournalError
 from rosmc_server.recording.reader import read_journal
+from rosmc_server.recording.revisions import missing_revisions
 
 _log = logging.getLogger(__name__)
 
@@ -35,11 +37,14 @@ class BagSummary:
         path: The bag file.
         counts: Messages per topic.
         warnings: What reading the journal found wrong (a cut-off tail, ...).
+        skipped: One line on the damaged bytes skipped and the revisions whose event the
+            bag therefore lacks ("" if none).
     """
 
     path: Path
     counts: dict[str, int]
     warnings: tuple[str, ...]
+    skipped: str = ""
 
     @property
     def total(self) -> int:
@@ -80,4 +85,6 @@ def journal_to_rosbag(
         bag_path.unlink(missing_ok=True)
         raise JournalError(f"cannot write the bag {bag_path}: {err}") from err
     _log.info("wrote %d messages of %s to %s", sum(counts.values()), result.path, bag_path)
-    return BagSummary(bag_path, dict(counts), result.warnings)
+    revisions = (int(r.message.revision) for r in result.records if r.topic == EVENTS_TOPIC)
+    skipped = skipped_line(result.path, result.damage, missing=missing_revisions(revisions))
+    return BagSummary(bag_path, dict(counts), result.warnings, skipped)

@@ -1,7 +1,6 @@
 """Appending accepted mission changes to an MCAP journal, durably, one write per change."""
 
 import logging
-import os
 import threading
 from dataclasses import dataclass
 from pathlib import Path
@@ -15,16 +14,15 @@ from rosmc_server.interface import (
     ROBOT_REPORTS_TOPIC,
 )
 from rosmc_server.recording import _format as fmt
-from rosmc_server.recording import _scan
 from rosmc_server.recording._codec import RosMessage, serialize
-from rosmc_server.recording._files import fsync_directory, open_locked, save_tail
-from rosmc_server.recording._section import DataSection
-from rosmc_server.recording.channels import JOURNAL_TOPICS, PROFILE, TELEMETRY_TOPICS
+from rosmc_server.recording._files import journal_parts, part_path
+from rosmc_server.recording._part import PartFile
+from rosmc_server.recording._resume import reopen
+from rosmc_server.recording.channels import JOURNAL_TOPICS, TELEMETRY_TOPICS
 from rosmc_server.recording.errors import JournalError
-from rosmc_server.recording.reader import JournalResult, decode_scan
+from rosmc_server.recording.reader import JournalResult
 
 _log = logging.getLogger(__name__)
-LIBRARY = "rosmc-journal/1"
 
 
 @dataclass(frozen=True)
@@ -41,46 +39,51 @@ class JournalOptions:
         snapshot_every: ``snapshot_due`` turns true after this many events.
         compress_from: zstd-compress a chunk whose records reach this many bytes (snapshots);
             0 never compresses.
+        part_bytes: Once a file holds this many bytes, ``snapshot_due`` turns true and the
+            next snapshot starts the next part file (any append does at twice the size), so
+            the writer's memory and the reading a resume does stay bounded however long the
+            journal grows.
     """
 
     fsync: bool = False
     chunked: bool = True
     snapshot_every: int = 500
     compress_from: int = 16384
+    part_bytes: int = 32 * 1024 * 1024
 
 
 class JournalWriter:
-    """Appends mission events, snapshots and telemetry to one MCAP file.
+    """Appends mission events, snapshots and telemetry to a journal.
 
     Every append reaches the operating system in a single ``write`` before it returns
     (and the disk, with ``fsync``), so a change acknowledged after ``append_event``
     survives a crash of the process. ``close`` adds the summary that makes the file a
-    complete, indexed MCAP file. Open one with :meth:`create` or :meth:`resume`.
-    Thread-safe: appends from several threads are written one after the other. An
-    advisory file lock keeps a second writer (in any process) off the same file.
+    complete, indexed MCAP file. A journal that grows past ``part_bytes`` goes on in
+    part files beside the first (see :mod:`._files`). Open one with :meth:`create` or
+    :meth:`resume`. Thread-safe: appends from several threads are written one after the
+    other. An advisory file lock keeps a second writer (in any process) off the same file.
     """
 
     def __init__(
         self,
-        path: Path,
-        fd: int,
-        section: DataSection,
+        base: Path,
+        part: PartFile,
         options: JournalOptions,
-        chunked: bool,
         recovered: JournalResult | None = None,
+        damaged: bool = False,
     ) -> None:
-        """Wrap an open, locked file positioned at its end; use create or resume instead."""
-        self._path = path
-        self._fd: int | None = fd
-        self._section = section
+        """Wrap an open part file; use create or resume instead."""
+        self._base = base
+        self._part = part
         self._options = options
-        self._chunked = chunked
-        self._offset = os.lseek(fd, 0, os.SEEK_END)
-        self._channels = section.channel_ids()
+        self._channels = part.section.channel_ids()
         self._events_since_snapshot = 0
+        self._rotation_failed = False
         self._lock = threading.RLock()
         self.recovered = recovered
-        """What resume recovered from the file (None for a new journal)."""
+        """What resume recovered from the journal (None for a new journal)."""
+        self.damaged = damaged
+        """Resume found damage in the last file and went on in a new part file."""
 
     @classmethod
     def create(
@@ -93,23 +96,19 @@ class JournalWriter:
         """Start a new journal that opens with ``snapshot``; never overwrites a file.
 
         Raises:
-            JournalError: The file exists or cannot be written.
+            JournalError: The file (or a part file of that name) exists or cannot be written.
         """
         path = Path(path)
-        writer = cls(
-            path,
-            open_locked(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL),
-            DataSection(),
-            options,
-            options.chunked,
-        )
+        _, parts = journal_parts(path)
+        if len(parts) > 1:
+            raise JournalError(
+                f"cannot open journal {path}: part files of an older journal of that name "
+                f"exist ({parts[1][1].name})"
+            )
+        writer = cls(path, PartFile.create(path, 1, options.chunked, options.fsync), options)
         try:
-            preamble = fmt.MAGIC + fmt.header(PROFILE, LIBRARY) + writer._declare()
-            writer._write(preamble, sync=False)
             writer.append_snapshot(snapshot, log_time_ns)
-            if options.fsync:
-                fsync_directory(path.parent)
-        except (OSError, JournalError):
+        except JournalError:
             writer.abandon()
             path.unlink()  # it holds nothing anybody was told about
             raise
@@ -119,73 +118,73 @@ class JournalWriter:
     def resume(
         cls, path: str | Path, options: JournalOptions = JournalOptions()
     ) -> "JournalWriter":
-        """Recover a journal and continue it in the same file.
+        """Recover a journal and continue it.
 
-        Keeps every intact record, cuts off a damaged tail (saving it beside the journal as
-        ``<name>.dropped-<offset>``) or the summary of a closed file, and appends after the
-        last intact record. What was recovered is in :attr:`recovered`.
+        Reads the journal's last file (and the one before if needed, see :mod:`._resume`),
+        keeps every intact record and continues after the last one; a torn tail is cut off
+        (and saved beside the file as ``<name>.dropped-<offset>``), as is the summary of a
+        closed file. A last file with damage is left untouched and the journal goes on in
+        a new part file (:attr:`damaged`). What was recovered is in :attr:`recovered`;
+        :attr:`needs_snapshot` says whether the file now written lacks a snapshot.
 
         Raises:
             JournalError: The file is missing, locked by another writer, or not a journal.
         """
-        path = Path(path)
-        fd = open_locked(path, os.O_RDWR)
-        try:
-            scan = _scan.scan(path)
-            if scan.profile != PROFILE:
-                raise JournalError(
-                    f"{path} is an MCAP file of profile {scan.profile!r}, not a journal"
-                )
-            if scan.top_level_messages and scan.chunk_indexes:
-                raise JournalError(f"journal {path} mixes chunked and bare messages")
-            chunked = bool(scan.chunk_indexes) if scan.messages else options.chunked
-            recovered = decode_scan(scan)
-            if not scan.complete and scan.dropped_bytes:
-                save_tail(path, scan.data_end)
-            os.ftruncate(fd, scan.data_end)
-            writer = cls(path, fd, DataSection.from_scan(scan), options, chunked, recovered)
-        except (OSError, JournalError) as err:
-            os.close(fd)
-            if isinstance(err, JournalError):
-                raise
-            raise JournalError(f"cannot resume journal {path}: {err.strerror}") from err
-        try:
-            writer._finish_resume(scan)
-        except JournalError:
-            writer.abandon()
-            raise
+        reopened = reopen(Path(path), options.chunked, options.fsync)
+        writer = cls(reopened.base, reopened.part, options, reopened.recovered, reopened.damaged)
+        for record in reopened.recovered.records:
+            if record.topic == MISSION_TOPIC:
+                writer._events_since_snapshot = 0
+            elif record.topic == EVENTS_TOPIC:
+                writer._events_since_snapshot += 1
         _log.info(
-            "resumed journal %s: %d records, continuing at byte %d",
-            path,
-            len(recovered.records),
+            "resumed journal %s: %d records, continuing in %s at byte %d",
+            reopened.base,
+            len(reopened.recovered.records),
+            reopened.part.path.name,
             writer.offset,
         )
         return writer
 
     @property
     def path(self) -> Path:
-        """The journal file."""
-        return self._path
+        """The journal: its first file, which names every part for the readers."""
+        return self._base
+
+    @property
+    def part_path(self) -> Path:
+        """The file appends go to now."""
+        return self._part.path
 
     @property
     def offset(self) -> int:
-        """Bytes handed to the operating system so far (the file size while open)."""
-        return self._offset
+        """Bytes handed to the operating system so far in the current file (its size)."""
+        return self._part.offset
 
     @property
     def chunked(self) -> bool:
         """Whether each append is written as its own chunk."""
-        return self._chunked
+        return self._part.chunked
 
     @property
     def closed(self) -> bool:
         """Whether close() has been called."""
-        return self._fd is None
+        return self._part.fd is None
 
     @property
     def snapshot_due(self) -> bool:
-        """Whether ``snapshot_every`` events were appended since the last snapshot."""
-        return self._events_since_snapshot >= self._options.snapshot_every
+        """Whether a snapshot should be appended: ``snapshot_every`` events since the last
+        one, or the current file is full (the snapshot then starts the next part)."""
+        return (
+            self._events_since_snapshot >= self._options.snapshot_every
+            or self._part.offset >= self._options.part_bytes
+        )
+
+    @property
+    def needs_snapshot(self) -> bool:
+        """Whether the current file holds no snapshot yet (after a resume into a new part):
+        append one before anything else so the file can start the mission on its own."""
+        return self._part.snapshots == 0
 
     def append_event(self, event: RosMessage, log_time_ns: int) -> None:
         """Record one accepted change (``rosmc/MissionEvent``); durable when this returns."""
@@ -216,30 +215,17 @@ class JournalWriter:
     def sync(self) -> None:
         """Flush everything appended so far to the disk (fdatasync)."""
         with self._lock:
-            try:
-                os.fdatasync(self._open_fd())
-            except OSError as err:
-                raise JournalError(f"cannot sync journal {self._path}: {err.strerror}") from err
+            self._part.sync()
 
     def close(self) -> None:
         """Write the summary and footer, sync and close; a closed journal is complete MCAP."""
         with self._lock:
-            if self._fd is None:
-                return
-            try:
-                self._write(self._section.closing_bytes(self._offset), sync=False)
-                os.fdatasync(self._open_fd())
-            except OSError as err:
-                raise JournalError(f"cannot close journal {self._path}: {err.strerror}") from err
-            finally:
-                self.abandon()
+            self._part.close()
 
     def abandon(self) -> None:
         """Close the file without a summary, as a crash leaves it; resume recovers it."""
         with self._lock:
-            if self._fd is not None:
-                os.close(self._fd)
-                self._fd = None
+            self._part.abandon()
 
     def __enter__(self) -> Self:
         return self
@@ -256,60 +242,56 @@ class JournalWriter:
         expected = JOURNAL_TOPICS[topic]
         if getattr(msg, "_type", None) != expected:
             raise JournalError(f"{topic} records {expected}, not {type(msg).__name__}")
-        channel_id = self._channels[topic]
         data = serialize(msg)  # outside the lock: a big snapshot takes a while
         with self._lock:
-            record = fmt.message(channel_id, self._section.sequence(channel_id), log_time_ns, data)
+            self._part.open_fd()
+            if self._rotation_due(topic):
+                self._rotate()
+            part = self._part
+            channel_id = self._channels[topic]
+            record = fmt.message(channel_id, part.section.sequence(channel_id), log_time_ns, data)
             chunk_index = None
-            if self._chunked:
+            if part.chunked:
                 compress_from = self._options.compress_from
-                record, chunk_index = self._section.chunk(
-                    self._offset, channel_id, log_time_ns, record, compress_from
+                record, chunk_index = part.section.chunk(
+                    part.offset, channel_id, log_time_ns, record, compress_from
                 )
-            self._write(record, sync)
-            self._section.count(channel_id, log_time_ns, chunk_index)
+            part.write(record, sync, self._options.fsync)
+            part.section.count(channel_id, log_time_ns, chunk_index)
             if topic == MISSION_TOPIC:
                 self._events_since_snapshot = 0
+                part.snapshots += 1
             elif topic == EVENTS_TOPIC:
                 self._events_since_snapshot += 1
 
-    def _write(self, data: bytes, sync: bool) -> None:
-        """Write all of ``data`` at the end; on failure cut the file back and raise."""
-        fd = self._open_fd()
+    def _rotation_due(self, topic: str) -> bool:
+        full = self._options.part_bytes
+        offset = self._part.offset
+        if self._rotation_failed or offset < full:
+            return False
+        return topic == MISSION_TOPIC or offset >= 2 * full
+
+    def _rotate(self) -> None:
+        """Go on in the next part file; on failure keep writing this one."""
+        old = self._part
+        number = old.number + 1
         try:
-            view = memoryview(data)
-            while view:
-                view = view[os.write(fd, view) :]
-            if sync and self._options.fsync:
-                os.fdatasync(fd)
-        except OSError as err:
-            try:  # a partial record must not stay in front of the next append
-                os.ftruncate(fd, self._offset)
-                os.lseek(fd, self._offset, os.SEEK_SET)
-            except OSError:
-                self.abandon()
-            raise JournalError(f"cannot write journal {self._path}: {err.strerror}") from err
-        self._offset += len(data)
-
-    def _open_fd(self) -> int:
-        if self._fd is None:
-            raise JournalError(f"journal {self._path} is closed")
-        return self._fd
-
-    def _declare(self) -> bytes:
-        """Declare the journal channels the file lacks; return their records."""
-        records = self._section.declare(JOURNAL_TOPICS)
-        self._channels = self._section.channel_ids()
-        return records
-
-    def _finish_resume(self, scan: _scan.ScanResult) -> None:
-        """Restore the last chunk's cut-off message indexes and declare missing channels."""
-        tail = self._section.restore_indexes(self._offset, scan.missing_indexes)
-        tail += self._declare()
-        if tail:
-            self._write(tail, sync=True)
-        for record in self.recovered.records if self.recovered else ():
-            if record.topic == MISSION_TOPIC:
-                self._events_since_snapshot = 0
-            elif record.topic == EVENTS_TOPIC:
-                self._events_since_snapshot += 1
+            new = PartFile.create(
+                part_path(self._base, number), number, old.chunked, self._options.fsync
+            )
+        except JournalError as err:
+            _log.warning(
+                "journal %s: cannot start its next part (%s); going on in %s",
+                self._base,
+                err,
+                old.path.name,
+            )
+            self._rotation_failed = True
+            return
+        self._part = new
+        self._channels = new.section.channel_ids()
+        try:
+            old.close()
+        except JournalError as err:  # readers recover an unclosed part all the same
+            _log.warning("journal %s: %s", self._base, err)
+        _log.info("journal %s: continuing in %s", self._base, new.path.name)

@@ -397,6 +397,7 @@ class OperatorServices:
 
     def _get_mission(self, req: Any, resp: Any) -> None:
         resp.mission = self._server.snapshot_msg()
+        resp.journal_alert = self._server.journal_alert
         return None
 
     def _get_library(self, req: Any, resp: Any) -> None:

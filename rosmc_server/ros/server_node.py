@@ -24,7 +24,9 @@ Parameters (private):
     ``~library`` (str): skill library YAML (default: the shipped Mars team library).
     ``~journal`` (str): journal file; "" = a new timestamped file in ``~journal_dir``.
     ``~journal_dir`` (str): where new journals go (default: ``bags/`` of the package).
-    ``~resume`` (bool): continue from ``~journal`` (recovering a damaged tail).
+    ``~resume`` (bool): continue from ``~journal`` (its last part file), recovering what a
+        crash cut short; damage is skipped, said once as an ERROR and kept for GetMission's
+        ``journal_alert`` (``rosmc status``).
     ``~link_timeout`` (float, s): silence after which a robot link is DOWN (3.0).
     ``~agent_state_rate`` (float, Hz): rate of ``/rosmc/agent_states`` (2.0).
     ``~fsync`` (bool): fsync the journal on every change (survives power loss).
@@ -65,6 +67,7 @@ from ..core import Library, Mission, MissionContent, MissionEvent, Unavailable, 
 from ..core.changes import EventKind
 from ..core.commands import commands_for_event
 from ..recording import JournalOptions, JournalWriter, default_journal_path, latest_state
+from ..recording.recovery import ResumeReport
 from .agent_states import AgentStatePublisher
 from .ground_link import GroundLink
 from .logging_bridge import bridge_logging_to_rosout
@@ -130,7 +133,12 @@ class MissionServer:
         self._stopping = False  # first: robot-link callbacks may arrive during construction
         self._lock = threading.RLock()
         self._converter = SnapshotConverter()
+        self.journal_alert = ""
+        """What resuming the journal could not recover ("" if nothing), for GetMission."""
+        self._snapshot_after_resume = False
         self.mission, self._journal = self._open_journal()
+        if self._snapshot_after_resume:  # the file now written must start the mission
+            self._journal.append_snapshot(self.snapshot_msg(), time.time_ns())
         self._events = rospy.Publisher(interface.EVENTS_TOPIC, wire.MissionEvent, queue_size=1000)
         self._snapshots = SnapshotPublisher(
             interface.MISSION_TOPIC, self.snapshot_msg, on_published=self._journal_snapshot
@@ -247,18 +255,36 @@ class MissionServer:
             if self.config.journal is None:
                 raise ValueError("~resume needs ~journal: the journal file to continue")
             writer = JournalWriter.resume(self.config.journal, options)
-            assert writer.recovered is not None
-            latest = latest_state(writer.recovered)  # logs what was dropped or is missing
-            content, revision = mission_from_msg(latest.snapshot)
-            mission = Mission(self.library, content, revision, clock=clock)
-            for event_msg in latest.events:
-                mission.replay(event_from_msg(event_msg))
-            _log.info("resumed from %s at revision %d", writer.path, mission.revision)
-            return mission, writer
+            return self._resumed(writer), writer
         mission = Mission(self.library, MissionContent.empty(self.library), clock=clock)
         path = self.config.journal or default_journal_path(self.config.journal_dir)
         snapshot = mission_to_msg(mission.state.content(), 0, time.time())
         return mission, JournalWriter.create(path, snapshot, time.time_ns(), options)
+
+    def _resumed(self, writer: JournalWriter) -> Mission:
+        """The mission a resumed journal holds; says once, loudly, what it could not recover.
+
+        After lost revisions the mission goes on above the highest revision the journal
+        holds (an operator may have seen it), and a snapshot records where it stands.
+        """
+        assert writer.recovered is not None
+        latest = latest_state(writer.recovered)
+        for note in latest.notes:
+            _log.warning("%s", note)
+        content, revision = mission_from_msg(latest.snapshot)
+        mission = Mission(self.library, content, revision, clock=rospy.get_time)
+        for event_msg in latest.events:
+            mission.replay(event_from_msg(event_msg))
+        report = ResumeReport.of(writer.path, writer.recovered.damage, latest, writer.part_path)
+        if not report.clean:
+            _log.error("%s", report.log_line())
+            self.journal_alert = report.alert()
+        if latest.next_revision > mission.revision + 1:
+            content = mission.state.content()
+            mission = Mission(self.library, content, latest.next_revision - 1, clock=rospy.get_time)
+        self._snapshot_after_resume = writer.needs_snapshot or latest.lost is not None
+        _log.info("resumed from %s at revision %d", writer.path, mission.revision)
+        return mission
 
 
 CLOCK_CHECK_PERIOD = 5.0  # seconds between looks at /use_sim_time

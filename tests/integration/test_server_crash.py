@@ -6,13 +6,18 @@ chose), cross-checked against GetMission as it goes. The server is killed with S
 while a request is in flight, restarted on its journal with ``_resume:=true``, and the
 restored mission must be exactly the last acknowledged one; only the request in flight
 may or may not have landed, and then as exactly the next revision. A torn journal tail
-(the last bytes of the file missing) is recovered to the last complete record.
+(the last bytes of the file missing) is recovered to the last complete record. A damaged
+byte in the middle costs the revisions it makes impossible to rebuild, said once as an ERROR
+and in ``rosmc status``, and no revision number is handed out twice.
 """
 
 from __future__ import annotations
 
+import json
 import random
 import struct
+import subprocess
+import sys
 import threading
 import time
 from collections.abc import Callable
@@ -23,9 +28,11 @@ from typing import Any
 import pytest
 import rosmc.msg as wire
 import rospy
+from mcap.reader import SeekingReader
 
 pytest.register_assert_rewrite("tests.integration.server_fixtures")
 
+from rosmc_server import interface  # noqa: E402
 from rosmc_server.conversions import (  # noqa: E402
     marker_from_msg,
     mission_from_msg,
@@ -34,6 +41,7 @@ from rosmc_server.conversions import (  # noqa: E402
     pose_from_msg,
 )
 from rosmc_server.core import Mission, RosmcError, load_library, parse_mission  # noqa: E402
+from rosmc_server.recording import _scan, latest_state, read_journal  # noqa: E402
 from tests.integration.server_fixtures import REPO, Client, ServerProcess, mission_key  # noqa: E402
 
 pytest_plugins = ["tests.integration.server_fixtures"]
@@ -422,3 +430,82 @@ def test_a_torn_journal_tail_is_dropped_with_a_warning(
     start_server("torn", journal=journal, resume=True)
     with Client() as client:
         assert mission_key(client.mission()) == expected.key()
+
+
+# -- a damaged journal -------------------------------------------------------------------------
+def test_a_damaged_journal_resumes_loudly_and_never_hands_out_a_revision_again(
+    start_server: Callable[..., ServerProcess], tmp_path: Path
+) -> None:
+    journal = tmp_path / "damaged.mcap"
+    server = start_server("damaged", journal=journal)
+    with Client() as client:
+        expected = Expected(client.mission())
+        session = Session()
+        operate(client, expected, random.Random(11), 80, -1, threading.Event(), session, True)
+        assert session.error is None and session.in_flight is None, session
+    last = expected.revision
+    server.kill9()
+    middle = last // 2
+    start, end = _event_chunk(journal, middle)
+    data = bytearray(journal.read_bytes())
+    data[(start + end) // 2] ^= 0x08  # one bit, inside the chunk of revision `middle`
+    journal.write_bytes(bytes(data))
+
+    server = start_server("damaged", journal=journal, resume=True)
+    errors = [line for line in server.log().splitlines() if "[ERROR]" in line]
+    assert len(errors) == 1, errors
+    assert f"skipped damaged bytes {start}.." in errors[0]
+    lost = f"r{middle}..r{last}"
+    assert f"{last - middle + 1} revisions {lost} cannot be rebuilt" in errors[0]
+    assert f"the mission resumed at r{middle - 1}, next revision r{last + 1}" in errors[0]
+    alert = (
+        f"journal: {last - middle + 1} revisions lost at resume ({lost}: the mission resumed "
+        f"at r{middle - 1}, next revision r{last + 1}), see {journal}"
+    )
+    status = _rosmc(server, "status", "--no-states")
+    assert status.splitlines()[0] == alert
+    assert json.loads(_rosmc(server, "--json", "status", "--no-states"))["journal_alert"] == alert
+    with Client() as client:
+        mission = client.mission()
+        assert mission.revision == last  # what the operators saw last is never reused...
+        mission.revision = middle - 1
+        assert mission_key(mission) == session.history[middle - 1]  # ...the content is r-1's
+        rev = client.call(
+            "add_task_marker",
+            base_revision=last,
+            marker=wire.TaskMarker(name="After", type=1, pose=wire.Pose6D(x=1.0)),
+        ).revision
+        assert rev == last + 1
+    assert server.stop() == 0  # a clean stop closes the new part with its summary
+    part = tmp_path / "damaged.part002.mcap"
+    with part.open("rb") as file:  # the mcap package reads it: a valid, indexed MCAP file
+        found = [m.log_time for _, _, m in SeekingReader(file, validate_crcs=True).iter_messages()]
+    assert len(found) >= 2  # the resume's snapshot (r{last}) and the new change
+    result = read_journal(journal)  # the whole journal, both files
+    assert result.files == (journal, part) and len(result.damage) == 1
+    state = latest_state(result)
+    assert state.revision == last + 1 and state.next_revision == last + 2
+    assert [str(gap.revisions) for gap in state.gaps] == [f"r{middle}..r{last - 1}"]
+
+
+def _event_chunk(journal: Path, revision: int) -> tuple[int, int]:
+    """The bytes of the chunk that holds the event of ``revision``."""
+    scan = _scan.scan(journal)
+    events = next(c.id for c in scan.channels.values() if c.topic == interface.EVENTS_TOPIC)
+    for message, span in zip(scan.messages, scan.spans, strict=True):
+        if message.channel_id == events and int.from_bytes(message.data[:8], "little") == revision:
+            return span
+    raise AssertionError(f"no event of revision {revision} in {journal}")
+
+
+def _rosmc(server: ServerProcess, *args: str) -> str:
+    """Run the ``rosmc`` command against the test's master; its standard output."""
+    done = subprocess.run(
+        [sys.executable, str(REPO / "scripts" / "rosmc"), *args],
+        env=server.env,
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=True,
+    )
+    return done.stdout

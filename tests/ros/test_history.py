@@ -248,7 +248,13 @@ def test_a_missing_revision_is_reported_and_the_next_snapshot_resumes(
             elif record.topic == MISSION_TOPIC:
                 writer.append_snapshot(record.message, record.log_time)
     gap = MissionHistory.from_journal(path)
-    assert any("revision 20" in problem for problem in gap.problems)
+    [lost] = gap.gaps
+    replaced = lost.revisions.last + 1  # the snapshot of the mission replacement
+    assert lost.revisions.first == 20 and lost.resumed_at == replaced
+    assert gap.problems == (
+        f"journal {path}: {replaced - 20} revisions r20..r{replaced - 1} cannot be rebuilt; "
+        f"the mission continues from the snapshot of r{replaced}",
+    )
     assert gap.at_revision(19).content() == recording.live[19]
     with pytest.raises(NotFound):
         gap.at_revision(20)

@@ -319,17 +319,19 @@ def test_missing_file_is_a_journal_error(tmp_path: Path) -> None:
         JournalWriter.resume(tmp_path / "nope.mcap")
 
 
-def test_damaged_record_in_the_middle_drops_everything_after_it(tmp_path: Path) -> None:
+def test_damaged_record_in_the_middle_costs_that_record_only(tmp_path: Path) -> None:
     path = tmp_path / "j.mcap"
     writer, rows = write_sample(path, chunked=True)
     writer.abandon()
     data = bytearray(path.read_bytes())
-    data[rows[2][3] + 60] ^= 0xFF  # inside the payload of the third record's chunk: bad CRC
+    data[rows[2][3] + 60] ^= 0xFF  # inside the payload of the fourth record's chunk: bad CRC
     path.write_bytes(bytes(data))
     result = read_journal(path)
-    assert_prefix(result, rows[:3])
-    assert result.dropped_bytes == len(data) - rows[2][3]
-    assert any("damaged chunk record" in w and "CRC" in w for w in result.warnings)
+    assert_prefix(result, rows[:3] + rows[4:])
+    assert result.dropped_bytes == 0 and not result.clean
+    [damage] = result.damage
+    assert (damage.start, damage.end) == (rows[2][3], rows[3][3])  # the chunk and its index
+    assert "CRC" in damage.what and not damage.kept
 
 
 def test_zero_filled_tail_is_damage_not_records(tmp_path: Path) -> None:
@@ -382,7 +384,7 @@ def test_kill_9_loses_no_acknowledged_change(tmp_path: Path) -> None:
         assert read_journal(path).clean
 
 
-def test_latest_state_picks_the_last_snapshot_and_reports_gaps(tmp_path: Path) -> None:
+def test_latest_state_picks_the_last_snapshot_and_stops_at_a_gap(tmp_path: Path) -> None:
     path = tmp_path / "j.mcap"
     with JournalWriter.create(path, mission(0), T0) as writer:
         for rev in (1, 2, 3):
@@ -395,11 +397,10 @@ def test_latest_state_picks_the_last_snapshot_and_reports_gaps(tmp_path: Path) -
         writer.append_event(event(9), T0 + 21)  # ...and the journal goes on
     state = latest_state(read_journal(path))
     assert state.snapshot == mission(3) and state.snapshot_time == T0 + 4
-    assert [e.revision for e in state.events] == [4, 5, 7, 8, 9]
-    assert state.revision == 9
-    assert len(state.problems) == 2
-    assert "revision 6 is missing before revision 7" in state.problems[0]
-    assert "revision 8 replaced the mission" in state.problems[1]
+    assert [e.revision for e in state.events] == [4, 5]  # nothing is applied over a gap
+    assert state.revision == 5 and state.highest == 9 and state.next_revision == 10
+    assert state.lost is not None and str(state.lost.revisions) == "r6..r9"
+    assert state.problems == (f"journal {path}: 4 revisions r6..r9 cannot be rebuilt",)
     assert state.notes == ()
 
 

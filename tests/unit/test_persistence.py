@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import copy
+import os
+import stat
 import time
 from pathlib import Path
 from typing import Any
@@ -21,6 +23,7 @@ from rosmc_server.core import (
     SkillStatus,
     TaskMarker,
     dump_mission,
+    durable,
     load_mission,
     mission_to_dict,
     parse_mission,
@@ -119,19 +122,34 @@ def test_save_is_atomic(rich: Any, tmp_path: Path, monkeypatch: Any) -> None:
     old = path.read_text(encoding="utf-8")
     assert [p.name for p in tmp_path.iterdir()] == ["mission.yaml"]
 
-    real_write = Path.write_text
-
-    def write_half_then_fail(self: Path, data: str, *args: Any, **kwargs: Any) -> int:
-        real_write(self, data[: len(data) // 2], *args, **kwargs)
+    def no_space(fd: int) -> None:
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(Path, "write_text", write_half_then_fail)
+    monkeypatch.setattr(durable.os, "fsync", no_space)  # the new file never reaches the disk
     with pytest.raises(MissionFileError, match="No space left") as caught:
         save_mission(path, rich.state.content(), 2)
     assert str(path) in str(caught.value) and "\n" not in str(caught.value)
     monkeypatch.undo()
-    # The target still holds the complete previous save.
+    # The target still holds the complete previous save, and nothing else is left behind.
     assert path.read_text(encoding="utf-8") == old
+    assert [p.name for p in tmp_path.iterdir()] == ["mission.yaml"]
+
+
+def test_save_survives_a_power_loss(rich: Any, tmp_path: Path, monkeypatch: Any) -> None:
+    """The new file is on the disk before it replaces the old one, and the rename after."""
+    path = tmp_path / "mission.yaml"
+    synced: list[tuple[str, str]] = []
+    real_fsync = os.fsync
+
+    def fsync(fd: int) -> None:
+        kind = "directory" if stat.S_ISDIR(os.fstat(fd).st_mode) else "file"
+        synced.append((kind, path.read_text(encoding="utf-8") if path.exists() else ""))
+        real_fsync(fd)
+
+    monkeypatch.setattr(durable.os, "fsync", fsync)
+    save_mission(path, rich.state.content(), 3)
+    saved = path.read_text(encoding="utf-8")
+    assert synced == [("file", ""), ("directory", saved)]
 
 
 def test_save_into_a_missing_folder(rich: Any, tmp_path: Path) -> None:

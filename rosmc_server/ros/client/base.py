@@ -26,6 +26,9 @@ class ClientBase:
     def __init__(self, timeout: float = 5.0, prefix: str = "") -> None:
         self._caller = ServiceCaller(timeout, prefix)
         self.revision: int | None = None
+        self.journal_alert = ""
+        """What the server's last resume could not recover from its journal, as of the last
+        mission fetched ("" if nothing)."""
         self._library: Library | None = None
         self._kinds: dict[str, tuple[str, str]] = {}
         self._lock = threading.RLock()
@@ -67,7 +70,9 @@ class ClientBase:
 
     def fetch_mission(self) -> MissionState:
         """The current mission, leaving the client's known revision as it was."""
-        content, revision = mission_from_msg(self._caller.call("get_mission").mission)
+        response = self._caller.call("get_mission")
+        self.journal_alert = str(response.journal_alert)
+        content, revision = mission_from_msg(response.mission)
         state = MissionState(content, revision)
         self._kinds.update({s.id: (s.agent, s.skill) for s in state.skills()})
         return state
