@@ -23,6 +23,7 @@ import itertools
 import json
 import math
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -186,6 +187,7 @@ class MissionMachine(RuleBasedStateMachine):
         self.start = self.mission.state.content()
         self.events: list[MissionEvent] = []
         self.finished: dict[str, SkillInstance] = {}
+        self.renamed: dict[str, str] = {}  # markers renamed since the last invariant check
         self.saved_revision = -1
 
     # -- helpers -------------------------------------------------------------------------
@@ -540,7 +542,9 @@ class MissionMachine(RuleBasedStateMachine):
         self.attempt("move_marker", name, data.draw(poses), vertices)
 
     def rename_marker(self, data: Any) -> None:
-        self.attempt("rename_marker", self.marker_name(data), self.marker_name(data))
+        old, new = self.marker_name(data), self.marker_name(data)
+        if self.attempt("rename_marker", old, new) is not None:
+            self.renamed[old] = new
 
     def delete_marker(self, data: Any) -> None:
         self.attempt("delete_marker", self.marker_name(data))
@@ -648,16 +652,22 @@ class MissionMachine(RuleBasedStateMachine):
 
     @invariant()
     def finished_skills_never_change(self) -> None:
+        """A finished skill is a log: only its resolution changes, and the name of a marker
+        it is bound to follows a rename (bindings always name an existing marker)."""
         present = {s.id: s for s in self.mission.state.skills()}
         for skill_id, recorded in self.finished.items():
             assert skill_id in present, f"finished skill {skill_id} disappeared"
             now = present[skill_id]
+            followed = {param: self.renamed.get(m, m) for param, m in recorded.bindings.items()}
+            assert now.bindings == followed, (skill_id, recorded.bindings, now.bindings)
+            recorded = replace(recorded, bindings=now.bindings)
             if recorded.resolution is not Resolution.NONE:
                 assert now == recorded
             else:
                 assert now.resolution in (Resolution.NONE, Resolution.RETRIED, Resolution.SKIPPED)
-                assert now == recorded.__class__(**{**vars(recorded), "resolution": now.resolution})
+                assert now == replace(recorded, resolution=now.resolution)
         self.finished = {s.id: s for s in self.mission.state.skills() if s.status.is_final}
+        self.renamed = {}
 
     @invariant()
     def barriers_are_sound(self) -> None:
