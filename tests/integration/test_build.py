@@ -58,14 +58,16 @@ def top_level_imports() -> str:
     return f"import {', '.join(names)}; print(rosmc.msg.__file__)"
 
 
+# `sed -n 1p` reads everything: piped into `head -n 1`, rosmsg/rossrv die of a broken pipe now
+# and then, which fails the script under pipefail.
 PRINT_LOOKUPS = f"""
 rospack find rosmc
 rosrun --prefix echo rosmc rosmc_demo
 roslaunch --files rosmc mission_server.launch
 roslaunch --nodes rosmc mission_server.launch
 {SYSTEM_PYTHON} -c '{top_level_imports()}'
-rosmsg show rosmc/Pose6D | head -n 1
-rossrv show rosmc/AddSkill | head -n 1
+rosmsg show rosmc/Pose6D | sed -n 1p
+rossrv show rosmc/AddSkill | sed -n 1p
 """
 
 # What an entry script does first: find the project's PyPI packages (rosmc_server/venv.py),
