@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import os
 import time
 from pathlib import Path
 from typing import Any
@@ -24,6 +25,7 @@ from rosmc_server.core import (
     load_mission,
     mission_to_dict,
     parse_mission,
+    persistence,
     save_mission,
 )
 from rosmc_server.core.persistence import mission_from_dict
@@ -119,19 +121,33 @@ def test_save_is_atomic(rich: Any, tmp_path: Path, monkeypatch: Any) -> None:
     old = path.read_text(encoding="utf-8")
     assert [p.name for p in tmp_path.iterdir()] == ["mission.yaml"]
 
-    real_write = Path.write_text
-
-    def write_half_then_fail(self: Path, data: str, *args: Any, **kwargs: Any) -> int:
-        real_write(self, data[: len(data) // 2], *args, **kwargs)
+    def disk_full(fd: int) -> None:  # the data was written; flushing it fails
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(Path, "write_text", write_half_then_fail)
+    monkeypatch.setattr(persistence.os, "fsync", disk_full)
     with pytest.raises(MissionFileError, match="No space left") as caught:
         save_mission(path, rich.state.content(), 2)
     assert str(path) in str(caught.value) and "\n" not in str(caught.value)
     monkeypatch.undo()
-    # The target still holds the complete previous save.
+    # The target still holds the complete previous save, and no temporary file is left.
     assert path.read_text(encoding="utf-8") == old
+    assert [p.name for p in tmp_path.iterdir()] == ["mission.yaml"]
+
+
+def test_save_flushes_the_file_and_its_folder(rich: Any, tmp_path: Path, monkeypatch: Any) -> None:
+    flushed: list[tuple[str, int]] = []
+    real_fsync = os.fsync
+
+    def recording_fsync(fd: int) -> None:
+        flushed.append((os.readlink(f"/proc/self/fd/{fd}"), os.fstat(fd).st_size))
+        real_fsync(fd)
+
+    monkeypatch.setattr(persistence.os, "fsync", recording_fsync)
+    path = tmp_path / "mission.yaml"
+    save_mission(path, rich.state.content(), rich.revision)
+    size = path.stat().st_size
+    # The whole text reached the disk before the rename, and the rename after it.
+    assert flushed == [(str(tmp_path / ".mission.yaml.tmp"), size), (str(tmp_path), flushed[1][1])]
 
 
 def test_save_into_a_missing_folder(rich: Any, tmp_path: Path) -> None:
