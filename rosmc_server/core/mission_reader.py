@@ -136,34 +136,42 @@ class _TaskReader:
         return found
 
     def quick(self, raw: object, agent: str) -> SkillInstance | None:
-        """The skill a well-formed entry holds, or None (then :meth:`precise` says why)."""
+        """The skill a well-formed entry holds, or None (then :meth:`precise` says why).
+
+        The same checks as :meth:`precise`, called directly; a field the entry leaves out
+        takes its default without a check.
+        """
         if type(raw) is not dict or not _REQUIRED <= raw.keys() <= _KEYS:
             return None
-        get = raw.get
-        name, params, bindings = raw["skill"], raw["params"], get("bindings", {})
+        name, params, bindings = raw["skill"], raw["params"], raw.get("bindings", {})
         label: object = raw.get("label", name)
-        status_text = get("status_text", "")
-        status = _enum(_STATUS, get("status", "IDLE"))
-        transfer = _enum(_TRANSFER, get("transfer", "NONE"))
-        resolution = _enum(_RESOLUTION, get("resolution", "NONE"))
+        status_text: object = raw.get("status_text", "")
+        status = _enum(_STATUS, raw["status"]) if "status" in raw else SkillStatus.IDLE
+        transfer = _enum(_TRANSFER, raw["transfer"]) if "transfer" in raw else Transfer.NONE
+        resolution = (
+            _enum(_RESOLUTION, raw["resolution"]) if "resolution" in raw else Resolution.NONE
+        )
         if (
             type(name) is not str
             or not name.strip()
             or not isinstance(label, str)
+            or not isinstance(status_text, str)
             or type(params) is not dict
             or type(bindings) is not dict
             or status is None
             or transfer is None
             or resolution is None
-            or not all(type(m) is str and m.strip() for m in bindings.values())
+            or (bindings and not all(type(m) is str and m.strip() for m in bindings.values()))
         ):
             return None
         try:
             check_label(label, None)
-            check_one_line(status_text, "a status text", MAX_STATUS_TEXT, empty=True)
+            if status_text:
+                check_one_line(status_text, "a status text", MAX_STATUS_TEXT, empty=True)
             spec = self.spec(agent, name)
             checked = check_params(spec, params)
-            bound_values(self.marker, spec, bindings)
+            if bindings:
+                bound_values(self.marker, spec, bindings)
             if len(checked) != len(spec.parameters):  # one is missing: say which on the way
                 return None
             return SkillInstance(
@@ -176,12 +184,12 @@ class _TaskReader:
                 status=status,
                 transfer=transfer,
                 resolution=resolution,
-                attempt=check_whole(get("attempt", 1), "an attempt", 1, MAX_ATTEMPT),
-                timeout=check_timeout(get("timeout", 0.0)),
-                max_retries=check_retries(get("max_retries", 0)),
+                attempt=_check(raw, "attempt", 1, check_whole, "an attempt", 1, MAX_ATTEMPT),
+                timeout=_check(raw, "timeout", 0.0, check_timeout),
+                max_retries=_check(raw, "max_retries", 0, check_retries),
                 status_text=status_text,
-                started=check_time(get("started", 0.0), "a start time"),
-                finished=check_time(get("finished", 0.0), "a finish time"),
+                started=_check(raw, "started", 0.0, check_time, "a start time"),
+                finished=_check(raw, "finished", 0.0, check_time, "a finish time"),
             )
         except RosmcError:
             return None
@@ -212,6 +220,11 @@ def _enum(members: Mapping[str, Any], raw: object) -> Any:
     return members.get(raw) if isinstance(raw, str) else None
 
 
+def _check(raw: dict[str, Any], key: str, default: Any, check: Any, *args: Any) -> Any:
+    """``check(raw[key], *args)``, or ``default`` when the entry leaves ``key`` out."""
+    return check(raw[key], *args) if key in raw else default
+
+
 def _read_tasks(
     reader: DocumentReader,
     raw: object,
@@ -227,10 +240,11 @@ def _read_tasks(
             reader.fail(f"tasks.{agent}", "names no dynamic agent of the library")
         task = tasks[agent]
         for i, entry in enumerate(reader.items(entries, f"tasks.{agent}")):
-            key = f"tasks.{agent}[{i}]"
-            skill = skills.quick(entry, agent) or skills.precise(entry, agent, key, seen)
+            skill = skills.quick(entry, agent)
+            if skill is None:
+                skill = skills.precise(entry, agent, f"tasks.{agent}[{i}]", seen)
             if skill.id in seen:
-                reader.fail(f"{key}.id", f"skill id {skill.id!r} appears twice")
+                reader.fail(f"tasks.{agent}[{i}].id", f"skill id {skill.id!r} appears twice")
             seen.add(skill.id)
             task.append(skill)
         _check_sections(reader, task, f"tasks.{agent}")

@@ -26,11 +26,14 @@ import json
 import re
 import secrets
 import threading
+from collections.abc import Mapping
+from json.scanner import make_scanner
 from typing import Any
 
 import yaml
 
 from .documents import SafeDumper, load_yaml
+from .errors import MissionFileError
 from .model import Barrier, SkillInstance, TaskMarker
 from .params import value_to_data
 from .state import MissionContent
@@ -128,7 +131,9 @@ def _refuse_constant(name: str) -> None:
 
 
 _ENCODER = json.JSONEncoder(ensure_ascii=False)
-_DECODER = json.JSONDecoder(parse_constant=_refuse_constant)
+# The C scanner json.loads runs, called directly (one line is one call). typeshed's stub
+# wants the scanner's own type for its context; a decoder has every attribute it reads.
+_SCAN = make_scanner(json.JSONDecoder(parse_constant=_refuse_constant))  # type: ignore[arg-type]
 
 
 def flow_line(data: dict[str, Any]) -> str | None:
@@ -175,8 +180,8 @@ def _has_long_key(data: object) -> bool:
 def _scan_line(text: str) -> dict[str, Any] | None:
     """The mapping a line of JSON holds (exactly one value, nothing after it), or None."""
     try:
-        data, end = _DECODER.raw_decode(text)
-    except (ValueError, RecursionError):
+        data, end = _SCAN(text, 0)
+    except (StopIteration, ValueError, RecursionError):
         return None
     return data if end == len(text) and type(data) is dict else None
 
@@ -256,7 +261,7 @@ def _section(name: str, entries: list[dict[str, Any]]) -> str:
     return f"{name}:\n" + "".join(entry(data, "") for data in entries)
 
 
-def read_document(text: str) -> Any:
+def read_document(text: str, source: str) -> Any:
     """Parse a mission document as YAML does, reading flow-line entries with ``json``.
 
     Each run of consecutive flow lines (at one indentation) that is exactly what
@@ -265,7 +270,9 @@ def read_document(text: str) -> Any:
     entries. If a placeholder is missing or stands where no list item could, the whole
     text is parsed as YAML instead.
 
-    Raises what :func:`~.documents.load_yaml` raises for text that is not valid YAML.
+    Raises:
+        yaml.YAMLError: What :func:`~.documents.load_yaml` raises for the text.
+        MissionFileError: YAML aliases expand the document beyond reason.
     """
     runs: list[tuple[int, int, str, list[str], list[dict[str, Any]]]] = []
     for match in _FLOW_ENTRY.finditer(text):
@@ -282,23 +289,56 @@ def read_document(text: str) -> Any:
         runs[-1][4].append(data)
     token = secrets.token_hex(12)
     kept: list[list[dict[str, Any]]] = []
+    weights: dict[str, int] = {}  # a placeholder stands for at most this many values
     pieces: list[str] = []
     done = 0
     for start, end, indent, lines, items in runs:
         if _written_alike(lines, items):
-            pieces += [text[done:start], f'{indent}- "{token}:{len(kept)}"']
+            placeholder = f"{token}:{len(kept)}"
+            pieces += [text[done:start], f'{indent}- "{placeholder}"']
+            weights[placeholder] = end - start
             kept.append(items)
             done = end
-    if not kept:
-        return load_yaml(text)
-    pieces.append(text[done:])
-    try:
-        data = load_yaml("".join(pieces))
-    except yaml.YAMLError:
-        return load_yaml(text)  # the error as the document itself shows it
-    if not _put_back(data, f"{token}:", kept):
-        return load_yaml(text)
+    if kept:
+        pieces.append(text[done:])
+        try:
+            data = load_yaml("".join(pieces))
+        except yaml.YAMLError:
+            data = None  # the error as the document itself shows it, below
+        if data is not None:
+            refuse_alias_bombs(data, len(text), source, weights)
+            if _put_back(data, f"{token}:", kept):
+                return data
+    data = load_yaml(text)
+    refuse_alias_bombs(data, len(text), source)
     return data
+
+
+def refuse_alias_bombs(
+    data: object, length: int, source: str, weights: Mapping[str, int] | None = None
+) -> None:
+    """Refuse a document whose YAML aliases expand it far beyond its own size.
+
+    An alias refers to a value written once, but checking copies it wherever it
+    is used, so a few hundred bytes of nested aliases ("billion laughs") would
+    take hours to load. Ordinary sharing (what yaml.safe_dump writes for repeated
+    values) stays well within the allowance. A string of ``weights`` counts as that
+    many values (a placeholder for entries read apart).
+    """
+    allowance = 100_000 + 20 * length
+    weigh = (weights or {}).get
+    pending, count = [data], 0
+    while pending:
+        item = pending.pop()
+        count += weigh(item, 1) if isinstance(item, str) else 1
+        if count > allowance:
+            raise MissionFileError(
+                f"{source}: its YAML aliases expand it to more than {allowance} values"
+            )
+        if isinstance(item, dict):
+            pending.extend(item.values())
+        elif isinstance(item, list):
+            pending.extend(item)
 
 
 def _put_back(data: Any, prefix: str, runs: list[list[dict[str, Any]]]) -> bool:

@@ -101,7 +101,7 @@ TRICKY_TEXT = st.lists(st.sampled_from(TRICKY), max_size=5).map("".join) | st.te
 def test_every_entry_reads_back_as_written(data: dict[str, Any]) -> None:
     document = "items:\n" + entry(data, "") + entry(data, "")
     assert yaml.load(document, Loader=yaml.CSafeLoader) == {"items": [data, data]}
-    assert read_document(document) == {"items": [data, data]}
+    assert read_document(document, "x") == {"items": [data, data]}
     line = flow_line(data)
     if line is not None:  # JSON that YAML reads the same: no float without a fraction
         assert yaml.load(f"- {line}", Loader=yaml.SafeLoader) == [data]
@@ -130,9 +130,9 @@ def test_lines_that_only_look_like_the_writers_read_as_yaml_does(row: str) -> No
         expected = load_yaml(document)
     except yaml.YAMLError as error:
         with pytest.raises(type(error)):
-            read_document(document)
+            read_document(document, "x")
         return
-    assert read_document(document) == expected
+    assert read_document(document, "x") == expected
 
 
 def test_flow_lines_inside_other_yaml_stay_what_yaml_makes_of_them() -> None:
@@ -149,9 +149,9 @@ def test_flow_lines_inside_other_yaml_stay_what_yaml_makes_of_them() -> None:
             expected = load_yaml(document)
         except yaml.YAMLError:
             with pytest.raises(yaml.YAMLError):
-                read_document(document)
+                read_document(document, "x")
             continue
-        assert read_document(document) == expected, document
+        assert read_document(document, "x") == expected, document
 
 
 def test_a_guessed_placeholder_is_just_text(library: Library) -> None:
@@ -160,7 +160,7 @@ def test_a_guessed_placeholder_is_just_text(library: Library) -> None:
     # Placeholder-shaped strings (the real token is random per read) stay strings.
     shaped = '"0123456789abcdef01234567:0"'
     spoofed = f'{text}note: {shaped}\nextra:\n- {shaped}\n- {{"a": 1.5}}\n'
-    data = read_document(spoofed)
+    data = read_document(spoofed, "x")
     assert data == load_yaml(spoofed)
     assert data["extra"] == ["0123456789abcdef01234567:0", {"a": 1.5}]
 
@@ -191,3 +191,10 @@ def test_a_bad_skill_among_quick_ones_is_named_precisely(library: Library) -> No
     index = int(data["id"].split("-")[1])  # its place in bravo's task
     message = f"m.yaml: tasks.bravo[{index}].attempt: must be a whole number >= 1, got 0"
     assert str(caught.value) == message
+
+
+def test_aliases_to_quickly_read_entries_count_in_full(library: Library) -> None:
+    run = "".join(f'- {{"n": {i}, "text": "{"x" * 20}"}}\n' for i in range(2000))
+    bomb = f"a: &run\n{run}b: [{', '.join(['*run'] * 5000)}]\n"
+    with pytest.raises(MissionFileError, match="aliases expand it"):
+        parse_mission(bomb, library, "bomb.yaml")
