@@ -5,13 +5,23 @@ skills per agent), a real ``mission_server`` on a generated library of that many
 agents. The mission is loaded as one document, then each operation is timed from a
 client with persistent service proxies: median and p95 latency of add, edit, delete,
 reorder, add barrier, marker move, synchronize and get_mission; bytes per event, per
-snapshot and per journaled change; the server's peak RSS. Run from the repository root::
+snapshot and per journaled change; the server's peak RSS. Then the whole-mission paths
+(``whole``): get_mission right after a change and again at the same revision (decoded by
+genpy, and as raw bytes: the server and transport alone), save to a path on the server and
+save returning the document (each right after a change), and loading the mission the
+server saved (also as the server's CPU time, which other work on the machine inflates
+less than the wall time), ``--whole-repeats`` times each, median and max.
+Run from the repository root::
 
     source env.sh
     python bench/bench_server.py [--sizes 2x10,5x100,20x500] [--samples 300] [--profile]
+    python bench/bench_server.py --sizes 2x500,10x500,20x500 --samples 0 --cpu-seconds 30
 
-``--profile`` runs the largest size a second time under cProfile (every server thread)
-and adds the top functions by internal time to the output.
+``--samples 0`` skips the per-change operations. ``--cpu-seconds N`` measures, at the
+largest size, the server's CPU time over N s of 10 changes/s without and then with a
+subscriber to the latched ``/rosmc/mission``. ``--profile`` runs the largest size a
+second time under cProfile (every server thread) and adds the top functions by internal
+time to the output.
 """
 
 from __future__ import annotations
@@ -23,6 +33,7 @@ import json
 import os
 import pstats
 import random
+import re
 import signal
 import socket
 import statistics
@@ -127,6 +138,7 @@ class Server:
             str(REPO / "scripts" / "mission_server"),
             f"_library:={library}",
             f"_journal_dir:={self.journal_dir}",
+            f"_mission_dir:={work / 'missions'}",
         ]
         env = dict(env)
         if profile is not None:
@@ -148,11 +160,32 @@ class Server:
                 raise RuntimeError(f"server did not start:\n{self.log_path.read_text()[-3000:]}")
             time.sleep(0.05)
 
+    def cpu_seconds(self) -> float:
+        """User and system CPU time the server has used so far."""
+        fields = Path(f"/proc/{self.process.pid}/stat").read_text().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+    def rss_mib(self) -> float:
+        """The server's resident memory now."""
+        for line in Path(f"/proc/{self.process.pid}/status").read_text().splitlines():
+            if line.startswith("VmRSS:"):
+                return round(int(line.split()[1]) / 1024, 1)
+        return -1.0
+
     def peak_rss_mib(self) -> float:
         for line in Path(f"/proc/{self.process.pid}/status").read_text().splitlines():
             if line.startswith("VmHWM:"):
                 return round(int(line.split()[1]) / 1024, 1)
         return -1.0
+
+    def load_phases(self) -> list[tuple[float, ...]]:
+        """Per load, as the server logs it: ms reading and checking, serializing, applying."""
+        pattern = re.compile(
+            r"read and checked in (\d+) ms, serialized in (\d+) ms, "
+            r"applied and journaled in (\d+) ms"
+        )
+        text = self.log_path.read_text(errors="replace")
+        return [tuple(float(x) for x in match.groups()) for match in pattern.finditer(text)]
 
     def journal_bytes(self) -> int:
         return sum(p.stat().st_size for p in self.journal_dir.glob("*.mcap"))
@@ -423,8 +456,172 @@ class Bench:
         return {name: int(statistics.median(values)) for name, values in sizes.items()}
 
 
+def timings(samples: list[float]) -> dict[str, float]:
+    """Median and max of a few timings, in milliseconds."""
+    return {
+        "median_ms": round(statistics.median(samples) * 1000, 1),
+        "max_ms": round(max(samples) * 1000, 1),
+        "n": len(samples),
+    }
+
+
+def raw_get_mission_proxy() -> Any:
+    """A persistent GetMission proxy that keeps the answer's bytes instead of decoding them.
+
+    Times the server and the transport alone: decoding 10,000 skills into genpy messages is
+    the client's own cost (timed apart as ``get_mission_client_decode``).
+    """
+    import rosmc.srv as srv
+    import rospy
+
+    from rosmc_server import interface
+
+    class RawResponse(srv.GetMissionResponse):  # type: ignore[misc]
+        def deserialize(self, data: bytes) -> Any:
+            self.raw = data
+            return self
+
+    class RawGetMission:
+        _type = srv.GetMission._type
+        _md5sum = srv.GetMission._md5sum
+        _request_class = srv.GetMissionRequest
+        _response_class = RawResponse
+
+    return rospy.ServiceProxy(interface.service_name("get_mission"), RawGetMission, persistent=True)
+
+
+class WholeMission:
+    """Times the operations that cost the whole mission: get, save and load."""
+
+    def __init__(self, bench: Bench, server: Server, work: Path, repeats: int) -> None:
+        self.bench = bench
+        self.server = server
+        self.work = work
+        self.repeats = repeats
+        self.number = 0
+        self.raw = raw_get_mission_proxy()
+        self.can_skip_document = (
+            "return_document" in bench.proxies["save_mission"].request_class.__slots__
+        )
+
+    def change(self) -> None:
+        """One small change (a label edit), so the next call meets a new revision."""
+        self.number += 1
+        pv = self.bench.wire.ParameterValue
+        agent = self.bench.agents[self.number % len(self.bench.agents)]
+        self.bench.call(
+            "edit_skill",
+            base_revision=self.bench.rev,
+            skill_id=f"{agent}-s{1 + 3 * (self.number % max(1, self.bench.skills // 3)):05d}",
+            label=f"whole {self.number}",
+            parameters=[pv(name="radius", type=pv.FLOAT, float_value=2.5)],
+        )
+
+    def run(self) -> dict[str, Any]:
+        times: dict[str, list[float]] = {}
+
+        def timed(name: str, operation: str, **fields: Any) -> Any:
+            elapsed, response = self.bench.timed(operation, **fields)
+            times.setdefault(name, []).append(elapsed)
+            return response
+
+        def raw_get(name: str) -> bytes:
+            started = time.perf_counter()
+            response = self.raw.call(self.raw.request_class())
+            times.setdefault(name, []).append(time.perf_counter() - started)
+            return bytes(response.raw)
+
+        import rosmc.srv as srv
+
+        path = str(self.work / "missions" / "bench.yaml")
+        document = ""
+        for _ in range(self.repeats):
+            self.change()
+            timed("get_mission_after_change", "get_mission")
+            timed("get_mission_same_revision", "get_mission")
+            self.change()
+            raw_get("get_mission_wire_after_change")
+            data = raw_get("get_mission_wire_same_revision")
+            started = time.perf_counter()
+            srv.GetMissionResponse().deserialize(data)
+            times.setdefault("get_mission_client_decode", []).append(time.perf_counter() - started)
+            self.change()
+            fields = {"return_document": False} if self.can_skip_document else {}
+            saved = timed("save_to_path", "save_mission", path=path, **fields)
+            self.change()
+            document = timed("save_returning_document", "save_mission").document
+        sizes = {"document_bytes": len(document.encode()), "path_reply_bytes": len(saved.document)}
+        peaks = {"server_peak_rss_after_get_and_save_mib": self.server.peak_rss_mib()}
+        for _ in range(self.repeats):
+            cpu = self.server.cpu_seconds()
+            timed(
+                "load_saved_document",
+                "load_mission",
+                base_revision=self.bench.rev,
+                document=document,
+            )
+            times.setdefault("load_saved_document_server_cpu", []).append(
+                self.server.cpu_seconds() - cpu
+            )
+        self.raw.close()
+        peaks["server_peak_rss_after_loads_mib"] = self.server.peak_rss_mib()
+        phases = self.server.load_phases()[-self.repeats :]
+        split = {
+            f"load_server_{name}_ms": round(statistics.median(values), 1)
+            for name, values in zip(
+                ("read_and_check", "serialize", "apply_and_journal"),
+                zip(*phases, strict=True),
+                strict=True,
+            )
+        }
+        return {name: timings(values) for name, values in times.items()} | sizes | peaks | split
+
+
+def subscriber_cpu(bench: Bench, server: Server, seconds: float) -> dict[str, Any]:
+    """The server's CPU share over ``seconds`` of 10 changes/s, without and with a subscriber."""
+    import rosmc.msg as wire
+
+    from rosmc_server import interface
+
+    whole = WholeMission(bench, server, server.journal_dir, 1)
+    received: list[int] = []
+
+    def run() -> float:
+        cpu, started = server.cpu_seconds(), time.monotonic()
+        for tick in range(int(seconds * 10)):
+            whole.change()
+            time.sleep(max(0.0, started + (tick + 1) * 0.1 - time.monotonic()))
+        return (server.cpu_seconds() - cpu) / (time.monotonic() - started)
+
+    time.sleep(3.0)  # let the load's snapshot settle
+    without = run()
+    subscriber = bench.rospy.Subscriber(
+        interface.MISSION_TOPIC, wire.Mission, lambda msg: received.append(msg.revision)
+    )
+    time.sleep(3.0)  # connected, and the latched snapshot delivered
+    try:
+        with_subscriber = run()
+    finally:
+        subscriber.unregister()
+    return {
+        "seconds": seconds,
+        "changes_per_s": 10,
+        "cpu_share_without_subscriber": round(without, 4),
+        "cpu_share_with_subscriber": round(with_subscriber, 4),
+        "subscriber_cost_share": round(with_subscriber - without, 4),
+        "snapshots_received": len(received),
+    }
+
+
 def bench_size(
-    env: dict[str, str], work: Path, agents: int, skills: int, samples: int, profile: Path | None
+    env: dict[str, str],
+    work: Path,
+    agents: int,
+    skills: int,
+    samples: int,
+    profile: Path | None,
+    repeats: int = 5,
+    cpu_seconds: float = 0.0,
 ) -> dict[str, Any]:
     import rosmc.msg  # noqa: F401  (fail early without the built messages)
 
@@ -435,27 +632,37 @@ def bench_size(
     bench = Bench(agents, skills, samples)
     try:
         document = mission_yaml(agents, skills)
+        rss_started = server.rss_mib()
         started = time.perf_counter()
         bench.call("load_mission", base_revision=bench.rev, document=document)
         load_s = time.perf_counter() - started
         time.sleep(0.5)  # the snapshot of the loaded mission is built and journaled
-        journal_start, changes_start = server.journal_bytes(), bench.changes
-        latencies = bench.run()
-        time.sleep(1.0)  # let coalesced snapshots land in the journal and events arrive
-        changes = bench.changes - changes_start
-        snapshot = bench.call("get_mission").mission
-        result = {
+        result: dict[str, Any] = {
             "agents": agents,
             "skills_per_agent": skills,
-            "total_skills": sum(len(t.skills) for t in snapshot.tasks),
             "load_document_s": round(load_s, 3),
-            "latency": latencies,
-            "event_bytes": bench.event_bytes(),
-            "snapshot_bytes": serialized_size(snapshot),
-            "journal_bytes_per_change": round((server.journal_bytes() - journal_start) / changes),
-            "changes": changes,
-            "server_peak_rss_mib": server.peak_rss_mib(),
+            "server_rss_before_load_mib": rss_started,
+            "server_peak_rss_after_load_mib": server.peak_rss_mib(),
         }
+        if repeats > 0:  # first: loading is refused once robots hold synchronized skills
+            (work / "missions").mkdir(exist_ok=True)
+            result["whole"] = WholeMission(bench, server, work, repeats).run()
+        if samples > 0:
+            journal_start, changes_start = server.journal_bytes(), bench.changes
+            result["latency"] = bench.run()
+            time.sleep(1.0)  # let coalesced snapshots land in the journal and events arrive
+            changes = bench.changes - changes_start
+            result["event_bytes"] = bench.event_bytes()
+            result["journal_bytes_per_change"] = round(
+                (server.journal_bytes() - journal_start) / changes
+            )
+            result["changes"] = changes
+        if cpu_seconds > 0:
+            result["snapshot_subscriber"] = subscriber_cpu(bench, server, cpu_seconds)
+        snapshot = bench.call("get_mission").mission
+        result["total_skills"] = sum(len(t.skills) for t in snapshot.tasks)
+        result["snapshot_bytes"] = serialized_size(snapshot)
+        result["server_peak_rss_mib"] = server.peak_rss_mib()
     finally:
         bench.close()
         server.stop(profiled=profile is not None)
@@ -474,8 +681,19 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--sizes", default="2x10,5x100,20x500", help="AGENTSxSKILLS,...")
     parser.add_argument("--samples", type=int, default=300, help="samples per operation")
     parser.add_argument("--profile", action="store_true", help="cProfile the largest size")
+    parser.add_argument(
+        "--whole-repeats", type=int, default=5, help="times each whole-mission path (0: skip)"
+    )
+    parser.add_argument(
+        "--cpu-seconds",
+        type=float,
+        default=0.0,
+        help="at the largest size, server CPU over this many s of 10 changes/s, "
+        "without and with a /rosmc/mission subscriber",
+    )
     args = parser.parse_args(argv)
     sizes = [tuple(int(x) for x in size.split("x")) for size in args.sizes.split(",")]
+    largest = max(sizes, key=lambda size: size[0] * size[1])
     with tempfile.TemporaryDirectory(prefix="bench_server_") as tmp:
         base = Path(tmp)
         (base / "log").mkdir()
@@ -484,13 +702,23 @@ def main(argv: list[str] | None = None) -> int:
 
             rospy.init_node("bench_server", anonymous=True, disable_signals=True)
             results = [
-                bench_size(env, base / f"{a}x{s}", a, s, args.samples, None) for a, s in sizes
+                bench_size(
+                    env,
+                    base / f"{a}x{s}",
+                    a,
+                    s,
+                    args.samples,
+                    None,
+                    args.whole_repeats,
+                    args.cpu_seconds if (a, s) == largest else 0.0,
+                )
+                for a, s in sizes
             ]
             output: dict[str, Any] = {"target_at_20x500": TARGET, "sizes": results}
             if args.profile:
-                a, s = max(sizes, key=lambda size: size[0] * size[1])
+                a, s = largest
                 stats = base / "server.prof"
-                bench_size(env, base / "profiled", a, s, args.samples, stats)
+                bench_size(env, base / "profiled", a, s, args.samples, stats, args.whole_repeats)
                 output["profile_top_tottime"] = profile_summary(stats)
             rospy.signal_shutdown("done")
     print(json.dumps(output, indent=2))
