@@ -1,6 +1,6 @@
 """Mission snapshots as ROS 1 wire bytes, built incrementally and serialized once.
 
-Part of :mod:`rosmc_server.conversions`. A snapshot of 10,000 skills is 4.6 MB; building
+Part of :mod:`rosmc_server.conversions`. A snapshot of 10,000 skills is megabytes; building
 it as genpy messages and serializing those costs a third of a second per snapshot.
 :class:`SnapshotPacker` keeps each skill's serialized bytes, keyed by the (frozen) core
 skill instance, so a snapshot after a change serializes only the changed skills and
@@ -8,8 +8,8 @@ joins the rest. The result is a :class:`PackedMission`: a ``rosmc/Mission`` whos
 ``serialize`` writes those bytes, which rospy publishes, answers a service with
 (:class:`PackedGetMissionResponse`) or the journal records, like any message.
 
-:func:`skill_bytes` writes a skill's wire bytes directly (four times faster than through
-a genpy message); it is used only while ``rosmc/Skill`` is the definition it was written
+:func:`skill_bytes` writes a skill's wire bytes directly (about five times faster than
+through a genpy message); it is used only while ``rosmc/Skill`` is the definition it was written
 for (its md5sum), and a test checks it against genpy's bytes for random skills.
 """
 
@@ -171,19 +171,24 @@ class SnapshotPacker:
     """
 
     def __init__(self) -> None:
-        self._bytes: dict[int, tuple[SkillInstance, bytes]] = {}
+        self._bytes: dict[int, tuple[SkillInstance, bytes]] = {}  # the last snapshot's
+        self._prepared: dict[int, tuple[SkillInstance, bytes]] = {}  # the last prepare's
         self._lock = threading.Lock()
 
     def prepare(self, skills: Iterable[SkillInstance]) -> None:
-        """Serialize ``skills`` now, so that the next snapshot holding them is quick."""
+        """Serialize ``skills`` now, so that the next snapshot holding them is quick.
+
+        Kept until the next call (a snapshot built meanwhile of the old mission does not
+        drop them).
+        """
         ready = {id(skill): (skill, skill_bytes(skill)) for skill in skills}
         with self._lock:
-            self._bytes.update(ready)
+            self._prepared = ready
 
     def body(self, content: MissionContent) -> bytes:
         """The wire bytes of a ``rosmc/Mission`` of ``content`` after its revision and stamp."""
         with self._lock:
-            previous = self._bytes
+            previous, prepared = self._bytes, self._prepared
         current: dict[int, tuple[SkillInstance, bytes]] = {}
         parts = [_string(content.library), _COUNT.pack(len(content.tasks))]
         for agent, task in content.tasks.items():
@@ -191,7 +196,9 @@ class SnapshotPacker:
             for skill in task:
                 entry = previous.get(id(skill))
                 if entry is None or entry[0] is not skill:  # ids are reused once freed
-                    entry = (skill, skill_bytes(skill))
+                    entry = prepared.get(id(skill))
+                    if entry is None or entry[0] is not skill:
+                        entry = (skill, skill_bytes(skill))
                 current[id(skill)] = entry
                 parts.append(entry[1])
         agent_of = _agents_of_members(content).__getitem__

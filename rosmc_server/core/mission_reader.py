@@ -19,6 +19,7 @@ from .documents import DocumentReader
 from .editing import bound_values, check_label, check_params, check_retries, check_timeout
 from .errors import MissionFileError, RosmcError
 from .library import Library, SkillSpec
+from .mission_text import MISSION_VERSION
 from .model import Barrier, Resolution, SkillInstance, SkillStatus, TaskMarker, Transfer
 from .params import MarkerType, Pose
 from .state import MissionContent
@@ -30,8 +31,6 @@ from .validation import (
     check_time,
     check_whole,
 )
-
-MISSION_VERSION = 1
 
 _REQUIRED = frozenset({"id", "skill", "params"})
 _OPTIONAL = frozenset(

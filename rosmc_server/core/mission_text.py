@@ -205,7 +205,12 @@ def entry(data: dict[str, Any], indent: str) -> str:
     line = flow_line(data)
     if line is not None:
         return f"{indent}- {line}\n"
-    return "".join(f"{indent}{row}\n" for row in yaml_block([data]).splitlines())
+    return _indented(yaml_block([data]), indent)
+
+
+def _indented(block: str, indent: str) -> str:
+    """YAML text shifted right by ``indent`` (split at newlines only: YAML escapes the rest)."""
+    return "".join(f"{indent}{row}\n" for row in block.rstrip("\n").split("\n"))
 
 
 # -- whole documents ---------------------------------------------------------------------------
@@ -230,8 +235,7 @@ class MissionDumper:
         for agent, task in content.tasks.items():
             key = _simple_key(agent)
             if key is None:  # written as YAML writes it
-                block = yaml_block({agent: [skill_to_dict(skill) for skill in task]})
-                parts.extend(f"  {row}\n" for row in block.splitlines())
+                parts.append(_indented(yaml_block({agent: [skill_to_dict(s) for s in task]}), "  "))
                 continue
             parts.append(f"  {key}:\n" if task else f"  {key}: []\n")
             for skill in task:

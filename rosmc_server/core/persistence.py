@@ -22,8 +22,8 @@ import yaml
 from .documents import DuplicateKeyError, yaml_problem
 from .errors import MissionFileError
 from .library import Library
-from .mission_reader import MISSION_VERSION, mission_from_dict
-from .mission_text import MissionDumper, mission_to_dict, read_document
+from .mission_reader import mission_from_dict
+from .mission_text import MISSION_VERSION, MissionDumper, mission_to_dict, read_document
 from .state import MissionContent
 
 __all__ = [
