@@ -167,7 +167,12 @@ def new(ctx: Context) -> int:
 
 
 def save(ctx: Context) -> int:
-    """Write the mission as YAML into a local file (or standard output)."""
+    """Write the mission as YAML into a local file (or standard output), or on the server."""
+    if ctx.args.on_server:
+        written = ctx.client.save_mission(ctx.args.file)
+        return ctx.emit_result(
+            written, f"saved revision {written.revision} to {written.path_written} on the server"
+        )
     saved = ctx.client.save_mission()
     if ctx.args.file == "-":
         sys.stdout.write(saved.document)
@@ -187,6 +192,8 @@ def save(ctx: Context) -> int:
 def load(ctx: Context) -> int:
     """Replace the mission with a saved one read from a local file (or standard input)."""
     name = ctx.args.file
+    if ctx.args.on_server:
+        return ctx.emit_result(ctx.client.load_mission(path=name, **ctx.against()))
     try:
         document = sys.stdin.read() if name == "-" else Path(name).read_text(encoding="utf-8")
     except OSError as error:

@@ -233,5 +233,15 @@ def _add_files(command: _Command) -> None:
     new.add_argument("--drop-markers", action="store_true", help="delete the task markers too")
     save = command("save", "save the mission as YAML into a local file")
     save.add_argument("file", metavar="FILE", help="where to write ('-': standard output)")
+    save.add_argument(
+        "--on-server",
+        action="store_true",
+        help="write FILE on the server's host instead (relative to its ~mission_dir)",
+    )
     load = command("load", "replace the mission with one saved before")
     load.add_argument("file", metavar="FILE", help="a saved mission ('-': standard input)")
+    load.add_argument(
+        "--on-server",
+        action="store_true",
+        help="read FILE on the server's host instead (relative to its ~mission_dir)",
+    )

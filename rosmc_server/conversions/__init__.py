@@ -13,6 +13,8 @@ Modules:
 
 * :mod:`.values`: times, poses and named parameter values;
 * :mod:`.mission`: skills, barriers, task markers, mission snapshots and events;
+* :mod:`.packing`: mission snapshots as wire bytes, built incrementally and serialized once
+  (import it from the module);
 * :mod:`.library`: the skill library, both ways;
 * :mod:`.agents`: agent states (``rosmc/AgentStates``) as core ``AgentStatus``;
 * :mod:`.policy`: the lost-link policy <-> ``rosmc/SetRobotOptions`` request fields;
@@ -28,7 +30,6 @@ ValueError in :mod:`.robot_link`, for the executor). Round trips are exact.
 from .agents import agent_status_from_msg, agent_statuses_from_msg
 from .library import library_from_msg, library_to_msg, parameter_spec_to_msg
 from .mission import (
-    SnapshotConverter,
     barrier_from_msg,
     barrier_to_msg,
     event_from_msg,
@@ -57,7 +58,6 @@ from .values import (
 
 __all__ = [
     "MAX_JSON_NESTING",
-    "SnapshotConverter",
     "agent_status_from_msg",
     "agent_statuses_from_msg",
     "barrier_from_msg",

@@ -144,37 +144,6 @@ def mission_to_msg(
     )
 
 
-class SnapshotConverter:
-    """Builds mission snapshots, converting only the skills changed since the last one.
-
-    Skill instances are frozen and replaced by a new instance on every change, so an
-    instance still in the mission converts to the message it converted to last time.
-    Converting all 10,000 skills of a large mission takes a third of a second of
-    Python; reusing the unchanged ones makes a snapshot cheap. The skill messages are
-    shared between snapshots, so a snapshot must not be modified. Safe to call from
-    several threads at once.
-    """
-
-    def __init__(self) -> None:
-        self._cache: dict[int, tuple[SkillInstance, wire.Skill]] = {}
-
-    def mission_to_msg(self, content: MissionContent, revision: int, stamp: float) -> wire.Mission:
-        """A full snapshot as ``rosmc/Mission``."""
-        previous = self._cache
-        current: dict[int, tuple[SkillInstance, wire.Skill]] = {}
-
-        def convert(skill: SkillInstance) -> wire.Skill:
-            entry = previous.get(id(skill))
-            if entry is None or entry[0] is not skill:  # the entry holds the skill: ids stay
-                entry = (skill, skill_to_msg(skill))
-            current[id(skill)] = entry
-            return entry[1]
-
-        msg = mission_to_msg(content, revision, stamp, convert)
-        self._cache = current
-        return msg
-
-
 def mission_from_msg(msg: wire.Mission) -> tuple[MissionContent, int]:
     """``rosmc/Mission`` as core content and revision."""
     tasks = {task.agent: [skill_from_msg(s) for s in task.skills] for task in msg.tasks}

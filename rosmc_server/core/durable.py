@@ -1,5 +1,6 @@
 """Writing files that survive a crash or a power loss (plain file system calls, no ROS)."""
 
+import contextlib
 import os
 from pathlib import Path
 
@@ -22,7 +23,8 @@ def write_durably(target: Path, text: str) -> None:
             os.fsync(file.fileno())
         temporary.replace(target)
     except OSError:
-        temporary.unlink(missing_ok=True)
+        with contextlib.suppress(OSError):  # e.g. a name too long to have been created at all
+            temporary.unlink(missing_ok=True)
         raise
     fsync_directory(target.parent)
 

@@ -62,9 +62,9 @@ class Pose:
         if isinstance(raw, Pose):
             values = raw.to_dict()
         elif isinstance(raw, Mapping):
-            unknown = sorted(str(key) for key in raw if key not in cls.FIELDS)
+            unknown = [str(key) for key in raw if key not in cls.FIELDS]
             if unknown:
-                raise InvalidRequest(f"{what} has unknown pose fields {', '.join(unknown)}")
+                raise InvalidRequest(f"{what} has unknown pose fields {', '.join(sorted(unknown))}")
             values = {name: raw.get(name, 0.0) for name in cls.FIELDS}
         else:
             raise InvalidRequest(f"{what} must be a pose (x, y, z, roll, pitch, yaw)")

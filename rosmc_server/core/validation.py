@@ -38,6 +38,8 @@ def excerpt(value: object, limit: int = EXCERPT) -> str:
 
 def has_control_characters(text: str) -> bool:
     """Whether ``text`` holds a line break, tab, escape or other control/format character."""
+    if text.isprintable():  # no Cc or Cf (nor spaces other than ' '): the common case, in C
+        return False
     return any(unicodedata.category(ch) in ("Cc", "Cf") for ch in text)
 
 

@@ -14,7 +14,6 @@ from __future__ import annotations
 import logging
 import re
 from collections.abc import Callable
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import rosmc.srv as srv
@@ -42,15 +41,13 @@ from ..core import (
     StaleRevision,
     Transfer,
     Unavailable,
-    dump_mission,
-    parse_mission,
-    save_mission,
 )
 from ..core.advice import unsynced_partners
 from ..core.commands import CommandKind, CommandSpec
 from ..core.link import LinkStatus
 from ..core.policy import options_argument
 from .command_queue import MAX_UNSENT
+from .whole_mission import WholeMissionServices
 
 if TYPE_CHECKING:
     from .server_node import MissionServer
@@ -103,44 +100,26 @@ def _text(value: str, what: str) -> str:
     return value
 
 
-def _host_path(path: str, mission_dir: Path) -> Path:
-    """A mission file path on the server's host, confined to ``mission_dir``.
-
-    Anybody on the ROS graph can call the services, so the server touches files
-    only below one directory; relative paths are taken from there.
-    """
-    # The operating system cannot take a NUL byte in a path; Python raises ValueError.
-    if "\0" in path:
-        raise InvalidRequest("a file path cannot contain a NUL character")
-    root = mission_dir.expanduser().resolve()
-    target = (root / Path(path).expanduser()).resolve()
-    if not target.is_relative_to(root):
-        raise InvalidRequest(
-            f"the server reads and writes mission files only under {root}; "
-            "pass the document itself to save or load elsewhere"
-        )
-    return target
-
-
 class OperatorServices:
     """Request handlers of every operator service."""
 
     def __init__(self, server: MissionServer) -> None:
         self._server = server
         self._library_msg = library_to_msg(server.library)
+        self._whole = WholeMissionServices(server)
         self._services: list[rospy.Service] = []
 
     def advertise(self) -> None:
         """Advertise every operator service."""
         for operation, type_name in interface.SERVICES.items():
             service_class = getattr(srv, type_name)
-            handler = getattr(self, f"_{operation}")
+            if operation == "get_mission":  # answered with the shared, serialized snapshot
+                callback: Callable[[Any], Any] = self._whole.get_mission
+            else:
+                handler = getattr(self, f"_{operation}", None) or getattr(self._whole, operation)
+                callback = self._answer(handler, service_class._response_class, operation)
             self._services.append(
-                rospy.Service(
-                    interface.service_name(operation),
-                    service_class,
-                    self._answer(handler, service_class._response_class, operation),
-                )
+                rospy.Service(interface.service_name(operation), service_class, callback)
             )
 
     def _answer(
@@ -363,42 +342,6 @@ class OperatorServices:
         return self._apply(
             lambda m: m.new_mission(keep_markers=req.keep_markers, base_revision=req.base_revision)
         )
-
-    def _save_mission(self, req: Any, resp: Any) -> None:
-        with self._server.locked():
-            content = self._server.mission.state.content()
-            revision = self._server.mission.revision
-        resp.document = dump_mission(content, revision)
-        if req.path:
-            target = _host_path(req.path, self._server.config.mission_dir)
-            if target.parent == self._server.config.mission_dir.expanduser().resolve():
-                target.parent.mkdir(parents=True, exist_ok=True)  # the mission folder itself
-            save_mission(target, content, revision)
-            resp.path_written = str(target)
-        resp.revision = revision
-        return None
-
-    def _load_mission(self, req: Any, resp: Any) -> MissionEvent:
-        if bool(req.path) == bool(req.document):
-            raise InvalidRequest("give exactly one of a path and a document to load")
-        if req.path:
-            from ..core import load_mission
-
-            path = _host_path(req.path, self._server.config.mission_dir)
-            content, _ = load_mission(path, self._server.library)
-            source = req.path
-        else:
-            try:
-                content, _ = parse_mission(req.document, self._server.library, "the document")
-            except RecursionError:  # the YAML parser recurses once per nesting level
-                raise InvalidRequest("the document nests its data too deeply to read") from None
-            source = "a document"
-        return self._apply(lambda m: m.load(content, source, base_revision=req.base_revision))
-
-    def _get_mission(self, req: Any, resp: Any) -> None:
-        resp.mission = self._server.snapshot_msg()
-        resp.journal_alert = self._server.journal_alert
-        return None
 
     def _get_library(self, req: Any, resp: Any) -> None:
         resp.library = self._library_msg

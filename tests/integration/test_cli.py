@@ -63,7 +63,12 @@ class Server:
         self.starts.append(log)
         with log.open("wb") as out:
             self.process = subprocess.Popen(
-                [sys.executable, str(SERVER), f"_journal_dir:={self.journal_dir}"],
+                [
+                    sys.executable,
+                    str(SERVER),
+                    f"_journal_dir:={self.journal_dir}",
+                    f"_mission_dir:={self.log_dir / 'missions'}",
+                ],
                 env=self.env,
                 cwd=REPO,
                 stdin=subprocess.DEVNULL,
@@ -380,6 +385,25 @@ def test_client_conflicts_and_local_checks(server: Server, fresh: MissionClient)
     with pytest.raises(RuleViolation):
         other.add_barrier([added.skill_id, fresh.get_mission().task("drone")[0].id])
     other.close()
+
+
+def test_save_and_load_on_the_servers_host(server: Server, fresh: MissionClient) -> None:
+    ids = build_mission(fresh)
+    before = mission_to_json(fresh.get_mission())
+    target = server.log_dir / "missions" / "team" / "plan.yaml"
+    target.parent.mkdir(parents=True, exist_ok=True)
+    out = rosmc(server, "save", "--on-server", "team/plan.yaml")
+    assert out == f"saved revision {before['revision']} to {target} on the server\n"
+    assert target.read_text().startswith("rosmc_mission: 1\n")
+    # The JSON answer has no document: it stayed on the server's host.
+    assert (
+        json.loads(rosmc(server, "--json", "save", "--on-server", "team/plan.yaml"))["document"]
+        == ""
+    )
+    fresh.delete_skills([ids["sci"]])
+    rosmc(server, "load", "--on-server", "team/plan.yaml")
+    after = mission_to_json(fresh.get_mission())
+    assert after["agents"] == before["agents"] and after["revision"] == before["revision"] + 2
 
 
 def test_save_new_load_restores(server: Server, fresh: MissionClient, tmp_path: Path) -> None:

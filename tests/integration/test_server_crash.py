@@ -13,6 +13,7 @@ and in ``rosmc status``, and no revision number is handed out twice.
 
 from __future__ import annotations
 
+import itertools
 import json
 import random
 import struct
@@ -40,7 +41,14 @@ from rosmc_server.conversions import (  # noqa: E402
     params_from_msgs,
     pose_from_msg,
 )
-from rosmc_server.core import Mission, RosmcError, load_library, parse_mission  # noqa: E402
+from rosmc_server.core import (  # noqa: E402
+    Mission,
+    MissionContent,
+    RosmcError,
+    dump_mission,
+    load_library,
+    parse_mission,
+)
 from rosmc_server.recording import _scan, latest_state, read_journal  # noqa: E402
 from tests.integration.server_fixtures import REPO, Client, ServerProcess, mission_key  # noqa: E402
 
@@ -252,11 +260,12 @@ def operate(
     at_kill_point: threading.Event,
     session: Session,
     keep_history: bool = False,
+    choose: Callable[[random.Random, Expected], Op] = random_op,
 ) -> None:
     """Send ``count`` operations; until the server dies, keep ``expected`` in step."""
     try:
         for number in range(count):
-            op = random_op(rng, expected)
+            op = choose(rng, expected)
             if number == kill_at:
                 at_kill_point.set()
             session.in_flight = op
@@ -367,6 +376,72 @@ def _seed_document(client: Client) -> str:
     document = str(client.call("save_mission").document)
     client.call("new_mission", base_revision=rev, keep_markers=False)
     return document
+
+
+def large_document(tag: str, skills: int) -> str:
+    """A saved mission of ``skills`` blueprint skills over every robot (default parameters)."""
+    counter = iter(range(10**9))
+    empty = MissionContent.empty(LIBRARY)
+    mission = Mission(LIBRARY, empty, new_id=lambda prefix: f"{tag}-{next(counter)}")
+    agents = LIBRARY.dynamic_agents
+    for number in range(skills):
+        agent = agents[number % len(agents)]
+        names = sorted(LIBRARY.skills_of(agent))
+        mission.add_skill(agent, names[number % len(names)], {}, label=f"{tag} {number}")
+    return dump_mission(mission.state.content(), 0)
+
+
+def loads_and_changes(documents: list[str], kill_at: int) -> Callable[[Any, Expected], Op]:
+    """Operations for :func:`operate`: a load every few, and always at the kill point."""
+    chosen = itertools.count()
+
+    def choose(rng: random.Random, expected: Expected) -> Op:
+        if next(chosen) == kill_at or rng.random() < 0.3:
+            fields = {"base_revision": expected.revision, "document": rng.choice(documents)}
+            return Op("load_mission", fields)
+        while (op := random_op(rng, expected)).operation == "synchronize":
+            pass  # an upload would keep every later load refused (no robot answers)
+        return op
+
+    return choose
+
+
+def test_kill_9_around_loads_of_large_missions(
+    start_server: Callable[..., ServerProcess], tmp_path: Path
+) -> None:
+    """A load is acknowledged only once its mission is durable; kill -9 lands inside loads."""
+    journal = tmp_path / "loads.mcap"
+    rng = random.Random(20261124)
+    documents = [large_document("a", 1500), large_document("b", 1800)]
+    server = start_server("loads", journal=journal)
+    with Client() as client:
+        expected = Expected(client.mission())
+    outcomes = []
+    for _ in range(3):
+        kill_at = rng.randrange(8, 30)
+        with Client() as client:
+            session = Session()
+            at_kill_point = threading.Event()
+            worker = threading.Thread(
+                target=operate,
+                args=(client, expected, rng, 200, kill_at, at_kill_point, session),
+                kwargs={"choose": loads_and_changes(documents, kill_at)},
+            )
+            worker.start()
+            assert at_kill_point.wait(120)
+            time.sleep(rng.uniform(0, 0.1))  # a load of 1,500 skills takes longer than that
+            server.kill9()
+            worker.join(120)
+            assert not worker.is_alive()
+            if session.error is not None:
+                raise session.error
+        in_flight = session.in_flight.operation if session.in_flight else "nothing"
+        server = start_server("loads", journal=journal, resume=True)
+        with Client() as client:
+            outcomes.append((in_flight, restored_matches(expected, session, client.mission())))
+        assert "Traceback" not in server.log(), server.log()[-3000:]
+    print("killed with in flight / restored as:", outcomes)
+    assert any(skill.id.startswith(("a-", "b-")) for skill in expected.mission.state.skills())
 
 
 # -- torn journal tails ------------------------------------------------------------------------

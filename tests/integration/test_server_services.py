@@ -18,6 +18,7 @@ from typing import Any
 
 import pytest
 import rosmc.msg as wire
+import yaml
 
 from rosmc_server import interface
 
@@ -643,10 +644,12 @@ def test_save_and_load_round_trip(scene: Scene, tmp_path: Path) -> None:
     c = scene.client
     before = c.mission()
     path = tmp_path / "saved.yaml"
-    saved = accepted(c.call("save_mission", path=str(path)))
-    assert (saved.path_written, saved.revision) == (str(path), scene.rev)
+    written = accepted(c.call("save_mission", path=str(path)))
+    assert (written.path_written, written.revision) == (str(path), scene.rev)
+    assert written.document == ""  # saved on the server's host: the document stays there
+    saved = accepted(c.call("save_mission", path=str(path), return_document=True))
     assert path.read_text() == saved.document
-    assert accepted(c.call("save_mission")).document == saved.document
+    assert accepted(c.call("save_mission")).document == saved.document  # no path: returned
     assert c.revision() == scene.rev  # saving is not a change
     do(c, "new_mission", keep_markers=False)
     loaded = do(c, "load_mission", document=saved.document)
@@ -1003,11 +1006,9 @@ def test_a_down_link_declines_execution_requests(
 def _failed_skill_document(client: Client) -> tuple[str, str]:
     skill_id = add(client, "drone", "take_off")
     add(client, "drone", "land")
-    document = accepted(client.call("save_mission")).document
-    document = document.replace(
-        "status: IDLE", "status: FAILURE\n    started: 10.0\n    finished: 20.0", 1
-    )
-    return skill_id, document
+    data = yaml.safe_load(accepted(client.call("save_mission")).document)
+    data["tasks"]["drone"][0].update(status="FAILURE", started=10.0, finished=20.0)
+    return skill_id, yaml.safe_dump(data, sort_keys=False)
 
 
 def test_retry_a_failed_skill(start_server: Any) -> None:

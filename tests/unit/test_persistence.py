@@ -152,6 +152,14 @@ def test_save_survives_a_power_loss(rich: Any, tmp_path: Path, monkeypatch: Any)
     assert synced == [("file", ""), ("directory", saved)]
 
 
+def test_save_under_a_name_too_long_for_the_file_system(rich: Any, tmp_path: Path) -> None:
+    target = tmp_path / ("x" * 300)
+    with pytest.raises(MissionFileError, match="File name too long") as caught:
+        save_mission(target, rich.state.content(), 1)
+    assert "\n" not in str(caught.value)
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_save_into_a_missing_folder(rich: Any, tmp_path: Path) -> None:
     target = tmp_path / "nowhere" / "m.yaml"
     with pytest.raises(MissionFileError) as caught:

@@ -351,9 +351,14 @@ class MissionClient(ClientBase):
             ).revision
         )
 
-    def save_mission(self, path: str = "") -> MissionSaved:
-        """The mission as a YAML document; with ``path``, also written on the server's host."""
-        response = self._caller.call("save_mission", path=path)
+    def save_mission(self, path: str = "", *, return_document: bool | None = None) -> MissionSaved:
+        """Save the mission: with ``path``, written on the server's host; else returned.
+
+        ``return_document`` (default: only without a path) asks for the YAML document in
+        the answer too; a large mission saved on the server need not travel back.
+        """
+        wanted = not path if return_document is None else return_document
+        response = self._caller.call("save_mission", path=path, return_document=wanted)
         raise_for(response, response.revision)
         return MissionSaved(response.revision, response.document, response.path_written)
 

@@ -92,7 +92,7 @@ class MarkerAdded(Result):
 
 @dataclass(frozen=True)
 class MissionSaved(Result):
-    """``save_mission``: the YAML document, and the server-side path if one was written."""
+    """``save_mission``: the YAML document (if asked for), and the server-side path written."""
 
     document: str
     path_written: str

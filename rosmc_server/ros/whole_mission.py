@@ -1,0 +1,138 @@
+"""The operator services that cost the whole mission: get, save and load.
+
+Part of the mission server's operator services (see :mod:`.operator_services`, which
+advertises them): ``/rosmc/get_mission`` (rosmc/GetMission), ``/rosmc/save_mission``
+(rosmc/SaveMission) and ``/rosmc/load_mission`` (rosmc/LoadMission).
+
+A mission of 10,000 skills is megabytes of YAML or of message, so none of them builds it
+afresh: GetMission answers with the snapshot of the current revision, serialized once
+(see :class:`~rosmc_server.conversions.packing.SnapshotPacker`); SaveMission reuses the
+file lines of unchanged skills (:class:`~rosmc_server.core.persistence.MissionDumper`)
+and returns the document only to a client that needs it; LoadMission parses and checks
+the document and serializes the new skills before it takes the server's lock.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import gc
+import logging
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import rosmc.srv as srv
+
+from ..conversions.packing import PackedGetMissionResponse
+from ..core import InvalidRequest, MissionEvent, load_mission, parse_mission
+from ..core.persistence import MissionDumper, write_document
+
+if TYPE_CHECKING:
+    from .server_node import MissionServer
+
+_log = logging.getLogger(__name__)
+
+
+def host_path(path: str, mission_dir: Path) -> Path:
+    """A mission file path on the server's host, confined to ``mission_dir``.
+
+    Anybody on the ROS graph can call the services, so the server touches files
+    only below one directory; relative paths are taken from there.
+    """
+    # The operating system cannot take a NUL byte in a path; Python raises ValueError.
+    if "\0" in path:
+        raise InvalidRequest("a file path cannot contain a NUL character")
+    root = mission_dir.expanduser().resolve()
+    target = (root / Path(path).expanduser()).resolve()
+    if not target.is_relative_to(root):
+        raise InvalidRequest(
+            f"the server reads and writes mission files only under {root}; "
+            "pass the document itself to save or load elsewhere"
+        )
+    return target
+
+
+class WholeMissionServices:
+    """Handlers of GetMission, SaveMission and LoadMission."""
+
+    def __init__(self, server: MissionServer) -> None:
+        self._server = server
+        self._dumper = MissionDumper()
+
+    def get_mission(self, req: Any) -> Any:
+        """The mission snapshot of the current revision, serialized once and shared."""
+        try:
+            return PackedGetMissionResponse(self._server.snapshot_msg(), self._server.journal_alert)
+        except Exception:  # a server fault must not reach the caller as a stack trace
+            _log.exception("service get_mission failed")
+            return srv.GetMissionResponse()
+
+    def save_mission(self, req: Any, resp: Any) -> None:
+        """Write the mission on the server's host and/or return it as a document."""
+        with self._server.locked():
+            content = self._server.mission.state.content()
+            revision = self._server.mission.revision
+        document = self._dumper.dump(content, revision)
+        if req.path:
+            mission_dir = self._server.config.mission_dir
+            target = host_path(req.path, mission_dir)
+            if target.parent == mission_dir.expanduser().resolve():
+                target.parent.mkdir(parents=True, exist_ok=True)  # the mission folder itself
+            write_document(target, document)
+            resp.path_written = str(target)
+        if req.return_document or not req.path:
+            resp.document = document
+        resp.revision = revision
+
+    def load_mission(self, req: Any, resp: Any) -> MissionEvent:
+        """Replace the mission with a document, or a file on the server's host."""
+        if bool(req.path) == bool(req.document):
+            raise InvalidRequest("give exactly one of a path and a document to load")
+        library = self._server.library
+        started = time.perf_counter()
+        with collector_paused():  # the new mission is acyclic: nothing for it to find
+            if req.path:
+                mission_dir = self._server.config.mission_dir
+                content, _ = load_mission(host_path(req.path, mission_dir), library)
+                source = req.path
+            else:
+                try:
+                    content, _ = parse_mission(req.document, library, "the document")
+                except RecursionError:  # the YAML parser recurses once per nesting level
+                    too_deep = "the document nests its data too deeply to read"
+                    raise InvalidRequest(too_deep) from None
+                source = "a document"
+            read = time.perf_counter()
+            # Serialized now, outside the server lock: the new mission's journal snapshot,
+            # written before the load is acknowledged, then only joins the bytes.
+            skills = [s for task in content.tasks.values() for s in task]
+            self._server.prepare_snapshot(skills)
+        serialized = time.perf_counter()
+        event = self._server.apply(
+            lambda m: m.load(content, source, base_revision=req.base_revision)
+        )
+        assert event is not None
+        _log.info(
+            "loaded %d skills from %s: read and checked in %.0f ms, serialized in %.0f ms, "
+            "applied and journaled in %.0f ms",
+            len(skills), source, 1000 * (read - started), 1000 * (serialized - read),
+            1000 * (time.perf_counter() - serialized),
+        )  # fmt: skip
+        # The loaded mission lives until it is replaced and is then freed by reference
+        # counting; kept out of the collector's way, it does not lengthen every later
+        # full collection (tens of milliseconds at 10,000 skills).
+        gc.freeze()
+        return event
+
+
+@contextlib.contextmanager
+def collector_paused() -> Iterator[None]:
+    """Run the body without cyclic garbage collection (several passes over a new mission)."""
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was_enabled:
+            gc.enable()
