@@ -138,6 +138,14 @@ def field_strategy(type_name: str, known: list[str], tmp: Path) -> st.SearchStra
         "rosmc/ParameterValue[]": st.lists(parameter_values(known), max_size=4),
         "rosmc/Pose6D": POSES,
         "rosmc/Pose6D[]": st.lists(POSES, max_size=6),
+        "rosmc/SkillMove[]": st.lists(
+            st.builds(
+                wire.SkillMove,
+                skill_id=texts(known),
+                index=st.one_of(st.integers(0, 2**32 - 1), st.integers(0, 12)),
+            ),
+            max_size=6,
+        ),
         "rosmc/TaskMarker": st.builds(
             wire.TaskMarker,
             name=texts(known),
