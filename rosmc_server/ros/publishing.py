@@ -35,7 +35,7 @@ class SnapshotPublisher:
         quiet: float = 0.05,
         max_delay: float = 0.25,
         cost_factor: float = 20.0,
-        min_period: float = 2.0,
+        min_period: float = 0.5,
         on_published: Callable[[wire.Mission], None] | None = None,
     ) -> None:
         self._publisher = rospy.Publisher(topic, wire.Mission, queue_size=1, latch=True)
