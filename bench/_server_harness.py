@@ -1,12 +1,13 @@
 """What the mission-server benchmarks share (bench_server.py, bench_scale.py and others).
 
 A private ``rosmaster`` on a free loopback port, a real ``mission_server`` process (optionally
-under cProfile), persistent service proxies with an event recorder, generated libraries and
-mission documents, percentiles, and :func:`stop_process`, which stops a process whatever
-its signal disposition: a benchmark started with SIGINT ignored (``nohup``, a background
-job of a script, some CI shells) passes that on to every process it starts, and a
-``rosmaster`` that ignores SIGINT would otherwise be waited for until the benchmark is
-killed, with its figures unprinted.
+under cProfile; its CPU time, memory and logged load phases), persistent service proxies with
+an event recorder, a proxy that keeps an answer's bytes undecoded, percentiles (generated
+libraries and mission documents are in ``_missions.py``), and :func:`stop_process`, which
+stops a process whatever its signal disposition: a benchmark started with SIGINT ignored
+(``nohup``, a background job of a script, some CI shells) passes that on to every process it
+starts, and a ``rosmaster`` that ignores SIGINT would otherwise be waited for until the
+benchmark is killed, with its figures unprinted.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import contextlib
 import io
 import json
 import os
+import re
 import signal
 import socket
 import statistics
@@ -28,10 +30,12 @@ from pathlib import Path
 from types import FrameType
 from typing import Any
 
-import yaml
-
 REPO = Path(__file__).resolve().parents[1]
 LOOPBACK = "127.0.0.1"
+# The server's log line of a load (rosmc_server/ros/whole_mission.py), its phases in ms.
+LOAD_PHASES = re.compile(
+    r"read and checked in (\d+) ms, serialized in (\d+) ms, applied and journaled in (\d+) ms"
+)
 
 # Runs the server script with a cProfile profiler in every thread (rospy serves each
 # connection on its own thread); SIGUSR1 writes the merged statistics and exits.
@@ -156,11 +160,13 @@ class Server:
 
     def __init__(self, env: dict[str, str], work: Path, library: Path, profile: Path | None):
         self.journal_dir = work / "journal"
+        self.mission_dir = work / "missions"  # where SaveMission and LoadMission take paths
         self.profiled = profile is not None
         argv = [
             str(REPO / "scripts" / "mission_server"),
             f"_library:={library}",
             f"_journal_dir:={self.journal_dir}",
+            f"_mission_dir:={self.mission_dir}",
         ]
         env = dict(env)
         if profile is not None:
@@ -185,10 +191,31 @@ class Server:
 
     def peak_rss_mib(self) -> float:
         """The server's peak resident memory so far."""
+        return self._status_mib("VmHWM")
+
+    def rss_mib(self) -> float:
+        """The server's resident memory now."""
+        return self._status_mib("VmRSS")
+
+    def _status_mib(self, field: str) -> float:
         for line in Path(f"/proc/{self.process.pid}/status").read_text().splitlines():
-            if line.startswith("VmHWM:"):
+            if line.startswith(f"{field}:"):
                 return round(int(line.split()[1]) / 1024, 1)
         return -1.0
+
+    def cpu_seconds(self) -> float:
+        """User and system CPU time the server has used so far (all its threads)."""
+        stat = Path(f"/proc/{self.process.pid}/stat").read_text()
+        fields = stat.rsplit(")", 1)[1].split()  # after the command name, which may hold spaces
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+    def load_phases(self) -> list[tuple[float, float, float]]:
+        """Per load, as the server logs it: ms reading and checking, serializing, applying.
+
+        Empty for a server that does not log them.
+        """
+        text = self.log_path.read_text(errors="replace")
+        return [(float(a), float(b), float(c)) for a, b, c in LOAD_PHASES.findall(text)]
 
     def journal_bytes(self) -> int:
         """Bytes in the server's journal files."""
@@ -198,101 +225,6 @@ class Server:
         """Stop the server (a profiled one writes its statistics first)."""
         profiled = self.profiled if profiled is None else profiled
         stop_process(self.process, signal.SIGUSR1 if profiled else signal.SIGINT, grace=30.0)
-
-
-# -- generated libraries and missions ------------------------------------------------------------
-def agent_name(index: int) -> str:
-    """The name of the benchmark's agent number ``index``."""
-    return f"robot_{index:02d}"
-
-
-def skill_id(agent: int, number: int) -> str:
-    """The id :func:`mission_yaml` gives skill ``number`` of agent ``agent``."""
-    return f"{agent_name(agent)}-s{number:05d}"
-
-
-def library_yaml(agents: int) -> str:
-    """A library of ``agents`` dynamic agents of one model with typical skills."""
-    skills = {
-        "move": {
-            "duration": 60,
-            "parameters": {
-                "target": {"type": "pose", "default": {"x": 0.0, "y": 0.0}, "marker": "pose"},
-                "speed": {"type": "float", "default": 0.5, "min": 0.05, "max": 2.0},
-            },
-        },
-        "inspect": {
-            "duration": 30,
-            "parameters": {
-                "radius": {"type": "float", "default": 2.0, "min": 0.5, "max": 10.0},
-                "mode": {
-                    "type": "string",
-                    "default": "standard",
-                    "choices": ["quick", "standard", "detailed"],
-                },
-                "tries": {"type": "int", "default": 1, "min": 1, "max": 5},
-            },
-        },
-        "wait": {"duration": 10, "parameters": {"seconds": {"type": "float", "default": 5.0}}},
-    }
-    return yaml.safe_dump(
-        {
-            "rosmc_library": 1,
-            "name": f"bench_{agents}",
-            "models": {"robot": {"skills": skills}},
-            "agents": {agent_name(i): {"kind": "dynamic", "model": "robot"} for i in range(agents)},
-        },
-        sort_keys=False,
-    )
-
-
-def barrier_positions(skills: int, barriers: int) -> list[int]:
-    """Skill numbers, evenly spread over a task of ``skills``, that :func:`mission_yaml`
-    joins in barriers across all agents."""
-    step = skills // barriers if barriers else 0
-    return [number * step for number in range(barriers)] if step else []
-
-
-def mission_yaml(agents: int, skills: int, barriers: int = 0) -> str:
-    """A mission document: ``skills`` blueprint skills per agent, one task marker and
-    ``barriers`` barriers, each over the skills of one :func:`barrier_positions` number."""
-    kinds = ["move", "inspect", "wait"]
-    params = {
-        "move": {
-            "target": {"x": 1.0, "y": 2.0, "z": 0.0, "roll": 0.0, "pitch": 0.0, "yaw": 0.5},
-            "speed": 0.8,
-        },
-        "inspect": {"radius": 3.0, "mode": "quick", "tries": 2},
-        "wait": {"seconds": 5.0},
-    }
-    tasks = {}
-    for a in range(agents):
-        tasks[agent_name(a)] = [
-            {
-                "id": skill_id(a, k),
-                "skill": kinds[k % 3],
-                "label": f"step {k}",
-                "params": params[kinds[k % 3]],
-                "status": "IDLE",
-            }
-            for k in range(skills)
-        ]
-    groups = [
-        {"id": f"barrier-{k:05d}", "skills": [skill_id(a, k) for a in range(agents)]}
-        for k in barrier_positions(skills, barriers)
-    ]
-    marker = {"name": "Site", "type": "POSE", "pose": {"x": 3.0, "y": 4.0}}
-    return yaml.safe_dump(
-        {
-            "rosmc_mission": 1,
-            "library": f"bench_{agents}",
-            "revision": 0,
-            "tasks": tasks,
-            "barriers": groups,
-            "markers": [marker],
-        },
-        sort_keys=False,
-    )
 
 
 # -- measuring -------------------------------------------------------------------------------------
@@ -305,6 +237,33 @@ def percentiles(samples: list[float]) -> dict[str, float]:
         "p95_ms": round(p95 * 1000, 3),
         "n": len(ordered),
     }
+
+
+def raw_proxy(operation: str) -> Any:
+    """A persistent proxy of an operator service whose answers keep their bytes undecoded.
+
+    ``call`` returns an object with the answer's bytes in ``raw``: it times the server and
+    the transport alone, without the client decoding the answer into genpy messages.
+    """
+    import rosmc.srv as srv
+    import rospy
+
+    from rosmc_server import interface
+
+    service = getattr(srv, interface.SERVICES[operation])
+
+    class RawResponse(service._response_class):  # type: ignore[misc,name-defined]
+        def deserialize(self, data: bytes) -> Any:
+            self.raw = bytes(data)
+            return self
+
+    class RawService:
+        _type = service._type
+        _md5sum = service._md5sum
+        _request_class = service._request_class
+        _response_class = RawResponse
+
+    return rospy.ServiceProxy(interface.service_name(operation), RawService, persistent=True)
 
 
 def serialized_size(msg: Any) -> int:

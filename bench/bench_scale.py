@@ -40,18 +40,14 @@ from typing import Any
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+from _missions import agent_name, barrier_positions, library_yaml, mission_yaml, skill_id
 from _server_harness import (
     Server,
     ServerClient,
-    agent_name,
-    barrier_positions,
     figures_printed,
-    library_yaml,
-    mission_yaml,
     percentiles,
     ros_master,
     serialized_size,
-    skill_id,
 )
 
 AGENTS = 2

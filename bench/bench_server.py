@@ -5,18 +5,31 @@ skills per agent), a real ``mission_server`` on a generated library of that many
 agents. The mission is loaded as one document, then each operation is timed from a
 client with persistent service proxies: median and p95 latency of add, edit, delete,
 reorder, add barrier, marker move, synchronize and get_mission; bytes per event, per
-snapshot and per journaled change; the server's peak RSS. Run from the repository root::
+snapshot and per journaled change; the server's peak RSS after the load and after each
+phase. Before the per-change operations (a load is refused once robots hold synchronized
+skills), the whole-mission paths (``whole``), ``--whole-repeats`` times each, p50 and p95
+(with a few repeats, the max): get_mission right after a change and again at the same
+revision (decoded by genpy, and as raw bytes: the server and transport alone, with the
+client's decode timed apart), save to a path on the server and save returning the document
+(each right after a change), and loading the mission the server saved (also as the
+server's CPU time, which other work on the machine inflates less than the wall time, and
+the server's own read/serialize/apply split from its log). Run from the repository root::
 
     source env.sh
     python bench/bench_server.py [--sizes 2x10,5x100,20x500] [--samples 300] [--profile]
+    python bench/bench_server.py --sizes 2x500,10x500,20x500 --samples 0 --cpu-seconds 30
 
-``--profile`` runs the largest size a second time under cProfile (every server thread)
-and adds the top functions by internal time to the output.
+``--samples 0`` skips the per-change operations. ``--cpu-seconds N`` measures, at the
+largest size, the server's CPU time over N s of 10 changes/s without and then with a
+subscriber to the latched ``/rosmc/mission``. ``--profile`` runs the largest size a
+second time under cProfile (every server thread) and adds the top functions by internal
+time to the output.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import io
 import pstats
 import random
@@ -29,18 +42,17 @@ from typing import Any
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # also when imported as bench.bench_server
 
+from _missions import agent_name, library_yaml, mission_yaml, skill_id
 from _server_harness import (
     REPO,
     Server,
     ServerClient,
-    agent_name,
     figures_printed,
-    library_yaml,
-    mission_yaml,
     percentiles,
     ros_master,
     serialized_size,
 )
+from _whole_mission import WholeMission, subscriber_cpu
 
 __all__ = [  # other benchmarks and tools take these from here
     "REPO",
@@ -64,6 +76,27 @@ class Bench(ServerClient):
         self.skills = skills
         self.samples = samples
         self.rng = random.Random(seed)
+        self.label_edits = 0
+
+    def edit_label(self) -> None:
+        """One small change, so that the next call meets a new revision.
+
+        A label edit of an inspect skill in the back half of a task, where the per-change
+        run's synchronizing never reaches (a synchronized skill cannot be edited).
+        """
+        self.label_edits += 1
+        number = self.label_edits
+        last_inspect = self.skills - 1 - (self.skills - 2) % 3
+        pv = self.wire.ParameterValue
+        self.call(
+            "edit_skill",
+            base_revision=self.rev,
+            skill_id=skill_id(
+                number % len(self.agents), last_inspect - 3 * (number % max(1, self.skills // 6))
+            ),
+            label=f"whole {number}",
+            parameters=[pv(name="radius", type=pv.FLOAT, float_value=2.5)],
+        )
 
     def run(self) -> dict[str, dict[str, float]]:
         wire, n = self.wire, self.samples
@@ -161,43 +194,65 @@ class Bench(ServerClient):
         }
 
 
+@dataclasses.dataclass(frozen=True)
+class Options:
+    """What to measure at one mission size."""
+
+    samples: int  # per per-change operation; 0 skips them
+    whole_repeats: int  # of each whole-mission path; 0 skips them
+    cpu_seconds: float = 0.0  # of the subscriber measurement; 0 skips it
+    profile: Path | None = None  # where a cProfiled server writes its statistics
+
+
 def bench_size(
-    env: dict[str, str], work: Path, agents: int, skills: int, samples: int, profile: Path | None
+    env: dict[str, str], work: Path, agents: int, skills: int, options: Options
 ) -> dict[str, Any]:
+    """Every figure of one mission size, against a server of its own."""
     import rosmc.msg  # noqa: F401  (fail early without the built messages)
 
     work.mkdir(parents=True, exist_ok=True)
     library = work / "library.yaml"
     library.write_text(library_yaml(agents))
-    server = Server(env, work, library, profile)
+    server = Server(env, work, library, options.profile)
     try:
-        bench = Bench(agents, skills, samples)
+        bench = Bench(agents, skills, options.samples)
     except BaseException:
         server.stop()
         raise
     try:
         document = mission_yaml(agents, skills)
+        rss_before_load = server.rss_mib()
         started = time.perf_counter()
         bench.call("load_mission", base_revision=bench.rev, document=document)
         load_s = time.perf_counter() - started
         time.sleep(0.5)  # the snapshot of the loaded mission is built and journaled
-        journal_start, changes_start = server.journal_bytes(), bench.changes
-        latencies = bench.run()
-        time.sleep(1.0)  # let coalesced snapshots land in the journal and events arrive
-        changes = bench.changes - changes_start
-        snapshot = bench.call("get_mission").mission
-        result = {
+        result: dict[str, Any] = {
             "agents": agents,
             "skills_per_agent": skills,
-            "total_skills": sum(len(t.skills) for t in snapshot.tasks),
             "load_document_s": round(load_s, 3),
-            "latency": latencies,
-            "event_bytes": bench.event_bytes(bench.kind_names()),
-            "snapshot_bytes": serialized_size(snapshot),
-            "journal_bytes_per_change": round((server.journal_bytes() - journal_start) / changes),
-            "changes": changes,
-            "server_peak_rss_mib": server.peak_rss_mib(),
+            "server_rss_before_load_mib": rss_before_load,
+            "server_peak_rss_after_load_mib": server.peak_rss_mib(),
         }
+        if options.whole_repeats > 0:  # first: a load is refused once skills are synchronized
+            whole = WholeMission(bench, server, options.whole_repeats, bench.edit_label)
+            result["whole"] = whole.run()
+        if options.samples > 0:
+            journal_start, changes_start = server.journal_bytes(), bench.changes
+            result["latency"] = bench.run()
+            time.sleep(1.0)  # let coalesced snapshots land in the journal and events arrive
+            changes = bench.changes - changes_start
+            result["event_bytes"] = bench.event_bytes(bench.kind_names())
+            journaled = server.journal_bytes() - journal_start
+            result["journal_bytes_per_change"] = round(journaled / changes)
+            result["changes"] = changes
+            result["server_peak_rss_after_changes_mib"] = server.peak_rss_mib()
+        if options.cpu_seconds > 0:
+            seconds = options.cpu_seconds
+            result["snapshot_subscriber"] = subscriber_cpu(bench, server, seconds, bench.edit_label)
+        snapshot = bench.call("get_mission").mission
+        result["total_skills"] = sum(len(t.skills) for t in snapshot.tasks)
+        result["snapshot_bytes"] = serialized_size(snapshot)
+        result["server_peak_rss_mib"] = server.peak_rss_mib()
     finally:
         bench.close()
         server.stop()
@@ -216,8 +271,20 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--sizes", default="2x10,5x100,20x500", help="AGENTSxSKILLS,...")
     parser.add_argument("--samples", type=int, default=300, help="samples per operation")
     parser.add_argument("--profile", action="store_true", help="cProfile the largest size")
+    parser.add_argument(
+        "--whole-repeats", type=int, default=5, help="times each whole-mission path (0: skip)"
+    )
+    parser.add_argument(
+        "--cpu-seconds",
+        type=float,
+        default=0.0,
+        help="at the largest size, server CPU over this many s of 10 changes/s, "
+        "without and with a /rosmc/mission subscriber",
+    )
     args = parser.parse_args(argv)
     sizes = [tuple(int(x) for x in size.split("x")) for size in args.sizes.split(",")]
+    largest = max(sizes, key=lambda size: size[0] * size[1])
+    options = Options(args.samples, args.whole_repeats)
     output: dict[str, Any] = {"target_at_20x500": TARGET, "sizes": []}
     with figures_printed(output), tempfile.TemporaryDirectory(prefix="bench_server_") as tmp:
         base = Path(tmp)
@@ -227,11 +294,14 @@ def main(argv: list[str] | None = None) -> int:
 
             rospy.init_node("bench_server", anonymous=True, disable_signals=True)
             for a, s in sizes:
-                output["sizes"].append(bench_size(env, base / f"{a}x{s}", a, s, args.samples, None))
+                cpu_seconds = args.cpu_seconds if (a, s) == largest else 0.0
+                at_size = dataclasses.replace(options, cpu_seconds=cpu_seconds)
+                output["sizes"].append(bench_size(env, base / f"{a}x{s}", a, s, at_size))
             if args.profile:
-                a, s = max(sizes, key=lambda size: size[0] * size[1])
+                a, s = largest
                 stats = base / "server.prof"
-                bench_size(env, base / "profiled", a, s, args.samples, stats)
+                profiled = dataclasses.replace(options, profile=stats)
+                bench_size(env, base / "profiled", a, s, profiled)
                 output["profile_top_tottime"] = profile_summary(stats)
             rospy.signal_shutdown("done")
     return 0

@@ -1,9 +1,10 @@
 """Which figures of a benchmark's JSON make its headline table (used by run_all.py).
 
 A benchmark's JSON is flattened to dotted keys (``sizes.20x500.latency.add.p50``). Its
-headline rows are the keys matching the glob patterns listed for it in :data:`HEADLINES`, or,
-for a benchmark not listed, the keys whose last part looks like a figure (percentiles,
-maxima, sizes, rates, memory), at most :data:`MAX_ROWS` of them. A benchmark listed in
+headline rows are the keys matching the glob patterns listed for it in :data:`HEADLINES`
+(every one of them: the list is the choice), or, for a benchmark not listed, the keys whose
+last part looks like a figure (percentiles, maxima, sizes, rates, memory), at most
+:data:`MAX_ROWS` of them. A benchmark listed in
 :data:`CURVES` is shown as its own table instead (``scale``: operations x mission sizes).
 """
 
@@ -45,6 +46,12 @@ HEADLINES: dict[str, tuple[str, ...]] = {
         "sizes.*.snapshot_bytes",
         "sizes.*.journal_bytes_per_change",
         "sizes.*.server_peak_rss_mib",
+        # The whole-mission paths at the largest size, and the CPU a snapshot subscriber costs.
+        "sizes.20x500.whole.get_mission_*.p50_ms",
+        "sizes.20x500.whole.save_*.p50_ms",
+        "sizes.20x500.whole.load_saved_document*.p50_ms",
+        "sizes.20x500.whole.load_server_*_ms",
+        "sizes.*.snapshot_subscriber.*share*",
     ),
     "journal": (
         "append.*.p50_us",
@@ -99,8 +106,10 @@ def headline_rows(name: str, flat: dict[str, Any]) -> list[Figure]:
     patterns = HEADLINES.get(name, DEFAULT_PATTERNS)
     if name in HEADLINES:
         keys = [k for p in patterns for k in flat if fnmatchcase(k, p)]
+        limit = len(keys)
     else:
         keys = [k for k in flat if any(fnmatchcase(k, p) for p in patterns)]
+        limit = MAX_ROWS
     unique = list(
         dict.fromkeys(
             k
@@ -108,7 +117,7 @@ def headline_rows(name: str, flat: dict[str, Any]) -> list[Figure]:
             if _is_figure(flat[k]) and not any(fnmatchcase(k, p) for p in EXCLUDED_PATTERNS)
         )
     )
-    return [Figure(key, _format(flat[key])) for key in unique[:MAX_ROWS]]
+    return [Figure(key, _format(flat[key])) for key in unique[:limit]]
 
 
 def _list_label(item: dict[str, Any], index: int) -> str:

@@ -54,6 +54,47 @@ def test_headlines_pick_figures_and_leave_targets_out() -> None:
     assert [row.label for row in listed] == ["sizes.20x500.latency.add.p50_ms"]
 
 
+def test_the_server_headlines_show_the_whole_mission_paths_and_every_listed_figure() -> None:
+    def timing(p50: float) -> dict[str, float]:
+        return {"p50_ms": p50, "p95_ms": p50 * 2, "n": 5}
+
+    operations = ("add", "edit", "delete", "reorder", "add_barrier", "marker_move", "sync")
+    paths = ("get_mission", "get_mission_wire")
+    timed = [f"{path}_{when}" for path in paths for when in ("after_change", "same_revision")]
+    timed += ["get_mission_client_decode", "save_to_path", "save_returning_document"]
+    timed += ["load_saved_document", "load_saved_document_server_cpu"]
+    phases = ("read_and_check", "serialize", "apply_and_journal")
+    largest = {  # what bench_server.py prints at 20x500 with --cpu-seconds
+        "agents": 20,
+        "skills_per_agent": 500,
+        "whole": {name: timing(3.0) for name in timed}
+        | {f"load_server_{phase}_ms": 70.0 for phase in phases}
+        | {"document_bytes": 1500000, "server_peak_rss_after_loads_mib": 110.0},
+        "latency": {name: timing(0.4) for name in (*operations, "get_mission")},
+        "event_bytes": dict.fromkeys(operations, 400),
+        "journal_bytes_per_change": 900,
+        "snapshot_subscriber": {
+            "cpu_share_without_subscriber": 0.016,
+            "cpu_share_with_subscriber": 0.018,
+            "subscriber_cost_share": 0.002,
+            "snapshots_received": 5,
+        },
+        "snapshot_bytes": 2700000,
+        "server_peak_rss_mib": 110.0,
+    }
+    smaller = {"agents": 2, "skills_per_agent": 500, "whole": {"save_to_path": timing(1.0)}}
+    flat = run_all.flatten({"sizes": [smaller, largest]})
+    labels = [row.label for row in headlines.headline_rows("server", flat)]
+    assert len(labels) > headlines.MAX_ROWS  # a listed benchmark's patterns are not cut short
+    for name in ("get_mission_after_change", "save_to_path", "load_saved_document"):
+        assert f"sizes.20x500.whole.{name}.p50_ms" in labels
+    assert "sizes.20x500.whole.load_server_serialize_ms" in labels
+    assert "sizes.20x500.snapshot_subscriber.subscriber_cost_share" in labels
+    assert "sizes.2x500.whole.save_to_path.p50_ms" not in labels  # the largest size only
+    assert "sizes.20x500.whole.document_bytes" not in labels
+    assert "sizes.20x500.snapshot_subscriber.snapshots_received" not in labels
+
+
 def test_the_readme_table_is_replaced_between_its_markers() -> None:
     text = f"intro\n{run_all.BEGIN}\nold\n{run_all.END}\noutro\n"
     assert run_all.update_readme(text, "new\n") == (
