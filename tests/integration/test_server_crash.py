@@ -271,8 +271,10 @@ def operate(
             session.in_flight = op
             try:
                 response = client.call(op.operation, **op.fields)
-            except (rospy.ServiceException, OSError):
-                return  # the server died with this request in flight
+            except (rospy.ROSException, OSError):  # ServiceException is a ROSException
+                # The server died with this request in flight, or before the first request
+                # of its kind found the service (wait_for_service timed out).
+                return
             session.in_flight = None
             if response.error_code != wire.ErrorCode.NONE:
                 session.refused += 1
