@@ -271,9 +271,9 @@ def operate(
             session.in_flight = op
             try:
                 response = client.call(op.operation, **op.fields)
-            except (rospy.ROSException, OSError):  # ServiceException is a ROSException
+            except (rospy.ServiceException, rospy.ROSException, OSError):
                 # The server died with this request in flight, or before the first request
-                # of its kind found the service (wait_for_service timed out).
+                # of its kind found the service (wait_for_service timed out: a ROSException).
                 return
             session.in_flight = None
             if response.error_code != wire.ErrorCode.NONE:
