@@ -694,8 +694,14 @@ def test_lost_link_policy_hold_on_a_silent_link(rosmc: Start) -> None:
     held = ground.wait_heard("report", lambda r: r.status.value == S.PAUSED, timeout=5.0)
     assert time.monotonic() - last_contact >= 0.9  # the robot heard command 3 a bit earlier
     assert held.status_text == "held after 1 s without ground contact"
-    snapshot = ground.received("snapshot")[-1]
-    ground.publish("report_ack", wire.ReportAck(agent="r1", seq=held.seq))  # the ground is back
+    # The ground is back and acknowledges as its heartbeat does, again and again: one ack
+    # followed by silence would trigger the policy anew a second later, possibly before the
+    # robot's next snapshot showed the contact.
+    deadline = time.monotonic() + 10.0
+    while not [s for s in ground.received("snapshot") if "ground contact is back" in s.policy]:
+        assert time.monotonic() < deadline, "the robot never said that ground contact is back"
+        ground.publish("report_ack", wire.ReportAck(agent="r1", seq=held.seq))
+        time.sleep(0.2)
     snapshot = ground.wait_heard("snapshot", lambda s: "ground contact is back" in s.policy)
     assert snapshot.state == "paused"
     assert snapshot.policy.startswith("on link loss: hold after 1 s; held after 1 s")
