@@ -76,12 +76,7 @@ def param_to_msg(name: str, value: Value, marker: str = "") -> wire.ParameterVal
 def param_from_msg(msg: wire.ParameterValue) -> tuple[str, object]:
     """The name and raw value of a ``rosmc/ParameterValue`` (checked later by the core)."""
     name = msg.name
-    if not name:
-        raise InvalidRequest("a parameter has an empty name")
-    try:
-        ptype = ParamType(msg.type)
-    except ValueError:
-        raise InvalidRequest(f"parameter '{name}' has unknown type number {msg.type}") from None
+    ptype = param_type(name, msg.type)
     if ptype is ParamType.BOOL:
         return name, bool(msg.bool_value)
     if ptype is ParamType.INT:
@@ -92,8 +87,25 @@ def param_from_msg(msg: wire.ParameterValue) -> tuple[str, object]:
         return name, msg.string_value
     if ptype is ParamType.POSE:
         return name, pose_from_msg(msg.pose_value)
+    return name, json_param(name, ptype, msg.json_value)
+
+
+def param_type(name: str, number: int) -> ParamType:
+    """The type of parameter ``name`` from its wire number; InvalidRequest for a bad
+    name or number."""
+    if not name:
+        raise InvalidRequest("a parameter has an empty name")
     try:
-        data = json.loads(msg.json_value)
+        return ParamType(number)
+    except ValueError:
+        raise InvalidRequest(f"parameter '{name}' has unknown type number {number}") from None
+
+
+def json_param(name: str, ptype: ParamType, text: str) -> object:
+    """The list or dict a LIST or DICT parameter's ``json_value`` holds (InvalidRequest if
+    it holds anything else, or nests too deeply)."""
+    try:
+        data = json.loads(text)
     except (ValueError, RecursionError):
         raise InvalidRequest(f"parameter '{name}' does not hold valid JSON") from None
     expected = list if ptype is ParamType.LIST else dict
@@ -103,7 +115,7 @@ def param_from_msg(msg: wire.ParameterValue) -> tuple[str, object]:
         raise InvalidRequest(
             f"parameter '{name}' nests its JSON deeper than {MAX_JSON_NESTING} levels"
         )
-    return name, data
+    return data
 
 
 def _nesting(data: object) -> int:

@@ -8,14 +8,13 @@ file, the key path and the problem, e.g.
 
 from __future__ import annotations
 
-import math
 import re
 from typing import Any, NoReturn
 
 import yaml
 
 from .errors import RosmcError
-from .validation import excerpt
+from .validation import excerpt, finite_float
 
 # libyaml's C loader and dumper when present: the same safe subset (plain data only,
 # no Python object tags), several times faster on large missions.
@@ -129,13 +128,14 @@ class DocumentReader:
         """A finite number within the bounds given."""
         if isinstance(raw, bool) or not isinstance(raw, (int, float)):
             self.fail(key, f"must be a number, got {excerpt(raw)}")
-        if not math.isfinite(raw):
+        number = finite_float(raw)
+        if number is None:
             self.fail(key, f"must be a finite number, got {excerpt(raw)}")
-        if minimum is not None and raw < minimum:
+        if minimum is not None and number < minimum:
             self.fail(key, f"must be at least {minimum:g}, got {excerpt(raw)}")
-        if maximum is not None and raw > maximum:
+        if maximum is not None and number > maximum:
             self.fail(key, f"must be at most {maximum:g}, got {excerpt(raw)}")
-        return float(raw)
+        return number
 
     def positive(self, raw: object, key: str) -> float:
         """A finite number above zero."""

@@ -7,7 +7,6 @@ change, so a rejected request leaves the mission untouched.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 
@@ -18,7 +17,14 @@ from .library import Library, SkillSpec
 from .model import SkillInstance, TaskMarker
 from .params import ParamType, Value
 from .state import MissionState
-from .validation import MAX_LABEL, MAX_RETRIES, check_one_line, check_whole
+from .validation import (
+    MAX_LABEL,
+    MAX_RETRIES,
+    check_one_line,
+    check_whole,
+    excerpt,
+    finite_float,
+)
 
 
 def plan_add_skill(
@@ -225,10 +231,13 @@ def check_label(label: str, default: str | None) -> str:
 def check_timeout(timeout: float) -> float:
     """A timeout in seconds: finite and not negative (0 means none)."""
     if isinstance(timeout, bool) or not isinstance(timeout, (int, float)):
-        raise InvalidRequest(f"a timeout must be a number of seconds, got {timeout!r}")
-    if not math.isfinite(timeout) or timeout < 0:
-        raise InvalidRequest(f"a timeout must be a finite, non-negative number, got {timeout!r}")
-    return float(timeout)
+        raise InvalidRequest(f"a timeout must be a number of seconds, got {excerpt(timeout)}")
+    seconds = finite_float(timeout)
+    if seconds is None or seconds < 0:
+        raise InvalidRequest(
+            f"a timeout must be a finite, non-negative number, got {excerpt(timeout)}"
+        )
+    return seconds
 
 
 def check_retries(max_retries: int) -> int:

@@ -24,6 +24,7 @@ from .params import (
     ParamType,
     Value,
     check_value,
+    quick_value,
 )
 from .site import SiteCheck
 from .validation import excerpt
@@ -59,6 +60,9 @@ class ParameterSpec:
         A parameter an area marker fills must be a polygon: at least three
         ``{x, y}`` points, since that is what robots receive from a marker.
         """
+        quick = quick_value(self.type, raw, self.minimum, self.maximum, self.choices)
+        if quick is not None:  # never a list: an area's polygon takes the full check
+            return quick
         what = f"parameter '{self.name}' of skill '{skill}'"
         value = check_value(self.type, raw, what, self.minimum, self.maximum, self.choices)
         if self.marker_type is MarkerType.AREA:

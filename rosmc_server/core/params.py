@@ -17,6 +17,7 @@ from typing import Any
 import yaml
 
 from .errors import InvalidRequest
+from .validation import excerpt, finite_float
 
 
 class ParamType(enum.IntEnum):
@@ -91,12 +92,14 @@ MARKER_PARAM_TYPE: Mapping[MarkerType, ParamType] = {
 
 def _finite(raw: object, what: str) -> float:
     if isinstance(raw, bool) or not isinstance(raw, (int, float)):
-        raise InvalidRequest(f"{what} must be a number, got {raw!r}")
-    if not math.isfinite(raw):
-        raise InvalidRequest(f"{what} must be a finite number, got {raw!r}")
-    return float(raw)
+        raise InvalidRequest(f"{what} must be a number, got {excerpt(raw)}")
+    number = finite_float(raw)
+    if number is None:
+        raise InvalidRequest(f"{what} must be a finite number, got {excerpt(raw)}")
+    return number
 
 
+INT_MIN, INT_MAX = -(2**63), 2**63 - 1  # an int parameter travels as int64
 MAX_DEPTH = 32  # nesting of list/dict parameter values; deeper data is refused
 
 
@@ -136,25 +139,27 @@ def check_value(
     value: Value
     if ptype is ParamType.BOOL:
         if not isinstance(raw, bool):
-            raise InvalidRequest(f"{what} must be true or false, got {raw!r}")
+            raise InvalidRequest(f"{what} must be true or false, got {excerpt(raw)}")
         value = raw
     elif ptype is ParamType.INT:
         if isinstance(raw, bool) or not isinstance(raw, int):
-            raise InvalidRequest(f"{what} must be a whole number, got {raw!r}")
+            raise InvalidRequest(f"{what} must be a whole number, got {excerpt(raw)}")
+        if not INT_MIN <= raw <= INT_MAX:  # robots receive an int64
+            raise InvalidRequest(f"{what} must fit in 64 bits, got {excerpt(raw)}")
         value = raw
     elif ptype is ParamType.FLOAT:
         value = _finite(raw, what)
     elif ptype is ParamType.STRING:
         if not isinstance(raw, str):
-            raise InvalidRequest(f"{what} must be text, got {raw!r}")
+            raise InvalidRequest(f"{what} must be text, got {excerpt(raw)}")
         value = raw
     elif ptype is ParamType.LIST:
         if not isinstance(raw, (list, tuple)):
-            raise InvalidRequest(f"{what} must be a list, got {raw!r}")
+            raise InvalidRequest(f"{what} must be a list, got {excerpt(raw)}")
         value = check_json_data(raw, what)
     elif ptype is ParamType.DICT:
         if not isinstance(raw, Mapping):
-            raise InvalidRequest(f"{what} must be a mapping, got {raw!r}")
+            raise InvalidRequest(f"{what} must be a mapping, got {excerpt(raw)}")
         value = check_json_data(raw, what)
     else:
         value = Pose.from_any(raw, what)
@@ -163,6 +168,59 @@ def check_value(
         allowed = ", ".join(repr(choice) for choice in choices)
         raise InvalidRequest(f"{what} must be one of {allowed}, got {value!r}")
     return value
+
+
+def quick_value(
+    ptype: ParamType,
+    raw: object,
+    minimum: float | None = None,
+    maximum: float | None = None,
+    choices: tuple[Value, ...] = (),
+) -> Value | None:
+    """What :func:`check_value` returns for a value in its usual form, or None if unsure.
+
+    A mission of thousands of skills is mostly floats, ints, text and poses of six floats
+    that pass every check; this accepts exactly those, without building the sentence a
+    failed check would need. Anything else (an int for a float, a missing pose field, a
+    value out of bounds) is None: :func:`check_value` then converts it or says what is
+    wrong. A test checks that both agree wherever this answers.
+    """
+    if type(raw) is dict:
+        return _quick_pose(raw) if ptype is ParamType.POSE and not choices else None
+    if not isinstance(raw, (bool, int, float, str)) or _QUICK_TYPES.get(type(raw)) is not ptype:
+        return None
+    if isinstance(raw, float) and not _isfinite(raw):
+        return None
+    if type(raw) is int and not INT_MIN <= raw <= INT_MAX:
+        return None
+    if not isinstance(raw, str) and (
+        (minimum is not None and raw < minimum) or (maximum is not None and raw > maximum)
+    ):
+        return None
+    return raw if not choices or raw in choices else None
+
+
+def _quick_pose(raw: dict[Any, Any]) -> Pose | None:
+    """A pose of finite floats from a mapping of its fields (missing ones 0.0), or None."""
+    if not raw.keys() <= _POSE_FIELDS:
+        return None
+    values = [raw.get(name, 0.0) for name in Pose.FIELDS]
+    for value in values:
+        if type(value) is not float or not _isfinite(value):
+            return None
+    return Pose(*values)
+
+
+_POSE_FIELDS = frozenset(Pose.FIELDS)
+# The Python type of the values quick_value takes for each parameter type (exactly that type:
+# a bool is no int here, and an int for a float takes the full check, which converts it).
+_QUICK_TYPES: Mapping[type, ParamType] = {
+    bool: ParamType.BOOL,
+    int: ParamType.INT,
+    float: ParamType.FLOAT,
+    str: ParamType.STRING,
+}
+_isfinite = math.isfinite
 
 
 def _check_range(value: Value, what: str, minimum: float | None, maximum: float | None) -> None:

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import enum
 import json
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -27,6 +26,7 @@ from typing import Any
 from .errors import InvalidRequest
 from .library import Library
 from .params import Pose, check_json_data, value_to_data
+from .validation import finite_float
 
 DEFAULT_AFTER = 60.0
 """Seconds without the ground before a policy acts, unless the operator says otherwise."""
@@ -73,12 +73,10 @@ class LostLinkPolicy:
         kind: object = self.kind
         if not isinstance(kind, LostLinkKind):
             object.__setattr__(self, "kind", LostLinkKind.parse(str(kind)))
-        after: object = self.after
-        if isinstance(after, bool) or not isinstance(after, (int, float)):
+        after = finite_float(self.after)
+        if after is None or after <= 0:
             raise InvalidRequest("lost-link 'after' must be a positive number of seconds")
-        if not (math.isfinite(after) and after > 0):
-            raise InvalidRequest("lost-link 'after' must be a positive number of seconds")
-        object.__setattr__(self, "after", float(after))
+        object.__setattr__(self, "after", after)
         skill: object = self.skill
         if not isinstance(skill, str):
             raise InvalidRequest("the lost-link safe skill must be a skill name")

@@ -77,18 +77,31 @@ def check_whole(value: object, what: str, minimum: int, maximum: int) -> int:
     return value
 
 
+def finite_float(value: object) -> float | None:
+    """``value`` as a float if it is a finite number (an int or float, not a bool), else None.
+
+    An integer too large for a float (YAML reads ``1`` followed by 400 digits as one) is
+    not a finite float either, rather than an OverflowError.
+    """
+    if type(value) is float:  # the common case first
+        return value if math.isfinite(value) else None
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return None
+    try:
+        number = float(value)
+    except OverflowError:
+        return None
+    return number if math.isfinite(number) else None
+
+
 def check_time(value: object, what: str) -> float:
     """A finite, non-negative number of seconds."""
-    if (
-        isinstance(value, bool)
-        or not isinstance(value, (int, float))
-        or not math.isfinite(value)
-        or value < 0
-    ):
+    number = finite_float(value)
+    if number is None or number < 0:
         raise InvalidRequest(
             f"{what} must be a finite number of seconds >= 0, got {excerpt(value)}"
         )
-    return float(value)
+    return number
 
 
 def clip_status_text(text: str) -> str:

@@ -322,6 +322,10 @@ def _mutations() -> list[tuple[str, Any, str]]:
         ("retries-a-billion", skill_set("alpha", 0, "max_retries", 10**9), "from 0 to 100"),
         ("attempt-huge", skill_set("alpha", 0, "attempt", 10**9), "an attempt"),
         ("timeout-infinite", skill_set("alpha", 0, "timeout", float("inf")), "timeout"),
+        # integers too large for a float: a sentence, not an OverflowError
+        ("timeout-too-large", skill_set("alpha", 0, "timeout", 10**400), "timeout: must"),
+        ("started-too-large", skill_set("alpha", 0, "started", 10**400), "started: must"),
+        ("param-too-large", param_set("alpha", 0, "speed", 10**400), "finite number"),
         ("status-text-lines", skill_set("alpha", 0, "status_text", "a\nb"), "status text"),
         ("status-text-long", skill_set("alpha", 0, "status_text", "s" * 501), "status text"),
         (

@@ -8,7 +8,7 @@ from typing import Any, Self
 
 from rosmc.msg import ErrorCode
 
-from ...conversions import library_from_msg, mission_from_msg, param_to_msg
+from ...conversions import library_from_msg, param_to_msg
 from ...core import Library, MissionState, SkillInstance, SkillSpec
 from .connection import ServiceCaller, raise_for
 
@@ -70,10 +70,9 @@ class ClientBase:
 
     def fetch_mission(self) -> MissionState:
         """The current mission, leaving the client's known revision as it was."""
-        response = self._caller.call("get_mission")
+        response = self._caller.call("get_mission")  # an UnpackedGetMissionResponse
         self.journal_alert = str(response.journal_alert)
-        content, revision = mission_from_msg(response.mission)
-        state = MissionState(content, revision)
+        state = MissionState(response.content, response.revision)
         self._kinds.update({s.id: (s.agent, s.skill) for s in state.skills()})
         return state
 

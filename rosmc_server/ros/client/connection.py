@@ -23,6 +23,7 @@ from rosmc.msg import ErrorCode
 from rospy.exceptions import TransportException
 
 from ... import interface
+from ...conversions.unpacking import UnpackedGetMission
 from ...core import (
     InvalidRequest,
     NotFound,
@@ -41,6 +42,8 @@ _ERRORS: Mapping[int, type[RosmcError]] = {
     ErrorCode.UNAVAILABLE: Unavailable,
     ErrorCode.INTERNAL: RosmcError,
 }
+# Services whose answers are read straight into core objects rather than genpy messages.
+_ANSWERED_AS: Mapping[str, Any] = {"get_mission": UnpackedGetMission}
 # rospy's ServiceException texts when the server's handler (not the connection) failed.
 _HANDLER_FAILURES = ("service cannot process request", "error processing request")
 
@@ -114,7 +117,7 @@ class ServiceCaller:
             if time.monotonic() >= deadline or rospy.is_shutdown():
                 raise ServerUnavailable(self._not_reachable(name))
             time.sleep(0.1)
-        service_class = getattr(srv, interface.SERVICES[operation])
+        service_class = _ANSWERED_AS.get(operation) or getattr(srv, interface.SERVICES[operation])
         proxy = rospy.ServiceProxy(name, service_class, persistent=True)
         self._proxies[operation] = proxy
         return proxy

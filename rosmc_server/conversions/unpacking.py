@@ -1,0 +1,306 @@
+"""Mission snapshots read from ROS 1 wire bytes straight into core objects.
+
+Part of :mod:`rosmc_server.conversions`; the reverse of :mod:`.packing`. A client that
+decodes a 10,000-skill ``rosmc/Mission`` into genpy messages and then converts those
+(:func:`~.mission.mission_from_msg`) spends about 100 ms in Python; reading the bytes
+straight into :class:`~rosmc_server.core.SkillInstance` objects takes about a third of
+that. :class:`UnpackedGetMission` is a service class for ``rospy.ServiceProxy`` whose
+answers arrive that way (what :class:`~rosmc_server.ros.client.MissionClient` fetches).
+
+The reader is used only while ``rosmc/Mission`` is the definition it was written for
+(its md5sum); otherwise answers go through genpy as before. Tests check it against genpy
+and ``mission_from_msg`` for random missions, and that malformed bytes fail as genpy's do.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import gc
+import struct
+from collections.abc import Iterator, Mapping
+from typing import Any
+
+import genpy
+import rosmc.msg as wire
+import rosmc.srv as srv
+
+from ..core import (
+    Barrier,
+    InvalidRequest,
+    MarkerType,
+    MissionContent,
+    ParamType,
+    Pose,
+    Resolution,
+    SkillInstance,
+    SkillStatus,
+    TaskMarker,
+    Transfer,
+)
+from .mission import mission_from_msg
+from .values import json_param, param_type
+
+# The rosmc/Mission definition the reader follows (with its nested types).
+UNPACKED_MISSION_MD5 = "afb150ec3f57bc7466152152c338c587"
+
+_COUNT = struct.Struct("<I").unpack_from
+_HEADER = struct.Struct("<Q2I")  # revision, stamp
+_PARAM_NUMBERS = struct.Struct("<2Bqd").unpack_from  # type, bool_value, int_value, float_value
+_POSE = struct.Struct("<6d").unpack_from
+_SKILL_NUMBERS = struct.Struct("<3BIdI").unpack_from  # status ... max_retries
+_TIMES = struct.Struct("<2d").unpack_from  # started, finished
+_MARKER_TYPE = struct.Struct("<B").unpack_from
+
+
+class UnpackedGetMissionResponse(srv.GetMissionResponse):  # type: ignore[misc]
+    """A ``rosmc/GetMission`` answer read into ``content``, ``revision`` and ``journal_alert``.
+
+    ``mission`` stays empty: the answer never becomes genpy messages (but when the
+    definition changed, see the module's docstring).
+    """
+
+    mission: Any
+    content: MissionContent
+    revision: int
+
+    def deserialize(self, data: bytes) -> UnpackedGetMissionResponse:
+        """Read the answer's wire bytes (rospy calls this); genpy.DeserializationError if
+        they are malformed, InvalidRequest if they hold what no mission can."""
+        if wire.Mission._md5sum != UNPACKED_MISSION_MD5:
+            super().deserialize(data)
+            self.content, self.revision = mission_from_msg(self.mission)
+            self.mission = wire.Mission()  # as documented: not kept twice
+            return self
+        with _reading():
+            self.content, self.revision, end = _read_mission(data, 0)
+            self.journal_alert, end = _text(data, end)
+        if end != len(data):
+            raise genpy.DeserializationError(f"{len(data) - end} bytes after the answer")
+        return self
+
+
+class UnpackedGetMission:
+    """The ``rosmc/GetMission`` service, answering with :class:`UnpackedGetMissionResponse`."""
+
+    _type = srv.GetMission._type
+    _md5sum = srv.GetMission._md5sum
+    _request_class = srv.GetMissionRequest
+    _response_class = UnpackedGetMissionResponse
+
+
+def mission_from_bytes(data: bytes, start: int = 0) -> tuple[MissionContent, int, int]:
+    """The content and revision of the ``rosmc/Mission`` at ``data[start:]``, and where it ends.
+
+    Raises:
+        genpy.DeserializationError: The bytes end early or are not a mission.
+        InvalidRequest: The mission holds an unknown status, type or marker number, a
+            parameter without a name or with malformed JSON (as ``mission_from_msg``).
+    """
+    with _reading():
+        return _read_mission(data, start)
+
+
+@contextlib.contextmanager
+def _reading() -> Iterator[None]:
+    """Read without the cyclic collector (thousands of new containers, none in a cycle);
+    bytes that end early or hold nonsense counts raise genpy.DeserializationError."""
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    except (struct.error, IndexError, OverflowError) as error:
+        raise genpy.DeserializationError(f"a malformed rosmc/Mission: {error}") from error
+    finally:
+        if was_enabled:
+            gc.enable()
+
+
+def _read_mission(data: bytes, pos: int) -> tuple[MissionContent, int, int]:
+    revision = _HEADER.unpack_from(data, pos)[0]
+    library, pos = _text(data, pos + _HEADER.size)
+    (count,) = _COUNT(data, pos)
+    pos += 4
+    tasks: dict[str, list[SkillInstance]] = {}
+    for _ in range(count):
+        agent, pos = _text(data, pos)
+        tasks[agent], pos = _read_skills(data, pos)
+    barriers: dict[str, Barrier] = {}
+    (count,) = _COUNT(data, pos)
+    pos += 4
+    for _ in range(count):
+        barrier_id, pos = _text(data, pos)
+        members, pos = _texts(data, pos)
+        _, pos = _texts(data, pos)  # each member's agent: the core knows it from the tasks
+        barriers[barrier_id] = Barrier(barrier_id, tuple(members))
+    markers: dict[str, TaskMarker] = {}
+    (count,) = _COUNT(data, pos)
+    pos += 4
+    for _ in range(count):
+        marker, pos = _read_marker(data, pos)
+        markers[marker.name] = marker
+    if pos > len(data):
+        raise genpy.DeserializationError("the bytes end inside the mission")
+    return MissionContent(library, tasks, barriers, markers), revision, pos
+
+
+def _read_skills(data: bytes, pos: int) -> tuple[list[SkillInstance], int]:
+    """The ``rosmc/Skill[]`` at ``pos`` as core skills, and where it ends.
+
+    The hot loop of a snapshot: its strings are read inline, not through :func:`_text`
+    (a call per string would cost a fifth more). A string read past the end of ``data``
+    comes out short; the caller checks where the mission ends.
+    """
+    count = _COUNT(data, pos)[0]
+    pos += 4
+    skills: list[SkillInstance] = []
+    append = skills.append
+    for _ in range(count):
+        size = _COUNT(data, pos)[0]
+        pos += 4
+        skill_id = data[pos : pos + size].decode("utf-8", "rosmsg")
+        pos += size
+        size = _COUNT(data, pos)[0]
+        pos += 4
+        agent = data[pos : pos + size].decode("utf-8", "rosmsg")
+        pos += size
+        size = _COUNT(data, pos)[0]
+        pos += 4
+        name = data[pos : pos + size].decode("utf-8", "rosmsg")
+        pos += size
+        size = _COUNT(data, pos)[0]
+        pos += 4
+        label = data[pos : pos + size].decode("utf-8", "rosmsg")
+        pos += size
+        params, bindings, pos = _read_params(data, pos)
+        numbers = _SKILL_NUMBERS(data, pos)  # status, transfer, resolution, attempt, ...
+        pos += 19
+        size = _COUNT(data, pos)[0]  # status_text
+        status_text = data[pos + 4 : pos + 4 + size].decode("utf-8", "rosmsg") if size else ""
+        pos += 4 + size
+        started, finished = _TIMES(data, pos)
+        pos += 16
+        status = _STATUS.get(numbers[0])
+        transfer = _TRANSFER.get(numbers[1])
+        resolution = _RESOLUTION.get(numbers[2])
+        if status is None or transfer is None or resolution is None:
+            raise _unknown_number(numbers[:3])
+        append(
+            SkillInstance(
+                skill_id,
+                agent,
+                name,
+                label,
+                params,
+                bindings,
+                status,
+                transfer,
+                resolution,
+                numbers[3],
+                numbers[4],
+                numbers[5],
+                status_text,
+                started,
+                finished,
+            )
+        )
+    return skills, pos
+
+
+def _read_params(data: bytes, pos: int) -> tuple[dict[str, Any], dict[str, str], int]:
+    """The ``rosmc/ParameterValue[]`` at ``pos``: values, marker bindings, where it ends."""
+    count = _COUNT(data, pos)[0]
+    pos += 4
+    params: dict[str, Any] = {}
+    bindings: dict[str, str] = {}
+    for _ in range(count):
+        size = _COUNT(data, pos)[0]
+        pos += 4
+        name = data[pos : pos + size].decode("utf-8", "rosmsg")
+        pos += size
+        type_number, bool_value, int_value, float_value = _PARAM_NUMBERS(data, pos)
+        pos += 18
+        size = _COUNT(data, pos)[0]  # string_value, mostly empty
+        text = data[pos + 4 : pos + 4 + size].decode("utf-8", "rosmsg") if size else ""
+        pos += 4 + size
+        size = _COUNT(data, pos)[0]  # json_value, mostly empty
+        json_text = data[pos + 4 : pos + 4 + size].decode("utf-8", "rosmsg") if size else ""
+        pos += 4 + size
+        ptype = _PARAM_TYPES.get(type_number) if name else None
+        if ptype is ParamType.FLOAT:  # the common types first
+            params[name] = float_value
+        elif ptype is ParamType.POSE:
+            params[name] = Pose(*_POSE(data, pos))
+        elif ptype is ParamType.INT:
+            params[name] = int_value
+        elif ptype is ParamType.STRING:
+            params[name] = text
+        elif ptype is ParamType.BOOL:
+            params[name] = bool(bool_value)
+        else:  # LIST, DICT, or InvalidRequest for a nameless or unknown parameter
+            if pos > len(data):  # the JSON text was cut short: malformed, not invalid
+                raise genpy.DeserializationError("the bytes end inside a parameter")
+            params[name] = json_param(name, param_type(name, type_number), json_text)
+        pos += 48
+        size = _COUNT(data, pos)[0]  # marker, mostly empty
+        if size:
+            bindings[name] = data[pos + 4 : pos + 4 + size].decode("utf-8", "rosmsg")
+        pos += 4 + size
+    return params, bindings, pos
+
+
+def _read_marker(data: bytes, pos: int) -> tuple[TaskMarker, int]:
+    name, pos = _text(data, pos)
+    (type_number,) = _MARKER_TYPE(data, pos)
+    pose = Pose(*_POSE(data, pos + 1))
+    pos += 49
+    (count,) = _COUNT(data, pos)
+    pos += 4
+    vertices = []
+    for _ in range(count):
+        vertices.append(Pose(*_POSE(data, pos)))
+        pos += 48
+    marker_type = _enum(_MARKER_TYPES, type_number, "marker type")
+    return TaskMarker(name, marker_type, pose, tuple(vertices)), pos
+
+
+def _text(data: bytes, pos: int) -> tuple[str, int]:
+    """The ROS string at ``pos`` and where it ends (undecodable bytes replaced, as genpy does)."""
+    size = _COUNT(data, pos)[0]
+    pos += 4
+    return data[pos : pos + size].decode("utf-8", "rosmsg"), pos + size
+
+
+def _texts(data: bytes, pos: int) -> tuple[list[str], int]:
+    """The ROS ``string[]`` at ``pos`` and where it ends."""
+    (count,) = _COUNT(data, pos)
+    pos += 4
+    texts = []
+    for _ in range(count):
+        text, pos = _text(data, pos)
+        texts.append(text)
+    return texts, pos
+
+
+def _enum(members: Mapping[int, Any], number: int, what: str) -> Any:
+    """The member numbered ``number``; InvalidRequest as ``enum_from_number`` says it."""
+    member = members.get(number)
+    if member is None:
+        raise InvalidRequest(f"unknown {what} number {number}")
+    return member
+
+
+def _unknown_number(numbers: tuple[int, ...]) -> InvalidRequest:
+    """The error for a skill's status, transfer and resolution numbers, one unknown."""
+    for members, number, what in zip(_SKILL_ENUMS, numbers, _SKILL_ENUM_NAMES, strict=True):
+        if number not in members:
+            return InvalidRequest(f"unknown {what} number {number}")
+    raise AssertionError("every number is known")  # pragma: no cover
+
+
+_STATUS: Mapping[int, SkillStatus] = {int(s): s for s in SkillStatus}
+_TRANSFER: Mapping[int, Transfer] = {int(t): t for t in Transfer}
+_RESOLUTION: Mapping[int, Resolution] = {int(r): r for r in Resolution}
+_MARKER_TYPES: Mapping[int, MarkerType] = {int(m): m for m in MarkerType}
+_PARAM_TYPES: Mapping[int, ParamType] = {int(t): t for t in ParamType}
+_SKILL_ENUMS = (_STATUS, _TRANSFER, _RESOLUTION)
+_SKILL_ENUM_NAMES = ("status", "transfer", "resolution")
