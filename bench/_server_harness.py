@@ -276,6 +276,9 @@ def serialized_size(msg: Any) -> int:
 class ServerClient:
     """Persistent proxies of every operator service, and the events the server publishes.
 
+    ``get_mission_core`` is GetMission read as ``MissionClient`` reads it (core objects,
+    no genpy messages); ``get_mission`` answers with genpy messages.
+
     Needs an initialized rospy node. ``rev`` follows the revision of every answer.
     """
 
@@ -285,6 +288,7 @@ class ServerClient:
         import rospy
 
         from rosmc_server import interface
+        from rosmc_server.conversions.unpacking import UnpackedGetMission
 
         self.wire, self.rospy = wire, rospy
         self.proxies: dict[str, Any] = {}
@@ -293,6 +297,10 @@ class ServerClient:
             self.proxies[operation] = rospy.ServiceProxy(
                 interface.service_name(operation), getattr(srv, type_name), persistent=True
             )
+        # GetMission as the project's client reads it: straight into core objects.
+        self.proxies["get_mission_core"] = rospy.ServiceProxy(
+            interface.service_name("get_mission"), UnpackedGetMission, persistent=True
+        )
         self.events: list[Any] = []
         self._lock = threading.Lock()
         self.subscriber = rospy.Subscriber(

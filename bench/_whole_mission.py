@@ -1,6 +1,7 @@
 """The whole-mission figures of the server benchmarks: what costs the whole mission.
 
-:class:`WholeMission` times get_mission (decoded by genpy and as raw bytes), saving (to a
+:class:`WholeMission` times get_mission (decoded by genpy, read into core objects as the
+project's client reads it, and as raw bytes, with each client-side read apart), saving (to a
 path on the server and returning the document) and loading the saved mission, each right
 after a change; :func:`subscriber_cpu` measures the server's CPU while changes come, without
 and with a subscriber to the latched ``/rosmc/mission``. Both take a running
@@ -37,12 +38,14 @@ class WholeMission:
         return response
 
     def get_and_save(self) -> tuple[str, int]:
-        """get_mission (genpy and raw) and both saves, each right after a change.
+        """get_mission (genpy, core objects and raw) and both saves, each after a change.
 
         Returns the document saved last and the bytes of the document in the answer to a
         save to a path (none: it is returned only on request).
         """
         import rosmc.srv as srv
+
+        from rosmc_server.conversions.unpacking import UnpackedGetMissionResponse
 
         raw = raw_proxy("get_mission")
         try:
@@ -59,6 +62,13 @@ class WholeMission:
                 srv.GetMissionResponse().deserialize(data)
                 elapsed = time.perf_counter() - started
                 self.times.setdefault("get_mission_client_decode", []).append(elapsed)
+                started = time.perf_counter()
+                UnpackedGetMissionResponse().deserialize(data)
+                elapsed = time.perf_counter() - started
+                self.times.setdefault("get_mission_client_read", []).append(elapsed)
+                self.change()
+                self.timed("get_mission_core_after_change", "get_mission_core")
+                self.timed("get_mission_core_same_revision", "get_mission_core")
                 self.change()
                 to_path = self.timed("save_to_path", "save_mission", path="bench.yaml")
                 self.change()

@@ -15,8 +15,10 @@ service proxies; see ``_server_harness.py``), loads the mission as one document 
   request with one move: a skill in no barrier to a random place of its blueprint);
 * ``reorder_whole``: the same change requested as the blueprint's whole new order, a
   request that grows with the blueprint by nature (its event carries the one move);
-* whole-mission operations, p50 and p95 of a few calls: ``get_mission``, ``save`` (the
-  document in the answer) and ``load`` (the saved document), with their bytes;
+* whole-mission operations, p50 and p95 of a few calls: ``get_mission`` (read into core
+  objects, as the project's client reads it; ``get_mission_genpy``: into genpy messages,
+  as any rospy client), ``save`` (the document in the answer) and ``load`` (the saved
+  document), with their bytes;
 * ``spaced_edit``: edits 60 ms apart (``--spaced`` of them), at each size and at 700
   skills, where the latched snapshot is rebuilt between changes.
 
@@ -101,7 +103,7 @@ class ScaleBench(ServerClient):
 
     def timed_as(self, figure: str, operation: str, /, **fields: Any) -> Any:
         """Call ``operation`` on the current revision; its time counts for ``figure``."""
-        if operation not in ("get_mission", "save_mission"):
+        if operation not in ("get_mission", "get_mission_core", "save_mission"):
             fields.setdefault("base_revision", self.rev)
         elapsed, response = self.timed(operation, **fields)
         self.times.setdefault(figure, []).append(elapsed)
@@ -203,7 +205,9 @@ class ScaleBench(ServerClient):
         """
         sizes = {}
         for _ in range(calls):
-            sizes["get_mission"] = serialized_size(self.timed_as("get_mission", "get_mission"))
+            self.timed_as("get_mission", "get_mission_core")
+            answer = self.timed_as("get_mission_genpy", "get_mission")
+            sizes["get_mission"] = serialized_size(answer)
         saved = document
         for _ in range(calls):
             saved = self.timed_as("save", "save_mission", path="").document

@@ -43,6 +43,7 @@ _TIMES = struct.Struct("<2d")  # started, finished
 _EMPTY = _COUNT.pack(0)  # an empty string or array
 _NO_TEXT_NO_POSE = _EMPTY + _EMPTY + _NO_POSE  # a number parameter's unused fields
 _POSE_HEAD = _PARAM_NUMBERS.pack(ParamType.POSE, False, 0, 0.0) + _EMPTY + _EMPTY
+_STRING_HEAD = _PARAM_NUMBERS.pack(ParamType.STRING, False, 0, 0.0)
 
 
 def _string(text: str) -> bytes:
@@ -62,40 +63,48 @@ def _param_body(value: Value) -> bytes:
         assert isinstance(pose, Pose)
         numbers = _POSE.pack(pose.x, pose.y, pose.z, pose.roll, pose.pitch, pose.yaw)
         return _POSE_HEAD + numbers
+    if kind is int:
+        return _PARAM_NUMBERS.pack(ParamType.INT, False, value, 0.0) + _NO_TEXT_NO_POSE
+    if kind is str:
+        assert isinstance(value, str)
+        return _STRING_HEAD + _string(value) + _EMPTY + _NO_POSE
     ptype = value_type(value)
     return b"".join(
         (
-            _PARAM_NUMBERS.pack(
-                ptype,
-                value if ptype is ParamType.BOOL else False,
-                value if ptype is ParamType.INT else 0,
-                value if ptype is ParamType.FLOAT else 0.0,
-            ),
-            _string(value) if isinstance(value, str) else _EMPTY,
+            _PARAM_NUMBERS.pack(ptype, value if ptype is ParamType.BOOL else False, 0, 0.0),
+            _EMPTY,
             _string(json.dumps(value, separators=(",", ":")))
             if ptype in (ParamType.LIST, ParamType.DICT)
             else _EMPTY,
-            _POSE.pack(value.x, value.y, value.z, value.roll, value.pitch, value.yaw)
-            if isinstance(value, Pose)
-            else _NO_POSE,
+            _NO_POSE,
         )
     )
 
 
-def skill_bytes(skill: SkillInstance) -> bytes:
-    """The ROS 1 wire bytes of ``skill_to_msg(skill)``."""
+def skill_bytes(skill: SkillInstance, names: dict[str, bytes] | None = None) -> bytes:
+    """The ROS 1 wire bytes of ``skill_to_msg(skill)``.
+
+    ``names`` keeps the encoded agent, skill and parameter names between calls (a library
+    has few of them); pass the same dict to every call.
+    """
     if wire.Skill._md5sum != PACKED_SKILL_MD5:  # the definition changed: go through genpy
         return serialized(skill_to_msg(skill))
+    if names is None:
+        names = {}
     bindings = skill.bindings
     parts = [
         _string(skill.id),
-        _string(skill.agent),
-        _string(skill.skill),
+        names.get(skill.agent) or names.setdefault(skill.agent, _string(skill.agent)),
+        names.get(skill.skill) or names.setdefault(skill.skill, _string(skill.skill)),
         _string(skill.label),
         _COUNT.pack(len(skill.params)),
     ]
     for name, value in skill.params.items():
-        parts += (_string(name), _param_body(value), _string(bindings.get(name, "")))
+        parts += (
+            names.get(name) or names.setdefault(name, _string(name)),
+            _param_body(value),
+            _string(bindings[name]) if name in bindings else _EMPTY,
+        )
     parts += (
         _SKILL_NUMBERS.pack(
             skill.status,
@@ -174,6 +183,7 @@ class SnapshotPacker:
     def __init__(self) -> None:
         self._bytes: dict[int, tuple[SkillInstance, bytes]] = {}  # the last snapshot's
         self._prepared: dict[int, tuple[SkillInstance, bytes]] = {}  # the last prepare's
+        self._names: dict[str, bytes] = {}  # agent, skill and parameter names, encoded
         self._lock = threading.Lock()
 
     def prepare(self, skills: Iterable[SkillInstance]) -> None:
@@ -182,7 +192,8 @@ class SnapshotPacker:
         Kept until the next call (a snapshot built meanwhile of the old mission does not
         drop them).
         """
-        ready = {id(skill): (skill, skill_bytes(skill)) for skill in skills}
+        names = self._names
+        ready = {id(skill): (skill, skill_bytes(skill, names)) for skill in skills}
         with self._lock:
             self._prepared = ready
 
@@ -199,7 +210,7 @@ class SnapshotPacker:
                 if entry is None or entry[0] is not skill:  # ids are reused once freed
                     entry = prepared.get(id(skill))
                     if entry is None or entry[0] is not skill:
-                        entry = (skill, skill_bytes(skill))
+                        entry = (skill, skill_bytes(skill, self._names))
                 current[id(skill)] = entry
                 parts.append(entry[1])
         agent_of = _agents_of_members(content).__getitem__

@@ -18,10 +18,10 @@ from .barriers import describe_cycle, find_deadlock
 from .documents import DocumentReader
 from .editing import bound_values, check_label, check_params, check_retries, check_timeout
 from .errors import MissionFileError, RosmcError
-from .library import Library, SkillSpec
+from .library import Library, ParameterSpec, SkillSpec
 from .mission_text import MISSION_VERSION
 from .model import Barrier, Resolution, SkillInstance, SkillStatus, TaskMarker, Transfer
-from .params import MarkerType, Pose
+from .params import MarkerType, Pose, Value, quick_value
 from .state import MissionContent
 from .validation import (
     MAX_ATTEMPT,
@@ -120,6 +120,7 @@ class _TaskReader:
         self.library = library
         self.markers = markers
         self._specs: dict[tuple[str, str], SkillSpec] = {}
+        self._parameters: dict[int, dict[str, ParameterSpec]] = {}  # by id(spec)
 
     def marker(self, name: str) -> TaskMarker:
         """The marker ``name`` of the document."""
@@ -168,11 +169,11 @@ class _TaskReader:
             if status_text:
                 check_one_line(status_text, "a status text", MAX_STATUS_TEXT, empty=True)
             spec = self.spec(agent, name)
-            checked = check_params(spec, params)
+            checked = self.params(spec, params)
+            if checked is None:
+                return None
             if bindings:
                 bound_values(self.marker, spec, bindings)
-            if len(checked) != len(spec.parameters):  # one is missing: say which on the way
-                return None
             return SkillInstance(
                 id=check_id(raw["id"]),
                 agent=agent,
@@ -183,15 +184,35 @@ class _TaskReader:
                 status=status,
                 transfer=transfer,
                 resolution=resolution,
-                attempt=_check(raw, "attempt", 1, check_whole, "an attempt", 1, MAX_ATTEMPT),
-                timeout=_check(raw, "timeout", 0.0, check_timeout),
-                max_retries=_check(raw, "max_retries", 0, check_retries),
+                # The optional fields: absent from most entries, then their defaults.
+                attempt=check_whole(raw["attempt"], "an attempt", 1, MAX_ATTEMPT)
+                if "attempt" in raw
+                else 1,
+                timeout=check_timeout(raw["timeout"]) if "timeout" in raw else 0.0,
+                max_retries=check_retries(raw["max_retries"]) if "max_retries" in raw else 0,
                 status_text=status_text,
-                started=_check(raw, "started", 0.0, check_time, "a start time"),
-                finished=_check(raw, "finished", 0.0, check_time, "a finish time"),
+                started=check_time(raw["started"], "a start time") if "started" in raw else 0.0,
+                finished=check_time(raw["finished"], "a finish time") if "finished" in raw else 0.0,
             )
         except RosmcError:
             return None
+
+    def params(self, spec: SkillSpec, raw: dict[Any, Any]) -> dict[str, Value] | None:
+        """Every parameter of ``spec`` checked (as :func:`~.editing.check_params` checks
+        them), or None if one is unknown or missing; RosmcError if a value is wrong."""
+        by_name = self._parameters.get(id(spec))  # the library keeps its specs alive
+        if by_name is None:
+            by_name = self._parameters[id(spec)] = {p.name: p for p in spec.parameters}
+        if len(raw) != len(by_name):
+            return None
+        checked: dict[str, Value] = {}
+        for name, value in raw.items():
+            param = by_name.get(name)
+            if param is None:
+                return None
+            quick = quick_value(param.type, value, param.minimum, param.maximum, param.choices)
+            checked[name] = param.check(value, spec.name) if quick is None else quick
+        return checked
 
     def precise(self, raw: object, agent: str, key: str, seen: set[str]) -> SkillInstance:
         """The skill an entry holds, or MissionFileError saying what is wrong and where."""
@@ -217,11 +238,6 @@ class _TaskReader:
 
 def _enum(members: Mapping[str, Any], raw: object) -> Any:
     return members.get(raw) if isinstance(raw, str) else None
-
-
-def _check(raw: dict[str, Any], key: str, default: Any, check: Any, *args: Any) -> Any:
-    """``check(raw[key], *args)``, or ``default`` when the entry leaves ``key`` out."""
-    return check(raw[key], *args) if key in raw else default
 
 
 def _read_tasks(

@@ -170,12 +170,21 @@ class SiteGuard:
         Only checked parameters whose value the change sets anew count: editing a label
         never fails for a target that was fine when the site was unknown.
         """
+        checked: dict[tuple[str, str], tuple[ParameterSpec, ...]] = {}  # per agent and skill
         for skill, is_new in _blueprint_skills(state, change):
+            kind = (skill.agent, skill.skill)
+            params = checked.get(kind)
+            if params is None:
+                spec = library.skill(skill.agent, skill.skill)
+                params = checked[kind] = tuple(
+                    p for p in spec.parameters if p.check_target is not None
+                )
+            if not params:  # most skills: nothing of theirs is checked against the site
+                continue
             old = None if is_new or change.replacement else state.skill(skill.id)
-            spec = library.skill(skill.agent, skill.skill)
-            for param in spec.parameters:
+            for param in params:
                 value = skill.params.get(param.name)
-                if param.check_target is None or value is None:
+                if value is None:
                     continue
                 if old is not None and old.params.get(param.name) == value:
                     continue

@@ -70,9 +70,9 @@ def test_a_snapshot_after_a_change_serializes_only_the_changed_skills(
     packed: list[str] = []
     real = packing.skill_bytes
 
-    def counting(skill: Any) -> bytes:
+    def counting(skill: Any, names: Any = None) -> bytes:
         packed.append(skill.id)
-        return real(skill)
+        return real(skill, names)
 
     monkeypatch.setattr(packing, "skill_bytes", counting)
     changed = content.copy()
