@@ -48,6 +48,12 @@ _HEADER = struct.Struct("<Q2I")  # revision, stamp
 _PARAM_NUMBERS = struct.Struct("<2Bqd").unpack_from  # type, bool_value, int_value, float_value
 _POSE = struct.Struct("<6d").unpack_from
 _SKILL_NUMBERS = struct.Struct("<3BIdI").unpack_from  # status ... max_retries
+# The usual forms in one read each: a skill's tail with an empty status_text (status ...
+# max_retries, status_text's length, started, finished) and a parameter with empty
+# string_value and json_value (type ... float_value, both lengths, pose, marker's length).
+# Each is at most as long as the field run it starts, so valid bytes never end inside it.
+_SKILL_TAIL = struct.Struct("<3BIdII2d").unpack_from
+_PARAM_FIXED = struct.Struct("<2BqdII6dI").unpack_from
 _TIMES = struct.Struct("<2d").unpack_from  # started, finished
 _MARKER_TYPE = struct.Struct("<B").unpack_from
 
@@ -172,20 +178,25 @@ def _read_skills(data: bytes, pos: int) -> tuple[list[SkillInstance], int]:
         label = data[pos : pos + size].decode("utf-8", "rosmsg")
         pos += size
         params, bindings, pos = _read_params(data, pos)
-        numbers = _SKILL_NUMBERS(data, pos)  # status, transfer, resolution, attempt, ...
-        pos += 19
-        size = _COUNT(data, pos)[0]  # status_text
-        status_text = data[pos + 4 : pos + 4 + size].decode("utf-8", "rosmsg") if size else ""
-        pos += 4 + size
-        started, finished = _TIMES(data, pos)
-        pos += 16
+        numbers = _SKILL_TAIL(data, pos)  # status ... max_retries, len(status_text), times
+        if numbers[6]:  # a status text: its bytes stand between the numbers and the times
+            numbers = _SKILL_NUMBERS(data, pos)
+            size = _COUNT(data, pos + 19)[0]
+            status_text = data[pos + 23 : pos + 23 + size].decode("utf-8", "rosmsg")
+            pos += 23 + size
+            started, finished = _TIMES(data, pos)
+            pos += 16
+        else:
+            status_text = ""
+            started, finished = numbers[7], numbers[8]
+            pos += 39
         status = _STATUS.get(numbers[0])
         transfer = _TRANSFER.get(numbers[1])
         resolution = _RESOLUTION.get(numbers[2])
         if status is None or transfer is None or resolution is None:
             raise _unknown_number(numbers[:3])
         append(
-            SkillInstance(
+            _assemble_skill(
                 skill_id,
                 agent,
                 name,
@@ -217,35 +228,60 @@ def _read_params(data: bytes, pos: int) -> tuple[dict[str, Any], dict[str, str],
         pos += 4
         name = data[pos : pos + size].decode("utf-8", "rosmsg")
         pos += size
-        type_number, bool_value, int_value, float_value = _PARAM_NUMBERS(data, pos)
-        pos += 18
-        size = _COUNT(data, pos)[0]  # string_value, mostly empty
-        text = data[pos + 4 : pos + 4 + size].decode("utf-8", "rosmsg") if size else ""
-        pos += 4 + size
-        size = _COUNT(data, pos)[0]  # json_value, mostly empty
-        json_text = data[pos + 4 : pos + 4 + size].decode("utf-8", "rosmsg") if size else ""
-        pos += 4 + size
-        ptype = _PARAM_TYPES.get(type_number) if name else None
-        if ptype is ParamType.FLOAT:  # the common types first
-            params[name] = float_value
-        elif ptype is ParamType.POSE:
-            params[name] = Pose(*_POSE(data, pos))
-        elif ptype is ParamType.INT:
-            params[name] = int_value
-        elif ptype is ParamType.STRING:
-            params[name] = text
-        elif ptype is ParamType.BOOL:
-            params[name] = bool(bool_value)
-        else:  # LIST, DICT, or InvalidRequest for a nameless or unknown parameter
-            if pos > len(data):  # the JSON text was cut short: malformed, not invalid
-                raise genpy.DeserializationError("the bytes end inside a parameter")
-            params[name] = json_param(name, param_type(name, type_number), json_text)
-        pos += 48
-        size = _COUNT(data, pos)[0]  # marker, mostly empty
-        if size:
-            bindings[name] = data[pos + 4 : pos + 4 + size].decode("utf-8", "rosmsg")
-        pos += 4 + size
+        # type, bool, int, float, len(string_value), len(json_value), pose, len(marker)
+        fixed = _PARAM_FIXED(data, pos)
+        type_number = fixed[0]
+        if type_number in _FIXED_TYPES and not (fixed[4] or fixed[5]) and name:
+            if type_number == _FLOAT:  # the usual forms, read at once
+                params[name] = fixed[3]
+            elif type_number == _POSE_TYPE:
+                params[name] = _assemble_pose(*fixed[6:12])
+            elif type_number == _INT:
+                params[name] = fixed[2]
+            else:
+                params[name] = bool(fixed[1])
+            pos += 78
+            size = fixed[12]
+        else:
+            params[name], pos = _read_param_value(data, pos, name)
+            size = _COUNT(data, pos)[0]
+            pos += 4
+        if size:  # a bound marker
+            bindings[name] = data[pos : pos + size].decode("utf-8", "rosmsg")
+            pos += size
     return params, bindings, pos
+
+
+def _read_param_value(data: bytes, pos: int, name: str) -> tuple[Any, int]:
+    """The value of the parameter whose fields start at ``pos``, and where its marker starts.
+
+    Any form: text, JSON, or numbers beside non-empty text fields (which are ignored).
+    """
+    type_number, bool_value, int_value, float_value = _PARAM_NUMBERS(data, pos)
+    pos += 18
+    size = _COUNT(data, pos)[0]  # string_value
+    text = data[pos + 4 : pos + 4 + size].decode("utf-8", "rosmsg") if size else ""
+    pos += 4 + size
+    size = _COUNT(data, pos)[0]  # json_value
+    json_text = data[pos + 4 : pos + 4 + size].decode("utf-8", "rosmsg") if size else ""
+    pos += 4 + size
+    ptype = _PARAM_TYPES.get(type_number) if name else None
+    value: Any
+    if ptype is ParamType.FLOAT:
+        value = float_value
+    elif ptype is ParamType.POSE:
+        value = _assemble_pose(*_POSE(data, pos))
+    elif ptype is ParamType.INT:
+        value = int_value
+    elif ptype is ParamType.STRING:
+        value = text
+    elif ptype is ParamType.BOOL:
+        value = bool(bool_value)
+    else:  # LIST, DICT, or InvalidRequest for a nameless or unknown parameter
+        if pos > len(data):  # the JSON text was cut short: malformed, not invalid
+            raise genpy.DeserializationError("the bytes end inside a parameter")
+        value = json_param(name, param_type(name, type_number), json_text)
+    return value, pos + 48
 
 
 def _read_marker(data: bytes, pos: int) -> tuple[TaskMarker, int]:
@@ -302,5 +338,9 @@ _TRANSFER: Mapping[int, Transfer] = {int(t): t for t in Transfer}
 _RESOLUTION: Mapping[int, Resolution] = {int(r): r for r in Resolution}
 _MARKER_TYPES: Mapping[int, MarkerType] = {int(m): m for m in MarkerType}
 _PARAM_TYPES: Mapping[int, ParamType] = {int(t): t for t in ParamType}
+_FLOAT, _POSE_TYPE, _INT = int(ParamType.FLOAT), int(ParamType.POSE), int(ParamType.INT)
+_FIXED_TYPES = frozenset({_FLOAT, _POSE_TYPE, _INT, int(ParamType.BOOL)})  # no text, no JSON
+_assemble_skill = SkillInstance.assemble
+_assemble_pose = Pose.assemble
 _SKILL_ENUMS = (_STATUS, _TRANSFER, _RESOLUTION)
 _SKILL_ENUM_NAMES = ("status", "transfer", "resolution")

@@ -21,7 +21,7 @@ from .errors import MissionFileError, RosmcError
 from .library import Library, ParameterSpec, SkillSpec
 from .mission_text import MISSION_VERSION
 from .model import Barrier, Resolution, SkillInstance, SkillStatus, TaskMarker, Transfer
-from .params import MarkerType, Pose, Value, quick_value
+from .params import MarkerType, Pose, QuickCheck, Value, quick_checker
 from .state import MissionContent
 from .validation import (
     MAX_ATTEMPT,
@@ -120,7 +120,8 @@ class _TaskReader:
         self.library = library
         self.markers = markers
         self._specs: dict[tuple[str, str], SkillSpec] = {}
-        self._parameters: dict[int, dict[str, ParameterSpec]] = {}  # by id(spec)
+        # by id(spec): each parameter with its quick check
+        self._parameters: dict[int, dict[str, tuple[ParameterSpec, QuickCheck]]] = {}
 
     def marker(self, name: str) -> TaskMarker:
         """The marker ``name`` of the document."""
@@ -174,25 +175,25 @@ class _TaskReader:
                 return None
             if bindings:
                 bound_values(self.marker, spec, bindings)
-            return SkillInstance(
-                id=check_id(raw["id"]),
-                agent=agent,
-                skill=name,
-                label=label,
-                params=checked,
-                bindings=dict(bindings),
-                status=status,
-                transfer=transfer,
-                resolution=resolution,
+            return SkillInstance.assemble(
+                check_id(raw["id"]),
+                agent,
+                name,
+                label,
+                checked,
+                dict(bindings),
+                status,
+                transfer,
+                resolution,
                 # The optional fields: absent from most entries, then their defaults.
-                attempt=check_whole(raw["attempt"], "an attempt", 1, MAX_ATTEMPT)
+                check_whole(raw["attempt"], "an attempt", 1, MAX_ATTEMPT)
                 if "attempt" in raw
                 else 1,
-                timeout=check_timeout(raw["timeout"]) if "timeout" in raw else 0.0,
-                max_retries=check_retries(raw["max_retries"]) if "max_retries" in raw else 0,
-                status_text=status_text,
-                started=check_time(raw["started"], "a start time") if "started" in raw else 0.0,
-                finished=check_time(raw["finished"], "a finish time") if "finished" in raw else 0.0,
+                check_timeout(raw["timeout"]) if "timeout" in raw else 0.0,
+                check_retries(raw["max_retries"]) if "max_retries" in raw else 0,
+                status_text,
+                check_time(raw["started"], "a start time") if "started" in raw else 0.0,
+                check_time(raw["finished"], "a finish time") if "finished" in raw else 0.0,
             )
         except RosmcError:
             return None
@@ -202,15 +203,19 @@ class _TaskReader:
         them), or None if one is unknown or missing; RosmcError if a value is wrong."""
         by_name = self._parameters.get(id(spec))  # the library keeps its specs alive
         if by_name is None:
-            by_name = self._parameters[id(spec)] = {p.name: p for p in spec.parameters}
+            by_name = self._parameters[id(spec)] = {
+                p.name: (p, quick_checker(p.type, p.minimum, p.maximum, p.choices))
+                for p in spec.parameters
+            }
         if len(raw) != len(by_name):
             return None
         checked: dict[str, Value] = {}
         for name, value in raw.items():
-            param = by_name.get(name)
-            if param is None:
+            found = by_name.get(name)
+            if found is None:
                 return None
-            quick = quick_value(param.type, value, param.minimum, param.maximum, param.choices)
+            param, quick_check = found
+            quick = quick_check(value)
             checked[name] = param.check(value, spec.name) if quick is None else quick
         return checked
 

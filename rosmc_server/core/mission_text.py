@@ -1,4 +1,4 @@
-"""Mission documents as text, written and read fast: one line per skill.
+"""Mission documents as text, written fast: one line per skill.
 
 A mission file is YAML (see :mod:`.persistence`), but emitting and parsing YAML in Python
 costs microseconds per value, which at 10,000 skills made saving and loading take
@@ -9,33 +9,30 @@ mapping in JSON syntax, which YAML reads as the same mapping::
       drone:
       - {"id": "drone-1a2b", "skill": "take_off", "label": "take off", "params": {...}, ...}
 
-:func:`read_document` reads such lines with the C ``json`` module and only the few lines
-around them with the YAML parser. A line is read as JSON only if it is exactly what
-:func:`flow_line` writes for the data it holds, and :func:`flow_line` writes only what
-YAML reads identically (it declines data for which JSON and YAML differ, and the entry is
-then written in YAML's block style), so a document reads the same either way: edited by
-hand, written by another tool or by an older ROSMC.
+:func:`flow_line` writes only what YAML reads identically (it declines data for which
+JSON and YAML differ, and the entry is then written in YAML's block style), so a document
+reads the same with any YAML reader. :func:`~.document_reading.read_document` reads such
+lines with the C ``json`` module and only the few lines around them with the YAML parser.
 
 :class:`MissionDumper` keeps each skill's line, keyed by the (immutable) skill instance,
-so saving a large mission after a change writes only the changed skills afresh.
+so saving a large mission after a change writes only the changed skills afresh, and ends
+the document with a digest of its text that lets the reader skip re-checking each line.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import re
-import secrets
 import threading
 from collections.abc import Mapping
-from json.scanner import make_scanner
 from typing import Any
 
 import yaml
 
-from .documents import SafeDumper, load_yaml
-from .errors import MissionFileError
-from .model import Barrier, SkillInstance, TaskMarker
-from .params import value_to_data
+from .documents import SafeDumper
+from .model import Barrier, Resolution, SkillInstance, SkillStatus, TaskMarker, Transfer
+from .params import Pose
 from .state import MissionContent
 
 MISSION_VERSION = 1
@@ -48,8 +45,6 @@ _UNSAFE = re.compile("[\x7f-\x9f\u2028\u2029\ud800-\udfff\ufeff\ufffe\uffff]")
 _EXPONENT = re.compile(r"([\d.]+)e[-+]\d")
 # YAML refuses an implicit key longer than 1024 characters; a line this long is checked.
 _LONG_KEY = 1000
-# One entry of a block sequence, written as a one-line flow mapping.
-_FLOW_ENTRY = re.compile(r"^( *)- (\{.*\})$", re.MULTILINE)
 
 
 class _PlainDumper(SafeDumper):  # type: ignore[misc, valid-type]
@@ -89,23 +84,35 @@ def skill_to_dict(skill: SkillInstance) -> dict[str, Any]:
         "id": skill.id,
         "skill": skill.skill,
         "label": skill.label,
-        "params": {name: value_to_data(value) for name, value in skill.params.items()},
-        "status": skill.status.name,
+        "params": {
+            name: value.to_dict() if type(value) is Pose else value
+            for name, value in skill.params.items()
+        },
+        "status": _STATUS_NAMES[skill.status],
     }
     if skill.bindings:
         data["bindings"] = dict(skill.bindings)
-    optional = {
-        "transfer": (skill.transfer.name, "NONE"),
-        "resolution": (skill.resolution.name, "NONE"),
-        "attempt": (skill.attempt, 1),
-        "timeout": (skill.timeout, 0.0),
-        "max_retries": (skill.max_retries, 0),
-        "status_text": (skill.status_text, ""),
-        "started": (skill.started, 0.0),
-        "finished": (skill.finished, 0.0),
-    }
-    data.update({key: value for key, (value, default) in optional.items() if value != default})
+    # The optional fields, each only if it differs from its default (in this order).
+    if skill.transfer is not Transfer.NONE:
+        data["transfer"] = skill.transfer.name
+    if skill.resolution is not Resolution.NONE:
+        data["resolution"] = skill.resolution.name
+    if skill.attempt != 1:
+        data["attempt"] = skill.attempt
+    if skill.timeout != 0.0:
+        data["timeout"] = skill.timeout
+    if skill.max_retries != 0:
+        data["max_retries"] = skill.max_retries
+    if skill.status_text != "":
+        data["status_text"] = skill.status_text
+    if skill.started != 0.0:
+        data["started"] = skill.started
+    if skill.finished != 0.0:
+        data["finished"] = skill.finished
     return data
+
+
+_STATUS_NAMES: Mapping[SkillStatus, str] = {status: status.name for status in SkillStatus}
 
 
 def barrier_to_dict(barrier: Barrier) -> dict[str, Any]:
@@ -126,14 +133,7 @@ def marker_to_dict(marker: TaskMarker) -> dict[str, Any]:
 
 
 # -- one line per entry -----------------------------------------------------------------------
-def _refuse_constant(name: str) -> None:
-    raise ValueError(f"{name} is not a YAML number")  # NaN and Infinity are text in YAML
-
-
-_ENCODER = json.JSONEncoder(ensure_ascii=False)
-# The C scanner json.loads runs, called directly (one line is one call). typeshed's stub
-# wants the scanner's own type for its context; a decoder has every attribute it reads.
-_SCAN = make_scanner(json.JSONDecoder(parse_constant=_refuse_constant))  # type: ignore[arg-type]
+JSON_ENCODER = json.JSONEncoder(ensure_ascii=False)  # what flow lines are written with
 
 
 def flow_line(data: dict[str, Any]) -> str | None:
@@ -144,13 +144,13 @@ def flow_line(data: dict[str, Any]) -> str | None:
     without a fraction (``1e-05``), and keys too long for YAML.
     """
     try:
-        text = _ENCODER.encode(data)
+        text = JSON_ENCODER.encode(data)
     except (TypeError, ValueError, RecursionError):
         return None
-    return text if _yaml_reads_alike(text, [text], [data]) else None
+    return text if yaml_reads_alike(text, [text], [data]) else None
 
 
-def _yaml_reads_alike(text: str, lines: list[str], items: list[dict[str, Any]]) -> bool:
+def yaml_reads_alike(text: str, lines: list[str], items: list[dict[str, Any]]) -> bool:
     """Whether YAML reads the JSON ``text`` of ``lines`` holding ``items`` as JSON does."""
     if _UNSAFE.search(text):
         return False
@@ -169,35 +169,12 @@ def _has_long_key(data: object) -> bool:
     while pending:
         item = pending.pop()
         if isinstance(item, dict):
-            if any(len(_ENCODER.encode(key)) > _LONG_KEY for key in item):
+            if any(len(JSON_ENCODER.encode(key)) > _LONG_KEY for key in item):
                 return True
             pending.extend(item.values())
         elif isinstance(item, list):
             pending.extend(item)
     return False
-
-
-def _scan_line(text: str) -> dict[str, Any] | None:
-    """The mapping a line of JSON holds (exactly one value, nothing after it), or None."""
-    try:
-        data, end = _SCAN(text, 0)
-    except (StopIteration, ValueError, RecursionError):
-        return None
-    return data if end == len(text) and type(data) is dict else None
-
-
-def _written_alike(lines: list[str], items: list[dict[str, Any]]) -> bool:
-    """Whether each line is exactly what :func:`flow_line` writes for its item.
-
-    One encoding of the whole run: each line holds exactly its item, so if the joined
-    texts are equal, each line equals its item's encoding (neither of two texts of one
-    complete JSON value can be a proper prefix of the other).
-    """
-    try:
-        text = _ENCODER.encode(items)
-    except (TypeError, ValueError, RecursionError):
-        return False
-    return text == f"[{', '.join(lines)}]" and _yaml_reads_alike(text, lines, items)
 
 
 def entry(data: dict[str, Any], indent: str) -> str:
@@ -206,6 +183,29 @@ def entry(data: dict[str, Any], indent: str) -> str:
     if line is not None:
         return f"{indent}- {line}\n"
     return _indented(yaml_block([data]), indent)
+
+
+def entries(items: list[dict[str, Any]], indent: str) -> list[str]:
+    """:func:`entry` of each item, with YAML's reading of their JSON lines checked at once.
+
+    One pass of the checks over all lines (almost always passed) instead of one per line.
+    """
+    try:
+        texts = [JSON_ENCODER.encode(data) for data in items]
+    except (TypeError, ValueError, RecursionError):
+        return [entry(data, indent) for data in items]  # each tried on its own
+    if yaml_reads_alike("\n".join(texts), texts, items):
+        return [f"{indent}- {text}\n" for text in texts]
+    return [entry(data, indent) for data in items]
+
+
+def digest_line(text: str) -> str:
+    """The comment a document ends with: the SHA-256 of its text before it.
+
+    While it matches, the reader knows the text is as written and every flow line checked
+    (see :mod:`.document_reading`); any edit only makes reading it take the full checks.
+    """
+    return f"# sha256 of the text above: {hashlib.sha256(text.encode()).hexdigest()}\n"
 
 
 def _indented(block: str, indent: str) -> str:
@@ -226,10 +226,20 @@ class MissionDumper:
         self._lock = threading.Lock()
 
     def dump(self, content: MissionContent, revision: int) -> str:
-        """The mission as a YAML document."""
+        """The mission as a YAML document, ending with its :func:`digest_line`."""
         with self._lock:
             previous = self._lines
         current: dict[int, tuple[SkillInstance, str]] = {}
+        fresh: list[SkillInstance] = []
+        for task in content.tasks.values():
+            for skill in task:
+                cached = previous.get(id(skill))
+                if cached is not None and cached[0] is skill:  # ids are reused once freed
+                    current[id(skill)] = cached
+                else:
+                    fresh.append(skill)
+        lines = entries([skill_to_dict(skill) for skill in fresh], "  ")
+        current.update((id(skill), (skill, line)) for skill, line in zip(fresh, lines, strict=True))
         head = {"rosmc_mission": MISSION_VERSION, "library": content.library, "revision": revision}
         parts = [yaml_block(head), "tasks:\n" if content.tasks else "tasks: {}\n"]
         for agent, task in content.tasks.items():
@@ -238,17 +248,13 @@ class MissionDumper:
                 parts.append(_indented(yaml_block({agent: [skill_to_dict(s) for s in task]}), "  "))
                 continue
             parts.append(f"  {key}:\n" if task else f"  {key}: []\n")
-            for skill in task:
-                cached = previous.get(id(skill))
-                if cached is None or cached[0] is not skill:  # ids are reused once freed
-                    cached = (skill, entry(skill_to_dict(skill), "  "))
-                current[id(skill)] = cached
-                parts.append(cached[1])
+            parts += [current[id(skill)][1] for skill in task]
         parts.append(_section("barriers", [barrier_to_dict(b) for b in content.barriers.values()]))
         parts.append(_section("markers", [marker_to_dict(m) for m in content.markers.values()]))
         with self._lock:
             self._lines = current
-        return "".join(parts)
+        text = "".join(parts)
+        return text + digest_line(text)
 
 
 def _simple_key(name: str) -> str | None:
@@ -263,115 +269,3 @@ def _section(name: str, entries: list[dict[str, Any]]) -> str:
     if not entries:
         return f"{name}: []\n"
     return f"{name}:\n" + "".join(entry(data, "") for data in entries)
-
-
-def read_document(text: str, source: str) -> Any:
-    """Parse a mission document as YAML does, reading flow-line entries with ``json``.
-
-    Each run of consecutive flow lines (at one indentation) that is exactly what
-    :func:`flow_line` writes is replaced by one placeholder item (a random token nobody
-    can guess), the rest is parsed as YAML, and each placeholder is replaced by its run's
-    entries. If a placeholder is missing or stands where no list item could, the whole
-    text is parsed as YAML instead.
-
-    Raises:
-        yaml.YAMLError: What :func:`~.documents.load_yaml` raises for the text.
-        MissionFileError: YAML aliases expand the document beyond reason.
-    """
-    runs: list[tuple[int, int, str, list[str], list[dict[str, Any]]]] = []
-    for match in _FLOW_ENTRY.finditer(text):
-        data = _scan_line(match.group(2))
-        if data is None:
-            continue
-        indent = match.group(1)
-        if runs and runs[-1][1] + 1 == match.start() and runs[-1][2] == indent:
-            start, _, _, lines, items = runs[-1]
-            runs[-1] = (start, match.end(), indent, lines, items)
-        else:
-            runs.append((match.start(), match.end(), indent, [], []))
-        runs[-1][3].append(match.group(2))
-        runs[-1][4].append(data)
-    token = secrets.token_hex(12)
-    kept: list[list[dict[str, Any]]] = []
-    weights: dict[str, int] = {}  # a placeholder stands for at most this many values
-    pieces: list[str] = []
-    done = 0
-    for start, end, indent, lines, items in runs:
-        if _written_alike(lines, items):
-            placeholder = f"{token}:{len(kept)}"
-            pieces += [text[done:start], f'{indent}- "{placeholder}"']
-            weights[placeholder] = end - start
-            kept.append(items)
-            done = end
-    if kept:
-        pieces.append(text[done:])
-        try:
-            data = load_yaml("".join(pieces))
-        except yaml.YAMLError:
-            data = None  # the error as the document itself shows it, below
-        if data is not None:
-            refuse_alias_bombs(data, len(text), source, weights)
-            if _put_back(data, f"{token}:", kept):
-                return data
-    data = load_yaml(text)
-    refuse_alias_bombs(data, len(text), source)
-    return data
-
-
-def refuse_alias_bombs(
-    data: object, length: int, source: str, weights: Mapping[str, int] | None = None
-) -> None:
-    """Refuse a document whose YAML aliases expand it far beyond its own size.
-
-    An alias refers to a value written once, but checking copies it wherever it
-    is used, so a few hundred bytes of nested aliases ("billion laughs") would
-    take hours to load. Ordinary sharing (what yaml.safe_dump writes for repeated
-    values) stays well within the allowance. A string of ``weights`` counts as that
-    many values (a placeholder for entries read apart).
-    """
-    allowance = 100_000 + 20 * length
-    weigh = (weights or {}).get
-    pending, count = [data], 0
-    while pending:
-        item = pending.pop()
-        count += weigh(item, 1) if isinstance(item, str) else 1
-        if count > allowance:
-            raise MissionFileError(
-                f"{source}: its YAML aliases expand it to more than {allowance} values"
-            )
-        if isinstance(item, dict):
-            pending.extend(item.values())
-        elif isinstance(item, list):
-            pending.extend(item)
-
-
-def _put_back(data: Any, prefix: str, runs: list[list[dict[str, Any]]]) -> bool:
-    """Replace each placeholder item of a list by its run; whether each was found once.
-
-    A placeholder anywhere but as a list item (a key, a mapping value) counts as missing.
-    """
-    found: set[int] = set()
-    pending, seen = [data], set()
-    while pending:
-        item = pending.pop()
-        if id(item) in seen:  # a YAML alias shares one list between places
-            continue
-        seen.add(id(item))
-        values = list(item.values()) if isinstance(item, dict) else item
-        expanded: list[Any] = []
-        replaced = False
-        for value in values:
-            if isinstance(value, str) and value.startswith(prefix):
-                number = int(value[len(prefix) :]) if value[len(prefix) :].isdigit() else -1
-                if not isinstance(item, list) or not 0 <= number < len(runs) or number in found:
-                    return False
-                found.add(number)
-                expanded.extend(runs[number])
-                replaced = True
-                continue
-            expanded.append(value)
-            if isinstance(value, (dict, list)):
-                pending.append(value)
-        if replaced:
-            item[:] = expanded  # only lists get here
-    return len(found) == len(runs)

@@ -12,6 +12,8 @@ from dataclasses import dataclass, field
 
 from .params import MarkerType, Pose, Value
 
+_new_object = object.__new__  # an instance without running its constructor
+
 
 class SkillStatus(enum.IntEnum):
     """Execution status of a skill instance (numbers match ``rosmc/SkillStatus``)."""
@@ -82,6 +84,52 @@ class SkillInstance:
     status_text: str = ""
     started: float = 0.0
     finished: float = 0.0
+
+    @classmethod
+    def assemble(
+        cls,
+        id: str,
+        agent: str,
+        skill: str,
+        label: str,
+        params: Mapping[str, Value],
+        bindings: Mapping[str, str],
+        status: SkillStatus,
+        transfer: Transfer,
+        resolution: Resolution,
+        attempt: int,
+        timeout: float,
+        max_retries: int,
+        status_text: str,
+        started: float,
+        finished: float,
+    ) -> SkillInstance:
+        """The skill of these already checked fields, built without the constructor.
+
+        A frozen dataclass's constructor sets each of the fifteen fields through
+        ``object.__setattr__``; filling the instance's dict directly (in field order, so
+        it stays a compact key-sharing dict) is three times as fast, which counts where
+        thousands of skills are read at once (mission files, snapshots). A test checks
+        that both build equal skills with every field.
+        """
+        made = _new_object(cls)
+        fields = made.__dict__
+        fields["id"] = id
+        fields["agent"] = agent
+        fields["skill"] = skill
+        fields["label"] = label
+        fields["params"] = params
+        fields["bindings"] = bindings
+        fields["status"] = status
+        fields["transfer"] = transfer
+        fields["resolution"] = resolution
+        fields["attempt"] = attempt
+        fields["timeout"] = timeout
+        fields["max_retries"] = max_retries
+        fields["status_text"] = status_text
+        fields["started"] = started
+        fields["finished"] = finished
+        return made
 
     @property
     def is_editable(self) -> bool:

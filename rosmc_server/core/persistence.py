@@ -17,12 +17,13 @@ from pathlib import Path
 
 import yaml
 
+from .document_reading import read_document
 from .documents import DuplicateKeyError, yaml_problem
 from .durable import write_durably
 from .errors import MissionFileError
 from .library import Library
 from .mission_reader import mission_from_dict
-from .mission_text import MISSION_VERSION, MissionDumper, mission_to_dict, read_document
+from .mission_text import MISSION_VERSION, MissionDumper, mission_to_dict
 from .state import MissionContent
 
 __all__ = [

@@ -10,6 +10,7 @@ scalar, guessed placeholders) are read exactly as YAML reads them.
 
 from __future__ import annotations
 
+import hashlib
 import json
 from dataclasses import replace
 from typing import Any
@@ -19,14 +20,22 @@ import yaml
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rosmc_server.core import Library, MissionFileError, dump_mission, mission_text, parse_mission
+from rosmc_server.core import (
+    Library,
+    MissionFileError,
+    document_reading,
+    dump_mission,
+    mission_text,
+    parse_mission,
+)
+from rosmc_server.core.document_reading import read_document
 from rosmc_server.core.documents import load_yaml, yaml_problem
 from rosmc_server.core.mission_text import (
     MissionDumper,
+    digest_line,
     entry,
     flow_line,
     mission_to_dict,
-    read_document,
 )
 from tests.unit.random_missions import TRICKY, random_content
 
@@ -66,7 +75,8 @@ def test_saving_again_writes_only_the_changed_skills_afresh(
         return real(skill)
 
     monkeypatch.setattr(mission_text, "skill_to_dict", counting)
-    assert dumper.dump(content, 2) == first.replace("revision: 1", "revision: 2", 1)
+    second = dumper.dump(content, 2)
+    assert body(second) == body(first).replace("revision: 1", "revision: 2", 1)
     assert written == []
     edited = content.copy()
     old = edited.tasks["bravo"][-1]
@@ -75,6 +85,60 @@ def test_saving_again_writes_only_the_changed_skills_afresh(
     assert written == [old.id]
     assert '"label": "edited label"' in text
     assert parse_mission(text, library, "x") == (edited, 3)
+
+
+def body(document: str) -> str:
+    """The document without its digest line (the last)."""
+    text, digest = document[:-1].rsplit("\n", 1)
+    assert digest.startswith("# sha256 of the text above: ")
+    return text + "\n"
+
+
+def test_a_document_ends_with_the_digest_of_its_text(library: Library) -> None:
+    text = MissionDumper().dump(random_content(library, 50, seed=3), 7)
+    assert text.endswith(digest_line(body(text)))
+    assert hashlib.sha256(body(text).encode()).hexdigest() in text.splitlines()[-1]
+
+
+def test_a_digested_document_is_read_without_checking_each_line(
+    library: Library, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    content = random_content(library, 300, seed=11)
+    text = MissionDumper().dump(content, 4)
+
+    def refuse(lines: list[str], items: list[dict[str, Any]]) -> bool:
+        raise AssertionError("a digested document's lines are not checked again")
+
+    monkeypatch.setattr(document_reading, "_written_alike", refuse)
+    assert read_document(text, "x") == yaml.load(text, Loader=yaml.CSafeLoader)
+    assert parse_mission(text, library, "x") == (content, 4)
+
+
+@pytest.mark.parametrize(
+    ("line", "edited"),
+    [
+        ('"speed": 0.5', '"speed": 5e-1'),  # JSON's float, YAML 1.1's text
+        ('"label": "a"', '"label": "a\u0085"'),  # NEL: a line break to YAML
+    ],
+    ids=["exponent", "next-line"],
+)
+def test_an_edited_document_is_read_as_yaml_reads_it(line: str, edited: str) -> None:
+    document = f'items:\n- {{{line}}}\n- {{"id": "b"}}\n'
+    document += digest_line(document)
+    assert read_document(document, "x") == yaml.load(document, Loader=yaml.CSafeLoader)
+    changed = document.replace(line, edited)  # the digest is stale now
+    assert read_document(changed, "x") == yaml.load(changed, Loader=yaml.CSafeLoader)
+
+
+def test_a_matching_digest_over_lines_the_writer_never_writes_changes_nothing() -> None:
+    # Two lines that are one JSON value, and one line holding two: as many values as
+    # lines, but no line is one entry. YAML refuses the text; so must the reader.
+    text = 'items:\n- {"a": [{}\n- {}]}\n- {"x": 1}, {"y": 2}\n'
+    text += digest_line(text)
+    with pytest.raises(yaml.YAMLError):
+        yaml.load(text, Loader=yaml.CSafeLoader)
+    with pytest.raises(yaml.YAMLError):
+        read_document(text, "x")
 
 
 TRICKY_TEXT = st.lists(st.sampled_from(TRICKY), max_size=5).map("".join) | st.text(max_size=6)

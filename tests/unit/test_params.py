@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 
 from rosmc_server.core import InvalidRequest, ParamType, Pose
 from rosmc_server.core.editing import check_timeout
-from rosmc_server.core.params import INT_MAX, INT_MIN, check_value, quick_value
+from rosmc_server.core.params import INT_MAX, INT_MIN, check_value, quick_checker, quick_value
 from rosmc_server.core.policy import LostLinkKind, LostLinkPolicy
 from rosmc_server.core.validation import check_time, finite_float
 
@@ -70,6 +70,20 @@ def test_the_quick_path_answers_as_the_full_check(
     full = check_value(ptype, raw, "p", minimum, maximum, choices)
     assert quick == full
     assert type(quick) is type(full)
+
+
+@settings(max_examples=3000, deadline=None)
+@given(st.sampled_from(list(ParamType)), raw_values, bounds, bounds, st.data())
+def test_a_specialized_quick_check_answers_as_the_quick_path(
+    ptype: ParamType, raw: Any, minimum: Any, maximum: Any, data: Any
+) -> None:
+    if ptype not in (ParamType.INT, ParamType.FLOAT):
+        minimum = maximum = None
+    choices = data.draw(choices_for(ptype))
+    specialized = quick_checker(ptype, minimum, maximum, choices)(raw)
+    general = quick_value(ptype, raw, minimum, maximum, choices)
+    assert specialized == general
+    assert type(specialized) is type(general)
 
 
 def test_the_quick_path_takes_the_usual_forms() -> None:

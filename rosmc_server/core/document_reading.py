@@ -1,0 +1,208 @@
+"""Mission documents read fast: flow-line entries with ``json``, the rest with YAML.
+
+The reverse of :class:`~.mission_text.MissionDumper` (see :mod:`.mission_text` for the
+format). :func:`read_document` reads a document exactly as YAML would, but the thousands
+of one-line skill entries with the C ``json`` module.
+
+A line is read as JSON only if it is exactly what :func:`~.mission_text.flow_line` writes
+for the data it holds, which YAML reads identically. Checking that costs a JSON encoding
+of each run of such lines and a search of it for what YAML reads otherwise; a document
+that ends with the digest its writer appends (:func:`~.mission_text.digest_line`), still
+matching its text, is as the writer wrote it, each line checked when it was written, so
+the lines that each hold one JSON mapping are taken as they read. Any edit makes the
+digest stale, and the document is then read with every check, as one from another tool
+or an older ROSMC.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import secrets
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from json.scanner import make_scanner
+from typing import Any
+
+import yaml
+
+from .documents import load_yaml
+from .errors import MissionFileError
+from .mission_text import JSON_ENCODER, digest_line, yaml_reads_alike
+
+# One entry of a block sequence, written as a one-line flow mapping.
+_FLOW_ENTRY = re.compile(r"^( *)- (\{.*\})$", re.MULTILINE)
+# The digest a document ends with (see mission_text.digest_line).
+_DIGEST = re.compile(r"^# sha256 of the text above: [0-9a-f]{64}\n\Z", re.MULTILINE)
+
+
+def _refuse_constant(name: str) -> None:
+    raise ValueError(f"{name} is not a YAML number")  # NaN and Infinity are text in YAML
+
+
+# The C scanner json.loads runs, called directly (one line is one call). typeshed's stub
+# wants the scanner's own type for its context; a decoder has every attribute it reads.
+_SCAN = make_scanner(json.JSONDecoder(parse_constant=_refuse_constant))  # type: ignore[arg-type]
+
+
+@dataclass
+class _Run:
+    """Consecutive flow lines at one indentation: where they stand and what they hold."""
+
+    start: int
+    end: int
+    indent: str
+    lines: list[str] = field(default_factory=list)
+    items: list[dict[str, Any]] = field(default_factory=list)
+
+
+def read_document(text: str, source: str) -> Any:
+    """Parse a mission document as YAML does, reading flow-line entries with ``json``.
+
+    Each run of consecutive flow lines (at one indentation) that is exactly what
+    :func:`~.mission_text.flow_line` writes is replaced by one placeholder item (a random
+    token nobody can guess), the rest is parsed as YAML, and each placeholder is replaced
+    by its run's entries. If a placeholder is missing or stands where no list item could,
+    the whole text is parsed as YAML instead.
+
+    Raises:
+        yaml.YAMLError: What :func:`~.documents.load_yaml` raises for the text.
+        MissionFileError: YAML aliases expand the document beyond reason.
+    """
+    runs = _checked_runs(text)
+    if not _digest_matches(text):
+        runs = [run for run in runs if _written_alike(run.lines, run.items)]
+    if runs:
+        data = _read_around(text, source, runs)
+        if data is not None:
+            return data
+    data = load_yaml(text)
+    refuse_alias_bombs(data, len(text), source)
+    return data
+
+
+def _digest_matches(text: str) -> bool:
+    """Whether ``text`` ends with the digest of the text before it (written, not edited)."""
+    digest = _DIGEST.search(text, max(0, len(text) - 200))
+    return digest is not None and digest_line(text[: digest.start()]) == digest.group()
+
+
+def _checked_runs(text: str) -> list[_Run]:
+    """The runs of lines that each hold one JSON mapping, read line by line."""
+    runs: list[_Run] = []
+    for match in _FLOW_ENTRY.finditer(text):
+        data = _scan_line(match.group(2))
+        if data is None:
+            continue
+        indent = match.group(1)
+        if runs and runs[-1].end + 1 == match.start() and runs[-1].indent == indent:
+            runs[-1].end = match.end()
+        else:
+            runs.append(_Run(match.start(), match.end(), indent))
+        runs[-1].lines.append(match.group(2))
+        runs[-1].items.append(data)
+    return runs
+
+
+def _scan_line(text: str) -> dict[str, Any] | None:
+    """The mapping a line of JSON holds (exactly one value, nothing after it), or None."""
+    try:
+        data, end = _SCAN(text, 0)
+    except (StopIteration, ValueError, RecursionError):
+        return None
+    return data if end == len(text) and type(data) is dict else None
+
+
+def _written_alike(lines: list[str], items: list[dict[str, Any]]) -> bool:
+    """Whether each line is exactly what :func:`~.mission_text.flow_line` writes for its item.
+
+    One encoding of the whole run: each line holds exactly its item, so if the joined
+    texts are equal, each line equals its item's encoding (neither of two texts of one
+    complete JSON value can be a proper prefix of the other).
+    """
+    try:
+        text = JSON_ENCODER.encode(items)
+    except (TypeError, ValueError, RecursionError):
+        return False
+    return text == f"[{', '.join(lines)}]" and yaml_reads_alike(text, lines, items)
+
+
+def _read_around(text: str, source: str, runs: list[_Run]) -> Any:
+    """The document with each run read apart and put back, or None if one is not a list item."""
+    token = secrets.token_hex(12)
+    weights: dict[str, int] = {}  # a placeholder stands for at most this many values
+    pieces: list[str] = []
+    done = 0
+    for number, run in enumerate(runs):
+        placeholder = f"{token}:{number}"
+        pieces += [text[done : run.start], f'{run.indent}- "{placeholder}"']
+        weights[placeholder] = run.end - run.start
+        done = run.end
+    pieces.append(text[done:])
+    try:
+        data = load_yaml("".join(pieces))
+    except yaml.YAMLError:
+        return None  # the error as the document itself shows it, from the caller
+    if data is None:
+        return None
+    refuse_alias_bombs(data, len(text), source, weights)
+    return data if _put_back(data, f"{token}:", [run.items for run in runs]) else None
+
+
+def refuse_alias_bombs(
+    data: object, length: int, source: str, weights: Mapping[str, int] | None = None
+) -> None:
+    """Refuse a document whose YAML aliases expand it far beyond its own size.
+
+    An alias refers to a value written once, but checking copies it wherever it
+    is used, so a few hundred bytes of nested aliases ("billion laughs") would
+    take hours to load. Ordinary sharing (what yaml.safe_dump writes for repeated
+    values) stays well within the allowance. A string of ``weights`` counts as that
+    many values (a placeholder for entries read apart).
+    """
+    allowance = 100_000 + 20 * length
+    weigh = (weights or {}).get
+    pending, count = [data], 0
+    while pending:
+        item = pending.pop()
+        count += weigh(item, 1) if isinstance(item, str) else 1
+        if count > allowance:
+            raise MissionFileError(
+                f"{source}: its YAML aliases expand it to more than {allowance} values"
+            )
+        if isinstance(item, dict):
+            pending.extend(item.values())
+        elif isinstance(item, list):
+            pending.extend(item)
+
+
+def _put_back(data: Any, prefix: str, runs: list[list[dict[str, Any]]]) -> bool:
+    """Replace each placeholder item of a list by its run; whether each was found once.
+
+    A placeholder anywhere but as a list item (a key, a mapping value) counts as missing.
+    """
+    found: set[int] = set()
+    pending, seen = [data], set()
+    while pending:
+        item = pending.pop()
+        if id(item) in seen:  # a YAML alias shares one list between places
+            continue
+        seen.add(id(item))
+        values = list(item.values()) if isinstance(item, dict) else item
+        expanded: list[Any] = []
+        replaced = False
+        for value in values:
+            if isinstance(value, str) and value.startswith(prefix):
+                number = int(value[len(prefix) :]) if value[len(prefix) :].isdigit() else -1
+                if not isinstance(item, list) or not 0 <= number < len(runs) or number in found:
+                    return False
+                found.add(number)
+                expanded.extend(runs[number])
+                replaced = True
+                continue
+            expanded.append(value)
+            if isinstance(value, (dict, list)):
+                pending.append(value)
+        if replaced:
+            item[:] = expanded  # only lists get here
+    return len(found) == len(runs)

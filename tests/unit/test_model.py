@@ -1,0 +1,44 @@
+"""Skills and poses assembled without their constructors are the ones the constructors build.
+
+Readers of thousands of skills (mission files, snapshots from the wire) build them with
+``SkillInstance.assemble`` and ``Pose.assemble``, which fill the instance's fields directly.
+They must give the very objects the constructors give: every field, in field order (so
+that the instance dict stays compact), equal and hashing alike.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from rosmc_server.core import Library, Pose, SkillInstance
+from tests.unit.random_missions import random_content
+
+
+def same_object(assembled: Any, made: Any) -> None:
+    assert type(assembled) is type(made)
+    assert list(vars(assembled)) == [f.name for f in dataclasses.fields(made)]
+    assert vars(assembled) == vars(made)
+    assert assembled == made
+
+
+@given(st.tuples(*[st.floats(allow_nan=False)] * 6))
+def test_an_assembled_pose_is_the_pose_the_constructor_builds(fields: tuple[float, ...]) -> None:
+    made, assembled = Pose(*fields), Pose.assemble(*fields)
+    same_object(assembled, made)
+    assert hash(assembled) == hash(made)
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_an_assembled_skill_is_the_skill_the_constructor_builds(
+    library: Library, seed: int
+) -> None:
+    content = random_content(library, 40, seed=seed)
+    for task in content.tasks.values():
+        for made in task:
+            fields = [getattr(made, f.name) for f in dataclasses.fields(made)]
+            same_object(SkillInstance.assemble(*fields), SkillInstance(*fields))
