@@ -312,8 +312,8 @@ class Mission:
         tasks = {
             agent: [
                 s
-                if s.status.is_final
-                or (s.status is SkillStatus.IDLE and s.transfer is Transfer.NONE)
+                if (s.status is SkillStatus.IDLE and s.transfer is Transfer.NONE)
+                or s.status.is_final
                 else replace(
                     s,
                     status=SkillStatus.IDLE,
@@ -385,10 +385,16 @@ class Mission:
         raise RuleViolation("could not find a free id; the id factory keeps repeating itself")
 
     def _require_robots_idle(self, action: str) -> None:
+        held = _HELD_BY_ROBOT
         for skill in self.state.skills():
-            busy = skill.status in (SkillStatus.IDLE_SYNCHRONIZED,) or skill.status.is_active
-            if busy or skill.transfer is not Transfer.NONE:
+            if skill.status in held or skill.transfer is not Transfer.NONE:
                 raise RuleViolation(
                     f"cannot {action} while {skill.agent} holds unfinished skill '{skill.id}'; "
                     "unsynchronize or stop it first"
                 )
+
+
+# What a robot holds: a synchronized skill not finished (waiting, running or paused too).
+_HELD_BY_ROBOT = frozenset({SkillStatus.IDLE_SYNCHRONIZED}) | frozenset(
+    status for status in SkillStatus if status.is_active
+)

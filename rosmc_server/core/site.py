@@ -159,6 +159,19 @@ class SiteGuard:
     def __init__(self) -> None:
         self.site: SiteModel | None = None
         self._said_unchecked = False
+        self._library_checks: tuple[Library, bool] | None = None  # the answer for a library
+
+    def _checks_targets(self, library: Library) -> bool:
+        """Whether any skill of ``library`` has a parameter checked against the site."""
+        if self._library_checks is None or self._library_checks[0] is not library:
+            checks = any(
+                param.check_target is not None
+                for skills in library.models.values()
+                for spec in skills.values()
+                for param in spec.parameters
+            )
+            self._library_checks = (library, checks)
+        return self._library_checks[1]
 
     def update(self, site: SiteModel) -> None:
         """Check targets against ``site`` from now on (skills already added stay as they are)."""
@@ -170,6 +183,8 @@ class SiteGuard:
         Only checked parameters whose value the change sets anew count: editing a label
         never fails for a target that was fine when the site was unknown.
         """
+        if not self._checks_targets(library):  # most libraries check no target
+            return
         checked: dict[tuple[str, str], tuple[ParameterSpec, ...]] = {}  # per agent and skill
         for skill, is_new in _blueprint_skills(state, change):
             kind = (skill.agent, skill.skill)

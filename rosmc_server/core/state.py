@@ -384,7 +384,8 @@ class MissionState:
             self._spread_keys(agent)
             self._agent_of.update(dict.fromkeys(map(_skill_id, task), agent))
             for skill in task:
-                self._bind(skill)
+                if skill.bindings:
+                    self._bind(skill)
                 if skill.transfer is not Transfer.NONE:
                     self._note_transfer(skill)
         for barrier in self._content.barriers.values():

@@ -90,3 +90,23 @@ def test_a_snapshot_after_a_change_serializes_only_the_changed_skills(
     packed.clear()
     assert packer.pack(fresh, 3, 0.0).unpacked() == mission_to_msg(fresh, 3, 0.0)
     assert packed == []
+
+
+def test_a_task_moved_or_made_of_equal_but_new_skills_packs_afresh(library: Library) -> None:
+    content = random_content(library, 600, seed=31)
+    packer = SnapshotPacker()
+    packer.pack(content, 1, 0.0)
+    changed = content.copy()
+    task = changed.tasks["alpha"]
+    task.insert(0, task.pop())  # every skill of the task moves one place
+    assert packer.pack(changed, 2, 0.0).unpacked() == mission_to_msg(changed, 2, 0.0)
+    # A skill equal to the one it replaces but not the same (-0.0 == 0.0) has its own
+    # bytes: a task is reused whole only while it holds the very same instances.
+    zero = replace(task[0], timeout=0.0)
+    task[0] = zero
+    packer.pack(changed, 3, 0.0)
+    task[0] = replace(zero, timeout=-0.0)
+    assert task[0] == zero
+    snapshot = packer.pack(changed, 4, 0.0)
+    assert snapshot.body == SnapshotPacker().body(changed)
+    assert snapshot.unpacked() == mission_to_msg(changed, 4, 0.0)
