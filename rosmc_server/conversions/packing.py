@@ -17,9 +17,11 @@ from __future__ import annotations
 
 import io
 import json
+import operator
 import struct
 import threading
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import genpy
@@ -171,58 +173,122 @@ class PackedGetMissionResponse(srv.GetMissionResponse):  # type: ignore[misc]
         buff.write(_string(self.journal_alert))
 
 
+@dataclass(frozen=True)
+class _PackedTask:
+    """An agent's task as packed: its skills and the bytes of each, in order."""
+
+    skills: list[SkillInstance]
+    parts: list[bytes]
+
+
 class SnapshotPacker:
     """Builds packed mission snapshots, serializing only the skills changed since the last.
 
     Skill instances are frozen and replaced by a new instance on every change, so an
-    instance still in the mission has the bytes it had last time. :meth:`prepare`
-    serializes skills ahead (e.g. a mission about to be loaded, outside the server's
-    lock). Safe to call from several threads at once.
+    instance still in the mission has the bytes it had last time: a task that holds the
+    very instances of last time is reused whole (checked in C, position by position), and
+    a changed task reuses the bytes of each skill still there. :meth:`prepare` serializes
+    a mission ahead (one about to be loaded, outside the server's lock). Safe to call from
+    several threads at once.
     """
 
     def __init__(self) -> None:
-        self._bytes: dict[int, tuple[SkillInstance, bytes]] = {}  # the last snapshot's
-        self._prepared: dict[int, tuple[SkillInstance, bytes]] = {}  # the last prepare's
+        self._tasks: dict[str, _PackedTask] = {}  # the last snapshot's, by agent
+        self._prepared: dict[str, _PackedTask] = {}  # the last prepare's, by agent
         self._names: dict[str, bytes] = {}  # agent, skill and parameter names, encoded
         self._lock = threading.Lock()
 
-    def prepare(self, skills: Iterable[SkillInstance]) -> None:
-        """Serialize ``skills`` now, so that the next snapshot holding them is quick.
+    def prepare(self, content: MissionContent) -> None:
+        """Serialize the skills of ``content`` now, so that the next snapshot holding them
+        is quick.
 
         Kept until the next call (a snapshot built meanwhile of the old mission does not
         drop them).
         """
         names = self._names
-        ready = {id(skill): (skill, skill_bytes(skill, names)) for skill in skills}
+        ready = {
+            agent: _PackedTask(list(task), [skill_bytes(skill, names) for skill in task])
+            for agent, task in content.tasks.items()
+        }
         with self._lock:
             self._prepared = ready
 
     def body(self, content: MissionContent) -> bytes:
         """The wire bytes of a ``rosmc/Mission`` of ``content`` after its revision and stamp."""
         with self._lock:
-            previous, prepared = self._bytes, self._prepared
-        current: dict[int, tuple[SkillInstance, bytes]] = {}
+            previous, prepared = self._tasks, self._prepared
+        tasks: dict[str, _PackedTask] = {}
         parts = [_string(content.library), _COUNT.pack(len(content.tasks))]
         for agent, task in content.tasks.items():
+            sources = [packed for packed in (previous.get(agent), prepared.get(agent)) if packed]
+            packed = next((p for p in sources if _same_instances(p.skills, task)), None)
+            if packed is None:
+                packed = self._pack_task(task, sources)
+            tasks[agent] = packed
             parts += (_string(agent), _COUNT.pack(len(task)))
-            for skill in task:
-                entry = previous.get(id(skill))
-                if entry is None or entry[0] is not skill:  # ids are reused once freed
-                    entry = prepared.get(id(skill))
-                    if entry is None or entry[0] is not skill:
-                        entry = (skill, skill_bytes(skill, self._names))
-                current[id(skill)] = entry
-                parts.append(entry[1])
+            parts += packed.parts
         agent_of = _agents_of_members(content).__getitem__
         parts.append(_array(barrier_to_msg(b, agent_of) for b in content.barriers.values()))
         parts.append(_array(marker_to_msg(m) for m in content.markers.values()))
         with self._lock:
-            self._bytes = current
+            self._tasks = tasks
+            taken = [agent for agent, packed in prepared.items() if tasks.get(agent) is packed]
+            if taken and self._prepared is prepared:
+                # A task this snapshot took over lives on in it; the others wait (a snapshot
+                # of the old mission may come first).
+                self._prepared = {a: p for a, p in prepared.items() if a not in taken}
         return b"".join(parts)
 
     def pack(self, content: MissionContent, revision: int, stamp: float) -> PackedMission:
         """A packed snapshot of ``content`` at ``revision``."""
         return PackedMission(revision, time_to_msg(stamp), self.body(content))
+
+    def _pack_task(self, task: Sequence[SkillInstance], sources: list[_PackedTask]) -> _PackedTask:
+        """``task`` packed, reusing the bytes of each skill ``sources`` hold (packed before).
+
+        A skill is looked for where it was, or one place off (one inserted, deleted or
+        moved before it); only a task that changed in more than a few places (a range
+        deleted, many moves) looks skills up by identity.
+        """
+        nearest = sources[0] if sources else _PackedTask([], [])
+        misses = 0
+        moved: dict[int, tuple[SkillInstance, bytes]] | None = None
+        parts: list[bytes] = []
+        for index, skill in enumerate(task):
+            if index < len(nearest.skills) and nearest.skills[index] is skill:  # most stay put
+                parts.append(nearest.parts[index])
+                continue
+            part = _near(sources, index, skill)
+            if part is None:
+                misses += 1
+                if moved is None and misses > _FEW_MISSES:
+                    moved = {
+                        id(s): (s, data)
+                        for source in sources
+                        for s, data in zip(source.skills, source.parts, strict=True)
+                    }
+                entry = moved.get(id(skill)) if moved else None
+                part = entry[1] if entry is not None and entry[0] is skill else None
+            parts.append(part if part is not None else skill_bytes(skill, self._names))
+        return _PackedTask(list(task), parts)
+
+
+_FEW_MISSES = 8  # skills of a task not found near their place before it looks them up by id
+
+
+def _near(sources: list[_PackedTask], index: int, skill: SkillInstance) -> bytes | None:
+    """The bytes of ``skill`` if a source holds it at ``index`` or one place off."""
+    for source in sources:
+        for at in (index, index + 1, index - 1):
+            if 0 <= at < len(source.skills) and source.skills[at] is skill:
+                return source.parts[at]
+    return None
+
+
+def _same_instances(old: list[SkillInstance], new: Sequence[SkillInstance]) -> bool:
+    """Whether ``new`` holds the very instances of ``old``, in order (not merely equal ones:
+    ``-0.0 == 0.0``, but their bytes differ)."""
+    return len(old) == len(new) and all(map(operator.is_, old, new))
 
 
 def _agents_of_members(content: MissionContent) -> dict[str, str]:

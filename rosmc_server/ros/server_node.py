@@ -49,7 +49,7 @@ import logging
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Sequence
 from contextlib import AbstractContextManager
 from dataclasses import dataclass
 from pathlib import Path
@@ -71,7 +71,6 @@ from ..core import (
     Mission,
     MissionContent,
     MissionEvent,
-    SkillInstance,
     Unavailable,
     load_library,
 )
@@ -279,9 +278,9 @@ class MissionServer:
         assert built is not None
         return PackedMission(built.revision, time_to_msg(rospy.get_time()), built.body)
 
-    def prepare_snapshot(self, skills: Iterable[SkillInstance]) -> None:
-        """Serialize skills about to enter the mission (e.g. a load), outside the lock."""
-        self._packer.prepare(skills)
+    def prepare_snapshot(self, content: MissionContent) -> None:
+        """Serialize a mission about to replace this one (a load), outside the lock."""
+        self._packer.prepare(content)
 
     # -- journal -------------------------------------------------------------------
     def _open_journal(self) -> tuple[Mission, JournalWriter]:

@@ -106,8 +106,7 @@ class WholeMissionServices:
             read = time.perf_counter()
             # Serialized now, outside the server lock: the new mission's journal snapshot,
             # written before the load is acknowledged, then only joins the bytes.
-            skills = [s for task in content.tasks.values() for s in task]
-            self._server.prepare_snapshot(skills)
+            self._server.prepare_snapshot(content)
         serialized = time.perf_counter()
         event = self._server.apply(
             lambda m: m.load(content, source, base_revision=req.base_revision)
@@ -116,8 +115,8 @@ class WholeMissionServices:
         _log.info(
             "loaded %d skills from %s: read and checked in %.0f ms, serialized in %.0f ms, "
             "applied and journaled in %.0f ms",
-            len(skills), source, 1000 * (read - started), 1000 * (serialized - read),
-            1000 * (time.perf_counter() - serialized),
+            sum(map(len, content.tasks.values())), source, 1000 * (read - started),
+            1000 * (serialized - read), 1000 * (time.perf_counter() - serialized),
         )  # fmt: skip
         # The loaded mission lives until it is replaced and is then freed by reference
         # counting; kept out of the collector's way, it does not lengthen every later

@@ -85,7 +85,7 @@ def test_a_snapshot_after_a_change_serializes_only_the_changed_skills(
     # Skills serialized ahead (a mission about to be loaded) are not serialized again, even
     # after a snapshot of the old mission was built in between.
     fresh = random_content(library, 300, seed=24)
-    packer.prepare(s for task in fresh.tasks.values() for s in task)
+    packer.prepare(fresh)
     packer.pack(changed, 2, 6.0)
     packed.clear()
     assert packer.pack(fresh, 3, 0.0).unpacked() == mission_to_msg(fresh, 3, 0.0)
