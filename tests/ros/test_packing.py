@@ -110,3 +110,31 @@ def test_a_task_moved_or_made_of_equal_but_new_skills_packs_afresh(library: Libr
     snapshot = packer.pack(changed, 4, 0.0)
     assert snapshot.body == SnapshotPacker().body(changed)
     assert snapshot.unpacked() == mission_to_msg(changed, 4, 0.0)
+
+
+def test_skills_shifted_far_keep_their_bytes(
+    library: Library, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    content = random_content(library, 900, seed=37)
+    packer = SnapshotPacker()
+    packer.pack(content, 1, 0.0)
+    packed: list[str] = []
+    real = packing.skill_bytes
+
+    def counting(skill: Any, names: Any = None) -> bytes:
+        packed.append(skill.id)
+        return real(skill, names)
+
+    monkeypatch.setattr(packing, "skill_bytes", counting)
+    changed = content.copy()
+    task = changed.tasks["bravo"]
+    del task[10:60]  # every later skill moves 50 places
+    task[3] = replace(task[3], label="edited")
+    first = task.pop(0)
+    task.insert(len(task) // 2, first)  # one moved far
+    snapshot = packer.pack(changed, 2, 0.0)
+    # The edited one (now third, after the move), and the few skills packed afresh before
+    # the packer sees that the task changed in more than a few places.
+    assert task[2].id in packed
+    assert len(packed) <= 1 + packing._FEW_MISSES
+    assert snapshot.body == SnapshotPacker().body(changed)
