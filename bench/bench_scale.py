@@ -262,7 +262,7 @@ def run_size(
                 bench.reorders()
                 time.sleep(0.5)  # the last events arrive
                 result["event_bytes"] = bench.event_bytes(bench.kind_names())
-                result["whole_bytes"] = bench.whole(document, 3 if total >= 5000 else 5)
+                result["whole_bytes"] = bench.whole(document, 5)
                 result["latency"] = {n: percentiles(t) for n, t in bench.times.items()}
             result["spaced_edit"] = bench.spaced_edits(spaced)
             result["server_peak_rss_mib"] = server.peak_rss_mib()
