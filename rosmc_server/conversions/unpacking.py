@@ -242,6 +242,13 @@ def _read_params(data: bytes, pos: int) -> tuple[dict[str, Any], dict[str, str],
                 params[name] = bool(fixed[1])
             pos += 78
             size = fixed[12]
+        elif type_number == _STRING and name and not _COUNT(data, pos + 22 + fixed[4])[0]:
+            # Text (its length where the fixed form has string_value's) and no JSON: the
+            # text, then the unused JSON, pose and the marker's length.
+            end = pos + 22 + fixed[4]
+            params[name] = data[pos + 22 : end].decode("utf-8", "rosmsg")
+            pos = end + 56
+            size = _COUNT(data, pos - 4)[0]
         else:
             params[name], pos = _read_param_value(data, pos, name)
             size = _COUNT(data, pos)[0]
@@ -339,6 +346,7 @@ _RESOLUTION: Mapping[int, Resolution] = {int(r): r for r in Resolution}
 _MARKER_TYPES: Mapping[int, MarkerType] = {int(m): m for m in MarkerType}
 _PARAM_TYPES: Mapping[int, ParamType] = {int(t): t for t in ParamType}
 _FLOAT, _POSE_TYPE, _INT = int(ParamType.FLOAT), int(ParamType.POSE), int(ParamType.INT)
+_STRING = int(ParamType.STRING)
 _FIXED_TYPES = frozenset({_FLOAT, _POSE_TYPE, _INT, int(ParamType.BOOL)})  # no text, no JSON
 _assemble_skill = SkillInstance.assemble
 _assemble_pose = Pose.assemble
