@@ -172,3 +172,24 @@ def test_a_huge_count_fails_quickly_as_malformed() -> None:
     data[count_at : count_at + 4] = struct.pack("<I", 2**32 - 1)
     with pytest.raises(genpy.DeserializationError):
         mission_from_bytes(bytes(data))
+
+
+@pytest.mark.parametrize(
+    "param",
+    [
+        wire.ParameterValue(name="s", type=3, string_value="abc"),
+        wire.ParameterValue(name="s", type=3, string_value=""),
+        wire.ParameterValue(name="s", type=3, string_value="abc", marker="m1"),
+        wire.ParameterValue(name="s", type=3, string_value="é", json_value="[1]"),
+        wire.ParameterValue(name="s", type=3, json_value="[1]", marker="m1"),
+        wire.ParameterValue(name="f", type=2, float_value=0.5, string_value="x"),
+    ],
+    ids=["text", "empty", "bound", "text-and-json", "json-only", "float-beside-text"],
+)
+def test_text_parameters_in_any_form_read_as_the_conversion_reads_them(
+    param: wire.ParameterValue,
+) -> None:
+    data = one_skill_mission(parameters=[param, wire.ParameterValue(name="g", type=2)])
+    read, _, end = mission_from_bytes(data)
+    assert (read, 3) == genpy_read(data)
+    assert end == len(data)
