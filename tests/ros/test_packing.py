@@ -61,12 +61,8 @@ def test_a_snapshot_packs_as_genpy_serializes_it(library: Library) -> None:
     assert "revision 77" in str(packed)
 
 
-def test_a_snapshot_after_a_change_serializes_only_the_changed_skills(
-    library: Library, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    content = random_content(library, 3000, seed=23)
-    packer = SnapshotPacker()
-    packer.pack(content, 1, 0.0)
+def count_packed(monkeypatch: pytest.MonkeyPatch) -> list[str]:
+    """The ids of the skills serialized from now on, in order."""
     packed: list[str] = []
     real = packing.skill_bytes
 
@@ -75,6 +71,16 @@ def test_a_snapshot_after_a_change_serializes_only_the_changed_skills(
         return real(skill, names)
 
     monkeypatch.setattr(packing, "skill_bytes", counting)
+    return packed
+
+
+def test_a_snapshot_after_a_change_serializes_only_the_changed_skills(
+    library: Library, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    content = random_content(library, 3000, seed=23)
+    packer = SnapshotPacker()
+    packer.pack(content, 1, 0.0)
+    packed = count_packed(monkeypatch)
     changed = content.copy()
     old = changed.tasks["charlie"][5]
     changed.tasks["charlie"][5] = replace(old, label="renamed")
@@ -118,14 +124,7 @@ def test_skills_shifted_far_keep_their_bytes(
     content = random_content(library, 900, seed=37)
     packer = SnapshotPacker()
     packer.pack(content, 1, 0.0)
-    packed: list[str] = []
-    real = packing.skill_bytes
-
-    def counting(skill: Any, names: Any = None) -> bytes:
-        packed.append(skill.id)
-        return real(skill, names)
-
-    monkeypatch.setattr(packing, "skill_bytes", counting)
+    packed = count_packed(monkeypatch)
     changed = content.copy()
     task = changed.tasks["bravo"]
     del task[10:60]  # every later skill moves 50 places
