@@ -61,8 +61,9 @@ class Pose:
 
         A frozen dataclass's constructor sets each field through ``object.__setattr__``;
         filling the instance's dict directly is about twice as fast, which counts where
-        thousands of poses are read at once (mission files, snapshots). A test checks that
-        both build equal poses with every field.
+        thousands of poses are read at once (mission files, snapshots), for about 64 bytes
+        more per pose (the dict becomes an object of its own). A test checks that both
+        build equal poses with every field.
         """
         made = _new_object(cls)
         fields = made.__dict__
