@@ -32,7 +32,7 @@ import yaml
 
 from .documents import SafeDumper
 from .model import Barrier, Resolution, SkillInstance, SkillStatus, TaskMarker, Transfer
-from .params import Pose
+from .params import value_to_data
 from .state import MissionContent
 
 MISSION_VERSION = 1
@@ -84,10 +84,7 @@ def skill_to_dict(skill: SkillInstance) -> dict[str, Any]:
         "id": skill.id,
         "skill": skill.skill,
         "label": skill.label,
-        "params": {
-            name: value.to_dict() if type(value) is Pose else value
-            for name, value in skill.params.items()
-        },
+        "params": {name: value_to_data(value) for name, value in skill.params.items()},
         "status": _STATUS_NAMES[skill.status],
     }
     if skill.bindings:
