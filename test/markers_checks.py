@@ -53,13 +53,13 @@ class MarkerNodeChecks(unittest.TestCase):
 
     def test_a_task_marker_added_on_the_server_appears(self) -> None:
         wait_for("the update subscription", lambda: self.updates.get_num_connections() > 0)
+        with self.lock:  # before the add: its update may arrive before add_marker returns
+            self.names.clear()
         with MissionClient(timeout=30.0) as client:
             client.get_mission()
             added = client.add_marker(
                 TaskMarker("rostest_flag", MarkerType.POSITION, Pose(3.0, -2.0, 0.0))
             )
-        with self.lock:
-            self.names.clear()
         wait_for("the new task marker", lambda: self._seen(task_name(added.name)))
 
     def _seen(self, name: str) -> bool:

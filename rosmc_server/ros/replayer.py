@@ -44,7 +44,6 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
-import rosgraph
 import rosmc.srv as wire_srv
 import rospy
 
@@ -54,7 +53,8 @@ from ..core import EventKind, InvalidRequest, MissionEvent, NotFound, RosmcError
 from ..recording import JournalRecord
 from ..recording.history import MissionHistory
 from ..recording.playback import PlaybackClock, PlaybackStatus, Playlist
-from .client import ServerUnavailable, init_node
+from .client import init_node
+from .client.graph_names import taken_names
 from .replay_control import ReplayControl
 from .replay_output import TYPES, ReplayOutput
 
@@ -101,26 +101,6 @@ class ReplayConfig:
     def topic(self, name: str) -> str:
         """A recorded topic's name in this replay."""
         return interface.prefixed(name, self.prefix)
-
-
-def taken_names(names: Sequence[str], caller_id: str = "/rosmc_replay") -> dict[str, list[str]]:
-    """The nodes publishing each of the topics, or serving each of the services, in ``names``.
-
-    Names nobody uses are left out.
-
-    Raises:
-        ServerUnavailable: The ROS master does not answer.
-    """
-    try:
-        publishers, _, services = rosgraph.Master(caller_id).getSystemState()
-    except (OSError, rosgraph.MasterException) as err:
-        raise ServerUnavailable(
-            f"no ROS master answers at {rosgraph.get_master_uri()} ({err}); start roscore first"
-        ) from err
-    wanted = set(names)
-    return {
-        name: sorted(nodes) for name, nodes in [*publishers, *services] if name in wanted and nodes
-    }
 
 
 class RecordingReplayer:

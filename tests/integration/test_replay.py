@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+import rosgraph
 import rosmc.msg as wire
 import rospy
 from geometry_msgs.msg import TransformStamped
@@ -28,6 +29,8 @@ from rosmc_server.core import Mission, Pose, TaskMarker, load_library
 from rosmc_server.core.params import MarkerType
 from rosmc_server.interface import MAP_FRAME, SCIENCE_TOPIC, TF_TOPIC, WORLD_TOPIC, base_link
 from rosmc_server.recording import JournalWriter
+from rosmc_server.ros.client.graph_names import taken_names
+from tests.conftest import free_port
 
 REPO = Path(__file__).resolve().parents[2]
 ROSMC = REPO / "scripts" / "rosmc"
@@ -194,6 +197,24 @@ def test_replay_refuses_live_names_but_plays_under_a_prefix(
         assert listener.events == list(range(1, EVENTS + 1))
     finally:
         live.unregister()
+
+
+def test_a_dead_nodes_registrations_do_not_block_a_replay(
+    node: Any, journal: Path, listen: Callable[[str], Listener]
+) -> None:
+    # What a mission server killed with -9 leaves behind: the master still lists it.
+    ghost = rosgraph.Master("/ghost_mission_server")
+    nobody = f"http://127.0.0.1:{free_port()}/"
+    ghost.registerPublisher("/rosmc/mission_events", "rosmc/MissionEvent", nobody)
+    try:
+        assert "/ghost_mission_server" in publishers(node, "/rosmc/mission_events")
+        assert taken_names(["/rosmc/mission_events"]) == {}
+        listener = listen("")
+        done = replay(node.env, str(journal), "--rate", "50")
+        assert done.returncode == 0, done.stderr
+        assert listener.wait(lambda: EVENTS in listener.snapshots)
+    finally:
+        ghost.unregisterPublisher("/rosmc/mission_events", nobody)
 
 
 def test_rosmc_watch_follows_a_replay(node: Any, journal: Path, launch_process: Any) -> None:
