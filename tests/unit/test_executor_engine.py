@@ -650,7 +650,7 @@ def test_a_barrier_added_to_a_waiting_skill_changes_whom_it_waits_for(robot: Rob
     wider = BarrierInfo("B", (("a", "r1"), ("x", "r2"), ("y", "r3")))
     robot.engine.hear(Signal("r2", "B", "x", SignalKind.WITHDRAWN, 0.0))
     robot.send(K.BARRIERS, barriers=(wider,))
-    assert robot.skill("a").status_text == "waiting for r2, r3"
+    assert robot.skill("a").status_text == "waiting on r2, r3 at B"
 
 
 def test_deleting_the_barrier_of_a_skill_paused_at_it_does_not_run_it(robot: Robot) -> None:
@@ -791,8 +791,8 @@ def test_the_first_robot_waits_at_the_barrier_until_the_peer_arrives(pair: Team)
     pair.tick(1.0)
     r1 = pair["r1"]
     assert r1.status("b1") is S.SYNCWAITING
-    assert r1.skill("b1").status_text == "waiting for r2"
-    assert r1.engine.snapshot().waiting_on == "r2"
+    assert r1.skill("b1").status_text == "waiting on r2 at B"
+    assert r1.engine.snapshot().waiting_on == "r2 at B"
     assert r1.engine.state_name() == "waiting"
     pair.tick(1.9)
     assert r1.status("b1") is S.SYNCWAITING
@@ -832,7 +832,7 @@ def test_released_lets_a_robot_start_that_missed_the_others_ready() -> None:
     robot.upload(make_skill("x3", agent="r3"), barriers=(barrier,))
     robot.send(K.START)
     robot.engine.hear(Signal("r1", "B", "x1", SignalKind.READY, 0.0))
-    assert robot.engine.snapshot().waiting_on == "r2"
+    assert robot.engine.snapshot().waiting_on == "r2 at B; r1 at B (arrived, not yet confirmed)"
     # r1 heard r2 (this robot did not) and started: everybody was ready.
     robot.engine.hear(Signal("r1", "B", "x1", SignalKind.RELEASED, 0.0))
     assert robot.status("x3") is S.RUNNING
@@ -846,7 +846,9 @@ def test_three_robots_release_together() -> None:
     team["r1"].send(K.START)
     team["r2"].send(K.START)
     team.deliver()
-    assert team["r1"].engine.snapshot().waiting_on == "r3"
+    assert team["r1"].engine.snapshot().waiting_on == (
+        "r3 at B; r2 at B (arrived, not yet confirmed)"
+    )
     team["r3"].send(K.START)
     team.deliver()
     assert [team[a].status(f"x{a[1]}") for a in ("r1", "r2", "r3")] == [S.RUNNING] * 3
@@ -864,7 +866,7 @@ def test_peers_arriving_one_by_one_cost_no_reports() -> None:
         team.deliver()
     first = team["r1"]
     assert [(r.status, r.status_text) for r in first.out.reports] == [
-        (S.SYNCWAITING, "waiting for r2, r3, r4, r5, r6"),
+        (S.SYNCWAITING, "waiting on r2, r3, r4, r5, r6 at B"),
         (S.RUNNING, ""),
     ]
     assert all(team[a].status(f"x{a}") is S.RUNNING for a in agents)
@@ -898,7 +900,7 @@ def test_withdrawal_keeps_the_peer_waiting(pair: Team) -> None:
     r2.send(K.START)
     pair.tick(3.0)
     assert r2.status("b2") is S.SYNCWAITING  # r1 withdrew: no release
-    assert r2.skill("b2").status_text == "waiting for r1"
+    assert r2.skill("b2").status_text == "waiting on r1 at B"
     pair.tick(2.0)
     assert r1.status("b1") is S.PAUSED  # paused robots do not re-announce or release
     assert r2.status("b2") is S.SYNCWAITING
@@ -1017,7 +1019,7 @@ def test_a_retried_member_rejoins_and_starts_with_the_waiting_partner(
     r2.send(K.START)
     team.tick(3.5)  # r1 gave up at 2 s; r2 reached b2 at 3 s and waits for r1
     assert r1.status("b1") is S.FAILURE
-    assert r2.status("b2") is S.SYNCWAITING and r2.skill("b2").status_text == "waiting for r1"
+    assert r2.status("b2") is S.SYNCWAITING and r2.skill("b2").status_text == "waiting on r1 at B"
     retry_b1(team, barriers_first)
     assert r1.status("b1x") is S.RUNNING and r2.status("b2") is S.RUNNING
     assert r1.skill("b1x").started == r2.skill("b2").started
@@ -1034,9 +1036,11 @@ def test_a_retry_after_the_release_runs_alone() -> None:
     r2.upload(make_skill("b2", agent="r2"), barriers=(barrier,))
     r2.send(K.START)
     team.deliver()
-    r1.send(K.START)  # r2 is ready: r1 releases the barrier itself
-    team.deliver(lose=frozenset({"r2"}))  # and never hears r2's RELEASED
-    assert r1.status("b1") is S.RUNNING and r2.status("b2") is S.RUNNING
+    r1.send(K.START)  # r2 is ready: r1 confirms, r2 starts on it
+    team.deliver(lose=frozenset({"r2"}))  # r1 never hears r2's CONFIRMED or RELEASED
+    assert r1.status("b1") is S.SYNCWAITING and r2.status("b2") is S.RUNNING
+    team.tick(0.5)  # r1's next CONFIRMED reaches r2, which answers RELEASED
+    assert r1.status("b1") is S.RUNNING
     team.tick(1.0)
     assert r1.status("b1") is S.FAILURE and r2.status("b2") is S.SUCCESS
     signals = len(r1.out.signals)
@@ -1187,7 +1191,7 @@ def test_state_round_trip_keeps_queue_reports_answers_barriers_and_policy(
     assert engine.queue[2] == robot.engine.queue[2]
     assert engine.lost_link.policy == robot.engine.lost_link.policy
     assert engine.board.barriers == robot.engine.board.barriers
-    assert engine.board.missing(barrier_of(("c", "r1"), ("y", "r2")), 0.0) == ()  # RELEASED kept
+    assert engine.board.may_start(barrier_of(("c", "r1"), ("y", "r2")), 0.0)  # RELEASED kept
     assert engine.last_command_seq == robot.engine.last_command_seq
     assert engine.acks == robot.engine.acks
     assert engine.mode is Mode.STOPPED  # a restarted robot waits for the operator
@@ -1262,7 +1266,7 @@ def test_a_ready_that_is_not_repeated_expires(pair: Team) -> None:
     del pair.robots["r1"]  # killed: no WITHDRAWN, no more READY
     pair.tick(2.5)
     assert r2.status("b2") is S.SYNCWAITING
-    assert r2.skill("b2").status_text == "waiting for r1"
+    assert r2.skill("b2").status_text == "waiting on r1 at B"
 
 
 def test_a_restarted_robot_hears_readiness_afresh(pair: Team, tmp_path: Path) -> None:

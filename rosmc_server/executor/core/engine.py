@@ -29,7 +29,7 @@ from .skills import Outcome, SkillBehavior, SkillContext, SkillType
 
 _log = logging.getLogger(__name__)
 S = SkillStatus
-ANNOUNCE_PERIOD = 0.5  # seconds between READY re-announcements while waiting
+ANNOUNCE_PERIOD = 0.5  # seconds between re-announcements (READY or CONFIRMED) while waiting
 KEPT_ACKS = 256
 
 
@@ -58,6 +58,8 @@ class _Active:
     paused_at: float = 0.0
     retries_used: int = 0
     last_announce: float = 0.0
+    announced: SignalKind | None = None  # what the robot last told its peers
+    last_confirmed: float = float("-inf")  # when it last said CONFIRMED
 
 
 class Engine:
@@ -126,8 +128,12 @@ class Engine:
 
     # -- peers and the ground -------------------------------------------------------------
     def hear(self, signal: Signal) -> None:
-        """A peer's barrier signal."""
-        self.board.hear(signal, self.clock())
+        """A peer's barrier signal: answered if this robot started there, else weighed."""
+        now = self.clock()
+        self.board.hear(signal, now)
+        answer = self.board.reply(signal, now)
+        if answer is not None:
+            self.outputs.signal(answer)
         active = self._active
         if active is not None and active.barrier is not None and active.behavior is None:
             self._try_release(active)
@@ -162,10 +168,10 @@ class Engine:
         if active.behavior is not None and self._status(active.skill_id) is S.RUNNING:
             self._update_running(active, now)
         elif self._status(active.skill_id) is S.SYNCWAITING:
-            if active.deadline and now >= active.deadline:
+            if active.deadline and now >= active.deadline and self._may_give_up(active, now):
                 self._give_up_waiting(active)
             elif now - active.last_announce >= ANNOUNCE_PERIOD:
-                self._announce(active, SignalKind.READY)
+                self._announce_wait(active)
 
     def _update_running(self, active: _Active, now: float) -> None:
         assert active.behavior is not None
@@ -229,7 +235,7 @@ class Engine:
         if upcoming.timeout > 0:  # the timeout bounds the wait too: partners may never come
             active.deadline = self.clock() + upcoming.timeout
         self._set(upcoming.id, S.SYNCWAITING, text=self._waiting_text(active.barrier))
-        self._announce(active, SignalKind.READY)
+        self._announce_wait(active)
         self._try_release(active)
 
     def _try_release(self, active: _Active) -> None:
@@ -240,13 +246,25 @@ class Engine:
             if active.behavior is None:
                 self._run(active)
             return
-        if self.board.missing(barrier, self.clock()):
+        now = self.clock()
+        if not self.board.may_start(barrier, now):
             # Still waiting. Who for is in the snapshot (waiting_on); a report per peer
             # arrival would cost n^2 reports over the ground link for an n-robot barrier.
+            # A change of what to tell the peers goes out at once, not at the next round.
+            if self.board.announcement(barrier, now) is not active.announced:
+                self._announce_wait(active)
             return
-        self.board.released(barrier.id)
+        self.board.released(barrier.id, active.skill_id)
         self._announce(active, SignalKind.RELEASED)
         self._run(active)
+
+    def _may_give_up(self, active: _Active, now: float) -> bool:
+        """Whether the wait may time out: not while a partner may count this robot confirmed.
+
+        A partner holding a CONFIRMED of this robot (for up to a lease) may start on it;
+        failing now would leave that partner running alone.
+        """
+        return now - active.last_confirmed > self.board.lease
 
     def _give_up_waiting(self, active: _Active) -> None:
         """The wait at the barrier outlasted the skill's timeout: it fails, partners are told.
@@ -257,7 +275,7 @@ class Engine:
         """
         skill = self._find(active.skill_id)
         assert skill is not None and active.barrier is not None
-        missing = ", ".join(self.board.missing(active.barrier, self.clock()))
+        missing = ", ".join(self.board.waiting_on(active.barrier, self.clock()))
         self._announce(active, SignalKind.WITHDRAWN)
         self._active = None
         text = f"timed out after {skill.timeout:g} s waiting at barrier '{active.barrier.id}'"
@@ -265,14 +283,21 @@ class Engine:
                   finished=self.clock())  # fmt: skip
 
     def _waiting_text(self, barrier: BarrierInfo) -> str:
-        missing = self.board.missing(barrier, self.clock())
-        return f"waiting for {', '.join(missing)}" if missing else ""
+        return self.board.waiting_text(barrier, self.clock())
+
+    def _announce_wait(self, active: _Active) -> None:
+        """Tell the peers this robot waits: READY, or CONFIRMED once all have arrived."""
+        if active.barrier is not None:
+            self._announce(active, self.board.announcement(active.barrier, self.clock()))
 
     def _announce(self, active: _Active, kind: SignalKind) -> None:
         if active.barrier is None:
             return
         now = self.clock()
         active.last_announce = now
+        active.announced = kind
+        if kind is SignalKind.CONFIRMED:
+            active.last_confirmed = now
         self.outputs.signal(Signal(self.agent, active.barrier.id, active.skill_id, kind, now))
 
     def _run(self, active: _Active) -> None:
@@ -354,7 +379,7 @@ class Engine:
             if active.barrier is not None:
                 # Back to waiting at the barrier, not to PAUSED (and not straight to running).
                 self._set(active.skill_id, S.SYNCWAITING, text=self._waiting_text(active.barrier))
-                self._announce(active, SignalKind.READY)
+                self._announce_wait(active)
             self._try_release(active)  # runs it if its barrier went away meanwhile
         active.paused_from = None
 
@@ -451,7 +476,7 @@ class Engine:
         active = self._active
         waiting = ""
         if active is not None and active.barrier is not None and active.behavior is None:
-            waiting = ", ".join(self.board.missing(active.barrier, self.clock()))
+            waiting = self.board.waiting_summary(active.barrier, self.clock())
         return Snapshot(
             self.clock(),
             self.last_command_seq,

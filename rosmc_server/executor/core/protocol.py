@@ -78,6 +78,7 @@ class SignalKind(enum.IntEnum):
     READY = 0
     WITHDRAWN = 1
     RELEASED = 2
+    CONFIRMED = 3
 
 
 @dataclass(frozen=True)
