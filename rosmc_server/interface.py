@@ -98,7 +98,9 @@ SELECTION_TOPIC = f"{NAMESPACE}/selection"
 
 
 # Robot-to-robot barrier coordination (never through the ground station).
-BARRIER_TOPIC = f"{NAMESPACE}/barriers"  # rosmc/BarrierSignal
+BARRIER_TOPIC = f"{NAMESPACE}/barriers"  # rosmc/BarrierSignal, for observers
+# Parameter namespace of the radio side channel: <name> -> "host:port" (ros/radio.py).
+RADIO_DIRECTORY = f"{NAMESPACE}/radio"
 
 
 @dataclass(frozen=True)

@@ -50,6 +50,7 @@ class Outgoing(Generic[Payload]):
     attempts: int = 0
     first_sent: float = 0.0
     next_send: float = 0.0
+    backoff: int = 0  # retransmissions since the last contact: the next delay doubles
 
 
 @dataclass(frozen=True)
@@ -124,11 +125,22 @@ class Outbox(Generic[Payload]):
                 self._last_seq += 1
                 item.seq = self._last_seq
                 item.first_sent = now
-            delay = min(self.max_retry, self.first_retry * 2**item.attempts)
+            delay = min(self.max_retry, self.first_retry * 2**item.backoff)
             item.attempts += 1
+            item.backoff += 1
             item.next_send = now + delay
             out.append(item)
         return out
+
+    def contact_returned(self, now: float) -> None:
+        """The robot is back after a silence: retransmit at once, backing off from the start.
+
+        The backoff grew while nothing could arrive; keeping it would hold the commands
+        back for up to ``max_retry`` after contact returned.
+        """
+        for item in self._pending:
+            item.backoff = 0
+            item.next_send = min(item.next_send, now)
 
     def acknowledge(self, seq: int, now: float) -> Outgoing[Payload] | None:
         """The robot acknowledged command ``seq``; returns it the first time, else None.

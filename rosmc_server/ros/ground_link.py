@@ -4,7 +4,10 @@ Per dynamic agent, on the topics of :func:`rosmc_server.interface.ground_link`:
 
 * publishes ``command`` (rosmc/RobotCommand) and ``report_ack`` (rosmc/ReportAck);
 * subscribes ``ack`` (rosmc/RobotAck), ``report`` (rosmc/RobotReport) and
-  ``snapshot`` (rosmc/ExecutorSnapshot).
+  ``snapshot`` (rosmc/ExecutorSnapshot);
+* beacons to each robot over the radio side channel (UDP, :mod:`.radio`, registered as
+  ``/rosmc/radio/ground``); a robot's beacon after a silence reconnects its topics and
+  retransmits its pending commands at once, whatever TCP's backoff has grown to.
 
 Commands are retransmitted with backoff until acknowledged; reports are
 applied once each and in order; the robot's periodic snapshot re-synchronizes
@@ -30,9 +33,11 @@ from ..conversions import barrier_to_msg, skill_to_msg, time_to_msg
 from ..core import Barrier, Mission, MissionEvent, RosmcError, SkillStatus, Transfer
 from ..core.commands import CommandKind, CommandSpec, queued_barriers, repair_command, synced_ids
 from ..core.link import Arrival, InboundSequence, LinkReport, LinkStatus, Outbox, queue_hash
+from ..core.radio import BEACON_PERIOD, ContactWatch
 from ..core.reconcile import RobotSkill
 from ..interface import ground_link
 from .command_queue import collapse
+from .radio import GROUND, Radio, TopicListener, reconnect_in_background
 
 _log = logging.getLogger(__name__)
 
@@ -70,7 +75,7 @@ class AgentLink:
     barriers_sent: tuple[Barrier, ...] = ()
     newest_stamp: float = 0.0  # robot clock of the newest message heard from it
     last_error: str = ""
-    subscribers: list[rospy.Subscriber] = field(default_factory=list)
+    listeners: list[TopicListener] = field(default_factory=list)
 
 
 class GroundLink:
@@ -87,7 +92,8 @@ class GroundLink:
         self._clock = clock
         self._started = clock()
         self._links: dict[str, AgentLink] = {}
-        self._next_heartbeat = 0.0
+        self._next_heartbeat = self._next_beacon = 0.0
+        self._contact = ContactWatch()
         for agent in agents:
             topics = ground_link(agent)
             link = AgentLink(
@@ -101,11 +107,12 @@ class GroundLink:
                 (topics.report, wire.RobotReport, self._on_report),
                 (topics.snapshot, wire.ExecutorSnapshot, self._on_snapshot),
             )
-            link.subscribers = [
-                rospy.Subscriber(topic, msg_type, self._guarded(handler, agent), queue_size=100)
+            link.listeners = [
+                TopicListener(topic, msg_type, self._guarded(handler, agent), queue_size=100)
                 for topic, msg_type, handler in handlers
             ]
             self._links[agent] = link
+        self.radio = Radio(GROUND, self._on_beacon)
 
     @property
     def _mission(self) -> Mission:
@@ -157,7 +164,12 @@ class GroundLink:
         heartbeat = now >= self._next_heartbeat
         if heartbeat:
             self._next_heartbeat = now + HEARTBEAT_PERIOD
+        beacon = now >= self._next_beacon
+        if beacon:
+            self._next_beacon = now + BEACON_PERIOD
         for link in self._links.values():
+            if beacon:
+                self.radio.beacon(link.agent)
             self._transmit(link)
             if heartbeat and link.reports is not None:
                 # Robots judge ground contact by what they hear; this keeps a quiet
@@ -184,6 +196,17 @@ class GroundLink:
             link.command_pub.publish(item.payload)
 
     # -- receiving -----------------------------------------------------------
+    def _on_beacon(self, sender: str) -> None:
+        link = self._links.get(sender)
+        if link is None or not self._contact.heard(sender, self._clock()):
+            return
+        # The robot is back after a silence. Its stalled connections would resume only
+        # at TCP's next retransmission, which backs off to minutes: connect afresh.
+        reconnect_in_background(link.listeners, f"the ground hears {sender} again")
+        with self._host.locked():
+            link.outbox.contact_returned(self._clock())
+            self._transmit(link)
+
     def _guarded(
         self, handler: Callable[[str, object], None], agent: str
     ) -> Callable[[object], None]:

@@ -17,12 +17,14 @@ from __future__ import annotations
 import contextlib
 import os
 import signal
+import socket
 import subprocess
 import sys
 import threading
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from io import BytesIO
 from pathlib import Path
 from typing import Any
 
@@ -36,6 +38,7 @@ from rosmc_server import interface
 from rosmc_server.conversions import mission_from_msg, param_to_msg, skill_to_msg
 from rosmc_server.core import MissionState, SkillInstance, SkillStatus
 from rosmc_server.core.commands import CommandKind
+from rosmc_server.core.radio import DatagramKind, encode_datagram, parse_endpoint
 from rosmc_server.recording import read_journal
 from tests.conftest import wait_until
 
@@ -353,6 +356,23 @@ def command_msg(
         barriers=list(barriers),
         argument=argument,
     )
+
+
+def signal_datagram(msg: wire.BarrierSignal) -> bytes:
+    """A barrier signal as the radio side channel carries it."""
+    buffer = BytesIO()
+    msg.serialize(buffer)
+    return encode_datagram(DatagramKind.BARRIER_SIGNAL, buffer.getvalue())
+
+
+def send_datagrams(name: str, *datagrams: bytes) -> None:
+    """Send raw datagrams to ``name``'s radio endpoint, read from the directory."""
+    key = f"{interface.RADIO_DIRECTORY}/{name}"
+    endpoint = wait_until(lambda: rospy.get_param(key, ""), 10.0, f"{name}'s radio endpoint")
+    host, port = parse_endpoint(endpoint)
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as udp:
+        for datagram in datagrams:
+            udp.sendto(datagram, (host, port))
 
 
 def describe(state: MissionState) -> str:

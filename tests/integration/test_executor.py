@@ -48,6 +48,8 @@ from tests.integration.executor_fixtures import (
     journal_reports,
     journal_timelines,
     running_stamps,
+    send_datagrams,
+    signal_datagram,
 )
 
 pytestmark = pytest.mark.integration
@@ -659,9 +661,9 @@ def test_bad_commands_over_the_link_are_refused_clearly(rosmc: Start) -> None:
     # Messages for other robots are none of this robot's business.
     ground.publish("command", command_msg("r2", 8, K.UPLOAD, skills=[wait_skill("x", "r2")]))
     ground.publish("report_ack", wire.ReportAck(agent="r2", seq=1000))
-    barriers = rospy.Publisher(interface.BARRIER_TOPIC, wire.BarrierSignal, queue_size=10)
-    wait_until(lambda: barriers.get_num_connections() > 0, 10.0, "the barrier topic")
-    barriers.publish(wire.BarrierSignal(agent="r9", barrier_id="B", skill_id="x", kind=9))
+    # Nor are stray datagrams on its radio: an unknown signal kind, garbage, a cut-off one.
+    stray = wire.BarrierSignal(agent="r9", barrier_id="B", skill_id="x", kind=9)
+    send_datagrams("r1", signal_datagram(stray), b"garbage", signal_datagram(stray)[:-3])
 
     last = send(8, K.UPLOAD, skills=[wait_skill("w8")])
     assert last.result == wire.RobotAck.ACCEPTED
@@ -670,7 +672,6 @@ def test_bad_commands_over_the_link_are_refused_clearly(rosmc: Start) -> None:
     snapshot = ground.wait_heard("snapshot", lambda s: s.last_command_seq == 8)
     assert [s.id for s in snapshot.queue] == ["w3", "w8"]
     assert system.alive("r1")
-    barriers.unregister()
     ground.close()
 
 

@@ -1,12 +1,14 @@
 """The mission executor node of one robot: ``/<robot>/mission_executor``.
 
 Subscribes:
-    ``<link>/command`` (rosmc/RobotCommand), ``<link>/report_ack`` (rosmc/ReportAck),
-    ``/rosmc/barriers`` (rosmc/BarrierSignal, robot-to-robot).
+    ``<link>/command`` (rosmc/RobotCommand), ``<link>/report_ack`` (rosmc/ReportAck).
 Publishes:
     ``<link>/ack`` (rosmc/RobotAck), ``<link>/report`` (rosmc/RobotReport, retransmitted
     until acknowledged), ``<link>/snapshot`` (rosmc/ExecutorSnapshot, every
-    ``~snapshot_period``), ``/rosmc/barriers``.
+    ``~snapshot_period``), ``/rosmc/barriers`` (rosmc/BarrierSignal, a copy for observers).
+Radio side channel (UDP, :mod:`rosmc_server.ros.radio`, registered as
+    ``/rosmc/radio/<robot>``): barrier signals to and from the other robots, and beacons
+    to and from the ground; a ground beacon after a silence reconnects the link's topics.
 
 ``<link>`` is ``/rosmc/link/<robot>`` (talking to the ground directly) or, with
 ``~robot_side:=true``, ``/<robot>/link`` (behind a link emulator).
@@ -51,6 +53,8 @@ from ...conversions.robot_link import (
     snapshot_to_msg,
 )
 from ...core import RosmcError
+from ...core.radio import BEACON_PERIOD, ContactWatch
+from ...ros.radio import GROUND, Radio, TopicListener, reconnect_in_background
 from ..core import Command, Engine, Report, Signal, SkillType
 from ..core.state_file import load_state, save_state
 
@@ -103,19 +107,12 @@ class ExecutorNode:
                     state_file,
                     ", ".join(interrupted) or "none",
                 )
-        self._subscribers = [
-            rospy.Subscriber(topics.command, wire.RobotCommand, self._on_command, queue_size=100),
-            rospy.Subscriber(
-                topics.report_ack, wire.ReportAck, self._on_report_ack, queue_size=100
-            ),
-            rospy.Subscriber(
-                interface.BARRIER_TOPIC,
-                wire.BarrierSignal,
-                self._on_signal,
-                queue_size=1000,
-                tcp_nodelay=True,
-            ),
+        self._listeners = [
+            TopicListener(topics.command, wire.RobotCommand, self._on_command, queue_size=100),
+            TopicListener(topics.report_ack, wire.ReportAck, self._on_report_ack, queue_size=100),
         ]
+        self._contact = ContactWatch()
+        self.radio = Radio(agent, self._on_beacon, self._on_signal)
 
     # -- engine outputs (called with the lock held) ------------------------------------
     def report(self, report: Report) -> None:
@@ -126,8 +123,10 @@ class ExecutorNode:
         self._report_pub.publish(report_to_msg(self.agent, report))
 
     def signal(self, signal: Signal) -> None:
-        """Publish a barrier signal to the peers."""
-        self._barrier_pub.publish(signal_to_msg(signal))
+        """Send a barrier signal to the peers over the radio (and publish it for observers)."""
+        msg = signal_to_msg(signal)
+        self.radio.signal(msg, self.radio.robots())
+        self._barrier_pub.publish(msg)
 
     def changed(self) -> None:
         """Persist soon."""
@@ -176,6 +175,12 @@ class ExecutorNode:
             msg.echo_sent, msg.echo_held = sent, time.monotonic() - received
         return msg
 
+    def _on_beacon(self, sender: str) -> None:
+        if sender == GROUND and self._contact.heard(GROUND, time.monotonic()):
+            # The ground is back after a silence: its stalled connections would resume
+            # only at TCP's next retransmission, which backs off to minutes.
+            reconnect_in_background(self._listeners, f"{self.agent} hears the ground again")
+
     def _on_signal(self, msg: wire.BarrierSignal) -> None:
         try:
             signal = signal_from_msg(msg)
@@ -188,10 +193,13 @@ class ExecutorNode:
     # -- the loop ------------------------------------------------------------------------
     def spin(self, tick_rate: float, snapshot_period: float, report_retry: float) -> None:
         """Tick the engine, retransmit reports and publish snapshots until shutdown."""
-        next_snapshot = next_retry = 0.0
+        next_snapshot = next_retry = next_beacon = 0.0
         period = 1.0 / tick_rate
         while not rospy.is_shutdown():
             now = time.monotonic()
+            if now >= next_beacon:
+                next_beacon = now + BEACON_PERIOD
+                self.radio.beacon(GROUND)
             with self._lock:
                 try:
                     self.engine.tick()
@@ -206,6 +214,7 @@ class ExecutorNode:
                     self._snapshot_pub.publish(self._snapshot_msg())
                 self._persist()
             time.sleep(max(0.0, period - (time.monotonic() - now)))
+        self.radio.close()
 
     def _persist(self) -> None:
         if self._dirty and self._state_file is not None:
