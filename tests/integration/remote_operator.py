@@ -137,6 +137,7 @@ def _methods(operator: Any) -> dict[str, Callable[..., Any]]:
         "statuses": lambda: statuses(operator.mission()),
         "started": lambda: {s.id: s.started for s in operator.mission().skills()},
         "links": links,
+        "waiting_on": lambda agent: operator.agent_state(agent).waiting_on,
         "revision": lambda: operator.mission().revision,
     }
 
