@@ -9,7 +9,14 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from rosmc_server.core import AgentStatus, Barrier, Library, SkillInstance, TaskMarker
+from rosmc_server.core import (
+    AgentStatus,
+    Barrier,
+    Library,
+    SkillInstance,
+    SkillStatus,
+    TaskMarker,
+)
 
 from .view_state import AgentView, ViewUpdate, barrier_tags
 
@@ -89,7 +96,20 @@ class MissionView:
         return -1
 
     def waiting_on(self, skill: SkillInstance) -> list[str]:
-        """Robots whose barrier partner of ``skill`` has not reached the barrier yet."""
+        """Whom ``skill`` waits for at its barrier.
+
+        As its robot reports it while it waits there (``r2 at B3 (arrived, not yet
+        confirmed)``: the robot knows what the ground cannot see during a cut), else the
+        robots whose partner skill has not started.
+        """
+        status = self.statuses.get(skill.agent)
+        if (
+            status is not None
+            and status.waiting_on
+            and status.current_skill == skill.id
+            and skill.status is SkillStatus.SYNCWAITING
+        ):
+            return [status.waiting_on]
         barrier = self.barrier_of(skill.id)
         if barrier is None:
             return []

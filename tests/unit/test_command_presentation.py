@@ -155,6 +155,12 @@ def test_barrier_members_share_a_tag_and_say_whom_they_wait_on(gui: Gui) -> None
     feed("report_status", b, S.SYNCWAITING)  # bravo arrives: alpha now waits on charlie only
     assert gui.cell("alpha", False, 0, STATUS, Qt.DisplayRole) == "waiting on charlie"
     assert gui.cell("bravo", False, 0, STATUS, Qt.DisplayRole) == "waiting on charlie"
+    # What the robot itself reports wins: during a cut it knows what the ground cannot.
+    reported = "charlie at B1 (arrived, not yet confirmed)"
+    feed.statuses(AgentStatus("alpha", link="up", current_skill=a, waiting_on=reported))
+    gui.app.processEvents()
+    assert gui.cell("alpha", False, 0, STATUS, Qt.DisplayRole) == f"waiting on {reported}"
+    assert gui.cell("bravo", False, 0, STATUS, Qt.DisplayRole) == "waiting on charlie"
 
 
 def test_robot_headers_in_words() -> None:

@@ -15,13 +15,14 @@ from __future__ import annotations
 import logging
 from collections import OrderedDict, deque
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Protocol
 
 from rosmc_server.core import SkillInstance, SkillStatus
 from rosmc_server.core.link import queue_hash
 
 from . import commanding, queueing
+from .barrier_wait import ANNOUNCE_PERIOD, Announcements, BarrierWaits
 from .barriers import BarrierBoard
 from .lost_link import LostLinkGuard
 from .protocol import Ack, BarrierInfo, Command, Mode, Report, Signal, SignalKind, Snapshot
@@ -29,8 +30,8 @@ from .skills import Outcome, SkillBehavior, SkillContext, SkillType
 
 _log = logging.getLogger(__name__)
 S = SkillStatus
-ANNOUNCE_PERIOD = 0.5  # seconds between re-announcements (READY or CONFIRMED) while waiting
 KEPT_ACKS = 256
+__all__ = ["ANNOUNCE_PERIOD", "KEPT_ACKS", "Engine", "EngineOutputs", "Mode"]
 
 
 class EngineOutputs(Protocol):
@@ -57,9 +58,7 @@ class _Active:
     deadline: float = 0.0
     paused_at: float = 0.0
     retries_used: int = 0
-    last_announce: float = 0.0
-    announced: SignalKind | None = None  # what the robot last told its peers
-    last_confirmed: float = float("-inf")  # when it last said CONFIRMED
+    told: Announcements = field(default_factory=Announcements)  # at its barrier
 
 
 class Engine:
@@ -88,6 +87,7 @@ class Engine:
         self.unacked: list[Report] = []
         self.acks: OrderedDict[int, Ack] = OrderedDict()
         self.board = BarrierBoard(agent)
+        self.waits = BarrierWaits(agent, self.board, clock, outputs.signal)
         self.lost_link = LostLinkGuard(agent, clock, self.skill_types)
         self._active: _Active | None = None
         # Progress texts from skill threads, applied by tick() (deque appends are atomic).
@@ -129,11 +129,7 @@ class Engine:
     # -- peers and the ground -------------------------------------------------------------
     def hear(self, signal: Signal) -> None:
         """A peer's barrier signal: answered if this robot started there, else weighed."""
-        now = self.clock()
-        self.board.hear(signal, now)
-        answer = self.board.reply(signal, now)
-        if answer is not None:
-            self.outputs.signal(answer)
+        self.waits.hear(signal)
         active = self._active
         if active is not None and active.barrier is not None and active.behavior is None:
             self._try_release(active)
@@ -168,9 +164,9 @@ class Engine:
         if active.behavior is not None and self._status(active.skill_id) is S.RUNNING:
             self._update_running(active, now)
         elif self._status(active.skill_id) is S.SYNCWAITING:
-            if active.deadline and now >= active.deadline and self._may_give_up(active, now):
+            if active.deadline and now >= active.deadline and self.waits.may_give_up(active.told):
                 self._give_up_waiting(active)
-            elif now - active.last_announce >= ANNOUNCE_PERIOD:
+            elif self.waits.reannounce_due(active.told):
                 self._announce_wait(active)
 
     def _update_running(self, active: _Active, now: float) -> None:
@@ -246,25 +242,8 @@ class Engine:
             if active.behavior is None:
                 self._run(active)
             return
-        now = self.clock()
-        if not self.board.may_start(barrier, now):
-            # Still waiting. Who for is in the snapshot (waiting_on); a report per peer
-            # arrival would cost n^2 reports over the ground link for an n-robot barrier.
-            # A change of what to tell the peers goes out at once, not at the next round.
-            if self.board.announcement(barrier, now) is not active.announced:
-                self._announce_wait(active)
-            return
-        self.board.released(barrier.id, active.skill_id)
-        self._announce(active, SignalKind.RELEASED)
-        self._run(active)
-
-    def _may_give_up(self, active: _Active, now: float) -> bool:
-        """Whether the wait may time out: not while a partner may count this robot confirmed.
-
-        A partner holding a CONFIRMED of this robot (for up to a lease) may start on it;
-        failing now would leave that partner running alone.
-        """
-        return now - active.last_confirmed > self.board.lease
+        if self.waits.try_release(active.skill_id, barrier, active.told):
+            self._run(active)
 
     def _give_up_waiting(self, active: _Active) -> None:
         """The wait at the barrier outlasted the skill's timeout: it fails, partners are told.
@@ -275,30 +254,20 @@ class Engine:
         """
         skill = self._find(active.skill_id)
         assert skill is not None and active.barrier is not None
-        missing = ", ".join(self.board.waiting_on(active.barrier, self.clock()))
-        self._announce(active, SignalKind.WITHDRAWN)
+        text = self.waits.give_up(skill.id, active.barrier, active.told, skill.timeout)
         self._active = None
-        text = f"timed out after {skill.timeout:g} s waiting at barrier '{active.barrier.id}'"
-        self._set(skill.id, S.FAILURE, text=text + (f" for {missing}" if missing else ""),
-                  finished=self.clock())  # fmt: skip
+        self._set(skill.id, S.FAILURE, text=text, finished=self.clock())
 
     def _waiting_text(self, barrier: BarrierInfo) -> str:
-        return self.board.waiting_text(barrier, self.clock())
+        return self.waits.text(barrier)
 
     def _announce_wait(self, active: _Active) -> None:
-        """Tell the peers this robot waits: READY, or CONFIRMED once all have arrived."""
         if active.barrier is not None:
-            self._announce(active, self.board.announcement(active.barrier, self.clock()))
+            self.waits.announce_wait(active.skill_id, active.barrier, active.told)
 
     def _announce(self, active: _Active, kind: SignalKind) -> None:
-        if active.barrier is None:
-            return
-        now = self.clock()
-        active.last_announce = now
-        active.announced = kind
-        if kind is SignalKind.CONFIRMED:
-            active.last_confirmed = now
-        self.outputs.signal(Signal(self.agent, active.barrier.id, active.skill_id, kind, now))
+        if active.barrier is not None:
+            self.waits.announce(active.skill_id, active.barrier, active.told, kind)
 
     def _run(self, active: _Active) -> None:
         skill = self._find(active.skill_id)
@@ -476,7 +445,7 @@ class Engine:
         active = self._active
         waiting = ""
         if active is not None and active.barrier is not None and active.behavior is None:
-            waiting = self.board.waiting_summary(active.barrier, self.clock())
+            waiting = self.waits.summary(active.barrier)
         return Snapshot(
             self.clock(),
             self.last_command_seq,
