@@ -15,13 +15,19 @@ ground; no link emulator). Measured at full speed, then with every radio limited
 * ``idle_radio``: bytes per second each way on every robot's radio while nothing happens
   (heartbeats and the robot's periodic snapshot), with the number of skills it holds.
 
-Then, still at ``--rate``, ``after_outage_of_every_radio`` / ``_of_one_radio``: every
-radio (or the first robot's) goes down (``ip link set down``) while the robots run towards
-a barrier, and comes back ``--outage`` seconds later; the time from the radios' return to
-the first and the last member starting, and the skew. A robot's connections resume with
-their next TCP retransmission, whose timer backs off while the radio is down; the last
-figures repeat the one-radio outage in a second lab whose hosts cap that backoff
-(``net.ipv4.tcp_rto_max_ms=--rto-max-ms``, Linux 6.11 and later).
+Then, still at ``--rate`` and with the kernel's default TCP settings, the radio cuts of
+docs/barriers.md, ``--outages`` times each (``ip link set down``, back ``--outage`` s later):
+
+* ``cut_while_members_approach``: every radio goes down while all members run towards
+  the barrier, so each arrives during the cut;
+* ``partner_cut_before_arrival``: two robots; the first waits, the second's radio goes
+  down 0.7 s before it arrives (it heard the first arrive; the first cannot hear it);
+* ``every_radio_cut_during_release``: every member but the last waits; all radios go
+  down as the last arrives.
+
+For each: the members' start skew, the time from the radios' return to the first and the
+last member starting (a negative first start would be a member that started during the
+cut: ``started_during_cut`` counts them, and must stay 0).
 
 All namespaces share one kernel, hence one clock: the robots' stamps, the operator's and
 this script's are directly comparable. Needs root; without it (or where namespaces are
@@ -52,8 +58,13 @@ sys.path.insert(0, str(REPO))
 
 from bench_executor import print_figures, summary, team_library  # noqa: E402
 
+from tests.integration.barrier_cuts import (  # noqa: E402
+    CutOutcome,
+    every_radio_cut_during_release,
+    partner_cut_before_arrival,
+)
 from tests.integration.multihost_fixtures import LabSystem, lab_base_env  # noqa: E402
-from tests.integration.netns import RadioLab, can_cap_tcp_backoff, unavailable  # noqa: E402
+from tests.integration.netns import RadioLab, unavailable  # noqa: E402
 from tests.integration.remote_operator import RemoteOperator  # noqa: E402
 
 MEASURES = "bench.bench_executor"  # run by the operator, next to the server
@@ -93,64 +104,65 @@ def idle_radio(
     }
 
 
-def outage_round(
-    op: RemoteOperator, lab: RadioLab, agents: Sequence[str], outage: float, cut: Sequence[str]
-) -> tuple[float, float, float]:
-    """One barrier reached while the radios of ``cut`` are down: (first start, last start, skew).
-
-    The starts are seconds after the radios came back.
-    """
+def cut_while_members_approach(
+    op: RemoteOperator, lab: RadioLab, agents: Sequence[str], outage: float
+) -> CutOutcome:
+    """Every radio goes down while all members run towards the barrier."""
     ahead = [op("add", agent, "wait", {"duration": 1.5}) for agent in agents]
-    members = [op("add", agent, "wait", {"duration": 0.05}) for agent in agents]
-    op("add_barrier", members)
+    members = {agent: op("add", agent, "wait", {"duration": 0.05}) for agent in agents}
+    op("add_barrier", list(members.values()))
     for agent in agents:
         op("sync", agent)
     op("wait_status", ahead, "RUNNING", 30.0)
-    lab.cut(cut)
+    lab.cut(agents)
+    down = time.time()
     time.sleep(outage)
     restored = time.time()
-    lab.restore(cut)
-    op("wait_status", members, "SUCCESS", 60.0, timeout=70.0)
+    lab.restore(agents)
+    op("wait_status", list(members.values()), "SUCCESS", 60.0, timeout=70.0)
     started = op("started")
-    stamps = [started[m] - restored for m in members]
-    if min(stamps) < 0:
-        raise RuntimeError(f"a member started before the radios came back: {stamps}")
-    return min(stamps), max(stamps), max(stamps) - min(stamps)
+    return CutOutcome(down, restored, {a: started[m] for a, m in members.items()})
 
 
-def outage_figures(
-    op: RemoteOperator,
-    lab: RadioLab,
-    agents: Sequence[str],
-    rounds: int,
-    outage: float,
-    cut: Sequence[str],
-) -> dict[str, Any]:
-    """Barrier release after an outage of the radios of ``cut``, over ``rounds`` rounds."""
-    results = [outage_round(op, lab, agents, outage, cut) for _ in range(rounds)]
+def cut_figures(outcomes: Sequence[CutOutcome], outage: float) -> dict[str, Any]:
+    """Skew and restore-to-start figures over repeated runs of one cut scenario."""
     return {
         "outage_s": outage,
-        "restore_to_first_start": summary([r[0] for r in results]),
-        "restore_to_last_start": summary([r[1] for r in results]),
-        "barrier_skew": summary([r[2] for r in results]),
+        "started_during_cut": sum(1 for o in outcomes for t in o.starts.values() if t < o.restored),
+        "barrier_skew": summary([o.skew for o in outcomes]),
+        "restore_to_first_start": summary([o.first_after_restore for o in outcomes]),
+        "restore_to_last_start": summary([o.last_after_restore for o in outcomes]),
+    }
+
+
+def barrier_cut_figures(
+    op: RemoteOperator, lab: RadioLab, agents: Sequence[str], runs: int, outage: float
+) -> dict[str, Any]:
+    """Every cut scenario of docs/barriers.md, ``runs`` times each."""
+    scenarios = {
+        "cut_while_members_approach": lambda: cut_while_members_approach(op, lab, agents, outage),
+        "partner_cut_before_arrival": lambda: partner_cut_before_arrival(
+            op, lab, agents[0], agents[1], outage
+        ),
+        "every_radio_cut_during_release": lambda: every_radio_cut_during_release(
+            op, lab, agents, outage
+        ),
+    }
+    return {
+        name: cut_figures([run() for _ in range(runs)], outage) for name, run in scenarios.items()
     }
 
 
 @contextlib.contextmanager
-def team(
-    args: argparse.Namespace, work: Path, rto_max_ms: int = 0
-) -> Iterator[tuple[RadioLab, RemoteOperator, float]]:
+def team(args: argparse.Namespace, work: Path) -> Iterator[tuple[RadioLab, RemoteOperator, float]]:
     """A lab of ``args.robots`` robots, linked and executing: (lab, operator, start-up seconds).
 
-    ``rto_max_ms`` caps TCP's retransmission backoff on every host before any node starts
-    (a socket keeps the setting it was made with).
+    The hosts keep the kernel's default TCP settings.
     """
     agents = [f"a{i:02d}" for i in range(1, args.robots + 1)]
     work.mkdir(parents=True)
     library = team_library(work, args.robots)
     with RadioLab(agents, subnet=os.getpid() % 250) as lab:
-        if rto_max_ms:
-            lab.tune_tcp(rto_max_ms)
         system = LabSystem(lab_base_env(work / "home"), work / "team", library=library, lab=lab)
         try:
             system.start_master()
@@ -168,7 +180,7 @@ def team(
 
 
 def measure(args: argparse.Namespace, work: Path) -> dict[str, Any]:
-    """Every figure: one lab with the kernel's TCP settings, one with the backoff capped."""
+    """Every figure, in one lab with the kernel's default TCP settings."""
     with team(args, work / "default") as (lab, op, startup):
         agents = list(lab.robots)
         figures: dict[str, Any] = {
@@ -179,18 +191,7 @@ def measure(args: argparse.Namespace, work: Path) -> dict[str, Any]:
         lab.shape(args.rate)
         figures[f"tbf_{args.rate}"] = link_figures(op, agents, args.samples, args.rounds)
         figures["idle_radio"] = idle_radio(op, lab, agents, 5.0)
-        outages = (op, lab, agents, args.outages, args.outage)
-        figures["after_outage_of_every_radio"] = outage_figures(*outages, agents)
-        figures["after_outage_of_one_radio"] = outage_figures(*outages, agents[:1])
-    if not can_cap_tcp_backoff():
-        figures["rto_max"] = "net.ipv4.tcp_rto_max_ms needs Linux 6.11 or later"
-        return figures
-    with team(args, work / "rto_max", args.rto_max_ms) as (lab, op, _):
-        lab.shape(args.rate)
-        outages = (op, lab, list(lab.robots), args.outages, args.outage)
-        figures[f"after_outage_of_one_radio_rto_max_{args.rto_max_ms}ms"] = outage_figures(
-            *outages, lab.robots[:1]
-        )
+        figures["radio_cuts"] = barrier_cut_figures(op, lab, agents, args.outages, args.outage)
     return figures
 
 
@@ -201,11 +202,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--samples", type=int, default=20, help="sync-to-start samples")
     parser.add_argument("--rounds", type=int, default=10, help="barrier rounds")
     parser.add_argument("--rate", default="256kbit", help="tbf rate of every radio")
-    parser.add_argument("--outages", type=int, default=3, help="outage rounds")
-    parser.add_argument("--outage", type=float, default=15.0, help="seconds each outage lasts")
-    parser.add_argument(
-        "--rto-max-ms", type=int, default=1000, help="net.ipv4.tcp_rto_max_ms of the last rounds"
-    )
+    parser.add_argument("--outages", type=int, default=3, help="runs of each cut scenario")
+    parser.add_argument("--outage", type=float, default=15.0, help="seconds each cut lasts")
     parser.add_argument("--keep", action="store_true", help="keep the work directory")
     args = parser.parse_args(argv)
     reason = unavailable()

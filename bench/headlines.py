@@ -72,8 +72,10 @@ HEADLINES: dict[str, tuple[str, ...]] = {
         "*.sync_to_start.operator_sees_running_after_return.median_ms",
         "*.barrier_skew.median_ms",
         "*.barrier_skew.max_ms",
-        "after_outage*.restore_to_last_start.median_ms",
-        "after_outage*.restore_to_last_start.max_ms",
+        "radio_cuts.*.started_during_cut",
+        "radio_cuts.*.restore_to_first_start.median_ms",
+        "radio_cuts.*.restore_to_last_start.median_ms",
+        "radio_cuts.*.restore_to_last_start.max_ms",
         "idle_radio.*.uplink_bytes_per_s",
     ),
 }

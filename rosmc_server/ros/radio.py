@@ -77,7 +77,8 @@ class Radio:
         self._socket.settimeout(0.5)
         host = rosgraph.network.get_host_name()
         self.endpoint = f"{host}:{self._socket.getsockname()[1]}"
-        self._addresses: dict[str, tuple[str, int]] = {}
+        self._addresses: dict[str, tuple[str, int]] = {}  # where to send, by name
+        self._listed: dict[str, tuple[str, int]] = {}  # as last read from the directory
         self._lock = threading.Lock()
         self._closed = threading.Event()
         self._registered = False
@@ -188,7 +189,11 @@ class Radio:
                 _log.debug("radio %s: skipping %s's endpoint: %s", self.name, name, error)
                 continue
             with self._lock:
-                self._addresses.setdefault(name, address)
+                # A new entry (a restarted peer) wins; an unchanged one does not override
+                # where the peer was last heard from.
+                if self._listed.get(name) != address:
+                    self._listed[name] = address
+                    self._addresses[name] = address
 
     def close(self) -> None:
         """Stop receiving and close the socket (the directory entry stays for a restart)."""

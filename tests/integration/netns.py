@@ -78,11 +78,6 @@ def unavailable() -> str:
     return ""
 
 
-def can_cap_tcp_backoff() -> bool:
-    """Whether this kernel has ``net.ipv4.tcp_rto_max_ms`` (Linux 6.11 and later)."""
-    return os.path.exists("/proc/sys/net/ipv4/tcp_rto_max_ms")
-
-
 def namespace_pids(namespace: str) -> list[int]:
     """The processes running in ``namespace``."""
     result = run_ip("ip", "netns", "pids", namespace, check=False)
@@ -266,17 +261,6 @@ class RadioLab:
         ground_end = run_ip(show[0], "-n", self.ground.namespace, *show[1:], host.radio)
         robot_end = run_ip(show[0], "-n", host.namespace, *show[1:], ROBOT_RADIO)
         return ground_end.stdout + robot_end.stdout
-
-    def tune_tcp(self, rto_max_ms: int, retries: int = 100) -> None:
-        """Cap TCP's retransmission backoff at ``rto_max_ms`` on every host of the lab.
-
-        (``net.ipv4.tcp_rto_max_ms``, Linux 6.11 and later, a per-namespace setting.) With a
-        lower cap a connection gives up after fewer seconds of ``tcp_retries2`` attempts, so
-        ``retries`` raises that too: a long outage must not close the robots' connections.
-        """
-        for host in self.hosts.values():
-            settings = (f"net.ipv4.tcp_rto_max_ms={rto_max_ms}", f"net.ipv4.tcp_retries2={retries}")
-            run_ip(*self.command(host.name, ["sysctl", "-q", "-w", *settings]))
 
     def sent_bytes(self, robot: str) -> tuple[int, int]:
         """Bytes a robot's radio has sent since it was shaped: (to the robot, from the robot)."""

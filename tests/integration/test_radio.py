@@ -1,0 +1,76 @@
+"""The radio side channel between real endpoints on a real master's directory."""
+
+from __future__ import annotations
+
+import socket
+import threading
+from io import BytesIO
+
+import rosmc.msg as wire
+import rospy
+
+from rosmc_server import interface
+from rosmc_server.core.radio import DatagramKind, encode_datagram
+from rosmc_server.ros.radio import Radio
+from tests.conftest import RosMaster, wait_until
+
+
+class Heard:
+    """What one endpoint heard."""
+
+    def __init__(self) -> None:
+        self.beacons: list[str] = []
+        self.signals: list[wire.BarrierSignal] = []
+        self.lock = threading.Lock()
+
+    def beacon(self, sender: str) -> None:
+        with self.lock:
+            self.beacons.append(sender)
+
+    def signal(self, msg: wire.BarrierSignal) -> None:
+        with self.lock:
+            self.signals.append(msg)
+
+
+def test_endpoints_find_each_other_through_the_directory(ros_master: RosMaster) -> None:
+    heard = {name: Heard() for name in ("ground", "r1", "r2")}
+    radios = {name: Radio(name, h.beacon, h.signal) for name, h in heard.items()}
+    try:
+        directory = ros_master.proxy()
+        wait_until(
+            lambda: (
+                set(directory.getParam("/t", interface.RADIO_DIRECTORY)[2] or {}) >= set(radios)
+            ),
+            10.0,
+            "every endpoint registered",
+        )
+        wait_until(lambda: set(radios["r1"].robots()) == {"r2"}, 10.0, "r1 to list r2 only")
+        signal = wire.BarrierSignal(agent="r1", barrier_id="B3", skill_id="s", kind=3)
+        signal.stamp = rospy.Time(12, 5)
+
+        def exchanged() -> bool:
+            radios["r1"].signal(signal, radios["r1"].robots())
+            radios["r2"].beacon("ground")
+            return bool(heard["r2"].signals) and "r2" in heard["ground"].beacons
+
+        wait_until(exchanged, 10.0, "a signal and a beacon to arrive")
+        got = heard["r2"].signals[0]
+        assert (got.agent, got.barrier_id, got.kind, got.stamp) == ("r1", "B3", 3, signal.stamp)
+        assert not heard["ground"].signals  # signals go to robots only
+
+        # Stray datagrams never stop the receiver.
+        buffer = BytesIO()
+        signal.serialize(buffer)
+        port = int(radios["r2"].endpoint.rsplit(":", 1)[1])
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as udp:
+            for stray in (b"junk", encode_datagram(DatagramKind.BARRIER_SIGNAL, b"\x01\x02")):
+                udp.sendto(stray, ("127.0.0.1", port))
+        count = len(heard["r2"].signals)
+        wait_until(
+            lambda: radios["r1"].signal(signal, ["r2"]) or len(heard["r2"].signals) > count,
+            10.0,
+            "r2 to hear on after stray datagrams",
+        )
+    finally:
+        for radio in radios.values():
+            radio.close()

@@ -1,0 +1,81 @@
+"""The radio side channel's pure parts: datagram framing, endpoints, contact, command resend."""
+
+from __future__ import annotations
+
+import pytest
+
+from rosmc_server.core import InvalidRequest
+from rosmc_server.core.link import Outbox
+from rosmc_server.core.radio import (
+    MAX_DATAGRAM,
+    ContactWatch,
+    DatagramKind,
+    decode_datagram,
+    encode_datagram,
+    parse_endpoint,
+)
+
+
+def test_a_datagram_reads_back_as_its_kind_and_payload() -> None:
+    for kind in DatagramKind:
+        assert decode_datagram(encode_datagram(kind, b"r1")) == (kind, b"r1")
+
+
+@pytest.mark.parametrize(
+    ("data", "sentence"),
+    [
+        (b"", "not a ROSMC radio datagram"),
+        (b"GET / HTTP/1.0\r\n", "not a ROSMC radio datagram"),
+        (b"RMC\x01", "not a ROSMC radio datagram"),
+        (b"RMC\x01\x63payload", "unknown radio datagram kind 99"),
+    ],
+)
+def test_foreign_datagrams_are_refused_in_a_sentence(data: bytes, sentence: str) -> None:
+    with pytest.raises(InvalidRequest, match=sentence):
+        decode_datagram(data)
+
+
+def test_a_payload_that_does_not_fit_one_datagram_is_refused() -> None:
+    with pytest.raises(InvalidRequest, match=f"at most {MAX_DATAGRAM} bytes"):
+        encode_datagram(DatagramKind.BARRIER_SIGNAL, bytes(MAX_DATAGRAM))
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        ("10.0.0.11:40000", ("10.0.0.11", 40000)),
+        ("[::1]:9", ("::1", 9)),
+        ("r1.lan:1", ("r1.lan", 1)),
+    ],
+)
+def test_endpoints_read_as_host_and_port(text: str, expected: tuple[str, int]) -> None:
+    assert parse_endpoint(text) == expected
+
+
+@pytest.mark.parametrize("text", ["", "10.0.0.11", ":40000", "host:0", "host:70000", "host:x"])
+def test_malformed_endpoints_are_refused(text: str) -> None:
+    with pytest.raises(InvalidRequest, match="host:port"):
+        parse_endpoint(text)
+
+
+def test_contact_returns_only_after_a_silence() -> None:
+    watch = ContactWatch(silence=1.5)
+    assert not watch.heard("r1", 10.0)  # first contact: nothing stalled to repair
+    assert not watch.heard("r1", 11.0)
+    assert watch.in_contact("r1", 12.5) and not watch.in_contact("r1", 12.6)
+    assert watch.heard("r1", 20.0)  # back after 9 s of silence
+    assert not watch.heard("r1", 20.5)
+    assert not watch.in_contact("r2", 20.5)
+
+
+def test_pending_commands_go_again_at_once_when_contact_returns() -> None:
+    outbox: Outbox[str] = Outbox(first_retry=0.25, max_retry=5.0)
+    outbox.robot_numbering(0, now=0.0)
+    outbox.enqueue("upload")
+    sent = [now for now in (0.0, 0.25, 0.75, 1.75, 3.75, 7.75, 12.75) if outbox.due(now)]
+    assert sent == [0.0, 0.25, 0.75, 1.75, 3.75, 7.75, 12.75]  # backed off to 5 s
+    assert not outbox.due(14.0)
+    outbox.contact_returned(14.0)
+    assert [item.payload for item in outbox.due(14.0)] == ["upload"]
+    assert not outbox.due(14.2) and outbox.due(14.25)  # the backoff starts again
+    assert outbox.pending()[0].attempts == 9  # every transmission still counts
