@@ -162,8 +162,19 @@ def _add_options(parser: argparse.ArgumentParser) -> None:
 
 def _add_execution(command: _Command) -> None:
     sync = command("sync", "upload a robot's blueprint (or a prefix of it) to the robot")
-    sync.add_argument("agent", metavar="ROBOT")
-    sync.add_argument("--upto", metavar="ID", help="upload up to and including this skill")
+    sync.add_argument("agent", metavar="ROBOT", nargs="?")
+    sync.add_argument(
+        "--upto",
+        metavar="ID",
+        action="append",
+        help="upload up to and including this skill (with --all: once per robot that stops early)",
+    )
+    sync.add_argument(
+        "--all",
+        dest="team",
+        action="store_true",
+        help="every robot with planned skills, in one change: all of them or none",
+    )
     unsync = command("unsync", "pull not-started synchronized skills back to the blueprint")
     unsync.add_argument("agent", metavar="ROBOT")
     unsync.add_argument(

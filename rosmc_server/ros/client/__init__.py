@@ -21,6 +21,7 @@ from .results import (
     ServerUnavailable,
     SkillAdded,
     SkillRetried,
+    TeamTransferred,
     Transferred,
 )
 from .watch import MissionWatch, init_node
@@ -42,6 +43,7 @@ __all__ = [
     "ServerUnavailable",
     "SkillAdded",
     "SkillRetried",
+    "TeamTransferred",
     "Transferred",
     "agent_status_from_msg",
     "agent_statuses_from_msg",
