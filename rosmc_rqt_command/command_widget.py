@@ -39,6 +39,7 @@ from .mission_view import MissionView
 from .parameter_panel import ParameterPanel
 from .requests import Answer, Backend, Request
 from .schedule_widget import ScheduleWidget
+from .team_dialog import ask_team_send
 from .view_state import ViewUpdate
 
 # Robot headers and robot buttons follow live reports at most this often (ms): robots
@@ -63,7 +64,9 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.files = FileController(self, self.actions_, self.view, self.messages, self.send)
         self._checker = alerts.ParameterChecker()
         self._robot_legal = RobotLegality()
-        self.dispatcher = Dispatcher(self.view, self.send, self._confirm, self._robot_legal.any)
+        self.dispatcher = Dispatcher(
+            self.view, self.send, self._confirm, self._robot_legal.any, self._confirm_team
+        )
         self._select_when_seen: list[str] = []
         self._pending_statuses: dict[str, AgentStatus] = {}
         self.connected = False
@@ -282,6 +285,9 @@ class CommandWidget(QWidget):  # type: ignore[misc]
             QMessageBox.No,
         )
         return bool(answer == QMessageBox.Yes)
+
+    def _confirm_team(self, text: str, warnings: list[str]) -> bool:
+        return ask_team_send(self, text, warnings)
 
     # -- slots ----------------------------------------------------------------------------------
     def _on_schedule_selection_changed(self, ids: list[str]) -> None:
