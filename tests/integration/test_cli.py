@@ -522,6 +522,38 @@ def test_sync_shows_uploading(server: Server, fresh: MissionClient) -> None:
     assert [s["transfer"] for s in drone] == ["NONE", "NONE", "NONE"], drone
 
 
+def test_sync_all_sends_every_robot_in_one_change(server: Server, fresh: MissionClient) -> None:
+    ids = build_mission(fresh)
+    fresh.add_barrier([ids["sci"], ids["man"]])
+    before = status(server)
+    # One robot's refusal (an unknown stop) sends nobody anything.
+    (refused,) = run_many(server.env, [["sync", "--all", "--upto", "nosuch"]])
+    assert_refused(refused, "nosuch")
+    assert status(server)["revision"] == before["revision"]
+    out = rosmc(server, "sync", "--all", "--upto", ids["cover"])
+    assert out.splitlines() == [
+        f"uploading to drone: {ids['climb']}, {ids['cover']}",
+        f"uploading to science_rover: {ids['sci']}",
+        f"uploading to manipulator_rover: {ids['man']}",
+        f"(revision {before['revision'] + 1})",
+        "queued for drone, science_rover, manipulator_rover: not heard since the server "
+        "started; it goes out when the robot first reports",
+    ], out
+    data = status(server)
+    assert data["revision"] == before["revision"] + 1  # one change for the whole team
+    transfers = {
+        a["name"]: [s["transfer"] for s in a["skills"]] for a in data["agents"] if a["skills"]
+    }
+    assert transfers == {
+        "drone": ["UPLOADING", "UPLOADING", "NONE"],
+        "science_rover": ["UPLOADING"],
+        "manipulator_rover": ["UPLOADING"],
+    }, transfers
+    # No robot answers here: take every upload back so later tests start empty.
+    results = run_many(server.env, [["unsync", agent] for agent in transfers])
+    assert [r.returncode for r in results] == [0, 0, 0], [r.stderr for r in results]
+
+
 def journal_of(server: Server) -> Path:
     """The journal the module's server writes now (the newest in its directory)."""
     return max(server.journal_dir.glob("*.mcap"), key=lambda path: path.stat().st_mtime)
