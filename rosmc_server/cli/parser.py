@@ -103,7 +103,9 @@ def _add_views(command: _Command) -> None:
     status = command("status", "print every robot's schedule, link and telemetry")
     status.add_argument("-v", "--verbose", action="store_true", help="show parameter values")
     status.add_argument(
-        "--no-states", action="store_true", help="do not wait for the robots' link states"
+        "--no-states",
+        action="store_true",
+        help="do not wait for the robots' link states or the science score",
     )
     library = command("library", "print the agents, their skills and parameter schemas")
     library.add_argument("agent", nargs="?", metavar="AGENT", help="only this agent")

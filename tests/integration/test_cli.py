@@ -21,6 +21,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+import rospy
+from rosmc.msg import SampleRegion, ScienceState
 
 from rosmc_server.cli.parser import build_parser
 from rosmc_server.cli.values import parse_vertices, typed_values
@@ -34,13 +36,16 @@ from rosmc_server.core import (
     TaskMarker,
     load_library,
 )
+from rosmc_server.interface import SCIENCE_TOPIC
 from rosmc_server.ros.client import (
     MissionClient,
     RevisionConflict,
     ServerUnavailable,
+    init_node,
     library_from_msg,
 )
 from rosmc_server.text import mission_to_json
+from tests.conftest import wait_until
 
 REPO = Path(__file__).resolve().parents[2]
 ROSMC = REPO / "scripts" / "rosmc"
@@ -552,6 +557,31 @@ def test_sync_all_sends_every_robot_in_one_change(server: Server, fresh: Mission
     # No robot answers here: take every upload back so later tests start empty.
     results = run_many(server.env, [["unsync", agent] for agent in transfers])
     assert [r.returncode for r in results] == [0, 0, 0], [r.stderr for r in results]
+
+
+def test_status_prints_the_science_score_when_published(
+    server: Server, fresh: MissionClient
+) -> None:
+    init_node("cli_science_publisher")
+    publisher = rospy.Publisher(SCIENCE_TOPIC, ScienceState, queue_size=1, latch=True)
+    try:
+        region = SampleRegion(
+            name="RSS A", x=16, y=9, radius=3, max_score=1, stones_left=2,
+            identified_by="collaborative",
+        )
+        publisher.publish(ScienceState(regions=[region], score=1.0, stones_delivered=1))
+        lines = rosmc(server, "status").splitlines()
+        assert lines[1:3] == [
+            "science score 1.00: 1 stone(s) delivered to the lander; regions discovered: RSS A",
+            "  RSS A at (16, 9): identified by both rovers, 2 stone(s) left (best 1)",
+        ], lines
+        science = status(server)["science"]
+        assert (science["score"], science["stones_delivered"]) == (1.0, 1), science
+        assert science["regions"][0]["identified_by"] == "collaborative", science
+    finally:
+        publisher.unregister()
+    wait_until(lambda: "science score" not in rosmc(server, "status"), 20.0, "no score")
+    assert status(server)["science"] is None
 
 
 def journal_of(server: Server) -> Path:

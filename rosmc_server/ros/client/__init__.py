@@ -24,6 +24,7 @@ from .results import (
     TeamTransferred,
     Transferred,
 )
+from .science import ScienceWatch
 from .watch import MissionWatch, init_node
 from .worker import AsyncMissionClient, Outcome
 
@@ -40,6 +41,7 @@ __all__ = [
     "Outcome",
     "Result",
     "RevisionConflict",
+    "ScienceWatch",
     "ServerUnavailable",
     "SkillAdded",
     "SkillRetried",
