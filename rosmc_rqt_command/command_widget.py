@@ -39,6 +39,7 @@ from .mission_view import MissionView
 from .parameter_panel import ParameterPanel
 from .requests import Answer, Backend, Request
 from .schedule_widget import ScheduleWidget
+from .science_strip import ScienceStrip
 from .team_dialog import ask_team_send
 from .view_state import ViewUpdate
 
@@ -116,6 +117,8 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         left_layout = QVBoxLayout(left)
         left_layout.setContentsMargins(0, 0, 0, 0)
         left_layout.setSpacing(2)
+        self.science = ScienceStrip()
+        left_layout.addWidget(self.science)
         left_layout.addWidget(self.schedule, 1)
         left_layout.addWidget(self.legend)
         self.splitter = QSplitter(Qt.Horizontal)

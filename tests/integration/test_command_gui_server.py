@@ -1,5 +1,5 @@
 """The command GUI when the mission server is gone, slow or restarted; two windows; files;
-sending the whole team's plans with the mouse.
+sending the whole team's plans with the mouse; the science score in view.
 
 A real master and real ``mission_server`` processes; the real widget and ROS bridge
 (offscreen Qt). While the server is stopped (or frozen with SIGSTOP) the operator keeps
@@ -19,6 +19,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+import rosmc.msg as wire
+import rospy
 
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
@@ -34,8 +36,10 @@ from python_qt_binding.QtWidgets import (
 
 from rosmc_rqt_command.command_widget import CommandWidget
 from rosmc_rqt_command.legality import Action
+from rosmc_rqt_command.science_strip import NO_SCORE
 from rosmc_rqt_command.standalone import build
 from rosmc_server.core import LostLinkKind, LostLinkPolicy
+from rosmc_server.interface import SCIENCE_TOPIC
 from rosmc_server.ros.client import MissionClient
 from tests import conftest
 from tests.integration.server_fixtures import ServerProcess, StartServer
@@ -346,6 +350,34 @@ def test_a_two_robot_barrier_plan_goes_out_with_one_click_and_one_question(
         "both plans in transfer",
     )
     no_traceback(window)
+
+
+def test_the_science_score_is_in_view_once_published(
+    start_server: StartServer, windows: Any
+) -> None:
+    start_server()
+    window = windows()
+    shown(window)
+    strip = window.w.science
+    assert strip.isVisible() and strip.text() == NO_SCORE
+    publisher = rospy.Publisher(SCIENCE_TOPIC, wire.ScienceState, queue_size=1, latch=True)
+    try:
+        regions = [
+            wire.SampleRegion(
+                name="RSS A", x=16, y=9, radius=3, max_score=1, stones_left=1,
+                identified_by="collaborative",
+            ),
+            wire.SampleRegion(name="RSS B", x=30, y=-16, radius=3.5, max_score=0.8, stones_left=2),
+        ]
+        publisher.publish(wire.ScienceState(regions=regions, score=1.1, stones_delivered=2))
+        wait_until(lambda: strip.science is not None, 10, "the science state")
+    finally:
+        publisher.unregister()
+    text = strip.text()
+    assert "Science score 1.10" in text and "2 stone(s) delivered" in text, text
+    assert "RSS A (16, 9): identified by both rovers, 1 left" in text, text
+    assert "RSS B (30, -16): not identified, 2 left" in text, text
+    assert "RSS B at (30, -16): not identified, 2 stone(s) left (best 0.8)" in strip.toolTip()
 
 
 def test_save_to_a_local_file_and_open_it_again(
