@@ -301,6 +301,14 @@ class Simulation:
                 return region
         return None
 
+    def stones_left(self, region: str) -> int:
+        """Stones still lying in ``region`` (neither carried nor delivered)."""
+        return sum(
+            1
+            for s in self.stones.values()
+            if s.region == region and not s.carried_by and not s.delivered
+        )
+
     def stone_value(self, stone: Stone) -> float:
         """What a stone scores when it reaches the lander."""
         region = self.regions[stone.region].spec
