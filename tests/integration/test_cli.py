@@ -554,7 +554,13 @@ def test_sync_all_sends_every_robot_in_one_change(server: Server, fresh: Mission
         "science_rover": ["UPLOADING"],
         "manipulator_rover": ["UPLOADING"],
     }, transfers
-    # No robot answers here: take every upload back so later tests start empty.
+    # No robot answers here: take every upload back; then send everything, and again back.
+    results = run_many(server.env, [["unsync", agent] for agent in transfers])
+    assert [r.returncode for r in results] == [0, 0, 0], [r.stderr for r in results]
+    out = rosmc(server, "sync", "--all")
+    assert out.splitlines()[0] == (
+        f"uploading to drone: {ids['climb']}, {ids['cover']}, {ids['land']}"
+    ), out
     results = run_many(server.env, [["unsync", agent] for agent in transfers])
     assert [r.returncode for r in results] == [0, 0, 0], [r.stderr for r in results]
 
