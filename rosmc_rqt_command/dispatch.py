@@ -110,7 +110,7 @@ class Dispatcher:
         who = "every robot" if agent is None else agent
         if kind is RobotAction.SYNC_ALL and agent is None:
             self.send_team(whole_team(self._view))
-        elif kind is RobotAction.SYNC_ALL:
+        elif kind is RobotAction.SYNC_ALL and agent is not None:
             if self._barriers_ok(self._view.view(agent).editable):
                 self.request("synchronize", agent, None, what=f"send {agent}'s whole plan")
         elif kind is RobotAction.UNSYNC_ALL and agent is not None:

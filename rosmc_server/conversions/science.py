@@ -10,9 +10,7 @@ from ..core.science import RegionScience, Science
 def science_from_msg(msg: wire.ScienceState) -> Science:
     """The score, the stones delivered and the discovered regions of a message."""
     regions = tuple(
-        RegionScience(
-            r.name, r.x, r.y, r.radius, r.max_score, int(r.stones_left), r.identified_by
-        )
+        RegionScience(r.name, r.x, r.y, r.radius, r.max_score, int(r.stones_left), r.identified_by)
         for r in msg.regions
     )
     return Science(float(msg.score), int(msg.stones_delivered), regions)

@@ -48,16 +48,11 @@ def synchronize_team(
         uploads = uploads_from_request(server, req)
         for agent in uploads:
             require_link(agent)
-        event = server.apply(
-            lambda m: m.synchronize_team(uploads, base_revision=req.base_revision)
-        )
+        event = server.apply(lambda m: m.synchronize_team(uploads, base_revision=req.base_revision))
         assert event is not None
         resp.agents = list(uploads)
         resp.skill_ids = [placed.skill.id for placed in event.change.put_skills]
         partners = unsynced_partners(server.mission.state, resp.skill_ids)
-        resp.note = "; ".join(
-            part
-            for part in (queued_note(list(uploads)), *(f"warning: {p.sentence()}" for p in partners))
-            if part
-        )
+        warnings = [f"warning: {partner.sentence()}" for partner in partners]
+        resp.note = "; ".join(part for part in (queued_note(list(uploads)), *warnings) if part)
     return event

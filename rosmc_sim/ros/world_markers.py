@@ -35,7 +35,10 @@ MIN_PERIOD = 0.5
 CIRCLE_POINTS = 72
 LANDER_HEIGHT = 1.2
 SCORE_HEIGHT = 8.0  # the score text floats this high over the lander (above the TF labels)
-IDENTIFIED = {LEVEL_SCIENCE: "identified by the science rover", LEVEL_COLLABORATIVE: "identified by both"}
+IDENTIFIED = {
+    LEVEL_SCIENCE: "identified by the science rover",
+    LEVEL_COLLABORATIVE: "identified by both",
+}
 _BOX_COLORS = {
     "wifi": (0.25, 0.55, 0.95, 1.0),
     "sample": (0.90, 0.90, 0.90, 1.0),
@@ -145,7 +148,8 @@ def _science_markers(sim: Simulation) -> list[Marker]:
         label = _marker("region_labels", i, Marker.TEXT_VIEW_FACING, spec.x, spec.y, 1.5)
         label.scale.z = 0.8
         how = IDENTIFIED.get(region.identified, "not identified")
-        label.text = f"{spec.name} (max {spec.max_score:g})\n{how}, {sim.stones_left(spec.name)} left"
+        left = sim.stones_left(spec.name)
+        label.text = f"{spec.name} (max {spec.max_score:g})\n{how}, {left} left"
         out.append(label)
     score = _marker("score", 0, Marker.TEXT_VIEW_FACING, 0.0, 0.0, SCORE_HEIGHT)
     score.scale.z = 2.5

@@ -572,7 +572,12 @@ def test_status_prints_the_science_score_when_published(
     publisher = rospy.Publisher(SCIENCE_TOPIC, ScienceState, queue_size=1, latch=True)
     try:
         region = SampleRegion(
-            name="RSS A", x=16, y=9, radius=3, max_score=1, stones_left=2,
+            name="RSS A",
+            x=16,
+            y=9,
+            radius=3,
+            max_score=1,
+            stones_left=2,
             identified_by="collaborative",
         )
         publisher.publish(ScienceState(regions=[region], score=1.0, stones_delivered=1))

@@ -328,8 +328,9 @@ def test_a_two_robot_barrier_plan_goes_out_with_one_click_and_one_question(
         ctrl_click_row(window, "science_rover", 0)
         QTest.mouseClick(window.w.control.buttons["synchronize"], Qt.LeftButton)
         wait_until(lambda: len(questions.asked) == 1, 10, "the question")
-        assert "drone will wait at a barrier for ever unless you also send science_rover's" in (
-            questions.asked[0]
+        assert (
+            "drone will wait at a barrier for ever unless you also send science_rover's"
+            in (questions.asked[0])
         ), questions.asked
         before = window.w.view.revision
         # Send all robots: one question for the team (no robot listed twice), then one change.
@@ -364,7 +365,12 @@ def test_the_science_score_is_in_view_once_published(
     try:
         regions = [
             wire.SampleRegion(
-                name="RSS A", x=16, y=9, radius=3, max_score=1, stones_left=1,
+                name="RSS A",
+                x=16,
+                y=9,
+                radius=3,
+                max_score=1,
+                stones_left=1,
                 identified_by="collaborative",
             ),
             wire.SampleRegion(name="RSS B", x=30, y=-16, radius=3.5, max_score=0.8, stones_left=2),

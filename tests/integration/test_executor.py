@@ -228,9 +228,7 @@ def test_team_send_is_one_change_for_every_robot_or_none(rosmc: Start) -> None:
         assert after.revision == before.revision, (agents, uptos)
         assert describe(after) == describe(before), (agents, uptos)
     seen = len(op.events)
-    response = op.call(
-        "synchronize_team", base_revision=before.revision, agents=[], upto_ids=[]
-    )
+    response = op.call("synchronize_team", base_revision=before.revision, agents=[], upto_ids=[])
     assert response.revision == before.revision + 1
     assert list(response.agents) == ["r1", "r2"]
     assert list(response.skill_ids) == r1 + r2

@@ -29,7 +29,7 @@ def two_barriers(gui: Gui) -> tuple[list[str], list[str]]:
 
 
 def test_send_all_robots_asks_once_and_sends_every_plan_in_one_request(gui: Gui) -> None:
-    alpha, bravo = two_barriers(gui)
+    two_barriers(gui)
     asked: list[tuple[str, list[str]]] = []
     answers = [False, True]
 
@@ -64,8 +64,6 @@ def test_send_up_to_the_selected_skills_lists_every_warning_in_one_question(gui:
     gui.click_row("bravo", True, 0, Qt.ControlModifier)
     assert "synchronize" in gui.enabled()
     QTest.mouseClick(gui.widget.control.buttons["synchronize"], Qt.LeftButton)
-    assert asked == [
-        ["alpha will wait at a barrier for ever unless you also send bravo's 'wait'."]
-    ]
+    assert asked == [["alpha will wait at a barrier for ever unless you also send bravo's 'wait'."]]
     assert gui.backend.operations() == ["synchronize_team"]
     assert gui.backend.requests[0].args == ({"alpha": alpha[1], "bravo": bravo[0]},)
