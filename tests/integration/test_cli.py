@@ -22,11 +22,12 @@ from typing import Any
 
 import pytest
 import rospy
-from rosmc.msg import SampleRegion, ScienceState
+from rosmc.msg import ScienceState
 
 from rosmc_server.cli.parser import build_parser
 from rosmc_server.cli.values import parse_vertices, typed_values
 from rosmc_server.conversions import library_to_msg
+from rosmc_server.conversions.science import science_to_msg
 from rosmc_server.core import (
     InvalidRequest,
     MarkerType,
@@ -36,6 +37,7 @@ from rosmc_server.core import (
     TaskMarker,
     load_library,
 )
+from rosmc_server.core.science import RegionScience, Science
 from rosmc_server.interface import SCIENCE_TOPIC
 from rosmc_server.ros.client import (
     MissionClient,
@@ -571,16 +573,8 @@ def test_status_prints_the_science_score_when_published(
     init_node("cli_science_publisher")
     publisher = rospy.Publisher(SCIENCE_TOPIC, ScienceState, queue_size=1, latch=True)
     try:
-        region = SampleRegion(
-            name="RSS A",
-            x=16,
-            y=9,
-            radius=3,
-            max_score=1,
-            stones_left=2,
-            identified_by="collaborative",
-        )
-        publisher.publish(ScienceState(regions=[region], score=1.0, stones_delivered=1))
+        region = RegionScience("RSS A", 16, 9, 3, 1, 2, "collaborative")
+        publisher.publish(science_to_msg(Science(1.0, 1, (region,))))
         lines = rosmc(server, "status").splitlines()
         assert lines[1:3] == [
             "science score 1.00: 1 stone(s) delivered to the lander; regions discovered: RSS A",

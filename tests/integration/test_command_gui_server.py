@@ -38,7 +38,9 @@ from rosmc_rqt_command.command_widget import CommandWidget
 from rosmc_rqt_command.legality import Action
 from rosmc_rqt_command.science_strip import NO_SCORE
 from rosmc_rqt_command.standalone import build
+from rosmc_server.conversions.science import science_to_msg
 from rosmc_server.core import LostLinkKind, LostLinkPolicy
+from rosmc_server.core.science import RegionScience, Science
 from rosmc_server.interface import SCIENCE_TOPIC
 from rosmc_server.ros.client import MissionClient
 from tests import conftest
@@ -363,19 +365,11 @@ def test_the_science_score_is_in_view_once_published(
     assert strip.isVisible() and strip.text() == NO_SCORE
     publisher = rospy.Publisher(SCIENCE_TOPIC, wire.ScienceState, queue_size=1, latch=True)
     try:
-        regions = [
-            wire.SampleRegion(
-                name="RSS A",
-                x=16,
-                y=9,
-                radius=3,
-                max_score=1,
-                stones_left=1,
-                identified_by="collaborative",
-            ),
-            wire.SampleRegion(name="RSS B", x=30, y=-16, radius=3.5, max_score=0.8, stones_left=2),
-        ]
-        publisher.publish(wire.ScienceState(regions=regions, score=1.1, stones_delivered=2))
+        regions = (
+            RegionScience("RSS A", 16, 9, 3, 1, 1, "collaborative"),
+            RegionScience("RSS B", 30, -16, 3.5, 0.8, 2, ""),
+        )
+        publisher.publish(science_to_msg(Science(1.1, 2, regions)))
         wait_until(lambda: strip.science is not None, 10, "the science state")
     finally:
         publisher.unregister()
