@@ -41,12 +41,17 @@ SKILL_ACTIONS: dict[Action, tuple[str, str, str]] = {
         "The selected skills no longer wait for each other",
     ),
 }
-# (text, shortcut) of each action on every robot at once.
-ALL_ROBOT_ACTIONS: dict[RobotAction, tuple[str, str]] = {
-    RobotAction.START: ("Start all", "F6"),
-    RobotAction.PAUSE: ("Pause all", "F7"),
-    RobotAction.RESUME: ("Resume all", "F8"),
-    RobotAction.STOP: ("Stop all", "F9"),
+# (text, shortcut, tooltip) of each action on every robot at once.
+ALL_ROBOT_ACTIONS: dict[RobotAction, tuple[str, str, str]] = {
+    RobotAction.SYNC_ALL: (
+        "Send all robots",
+        "F4",
+        "Synchronize every robot's whole plan in one step (one question, all or nothing)",
+    ),
+    RobotAction.START: ("Start all", "F6", "Start every robot"),
+    RobotAction.PAUSE: ("Pause all", "F7", "Pause every robot"),
+    RobotAction.RESUME: ("Resume all", "F8", "Resume every robot"),
+    RobotAction.STOP: ("Stop all", "F9", "Stop every robot"),
 }
 FILE_ACTIONS: dict[str, tuple[str, str, str]] = {
     "new": ("&New mission", "Ctrl+N", "Start an empty mission"),
@@ -76,8 +81,7 @@ class CommandActions(QObject):  # type: ignore[misc]
         self.file: dict[str, QAction] = {}
         for action, (text, keys, tip) in SKILL_ACTIONS.items():
             self.skill[action] = self._make(owner, text, keys, tip, action.value)
-        for robot_action, (text, keys) in ALL_ROBOT_ACTIONS.items():
-            tip = f"{text.split()[0]} every robot"
+        for robot_action, (text, keys, tip) in ALL_ROBOT_ACTIONS.items():
             self.all_robots[robot_action] = self._make(
                 owner, text, keys, tip, f"{robot_action.value}_all"
             )

@@ -39,6 +39,8 @@ from .mission_view import MissionView
 from .parameter_panel import ParameterPanel
 from .requests import Answer, Backend, Request
 from .schedule_widget import ScheduleWidget
+from .science_strip import ScienceStrip
+from .team_dialog import ask_team_send
 from .view_state import ViewUpdate
 
 # Robot headers and robot buttons follow live reports at most this often (ms): robots
@@ -63,7 +65,9 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.files = FileController(self, self.actions_, self.view, self.messages, self.send)
         self._checker = alerts.ParameterChecker()
         self._robot_legal = RobotLegality()
-        self.dispatcher = Dispatcher(self.view, self.send, self._confirm, self._robot_legal.any)
+        self.dispatcher = Dispatcher(
+            self.view, self.send, self._confirm, self._robot_legal.any, self._confirm_team
+        )
         self._select_when_seen: list[str] = []
         self._pending_statuses: dict[str, AgentStatus] = {}
         self.connected = False
@@ -113,6 +117,8 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         left_layout = QVBoxLayout(left)
         left_layout.setContentsMargins(0, 0, 0, 0)
         left_layout.setSpacing(2)
+        self.science = ScienceStrip()
+        left_layout.addWidget(self.science)
         left_layout.addWidget(self.schedule, 1)
         left_layout.addWidget(self.legend)
         self.splitter = QSplitter(Qt.Horizontal)
@@ -282,6 +288,9 @@ class CommandWidget(QWidget):  # type: ignore[misc]
             QMessageBox.No,
         )
         return bool(answer == QMessageBox.Yes)
+
+    def _confirm_team(self, text: str, warnings: list[str]) -> bool:
+        return ask_team_send(self, text, warnings)
 
     # -- slots ----------------------------------------------------------------------------------
     def _on_schedule_selection_changed(self, ids: list[str]) -> None:

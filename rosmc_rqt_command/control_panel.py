@@ -44,6 +44,8 @@ class ControlPanel(QGroupBox):  # type: ignore[misc]
                 grid.addWidget(self._button(actions.skill[kind], kind.value), row, column)
         layout.addLayout(grid)
         layout.addWidget(QLabel("All robots:"))
+        send = actions.all_robots[RobotAction.SYNC_ALL]
+        layout.addWidget(self._button(send, "send_all"))
         robots = QGridLayout()
         for column, robot_action in enumerate(ROBOT_ROW):
             action = actions.all_robots[robot_action]

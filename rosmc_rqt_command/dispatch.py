@@ -14,9 +14,10 @@ from typing import Any
 from rosmc_server.core import SkillInstance
 
 from . import alerts
-from .legality import Action, RobotAction, legal_actions, legal_robot_actions
+from .legality import Action, RobotAction, legal_actions, legal_robot_actions, selection_agent
 from .mission_view import MissionView
 from .requests import Request
+from .team_send import plan_team_send, team_question, up_to_selection, whole_team
 
 CONTROL_WORDS = {
     RobotAction.START: "START",
@@ -25,6 +26,7 @@ CONTROL_WORDS = {
     RobotAction.STOP: "STOP",
 }
 Confirm = Callable[[list[str]], bool]  # warnings -> send anyway?
+ConfirmTeam = Callable[[str, list[str]], bool]  # what goes, warnings -> send?
 
 
 class Dispatcher:
@@ -35,6 +37,7 @@ class Dispatcher:
         send: Hands a request to the backend.
         confirm: Asked with the warnings before a barrier member goes alone.
         legal_for_all: The robot actions legal on at least one robot now.
+        confirm_team: Asked once, with what goes and every warning, before a team send.
     """
 
     def __init__(
@@ -43,10 +46,12 @@ class Dispatcher:
         send: Callable[[Request], None],
         confirm: Confirm,
         legal_for_all: Callable[[], set[RobotAction]],
+        confirm_team: ConfirmTeam,
     ) -> None:
         self._view = view
         self._send = send
         self.confirm = confirm  # tests answer the question through this
+        self.confirm_team = confirm_team
         self._legal_for_all = legal_for_all
 
     def request(self, operation: str, *args: Any, what: str, **kwargs: Any) -> None:
@@ -65,6 +70,8 @@ class Dispatcher:
         elif kind in (Action.MOVE_UP, Action.MOVE_DOWN):
             order = moved([s.id for s in view.view(first.agent).editable], selected, kind)
             self.request("reorder", first.agent, order, what=f"move {names}")
+        elif kind is Action.SYNC and selection_agent(selected) is None:
+            self.send_team(up_to_selection(view, list(selected)))
         elif kind is Action.SYNC:
             editable = view.view(first.agent).editable
             last = max(view.position(s) for s in selected)
@@ -101,13 +108,25 @@ class Dispatcher:
         if kind not in legal:
             return
         who = "every robot" if agent is None else agent
-        if kind is RobotAction.SYNC_ALL and agent is not None:
+        if kind is RobotAction.SYNC_ALL and agent is None:
+            self.send_team(whole_team(self._view))
+        elif kind is RobotAction.SYNC_ALL and agent is not None:
             if self._barriers_ok(self._view.view(agent).editable):
                 self.request("synchronize", agent, None, what=f"send {agent}'s whole plan")
         elif kind is RobotAction.UNSYNC_ALL and agent is not None:
             self.request("unsynchronize", agent, None, what=f"take back {agent}'s plan")
         elif kind in CONTROL_WORDS:
             self.request("control", CONTROL_WORDS[kind], agent, what=f"{kind.value} {who}")
+
+    def send_team(self, uploads: dict[str, str | None]) -> None:
+        """Send several robots' plans in one change, after one question listing every warning."""
+        send = plan_team_send(self._view, uploads)
+        if send is None:
+            return
+        text, warnings = team_question(self._view, send)
+        if self.confirm_team(text, warnings):
+            robots = ", ".join(send.sending)
+            self.request("synchronize_team", dict(send.uploads), what=f"send the plans of {robots}")
 
     def _barriers_ok(self, sending: Sequence[SkillInstance]) -> bool:
         warnings = alerts.barrier_warnings(self._view, sending)

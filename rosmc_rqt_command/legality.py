@@ -57,9 +57,8 @@ def legal_actions(view: MissionView, selected: Sequence[SkillInstance]) -> set[A
         return legal
     agent = selection_agent(selected)
     if all(skill.is_editable for skill in selected):
-        legal.add(Action.DELETE)
+        legal.update((Action.DELETE, Action.SYNC))  # several robots: one team send
         if agent is not None:
-            legal.add(Action.SYNC)
             editable = view.view(agent).editable
             ids = [skill.id for skill in editable]
             picked = sorted(ids.index(s.id) for s in selected if s.id in ids)

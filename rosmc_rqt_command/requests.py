@@ -19,6 +19,7 @@ MUTATING = frozenset(
         "delete_skills",
         "reorder",
         "synchronize",
+        "synchronize_team",
         "unsynchronize",
         "retry",
         "skip",

@@ -11,7 +11,8 @@ per-batch work, not one per event.
 
 ROS interface (each name behind ``prefix``, e.g. ``/replay``):
     Subscribes ``/rosmc/mission_events`` (rosmc/MissionEvent) and ``/rosmc/agent_states``
-    (rosmc/AgentStates) through the follower, and ``/rosmc/selection`` (rosmc/Selection).
+    (rosmc/AgentStates) through the follower, ``/rosmc/selection`` (rosmc/Selection) and
+    ``/rosmc/sim/science`` (rosmc/ScienceState, through a ScienceWatch).
     Publishes ``/rosmc/selection`` (rosmc/Selection, latched; live server only).
     Calls the operator services ``/rosmc/<operation>`` (rosmc_server.interface.SERVICES).
 """
@@ -37,6 +38,7 @@ from rosmc_server.ros.client import (
     MissionFollower,
     Outcome,
     RevisionConflict,
+    ScienceWatch,
     ServerUnavailable,
 )
 
@@ -76,6 +78,7 @@ class RosBridge(QObject):  # type: ignore[misc]
     answered = Signal(object)  # Answer
     connection_changed = Signal(bool)
     selection_received = Signal(list, list)  # skill ids, marker names
+    science_received = Signal(object)  # rosmc_server.core.science.Science
 
     def __init__(self, prefix: str = "", timeout: float = 5.0) -> None:
         super().__init__()
@@ -96,6 +99,7 @@ class RosBridge(QObject):  # type: ignore[misc]
             else rospy.Publisher(topic, wire.Selection, queue_size=1, latch=True)
         )
         self._selection_sub = rospy.Subscriber(topic, wire.Selection, self._on_selection)
+        self._science = ScienceWatch(prefix, self.science_received.emit)
 
     @property
     def mirror_revision(self) -> int | None:
@@ -111,6 +115,7 @@ class RosBridge(QObject):  # type: ignore[misc]
         """Stop following and calling (pending calls are dropped)."""
         self._unsubscribe()
         self._selection_sub.unregister()
+        self._science.close()
         if self._selection_pub is not None:
             self._selection_pub.unregister()
         self._follower.close()

@@ -31,6 +31,7 @@ def connect(widget: CommandWidget, bridge: RosBridge) -> None:
     bridge.answered.connect(widget.on_answer)
     bridge.connection_changed.connect(widget.on_connection)
     bridge.selection_received.connect(widget.on_remote_selection)
+    bridge.science_received.connect(widget.science.show_science)
 
 
 class CommandWindow(QMainWindow):  # type: ignore[misc]

@@ -44,6 +44,7 @@ SERVICES = {
     "delete_skills": "DeleteSkills",
     "reorder_skills": "ReorderSkills",
     "synchronize": "Synchronize",
+    "synchronize_team": "SynchronizeTeam",
     "unsynchronize": "Unsynchronize",
     "control": "Control",
     "set_robot_options": "SetRobotOptions",

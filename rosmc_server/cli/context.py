@@ -9,7 +9,8 @@ from dataclasses import asdict, dataclass, field
 from typing import Any, TextIO
 
 from ..core import AgentStatus
-from ..ros.client import MissionClient, MissionWatch, Result, init_node
+from ..core.science import Science
+from ..ros.client import MissionClient, MissionWatch, Result, ScienceWatch, init_node
 
 # How long `rosmc status` waits for the robots' states (the server publishes at 2 Hz).
 STATES_WAIT = 1.5
@@ -61,6 +62,15 @@ class Context:
         note = getattr(result, "note", "")
         self.emit(f"{line}\n{note}" if note else line, asdict(result))
         return 0
+
+    def science(self) -> Science | None:
+        """The science state if someone publishes it (waiting briefly for it); else None."""
+        init_node()
+        watch = ScienceWatch()
+        try:
+            return watch.wait(min(self.client.timeout, STATES_WAIT))
+        finally:
+            watch.close()
 
     def agent_states(self) -> dict[str, AgentStatus]:
         """The robots' latest states, waiting briefly for them; empty if none arrive."""

@@ -89,11 +89,38 @@ def delete_barrier(ctx: Context) -> int:
 
 
 def sync(ctx: Context) -> int:
-    """Upload a robot's blueprint (up to --upto)."""
+    """Upload a robot's blueprint (up to --upto), or every robot's at once (--all)."""
     args = ctx.args
-    result = ctx.client.synchronize(args.agent, args.upto, **ctx.against())
+    uptos = args.upto or []
+    if args.team:
+        return sync_team(ctx, uptos)
+    if not args.agent or len(uptos) > 1:
+        raise InvalidRequest("name one robot (and at most one --upto), or give --all")
+    result = ctx.client.synchronize(args.agent, uptos[0] if uptos else None, **ctx.against())
     ids = ", ".join(result.skill_ids)
     return ctx.emit_result(result, f"uploading to {args.agent}: {ids} (revision {result.revision})")
+
+
+def sync_team(ctx: Context, uptos: list[str]) -> int:
+    """Upload every robot's blueprint in one change; each --upto stops its own robot early."""
+    if ctx.args.agent:
+        raise InvalidRequest("--all sends every robot; name no robot with it")
+    state = ctx.client.get_mission()
+    uploads: dict[str, str | None] = {}
+    for agent in state.agents:
+        if state.sections(agent).editable_start < len(state.task(agent)):
+            uploads[agent] = None
+    for upto in uptos:
+        agent, _ = state.locate(upto)  # NotFound for an unknown id
+        uploads[agent] = upto
+    result = ctx.client.synchronize_team(uploads, **ctx.against())
+    lines = [
+        f"uploading to {agent}: "
+        + ", ".join(i for i in result.skill_ids if state.locate(i)[0] == agent)
+        for agent in result.agents
+    ]
+    lines.append(f"(revision {result.revision})")
+    return ctx.emit_result(result, "\n".join(lines))
 
 
 def unsync(ctx: Context) -> int:

@@ -103,7 +103,9 @@ def _add_views(command: _Command) -> None:
     status = command("status", "print every robot's schedule, link and telemetry")
     status.add_argument("-v", "--verbose", action="store_true", help="show parameter values")
     status.add_argument(
-        "--no-states", action="store_true", help="do not wait for the robots' link states"
+        "--no-states",
+        action="store_true",
+        help="do not wait for the robots' link states or the science score",
     )
     library = command("library", "print the agents, their skills and parameter schemas")
     library.add_argument("agent", nargs="?", metavar="AGENT", help="only this agent")
@@ -162,8 +164,19 @@ def _add_options(parser: argparse.ArgumentParser) -> None:
 
 def _add_execution(command: _Command) -> None:
     sync = command("sync", "upload a robot's blueprint (or a prefix of it) to the robot")
-    sync.add_argument("agent", metavar="ROBOT")
-    sync.add_argument("--upto", metavar="ID", help="upload up to and including this skill")
+    sync.add_argument("agent", metavar="ROBOT", nargs="?")
+    sync.add_argument(
+        "--upto",
+        metavar="ID",
+        action="append",
+        help="upload up to and including this skill (with --all: once per robot that stops early)",
+    )
+    sync.add_argument(
+        "--all",
+        dest="team",
+        action="store_true",
+        help="every robot with planned skills, in one change: all of them or none",
+    )
     unsync = command("unsync", "pull not-started synchronized skills back to the blueprint")
     unsync.add_argument("agent", metavar="ROBOT")
     unsync.add_argument(

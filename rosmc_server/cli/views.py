@@ -24,15 +24,21 @@ from .context import Context
 
 
 def status(ctx: Context) -> int:
-    """Every robot's schedule, plus its link and telemetry line (and a journal alert first)."""
+    """Every robot's schedule with its link and telemetry line, the science score if published
+    (and a journal alert first)."""
     state = ctx.client.get_mission()
     library = ctx.client.library()
     statuses = None if ctx.args.no_states else ctx.agent_states()
     alert = ctx.client.journal_alert
+    science = None if ctx.args.no_states else ctx.science()
     if ctx.json:
-        ctx.emit("", {**mission_to_json(state, library, statuses), "journal_alert": alert})
+        data = {**mission_to_json(state, library, statuses), "journal_alert": alert}
+        ctx.emit("", {**data, "science": science.to_dict() if science else None})
         return 0
     text = format_schedule(state, statuses=statuses, verbose=ctx.args.verbose)
+    if science is not None:  # what the mission is for, under the schedule's first line
+        first, _, rest = text.partition("\n")
+        text = "\n".join([first, *science.lines(), rest])
     if alert:  # first, where nobody misses it
         text = f"{alert}\n{text}"
     if state.markers:

@@ -69,10 +69,16 @@ def commands_for_event(event: MissionEvent, state: MissionState) -> list[Command
     """The commands an event (already applied to ``state``) requires."""
     change = event.change
     kind = event.kind
-    if kind is EventKind.SYNC_REQUESTED:
-        skills = tuple(placed.skill for placed in change.put_skills)
-        barriers = queued_barriers(state, event.agent)
-        return [CommandSpec(event.agent, CommandKind.UPLOAD, skills, barriers=barriers)]
+    if kind is EventKind.SYNC_REQUESTED:  # one robot's upload, or a team's (one per robot)
+        by_agent: dict[str, list[SkillInstance]] = {}
+        for placed in change.put_skills:
+            by_agent.setdefault(placed.skill.agent, []).append(placed.skill)
+        return [
+            CommandSpec(
+                agent, CommandKind.UPLOAD, tuple(skills), barriers=queued_barriers(state, agent)
+            )
+            for agent, skills in by_agent.items()
+        ]
     if kind in (EventKind.UNSYNC_REQUESTED, EventKind.UPLOAD_CANCELLED):
         # A cancelled upload may have reached the robot after all: have it dropped.
         ids = tuple(placed.skill.id for placed in change.put_skills)

@@ -13,7 +13,7 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 
-from . import barriers, editing, execution, markers
+from . import barriers, editing, execution, markers, team
 from .changes import Change, EventKind, MissionEvent, Proposal, SkillMove
 from .errors import RuleViolation, StaleRevision
 from .library import Library
@@ -158,6 +158,15 @@ class Mission:
         """Start uploading a prefix of the agent's blueprint to its robot."""
         self._check_revision(base_revision)
         return self._commit(execution.plan_synchronize(self.state, agent, upto_id))
+
+    def synchronize_team(
+        self, uploads: team.TeamUploads | None = None, *, base_revision: int | None = None
+    ) -> MissionEvent:
+        """Start uploading several robots' blueprints in one change (None: every robot's all)."""
+        self._check_revision(base_revision)
+        if uploads is None:
+            uploads = team.robots_with_blueprints(self.state, list(self.state.agents))
+        return self._commit(team.plan_synchronize_team(self.state, uploads))
 
     def confirm_synchronized(self, agent: str, skill_ids: Sequence[str]) -> MissionEvent:
         """The robot acknowledged the upload of these skills."""

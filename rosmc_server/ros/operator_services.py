@@ -47,6 +47,7 @@ from ..core.commands import CommandKind, CommandSpec
 from ..core.link import LinkStatus
 from ..core.policy import options_argument
 from .command_queue import MAX_UNSENT
+from .team_sync import synchronize_team
 from .whole_mission import WholeMissionServices
 
 if TYPE_CHECKING:
@@ -229,6 +230,9 @@ class OperatorServices:
                 self._queued_note([req.agent]), *(f"warning: {p.sentence()}" for p in partners)
             )
         return event
+
+    def _synchronize_team(self, req: Any, resp: Any) -> MissionEvent:
+        return synchronize_team(self._server, self._require_link, self._queued_note, req, resp)
 
     def _unsynchronize(self, req: Any, resp: Any) -> MissionEvent:
         with self._server.locked():

@@ -253,6 +253,10 @@ class Simulation:
     # -- coverage ------------------------------------------------------------------
     def wifi(self, robot: Robot) -> tuple[float, bool]:
         """Signal strength (dBm) of the best source, and whether the robot is covered."""
+        return self.signal_at(robot.x, robot.y, robot.z + 0.5)
+
+    def signal_at(self, x: float, y: float, z: float = 0.5) -> tuple[float, bool]:
+        """Signal strength (dBm) and coverage at a point (``z``: the antenna's height)."""
         sources = [(0.0, 0.0, self.scenario.lander_wifi_radius)]
         sources += [
             (b.x, b.y, b.spec.wifi_radius)
@@ -260,9 +264,9 @@ class Simulation:
             if b.deployed and b.spec.kind == "wifi"
         ]
         best_dbm, covered = -120.0, False
-        for x, y, radius in sources:
-            distance = max(1.0, robot.distance_to(x, y))
-            sight = self._sight((x, y, 2.0), (robot.x, robot.y, robot.z + 0.5))
+        for sx, sy, radius in sources:
+            distance = max(1.0, math.hypot(x - sx, y - sy))
+            sight = self._sight((sx, sy, 2.0), (x, y, z))
             dbm = -40.0 - 25.0 * math.log10(distance) - (0.0 if sight else 20.0)
             best_dbm = max(best_dbm, dbm)
             covered = covered or (distance <= radius and sight)
@@ -300,6 +304,14 @@ class Simulation:
             if region.discovered and math.hypot(x - spec.x, y - spec.y) <= spec.radius + margin:
                 return region
         return None
+
+    def stones_left(self, region: str) -> int:
+        """Stones still lying in ``region`` (neither carried nor delivered)."""
+        return sum(
+            1
+            for s in self.stones.values()
+            if s.region == region and not s.carried_by and not s.delivered
+        )
 
     def stone_value(self, stone: Stone) -> float:
         """What a stone scores when it reaches the lander."""

@@ -27,6 +27,7 @@ COLORS = {
     "stones": (0.30, 0.30, 0.32, 1.0),
     "regions": (0.95, 0.85, 0.20, 0.35),
     "region_labels": (1.0, 1.0, 1.0, 1.0),
+    "score": (1.0, 0.45, 0.85, 1.0),  # the science score over the lander: a colour of its own
     "wifi": (0.20, 0.60, 1.00, 0.8),
 }
 ROBOT_SIZE = {

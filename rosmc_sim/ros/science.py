@@ -34,11 +34,7 @@ def science_state(sim: Simulation, events: list[str]) -> wire.ScienceState:
 
 def _region(sim: Simulation, region: RegionState) -> wire.SampleRegion:
     spec = region.spec
-    left = sum(
-        1
-        for s in sim.stones.values()
-        if s.region == spec.name and not s.carried_by and not s.delivered
-    )
+    left = sim.stones_left(spec.name)
     return wire.SampleRegion(
         name=spec.name,
         x=spec.x,

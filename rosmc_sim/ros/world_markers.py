@@ -2,8 +2,10 @@
 
 One array holds everything (after a DELETEALL, so what disappeared goes): the
 ground, obstacles, slopes (flat, translucent), the lander, payload boxes,
-discovered regions (translucent discs with a label), the stones lying in them,
-and the Wi-Fi coverage circles of the lander and of deployed Wi-Fi boxes.
+discovered regions (translucent discs with a label saying how far their stones are
+identified and how many are left), the stones lying in them, the science score and the
+stones delivered (a text over the lander), and the Wi-Fi coverage circles of the lander
+and of deployed Wi-Fi boxes.
 Robot bodies are left to TF and the interactive markers. Namespaces are per
 kind; ids are stable (the scenario's order). The array is republished when
 what it shows changes (checked every :data:`CHECK_PERIOD` wall seconds, sent
@@ -22,7 +24,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 
 from rosmc_server.interface import MAP_FRAME
 
-from ..core.sim import Simulation
+from ..core.sim import LEVEL_COLLABORATIVE, LEVEL_SCIENCE, Simulation
 from ..core.world import BOX_SIZE, COLORS, STONE_RADIUS
 from .robot_state import yaw_quaternion
 from .timing import Throttle
@@ -32,6 +34,11 @@ CHECK_PERIOD = 0.1
 MIN_PERIOD = 0.5
 CIRCLE_POINTS = 72
 LANDER_HEIGHT = 1.2
+SCORE_HEIGHT = 8.0  # the score text floats this high over the lander (above the TF labels)
+IDENTIFIED = {
+    LEVEL_SCIENCE: "identified by the science rover",
+    LEVEL_COLLABORATIVE: "identified by both",
+}
 _BOX_COLORS = {
     "wifi": (0.25, 0.55, 0.95, 1.0),
     "sample": (0.90, 0.90, 0.90, 1.0),
@@ -43,7 +50,8 @@ _BOX_COLORS = {
 def world_signature(sim: Simulation) -> Hashable:
     """What the markers show, coarsely: the array is republished when this changes."""
     return (
-        tuple(r.discovered for r in sim.regions.values()),
+        tuple((r.discovered, r.identified) for r in sim.regions.values()),
+        (round(sim.score, 3), sim.delivered),
         tuple(
             (round(b.x, 1), round(b.y, 1), round(b.z, 1), b.deployed) for b in sim.boxes.values()
         ),
@@ -139,8 +147,14 @@ def _science_markers(sim: Simulation) -> list[Marker]:
         out.append(_sized(disc, 2 * spec.radius, 2 * spec.radius, 0.04))
         label = _marker("region_labels", i, Marker.TEXT_VIEW_FACING, spec.x, spec.y, 1.5)
         label.scale.z = 0.8
-        label.text = f"{spec.name} (max {spec.max_score:g})"
+        how = IDENTIFIED.get(region.identified, "not identified")
+        left = sim.stones_left(spec.name)
+        label.text = f"{spec.name} (max {spec.max_score:g})\n{how}, {left} left"
         out.append(label)
+    score = _marker("score", 0, Marker.TEXT_VIEW_FACING, 0.0, 0.0, SCORE_HEIGHT)
+    score.scale.z = 2.5
+    score.text = f"science score {sim.score:.2f}\n{sim.delivered} stone(s) delivered"
+    out.append(score)
     discovered = {name for name, r in sim.regions.items() if r.discovered}
     for i, stone in enumerate(sim.stones.values()):
         if stone.region in discovered and not stone.carried_by and not stone.delivered:

@@ -21,10 +21,13 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+import rospy
+from rosmc.msg import ScienceState
 
 from rosmc_server.cli.parser import build_parser
 from rosmc_server.cli.values import parse_vertices, typed_values
 from rosmc_server.conversions import library_to_msg
+from rosmc_server.conversions.science import science_to_msg
 from rosmc_server.core import (
     InvalidRequest,
     MarkerType,
@@ -34,13 +37,17 @@ from rosmc_server.core import (
     TaskMarker,
     load_library,
 )
+from rosmc_server.core.science import RegionScience, Science
+from rosmc_server.interface import SCIENCE_TOPIC
 from rosmc_server.ros.client import (
     MissionClient,
     RevisionConflict,
     ServerUnavailable,
+    init_node,
     library_from_msg,
 )
 from rosmc_server.text import mission_to_json
+from tests.conftest import wait_until
 
 REPO = Path(__file__).resolve().parents[2]
 ROSMC = REPO / "scripts" / "rosmc"
@@ -520,6 +527,66 @@ def test_sync_shows_uploading(server: Server, fresh: MissionClient) -> None:
     assert cancelled.returncode == 0, (cancelled.stdout, cancelled.stderr)
     drone = skills_of(status(server), "drone")
     assert [s["transfer"] for s in drone] == ["NONE", "NONE", "NONE"], drone
+
+
+def test_sync_all_sends_every_robot_in_one_change(server: Server, fresh: MissionClient) -> None:
+    ids = build_mission(fresh)
+    fresh.add_barrier([ids["sci"], ids["man"]])
+    before = status(server)
+    # One robot's refusal (an unknown stop) sends nobody anything.
+    (refused,) = run_many(server.env, [["sync", "--all", "--upto", "nosuch"]])
+    assert_refused(refused, "nosuch")
+    assert status(server)["revision"] == before["revision"]
+    out = rosmc(server, "sync", "--all", "--upto", ids["cover"])
+    assert out.splitlines() == [
+        f"uploading to drone: {ids['climb']}, {ids['cover']}",
+        f"uploading to science_rover: {ids['sci']}",
+        f"uploading to manipulator_rover: {ids['man']}",
+        f"(revision {before['revision'] + 1})",
+        "queued for drone, science_rover, manipulator_rover: not heard since the server "
+        "started; it goes out when the robot first reports",
+    ], out
+    data = status(server)
+    assert data["revision"] == before["revision"] + 1  # one change for the whole team
+    transfers = {
+        a["name"]: [s["transfer"] for s in a["skills"]] for a in data["agents"] if a["skills"]
+    }
+    assert transfers == {
+        "drone": ["UPLOADING", "UPLOADING", "NONE"],
+        "science_rover": ["UPLOADING"],
+        "manipulator_rover": ["UPLOADING"],
+    }, transfers
+    # No robot answers here: take every upload back; then send everything, and again back.
+    results = run_many(server.env, [["unsync", agent] for agent in transfers])
+    assert [r.returncode for r in results] == [0, 0, 0], [r.stderr for r in results]
+    out = rosmc(server, "sync", "--all")
+    assert out.splitlines()[0] == (
+        f"uploading to drone: {ids['climb']}, {ids['cover']}, {ids['land']}"
+    ), out
+    results = run_many(server.env, [["unsync", agent] for agent in transfers])
+    assert [r.returncode for r in results] == [0, 0, 0], [r.stderr for r in results]
+
+
+def test_status_prints_the_science_score_when_published(
+    server: Server, fresh: MissionClient
+) -> None:
+    init_node("cli_science_publisher")
+    publisher = rospy.Publisher(SCIENCE_TOPIC, ScienceState, queue_size=1, latch=True)
+    try:
+        region = RegionScience("RSS A", 16, 9, 3, 1, 2, "collaborative")
+        publisher.publish(science_to_msg(Science(1.0, 1, (region,))))
+        lines = rosmc(server, "status").splitlines()
+        assert lines[1:3] == [
+            "science score 1.00: 1 stone(s) delivered to the lander; regions discovered: RSS A",
+            "  RSS A at (16, 9): identified by both rovers, 2 stone(s) left (best 1)",
+        ], lines
+        science = status(server)["science"]
+        assert (science["score"], science["stones_delivered"]) == (1.0, 1), science
+        assert science["regions"][0]["identified_by"] == "collaborative", science
+    finally:
+        publisher.unregister()
+    wait_until(lambda: "science score" not in rosmc(server, "status"), 20.0, "no score")
+    assert status(server)["science"] is None
 
 
 def journal_of(server: Server) -> Path:

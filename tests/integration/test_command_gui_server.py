@@ -1,4 +1,5 @@
-"""The command GUI when the mission server is gone, slow or restarted; two windows; files.
+"""The command GUI when the mission server is gone, slow or restarted; two windows; files;
+sending the whole team's plans with the mouse; the science score in view.
 
 A real master and real ``mission_server`` processes; the real widget and ROS bridge
 (offscreen Qt). While the server is stopped (or frozen with SIGSTOP) the operator keeps
@@ -18,17 +19,29 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+import rosmc.msg as wire
+import rospy
 
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
 from python_qt_binding.QtCore import Qt, QTimer
 from python_qt_binding.QtTest import QTest
-from python_qt_binding.QtWidgets import QApplication, QDialogButtonBox, QFileDialog, QLineEdit
+from python_qt_binding.QtWidgets import (
+    QApplication,
+    QDialogButtonBox,
+    QFileDialog,
+    QLineEdit,
+    QMessageBox,
+)
 
 from rosmc_rqt_command.command_widget import CommandWidget
 from rosmc_rqt_command.legality import Action
+from rosmc_rqt_command.science_strip import NO_SCORE
 from rosmc_rqt_command.standalone import build
+from rosmc_server.conversions.science import science_to_msg
 from rosmc_server.core import LostLinkKind, LostLinkPolicy
+from rosmc_server.core.science import RegionScience, Science
+from rosmc_server.interface import SCIENCE_TOPIC
 from rosmc_server.ros.client import MissionClient
 from tests import conftest
 from tests.integration.server_fixtures import ServerProcess, StartServer
@@ -260,6 +273,111 @@ def test_two_windows_stay_consistent_and_a_stale_edit_is_a_conflict(
     message = first.said("set drone's policy (on link loss: hold after 30 s)")
     assert "Done:" in message, message
     no_traceback(first)
+
+
+class Questions:
+    """Answers the modal questions the window asks (real QMessageBoxes) and keeps their text."""
+
+    def __init__(self, answers: list[QMessageBox.StandardButton]) -> None:
+        self.answers = answers
+        self.asked: list[str] = []
+        self.timer = QTimer()
+        self.timer.timeout.connect(self._answer)
+        self.timer.start(20)
+
+    def _answer(self) -> None:
+        box = QApplication.activeModalWidget()
+        if isinstance(box, QMessageBox) and box.isVisible():
+            self.asked.append(box.text())
+            QTest.mouseClick(box.button(self.answers.pop(0)), Qt.LeftButton)
+
+    def stop(self) -> None:
+        self.timer.stop()
+
+
+def ctrl_click_row(window: Window, agent: str, row: int) -> None:
+    table = window.w.schedule.columns[agent].blueprint_table
+    rect = table.visualRect(table.section.index(row, 2))
+    QTest.mouseClick(table.viewport(), Qt.LeftButton, Qt.ControlModifier, rect.center())
+
+
+def test_a_two_robot_barrier_plan_goes_out_with_one_click_and_one_question(
+    start_server: StartServer, windows: Any
+) -> None:
+    start_server()
+    window = windows()
+    shown(window)
+    for agent, skill in [("drone", "take_off"), ("drone", "land")] + [
+        ("science_rover", "navigate_to")
+    ] * 2:
+        window.add(agent, skill)
+    wait_until(
+        lambda: len(window.ids("drone")) == 2 and len(window.ids("science_rover")) == 2,
+        10,
+        "the four skills",
+    )
+    for row in (0, 1):  # barriers: the firsts start together, and so do the seconds
+        window.click_row("drone", row)
+        ctrl_click_row(window, "science_rover", row)
+        QTest.mouseClick(window.w.control.buttons["barrier"], Qt.LeftButton)
+        window.said("Done: start 'take_off', 'navigate_to' together" if row == 0 else "'land'")
+    wait_until(lambda: len(window.w.view.barriers) == 2, 10, "both barriers shown")
+    questions = Questions([QMessageBox.No, QMessageBox.Yes])
+    try:
+        # The drone up to 'land' but the rover only up to its first skill: one question
+        # names the barrier that would wait for ever; answered No, nothing is sent.
+        window.click_row("drone", 1)
+        ctrl_click_row(window, "science_rover", 0)
+        QTest.mouseClick(window.w.control.buttons["synchronize"], Qt.LeftButton)
+        wait_until(lambda: len(questions.asked) == 1, 10, "the question")
+        assert (
+            "drone will wait at a barrier for ever unless you also send science_rover's"
+            in (questions.asked[0])
+        ), questions.asked
+        before = window.w.view.revision
+        # Send all robots: one question for the team (no robot listed twice), then one change.
+        QTest.mouseClick(window.w.control.buttons["send_all"], Qt.LeftButton)
+        message = window.said("Done: send the plans of drone, science_rover")
+    finally:
+        questions.stop()
+    assert len(questions.asked) == 2, questions.asked
+    team = questions.asked[1]
+    assert "drone: 2 skill(s), its whole plan" in team and "science_rover: 2 skill(s)" in team
+    assert "Warnings" not in team, team
+    assert f"(revision {before + 1})" in message, message
+    wait_until(
+        lambda: all(
+            window.w.view.view(agent).editable == () for agent in ("drone", "science_rover")
+        ),
+        10,
+        "both plans in transfer",
+    )
+    no_traceback(window)
+
+
+def test_the_science_score_is_in_view_once_published(
+    start_server: StartServer, windows: Any
+) -> None:
+    start_server()
+    window = windows()
+    shown(window)
+    strip = window.w.science
+    assert strip.isVisible() and strip.text() == NO_SCORE
+    publisher = rospy.Publisher(SCIENCE_TOPIC, wire.ScienceState, queue_size=1, latch=True)
+    try:
+        regions = (
+            RegionScience("RSS A", 16, 9, 3, 1, 1, "collaborative"),
+            RegionScience("RSS B", 30, -16, 3.5, 0.8, 2, ""),
+        )
+        publisher.publish(science_to_msg(Science(1.1, 2, regions)))
+        wait_until(lambda: strip.science is not None, 10, "the science state")
+    finally:
+        publisher.unregister()
+    text = strip.text()
+    assert "Science score 1.10" in text and "2 stone(s) delivered" in text, text
+    assert "RSS A (16, 9): identified by both rovers, 1 left" in text, text
+    assert "RSS B (30, -16): not identified, 2 left" in text, text
+    assert "RSS B at (30, -16): not identified, 2 stone(s) left (best 0.8)" in strip.toolTip()
 
 
 def test_save_to_a_local_file_and_open_it_again(

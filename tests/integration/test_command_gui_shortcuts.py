@@ -58,6 +58,7 @@ def test_shortcuts_fire_in_a_real_window(tmp_path: Path) -> None:
         "Ctrl+Backspace": [["unsynchronize", ["alpha", "alpha-1"]]],
         "Ctrl+R": [["retry", ["alpha-1"]]],
         "Ctrl+K": [["skip", ["alpha-1"]]],
+        "F4": [["synchronize_team", [{"alpha": None, "bravo": None}]]],
         "F6": [["control", ["START", None]]],
         "F7": [["control", ["PAUSE", None]]],
         "F8": [["control", ["RESUME", None]]],
@@ -138,6 +139,8 @@ def drive() -> None:
     feed("add_barrier", [alpha[0], bravo])  # barrier-6
     press("Ctrl+Shift+B")
     feed("delete_barrier", "barrier-6")
+    widget.dispatcher.confirm_team = lambda text, warnings: True  # the one question: Yes
+    press("F4")
     feed.sync("alpha", alpha[0])
     select("alpha", 0, blueprint=False)
     press("Ctrl+Backspace")

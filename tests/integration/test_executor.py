@@ -205,6 +205,53 @@ def test_three_robots_two_barriers_run_to_completion_in_a_legal_order(rosmc: Sta
         assert seqs == list(range(1, len(seqs) + 1)), (agent, seqs)
 
 
+def test_team_send_is_one_change_for_every_robot_or_none(rosmc: Start) -> None:
+    """SynchronizeTeam: a refusal for one robot sends nobody; accepted, one revision and event."""
+    system, op = rosmc()
+    r1 = [op.add("r1", "wait", {"duration": 0.1}), op.add("r1", "wait", {"duration": 0.1})]
+    r2 = [op.add("r2", "wait", {"duration": 0.3}), op.add("r2", "wait", {"duration": 0.1})]
+    op.add_barrier([r1[1], r2[1]])
+    before = op.mission()
+    refusals = [
+        (["r1", "r2"], ["", r1[0]], ErrorCode.RULE),  # r1's skill as r2's stop
+        (["r1", "ufo"], [], ErrorCode.NOT_FOUND),
+        (["r1", "r1"], [], ErrorCode.INVALID),
+        (["r1", "r2"], [r1[0]], ErrorCode.INVALID),  # one stop for two robots
+        (["r1", "r3"], [], ErrorCode.RULE),  # r3 has nothing planned
+    ]
+    for agents, uptos, code in refusals:
+        with pytest.raises(OperatorError) as refused:
+            op.call(
+                "synchronize_team", base_revision=before.revision, agents=agents, upto_ids=uptos
+            )
+        assert refused.value.code == code, (agents, uptos, refused.value)
+        assert "\n" not in refused.value.message
+        after = op.mission()
+        assert after.revision == before.revision, (agents, uptos)
+        assert describe(after) == describe(before), (agents, uptos)
+    seen = len(op.events)
+    response = op.call("synchronize_team", base_revision=before.revision, agents=[], upto_ids=[])
+    assert response.revision == before.revision + 1
+    assert list(response.agents) == ["r1", "r2"]
+    assert list(response.skill_ids) == r1 + r2
+    assert response.note == ""  # both barrier members go: nobody waits for ever
+    wait_until(lambda: len(op.events) > seen, 10.0, "the team's event")
+    (_, event), *_ = op.events.since(seen)
+    assert (event.revision, event.kind, event.agent) == (
+        response.revision,
+        wire.MissionEvent.SYNC_REQUESTED,
+        "",
+    )
+    assert [p.skill.id for p in event.put_skills] == r1 + r2
+    wait_all_synced(op, r1 + r2)  # each robot got and confirmed its own upload
+    op.start()
+    op.wait_status(r1 + r2, S.SUCCESS, timeout=20.0)
+    system.stop("server")
+    lines = journal_timelines(system.journal)
+    for skill_id in (r1[1], r2[1]):
+        assert timeline(lines, skill_id) == happy(barrier=True), skill_id
+
+
 def test_barrier_release_skew_over_repeated_runs(rosmc: Start) -> None:
     system, op = rosmc()
     op.start()

@@ -179,6 +179,7 @@ def _leftovers(master_uri: str) -> list[str]:
 def test_rviz_draws_the_site_under_xvfb(ros_master: RosMaster, tmp_path: Path) -> None:
     config = load_config()
     wifi = blended(COLORS["wifi"], background(config))
+    score = blended(COLORS["score"], background(config))  # the score text over the lander
     output, log = tmp_path / "sim.png", tmp_path / "rviz.log"
     started = time.monotonic()
     result = subprocess.run(
@@ -195,6 +196,8 @@ def test_rviz_draws_the_site_under_xvfb(ros_master: RosMaster, tmp_path: Path) -
             "2",
             "--expect-color",
             ",".join(map(str, wifi)),
+            "--expect-color",
+            ",".join(map(str, score)),
             "--log",
             str(log),
         ],
@@ -221,6 +224,7 @@ def test_rviz_draws_the_site_under_xvfb(ros_master: RosMaster, tmp_path: Path) -
     assert view.width > 900 and view.height > 700, "the 3D view is small"
     assert view.distinct_colors() >= 100, "a few colours only: not a rendered scene"
     assert view.fraction_near(tuple(wifi), 24) > 0.0005, "no Wi-Fi coverage circle"
+    assert view.fraction_near(tuple(score), 24) > 0.0001, "no science score over the lander"
     red, green, blue = (view.pixels[..., i].astype(np.int16) for i in range(3))
     brown = (red > green) & (green > blue) & (red - blue >= 25) & (red >= 60)
     assert brown.mean() > 0.003, "no obstacles (brown, lit) on the site"

@@ -294,6 +294,10 @@ def test_fly_over_discovers_a_region(sim: dict[str, Robot]) -> None:
         wait_until(world_shows_region, TIMEOUT, "the region in the world markers")
         namespaces = {m.ns for m in world.last.markers}
         assert {"ground", "obstacles", "lander", "boxes", "wifi", "stones"} <= namespaces
+        # The site says what the science stands at: each region's label and the score.
+        texts = {m.ns: m.text for m in world.last.markers if m.type == m.TEXT_VIEW_FACING}
+        assert texts["region_labels"] == "RSS A (max 1)\nnot identified, 3 left", texts
+        assert texts["score"] == "science score 0.00\n0 stone(s) delivered", texts
     finally:
         science.close()
         world.close()

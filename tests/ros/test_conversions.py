@@ -45,6 +45,7 @@ from rosmc_server.conversions.robot_link import (
     signal_from_msg,
     signal_to_msg,
 )
+from rosmc_server.conversions.science import science_from_msg, science_to_msg
 from rosmc_server.core import (
     AgentKind,
     AgentSpec,
@@ -70,6 +71,7 @@ from rosmc_server.core import (
 )
 from rosmc_server.core.changes import SkillMove
 from rosmc_server.core.commands import CommandKind
+from rosmc_server.core.science import RegionScience, Science
 from rosmc_server.core.site import Footprint, GroundRobot, Shape, SiteCheck, SiteModel
 from rosmc_server.executor.core import Signal, SignalKind
 
@@ -356,3 +358,20 @@ def test_executor_commands_and_barrier_signals_survive() -> None:
     assert command.argument == msg.argument
     signal = Signal("rover", "b1", "rover-1", SignalKind.READY, 12.5)
     assert signal_from_msg(over_the_wire(signal_to_msg(signal))) == signal
+
+
+def test_the_science_state_survives_and_reads_as_sentences() -> None:
+    science = Science(
+        0.85,
+        2,
+        (
+            RegionScience("RSS A", 16.0, 9.0, 3.0, 1.0, 1, "collaborative"),
+            RegionScience("RSS B", 30.0, -16.0, 3.5, 0.8, 2, ""),
+        ),
+    )
+    assert science_from_msg(over_the_wire(science_to_msg(science))) == science
+    assert science.lines() == [
+        "science score 0.85: 2 stone(s) delivered to the lander; regions discovered: RSS A, RSS B",
+        "  RSS A at (16, 9): identified by both rovers, 1 stone(s) left (best 1)",
+        "  RSS B at (30, -16): not identified, 2 stone(s) left (best 0.8)",
+    ]

@@ -62,8 +62,9 @@ def test_planned_skills_of_two_robots_can_start_together(gui: Gui) -> None:
     gui.feed.add("bravo")
     gui.click_row("alpha", True, 0)
     gui.click_row("bravo", True, 0, Qt.ControlModifier)
-    # Not "send" or "move": those act on one robot's plan.
-    assert gui.enabled() == {"delete", "barrier"}
+    # "Send" sends both robots up to their selected skill (one team send); "move" acts on
+    # one robot's plan.
+    assert gui.enabled() == {"delete", "barrier", "synchronize"}
 
 
 def test_two_skills_of_one_robot_cannot_start_together(gui: Gui) -> None:

@@ -21,8 +21,10 @@ from .results import (
     ServerUnavailable,
     SkillAdded,
     SkillRetried,
+    TeamTransferred,
     Transferred,
 )
+from .science import ScienceWatch
 from .watch import MissionWatch, init_node
 from .worker import AsyncMissionClient, Outcome
 
@@ -39,9 +41,11 @@ __all__ = [
     "Outcome",
     "Result",
     "RevisionConflict",
+    "ScienceWatch",
     "ServerUnavailable",
     "SkillAdded",
     "SkillRetried",
+    "TeamTransferred",
     "Transferred",
     "agent_status_from_msg",
     "agent_statuses_from_msg",

@@ -25,6 +25,7 @@ from .results import (
     Result,
     SkillAdded,
     SkillRetried,
+    TeamTransferred,
     Transferred,
 )
 
@@ -204,6 +205,27 @@ class MissionClient(ClientBase):
             "synchronize", base_revision, retry_on_conflict, agent=agent, upto_id=upto_id or ""
         )
         return Transferred(response.revision, tuple(response.skill_ids), response.note)
+
+    def synchronize_team(
+        self,
+        uploads: Mapping[str, str | None] | None = None,
+        *,
+        base_revision: int | None = None,
+        retry_on_conflict: bool = False,
+    ) -> TeamTransferred:
+        """Upload several robots' blueprints in one change, all or nothing.
+
+        ``uploads`` maps each robot to the last skill to send (None: its whole blueprint);
+        None sends every robot's whole blueprint.
+        """
+        agents = list(uploads or {})
+        uptos = [upto or "" for upto in (uploads or {}).values()]
+        response = self._mutate(
+            "synchronize_team", base_revision, retry_on_conflict, agents=agents, upto_ids=uptos
+        )
+        return TeamTransferred(
+            response.revision, tuple(response.skill_ids), response.note, tuple(response.agents)
+        )
 
     def unsynchronize(
         self,

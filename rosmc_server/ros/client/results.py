@@ -62,6 +62,13 @@ class Transferred(Result):
 
 
 @dataclass(frozen=True)
+class TeamTransferred(Transferred):
+    """``synchronize_team`` succeeded: ``agents``' skills ``skill_ids`` are being uploaded."""
+
+    agents: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
 class ControlSent(Result):
     """A control command was sent to the robots of ``agents``."""
 

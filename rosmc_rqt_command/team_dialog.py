@@ -1,0 +1,19 @@
+"""The one question before a team send: what each robot gets, and every warning at once."""
+
+from __future__ import annotations
+
+from python_qt_binding.QtWidgets import QMessageBox, QWidget
+
+
+def ask_team_send(parent: QWidget, text: str, warnings: list[str]) -> bool:
+    """Ask once whether to send; with warnings the safe answer (No) is the default."""
+    box = QMessageBox(parent)
+    box.setObjectName("team_send_question")
+    box.setIcon(QMessageBox.Warning if warnings else QMessageBox.Question)
+    box.setWindowTitle("Send the team's plans")
+    if warnings:
+        text += "\n\nWarnings:\n" + "\n".join(f"  • {w}" for w in warnings)
+    box.setText(text + "\n\nSend?")
+    box.setStandardButtons(QMessageBox.Yes | QMessageBox.No)
+    box.setDefaultButton(QMessageBox.No if warnings else QMessageBox.Yes)
+    return bool(box.exec_() == QMessageBox.Yes)
