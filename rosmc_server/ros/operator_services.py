@@ -234,7 +234,8 @@ class OperatorServices:
                 # An upload still unanswered (the robot may be out of reach) is cancelled:
                 # the operator can always take back what the robot has not confirmed.
                 base = req.base_revision
-                event = self._apply(lambda m: m.cancel_uploads(req.agent, base_revision=base))
+                upto = req.from_id or None
+                event = self._apply(lambda m: m.cancel_uploads(req.agent, upto, base_revision=base))
                 resp.skill_ids = [placed.skill.id for placed in event.change.put_skills]
                 return event
             self._require_link(req.agent)
