@@ -964,7 +964,7 @@ def test_commands_for_a_robot_out_of_contact_wait_and_arrive_once_in_order(rosmc
     ground.close()
 
     system.stop("server")
-    CANCELLED = wire.CommandRecord.CANCELLED
+    cancel = wire.CommandRecord.CANCELLED
     records = read_journal(system.journal, [interface.ROBOT_COMMANDS_TOPIC]).records
     delivered = [
         (K(r.message.type), list(r.message.skill_ids), r.message.held)
@@ -974,5 +974,5 @@ def test_commands_for_a_robot_out_of_contact_wait_and_arrive_once_in_order(rosmc
     assert delivered == [(K.UPLOAD, [keep], True), (K.SET_OPTIONS, [], True)]
     late = [r.message for r in records if r.message.event == wire.CommandRecord.DELIVERED]
     assert all(m.delivered >= m.asked for m in late)
-    cancelled = [K(m.type) for m in (r.message for r in records) if m.event == CANCELLED]
+    cancelled = [K(m.type) for m in (r.message for r in records) if m.event == cancel]
     assert cancelled.count(K.SET_OPTIONS) == 1, "the first policy change was replaced"
