@@ -65,6 +65,12 @@ HEADLINES: dict[str, tuple[str, ...]] = {
         "memory.rss_growth_*_kib",
     ),
     "executor": ("*sync_to_start*median_ms", "*barrier_skew*median_ms", "*barrier_skew*max_ms"),
+    "outage": (
+        "refused",
+        "contact_to_delivery.p50_ms",
+        "contact_to_delivery.p95_ms",
+        "max_waiting_per_robot",
+    ),
     "sim": ("*.rtf", "*cpu_share"),
     "demo": ("runs.*.score", "runs.*.mission_sim_s", "runs.*.mission_wall_s"),
     "multihost": (

@@ -111,6 +111,8 @@ class AgentColumn(QFrame):  # type: ignore[misc]
     def __init__(self, agent: str, view: MissionView, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.agent = agent
+        self._view = view
+        self._out_of_contact = False  # as the rows last showed it
         self.setObjectName(f"column_{agent}")
         self.setFrameShape(QFrame.StyledPanel)
         self.setMinimumWidth(COLUMN_WIDTH)
@@ -199,6 +201,11 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         text = presentation.link_summary(status)
         colour = "#a00000" if status is not None and status.link == "down" else "#333333"
         self.status_label.setText(f"<span style='color:{colour}'>{text}</span>")
+        out_of_contact = self._view.out_of_contact(self.agent)
+        if out_of_contact != self._out_of_contact:  # transfers now wait (or go): say so
+            self._out_of_contact = out_of_contact
+            self.synced_model.refresh()
+            self.blueprint_model.refresh()
 
     def set_skills(self, names: Sequence[str]) -> None:
         """The skills the Add menu offers (the robot's skills)."""

@@ -18,6 +18,7 @@ from rosmc_server.core import (
     TaskMarker,
 )
 
+from . import presentation
 from .view_state import AgentView, ViewUpdate, barrier_tags
 
 
@@ -118,6 +119,17 @@ class MissionView:
             if partner.id != skill.id and not partner.status.has_started:
                 waiting.append(partner.agent)
         return waiting
+
+    def out_of_contact(self, agent: str) -> bool:
+        """The ground cannot hear ``agent``'s robot (never heard, or its link is down)."""
+        status = self.statuses.get(agent)
+        return status is not None and status.link != "up"
+
+    def status_text(self, skill: SkillInstance) -> str:
+        """The skill's status cell, as every panel shows it."""
+        return presentation.status_text(
+            skill, self.waiting_on(skill), self.out_of_contact(skill.agent)
+        )
 
     def bound_markers(self, skills: Sequence[SkillInstance]) -> list[str]:
         """Names of the task markers bound to any of ``skills`` (each once)."""

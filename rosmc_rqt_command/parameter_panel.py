@@ -26,7 +26,6 @@ from python_qt_binding.QtWidgets import (
 
 from rosmc_server.core import InvalidRequest, RosmcError, SkillInstance, SkillSpec
 
-from . import presentation
 from .mission_view import MissionView
 from .param_editors import Editor, MarkerPicker, make_editor
 
@@ -128,7 +127,7 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
             "ID": skill.id,
             "Robot": skill.agent,
             "Skill": skill.skill + (f" — {self._spec.description}" if self._spec else ""),
-            "Status": presentation.status_text(skill, self._view.waiting_on(skill)),
+            "Status": self._view.status_text(skill),
             "Attempt": str(skill.attempt),
             "Status text": skill.status_text or "—",
         }

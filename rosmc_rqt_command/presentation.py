@@ -83,8 +83,17 @@ def barrier_colour(number: int) -> str:
     return BARRIER_COLOURS[(number - 1) % len(BARRIER_COLOURS)]
 
 
-def status_text(skill: SkillInstance, waiting_on: list[str] | None = None) -> str:
-    """The status cell: a word, and what matters about it (pending transfer, wait, reason)."""
+def status_text(
+    skill: SkillInstance, waiting_on: list[str] | None = None, out_of_contact: bool = False
+) -> str:
+    """The status cell: a word, and what matters about it (pending transfer, wait, reason).
+
+    ``out_of_contact``: the robot cannot be heard, so a transfer waits for contact.
+    """
+    if skill.transfer is Transfer.UPLOADING and out_of_contact:
+        return "waiting for contact"
+    if skill.transfer is Transfer.REMOVING and out_of_contact:
+        return "take-back waiting for contact"
     if skill.transfer is Transfer.UPLOADING:
         return "uploading…"
     if skill.transfer is Transfer.REMOVING:
@@ -134,11 +143,14 @@ def params_summary(skill: SkillInstance, limit: int = 3) -> str:
 def link_summary(status: AgentStatus | None) -> str:
     """A robot's header line: link, seconds since heard, battery, Wi-Fi, policy."""
     if status is None or status.link == "unknown":
-        return "never heard"
+        waiting = status.waiting_text if status is not None else ""
+        return f"never heard · {waiting}" if waiting else "never heard"
     link = "link up" if status.link == "up" else "LINK DOWN"
     if status.last_heard >= 0 and (status.link != "up" or status.last_heard >= 2):
         link += f", heard {status.last_heard:.0f} s ago"
     parts = [link]
+    if status.commands_waiting:
+        parts.append(status.waiting_text)
     if status.battery is not None:
         parts.append(f"battery {status.battery * 100:.0f}%")
     if status.wifi_signal is not None:

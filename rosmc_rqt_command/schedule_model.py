@@ -212,7 +212,7 @@ class SectionModel(QAbstractTableModel):  # type: ignore[misc]
             return skill.label or skill.skill
         if column == PARAMS:
             return presentation.params_summary(skill)
-        return presentation.status_text(skill, self._view.waiting_on(skill))
+        return self._view.status_text(skill)
 
     def _tooltip(self, skill: SkillInstance) -> str:
         lines = [f"{skill.label or skill.skill} — skill {skill.skill}, id {skill.id}"]
@@ -221,7 +221,7 @@ class SectionModel(QAbstractTableModel):  # type: ignore[misc]
             barrier = self._view.barrier_of(skill.id)
             partners = [s.agent for s in self._view.skills(barrier.skill_ids if barrier else ())]
             lines.append(f"barrier B{number}: starts together with {', '.join(partners)}")
-        lines.append(f"status: {presentation.status_text(skill, self._view.waiting_on(skill))}")
+        lines.append(f"status: {self._view.status_text(skill)}")
         if skill.status_text:
             lines.append(skill.status_text)
         lines += [

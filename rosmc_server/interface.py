@@ -22,6 +22,8 @@ EVENTS_TOPIC = f"{NAMESPACE}/mission_events"  # rosmc/MissionEvent, one per chan
 AGENT_STATES_TOPIC = f"{NAMESPACE}/agent_states"  # rosmc/AgentStates, steady rate
 # Journaled only (the robots' skill status reports, for the audit trail); a replay publishes it.
 ROBOT_REPORTS_TOPIC = f"{NAMESPACE}/robot_reports"  # rosmc/RobotReport
+# Journaled only: each command for a robot, when asked and when delivered (or cancelled).
+ROBOT_COMMANDS_TOPIC = f"{NAMESPACE}/robot_commands"  # rosmc/CommandRecord
 # Published by robots (or the simulator), one topic per agent.
 TELEMETRY_TOPIC = "/{agent}/telemetry"  # rosmc/Telemetry
 # Published by the robots or the simulator, and journaled by the server (low rate) so that a

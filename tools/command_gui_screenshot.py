@@ -13,11 +13,17 @@ the operator client so that, when the picture is taken,
   region nobody has explored yet (the reason shows in the parameter panel);
 * each robot has skills on board (on robot) and planned in its blueprint.
 
-Then it selects the failed skill, waits ``--settle`` seconds, and writes the screenshot
-(``import -window root``) to ``--output`` (docs/command_gui.png). Every process it
-started is stopped, also on failure. Run after ``source env.sh``::
+With ``--out-of-contact AGENT`` that robot's executor then falls silent (SIGSTOP, as a robot
+out of radio range; SIGCONT after the picture), and once the server calls its link down the
+operator sends the rest of its blueprint and a new lost-link policy: both wait for contact
+(its header and rows say so). Then it selects the failed skill, waits
+``--settle`` seconds, and writes the screenshot (``import -window root``) to ``--output``
+(docs/command_gui.png). Every process it started is stopped, also on failure. Run after
+``source env.sh``::
 
     python tools/command_gui_screenshot.py -o docs/command_gui.png
+    python tools/command_gui_screenshot.py --out-of-contact manipulator_rover \
+        -o docs/command_gui_waiting.png
 
 Exit status: 0 when written, 1 when the mission did not reach the staged state in time
 (a screenshot is still written, to show why).
@@ -39,6 +45,7 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from bench.bench_server import ros_master  # noqa: E402
+from tools.out_of_contact import resume_executor, send_waiting_work, silence_executor  # noqa: E402
 from tools.rviz_screenshot import grab, require_programs, stop_group, virtual_screen  # noqa: E402
 
 STAGE_TIMEOUT = 120.0  # wall seconds for the mission to reach the staged state
@@ -51,6 +58,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--size", default="1600x1000", help="screen WIDTHxHEIGHT")
     parser.add_argument("--settle", type=float, default=2.0, help="seconds before the shot")
     parser.add_argument("--rate", type=float, default=4.0, help="simulation real-time factor")
+    parser.add_argument("--out-of-contact", default="", help="a robot cut off, work waiting")
     args = parser.parse_args(argv)
     require_programs("Xvfb", "import", "roslaunch")
     width, height = (int(v) for v in args.size.split("x"))
@@ -127,6 +135,7 @@ def run(
     window.setGeometry(screen)  # no window manager here: fill the screen exactly
     window.show()
     status = 1
+    silenced = 0
     try:
         wait(lambda: widget.view.loaded and widget.view.library, "the window shows the mission")
         wait(lambda: _answers(client), "the mission server answers", 60)
@@ -152,6 +161,8 @@ def run(
             "the window shows it all",
             20,
         )
+        if args.out_of_contact:
+            silenced = cut_off(client, widget, args.out_of_contact, wait)
         widget.schedule.select_ids([ids["identify"]])
         status = 0
     except TimeoutError as error:
@@ -163,6 +174,7 @@ def run(
         QTest.qWait(int(args.settle * 1000))
         grab(display).write_png(args.output)
         print(f"wrote {args.output}")
+        resume_executor(silenced)
         bridge.close()
         widget.files.ask = lambda _doing: "discard"  # the staged mission is not kept
         window.close()
@@ -170,6 +182,16 @@ def run(
         app.processEvents()
         rospy.signal_shutdown("screenshot taken")
     return status
+
+
+def cut_off(client: object, widget: object, agent: str, wait: Callable[..., None]) -> int:
+    """Silence ``agent``; once its link is down, send it work that then waits; its pid."""
+    statuses = widget.view.statuses  # type: ignore[attr-defined]
+    pid = silence_executor(agent, "/rosmc_command_screenshot")
+    wait(lambda: (s := statuses.get(agent)) is not None and s.link == "down", f"{agent} down", 30)
+    send_waiting_work(client, agent)
+    wait(lambda: statuses[agent].commands_waiting >= 2, f"work waiting for {agent}", 30)
+    return pid
 
 
 def _answers(client: object) -> bool:

@@ -16,6 +16,9 @@ journal in a temporary directory. Then plans and starts a small mission through
   synchronized: a blue flag),
 
 meanwhile rviz (``rviz/operator.rviz``) runs on a virtual screen (``tools/rviz_screenshot.py``).
+With ``--out-of-contact AGENT`` that robot then falls silent (``tools/out_of_contact.py``) and,
+once its link is down, its blueprint and a new lost-link policy wait for contact: its icon
+says ``LINK DOWN .. s, 2 WAITING .. s``.
 When the mission is in that state and rviz has drawn, it waits ``--settle`` seconds and
 writes the screenshot. Everything it started is stopped by process group at the end, also
 on Ctrl-C or SIGTERM.
@@ -47,6 +50,7 @@ from pathlib import Path
 from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+import out_of_contact
 import rviz_screenshot as shots  # the sibling tool: Xvfb, rviz, grabbing
 
 REPO = Path(__file__).resolve().parents[1]
@@ -245,6 +249,10 @@ def take(args: argparse.Namespace) -> int:
             if ready or time.monotonic() > deadline:
                 break
             time.sleep(0.5)
+        if ready and args.out_of_contact:
+            silenced = out_of_contact.silence_executor(args.out_of_contact, "/rviz_operator_shot")
+            stack.callback(out_of_contact.resume_executor, silenced)
+            waiting_for_contact(watch, client, args.out_of_contact)
         if ready:
             time.sleep(args.settle)  # rviz draws the last updates; the state lasts minutes
             shot = shots.grab(display)
@@ -261,6 +269,19 @@ def take(args: argparse.Namespace) -> int:
     shutil.rmtree(home, ignore_errors=True)  # kept (logs) only when something went wrong
     print(f"rviz_operator_screenshot: {args.output} written")
     return 0
+
+
+def waiting_for_contact(watch: Any, client: object, agent: str) -> None:
+    """Once ``agent``'s link is down, send it work; return when the server shows it waiting."""
+    states: dict[str, Any] = {}
+
+    def shown(test: Callable[[Any], bool]) -> bool:
+        states.update(watch.take_agent_states() or {})
+        return agent in states and test(states[agent])
+
+    wait_for(lambda: shown(lambda s: s.link == "down"), f"{agent}'s link down", 30.0)
+    out_of_contact.send_waiting_work(client, agent)
+    wait_for(lambda: shown(lambda s: s.commands_waiting >= 2), f"work waiting for {agent}", 30.0)
 
 
 def _raise_keyboard_interrupt(_signum: int, _frame: object) -> None:
@@ -280,6 +301,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--size", type=shots._size, default=shots.DEFAULT_SIZE)
     parser.add_argument("-v", "--verbose", action="store_true", help="say what is missing")
     parser.add_argument("--view", help="a saved view of operator.rviz (default: its current)")
+    parser.add_argument("--out-of-contact", default="", help="a robot cut off, work waiting")
     args = parser.parse_args(argv)
     signal.signal(signal.SIGTERM, _raise_keyboard_interrupt)
     try:

@@ -7,7 +7,8 @@ without covering the others:
   (``science_rover: navigate_to > running``), coloured by the status;
 * its health: battery, Wi-Fi and ground link
   (``BAT 97% | WiFi -54 dBm | link up``), coloured by the worst of the three (green,
-  yellow, red; the part past its threshold is written in capitals).
+  yellow, red; the part past its threshold is written in capitals). Commands waiting
+  for contact follow the link (``LINK DOWN 40 s, 2 WAITING 1 min``).
 
 No data is shown as such (``?``, "never heard"), never left out. Robots standing close
 together (at the lander, at one region) get their blocks lifted by whole blocks
@@ -22,6 +23,7 @@ from dataclasses import dataclass
 
 from rosmc_server.core.agent_status import AgentStatus
 from rosmc_server.core.model import SkillStatus
+from rosmc_server.core.waiting import duration_text
 
 from .geometry import Color, Point
 
@@ -76,8 +78,17 @@ def wifi_row(dbm: float | None) -> IconRow:
     return IconRow("wifi", f"{word} {dbm:.0f} dBm", color)
 
 
-def link_row(link: str, last_heard: float) -> IconRow:
-    """Ground link: up / down / never heard, with seconds since the robot was heard."""
+def link_row(link: str, last_heard: float, waiting: int = 0, waiting_for: float = -1.0) -> IconRow:
+    """Ground link: up / down / never heard, with seconds since the robot was heard, and
+    how many commands wait for contact (for how long); waiting work is at least yellow."""
+    row = _link_only(link, last_heard)
+    if waiting <= 0 or link == "up":
+        return row
+    age = f" {duration_text(waiting_for)}" if waiting_for >= 0 else ""
+    return IconRow("link", f"{row.text}, {waiting} WAITING{age}", worst([row.color, WARN]))
+
+
+def _link_only(link: str, last_heard: float) -> IconRow:
     if link == "unknown" or last_heard < 0:
         return IconRow("link", "link never heard", DIM if link == "unknown" else BAD)
     if link == "up":
@@ -122,7 +133,7 @@ def status_parts(status: AgentStatus | None, skill_label: str = "") -> tuple[Ico
         )
     return (
         skill_row(skill_label or status.current_skill, status.current_status, status.waiting_on),
-        link_row(status.link, status.last_heard),
+        link_row(status.link, status.last_heard, status.commands_waiting, status.waiting_for),
         wifi_row(status.wifi_signal),
         battery_row(status.battery),
     )

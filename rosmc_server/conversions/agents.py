@@ -33,6 +33,9 @@ def agent_status_from_msg(msg: wire.AgentState) -> AgentStatus:
         round_trip=msg.link.round_trip,
         commands_in_flight=msg.link.commands_in_flight,
         hash_mismatch=msg.link.hash_mismatch,
+        # Journals recorded before these fields existed decode without them.
+        commands_waiting=getattr(msg.link, "commands_waiting", 0),
+        waiting_for=getattr(msg.link, "waiting_for", -1.0),
         queue_hash=msg.link.queue_hash,
         robot_queue_hash=msg.link.robot_queue_hash,
         battery=_finite(telemetry.battery),

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 from .model import SkillStatus
 from .params import Pose
+from .waiting import waiting_text
 
 
 @dataclass(frozen=True)
@@ -21,7 +22,9 @@ class AgentStatus:
     telemetry. ``queue_hash`` is the synchronized queue as the ground sees it and
     ``robot_queue_hash`` as the robot last reported it (``hash_mismatch``: a repair is under
     way). ``policy`` is the lost-link policy the robot reports in force (and whether it
-    triggered), as the robot words it; "" if the robot has not said.
+    triggered), as the robot words it; "" if the robot has not said. ``commands_waiting``
+    commands wait for contact with the robot, the oldest for ``waiting_for`` seconds (-1:
+    none waits).
     """
 
     agent: str
@@ -41,3 +44,10 @@ class AgentStatus:
     executor_state: str = ""
     waiting_on: str = ""
     policy: str = ""
+    commands_waiting: int = 0
+    waiting_for: float = -1.0
+
+    @property
+    def waiting_text(self) -> str:
+        """``2 commands waiting for contact 3 min``, or "" when nothing waits."""
+        return waiting_text(self.commands_waiting, self.waiting_for)

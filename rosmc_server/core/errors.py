@@ -56,7 +56,8 @@ class StaleRevision(RosmcError):
 
 
 class Unavailable(RosmcError):
-    """The robot a request needs cannot be reached right now."""
+    """The request cannot be served now (too much waits for a robot out of contact, or the
+    server is shutting down); out of contact alone is never the reason."""
 
 
 class LibraryError(RosmcError):

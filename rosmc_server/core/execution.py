@@ -97,14 +97,19 @@ def plan_decline_sync(
     )
 
 
-def plan_cancel_uploads(state: MissionState, agent: str) -> Proposal:
+def plan_cancel_uploads(state: MissionState, agent: str, from_id: str | None = None) -> Proposal:
     """Give up on unanswered uploads: the skills return to the editable blueprint now.
 
-    The robot is told to drop them (see commands), in case it got them after all.
+    With ``from_id`` among them, only it and the later ones do (the synchronized section
+    stays a prefix); otherwise all of them. The robot is told to drop them (see commands),
+    in case it got them after all; while they still wait to leave, they never will.
     """
     uploading = state.pending(agent, Transfer.UPLOADING)
     if not uploading:
         raise RuleViolation(f"no upload to {agent} awaits an answer")
+    ids = [skill.id for skill in uploading]
+    if from_id in ids:
+        uploading = uploading[ids.index(from_id) :]
     text = "upload cancelled by the operator"
     puts = _placed(state, [replace(s, transfer=Transfer.NONE, status_text=text) for s in uploading])
     return Proposal(

@@ -10,6 +10,9 @@ Both ends speak the same rules:
 * Reports go the other way under the same rules (:class:`InboundSequence`).
 * Until the ground has heard a robot's snapshot it does not know where the
   robot's numbering stands, so it sends nothing (the commands wait in order).
+  While the robot is out of contact (its link DOWN) new commands wait the same
+  way, unnumbered, and only those already numbered are retransmitted
+  (:mod:`rosmc_server.core.waiting` has the rules for what waits).
 """
 
 from __future__ import annotations
@@ -51,6 +54,8 @@ class Outgoing(Generic[Payload]):
     first_sent: float = 0.0
     next_send: float = 0.0
     backoff: int = 0  # retransmissions since the last contact: the next delay doubles
+    asked: float = 0.0  # when it was queued (the outbox's clock)
+    held: bool = False  # queued while the robot was out of contact
 
 
 @dataclass(frozen=True)
@@ -61,6 +66,8 @@ class LinkReport:
     last_heard: float  # seconds ago, -1 if never
     round_trip: float  # seconds, -1 if unknown
     in_flight: int
+    waiting: int = 0  # unacknowledged while the robot is out of contact
+    waiting_for: float = -1.0  # seconds the oldest of them has waited, -1 if none
 
 
 @dataclass
@@ -85,9 +92,13 @@ class Outbox(Generic[Payload]):
         """Whether the robot's command numbering is known (a snapshot was heard)."""
         return self._last_seq is not None
 
-    def enqueue(self, payload: Payload) -> Outgoing[Payload]:
-        """Queue a command; it is sent by :meth:`due` in order."""
-        item = Outgoing(payload)
+    def prepare(self, payload: Payload, now: float = 0.0) -> Outgoing[Payload]:
+        """A command asked at ``now``, as it would wait in this outbox (not queued)."""
+        return Outgoing(payload, asked=now, held=self.status(now) is not LinkStatus.UP)
+
+    def enqueue(self, payload: Payload, now: float = 0.0) -> Outgoing[Payload]:
+        """Queue a command asked at ``now``; it is sent by :meth:`due` in order."""
+        item = self.prepare(payload, now)
         self._pending.append(item)
         return item
 
@@ -113,14 +124,18 @@ class Outbox(Generic[Payload]):
         """Commands to transmit now, oldest first; numbers them on first send.
 
         When one command is due, every later unacknowledged one goes with it,
-        so the robot always receives a gap-free run.
+        so the robot always receives a gap-free run. While the robot is out of
+        contact only commands already numbered go (retransmissions); the others
+        wait, unnumbered, until it is heard again.
         """
         if self._last_seq is None or not self._pending:
             return []
-        if not any(item.next_send <= now for item in self._pending):
+        held = self.status(now) is not LinkStatus.UP
+        going = [item for item in self._pending if not (held and item.seq == 0)]
+        if not any(item.next_send <= now for item in going):
             return []
         out = []
-        for item in self._pending:
+        for item in going:
             if item.seq == 0:
                 self._last_seq += 1
                 item.seq = self._last_seq
@@ -194,13 +209,20 @@ class Outbox(Generic[Payload]):
             return LinkStatus.UNKNOWN
         return LinkStatus.UP if now - self._last_heard <= self.timeout else LinkStatus.DOWN
 
+    def waiting(self, now: float) -> Sequence[Outgoing[Payload]]:
+        """Commands waiting for contact: every unacknowledged one while the link is not UP."""
+        return () if self.status(now) is LinkStatus.UP else tuple(self._pending)
+
     def report(self, now: float) -> LinkReport:
         """The link's state for display."""
+        waiting = self.waiting(now)
         return LinkReport(
             self.status(now),
             -1.0 if self._last_heard is None else now - self._last_heard,
             -1.0 if self._rtt is None else self._rtt,
             len(self._pending),
+            len(waiting),
+            max((now - item.asked for item in waiting), default=-1.0),
         )
 
 

@@ -189,10 +189,13 @@ class Mission:
         self._check_revision(base_revision)
         return self._commit(execution.plan_request_unsync(self.state, agent, from_id))
 
-    def cancel_uploads(self, agent: str, *, base_revision: int | None = None) -> MissionEvent:
-        """Give up on the agent's unanswered uploads; they return to the blueprint."""
+    def cancel_uploads(
+        self, agent: str, from_id: str | None = None, *, base_revision: int | None = None
+    ) -> MissionEvent:
+        """Give up on the agent's unanswered uploads (from ``from_id`` on, if it is one of
+        them); they return to the blueprint."""
         self._check_revision(base_revision)
-        return self._commit(execution.plan_cancel_uploads(self.state, agent))
+        return self._commit(execution.plan_cancel_uploads(self.state, agent, from_id))
 
     def confirm_unsynchronized(self, agent: str, removed_ids: Sequence[str]) -> MissionEvent:
         """The robot removed ``removed_ids`` (the others had started)."""

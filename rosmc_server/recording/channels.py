@@ -13,6 +13,7 @@ from rosmc_server.interface import (
     AGENT_STATES_TOPIC,
     EVENTS_TOPIC,
     MISSION_TOPIC,
+    ROBOT_COMMANDS_TOPIC,
     ROBOT_REPORTS_TOPIC,
     SCIENCE_TOPIC,
     TF_TOPIC,
@@ -28,6 +29,8 @@ JOURNAL_TOPICS: Final[Mapping[str, str]] = MappingProxyType(
         TF_TOPIC: "tf2_msgs/TFMessage",  # map -> <robot>/base_link, 2 Hz
         SCIENCE_TOPIC: "rosmc/ScienceState",  # the score and discovered regions, on change
         WORLD_TOPIC: "visualization_msgs/MarkerArray",  # the simulated site, on change
+        # Added later, so last: older journals lack it and keep their channel ids.
+        ROBOT_COMMANDS_TOPIC: "rosmc/CommandRecord",  # commands for robots: asked, delivered
     }
 )
 """Every journal channel with the ROS message type it carries, in channel-id order."""
@@ -38,6 +41,7 @@ TELEMETRY_TOPICS: Final = (
     TF_TOPIC,
     SCIENCE_TOPIC,
     WORLD_TOPIC,
+    ROBOT_COMMANDS_TOPIC,
 )
 """Channels of what the robots and the site did: written, never fsynced on their own."""
 

@@ -11,6 +11,7 @@ from rosmc_server.interface import (
     AGENT_STATES_TOPIC,
     EVENTS_TOPIC,
     MISSION_TOPIC,
+    ROBOT_COMMANDS_TOPIC,
     ROBOT_REPORTS_TOPIC,
 )
 from rosmc_server.recording import _format as fmt
@@ -197,6 +198,10 @@ class JournalWriter:
     def append_report(self, report: RosMessage, log_time_ns: int) -> None:
         """Record a ``rosmc/RobotReport`` (telemetry: written, never fsynced on its own)."""
         self._append(ROBOT_REPORTS_TOPIC, report, log_time_ns, sync=False)
+
+    def append_command(self, record: RosMessage, log_time_ns: int) -> None:
+        """Record a ``rosmc/CommandRecord`` (telemetry: written, never fsynced on its own)."""
+        self._append(ROBOT_COMMANDS_TOPIC, record, log_time_ns, sync=False)
 
     def append_agent_states(self, states: RosMessage, log_time_ns: int) -> None:
         """Record a ``rosmc/AgentStates`` (telemetry: written, never fsynced on its own)."""

@@ -93,6 +93,8 @@ class AgentStatePublisher:
             queue_hash=server.link.expected_hash(agent),
             robot_queue_hash=link.robot_hash,
             hash_mismatch=link.mismatch,
+            commands_waiting=report.waiting,
+            waiting_for=report.waiting_for,
         )
         current = next(
             (

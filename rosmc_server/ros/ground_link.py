@@ -9,7 +9,8 @@ Per dynamic agent, on the topics of :func:`rosmc_server.interface.ground_link`:
   ``/rosmc/radio/ground``); a robot's beacon after a silence reconnects its topics and
   retransmits its pending commands at once, whatever TCP's backoff has grown to.
 
-Commands are retransmitted with backoff until acknowledged; reports are
+Commands are retransmitted with backoff until acknowledged; while a robot is out of
+contact new commands wait unsent for it (:mod:`rosmc_server.core.waiting`); reports are
 applied once each and in order; the robot's periodic snapshot re-synchronizes
 numbering after restarts and reconciles statuses after outages, and its queue
 hash is checked against the ground's, with a repair sent on a mismatch.
@@ -32,11 +33,20 @@ import rospy
 from ..conversions import barrier_to_msg, skill_to_msg, time_to_msg
 from ..core import Barrier, Mission, MissionEvent, RosmcError, SkillStatus, Transfer
 from ..core.commands import CommandKind, CommandSpec, queued_barriers, repair_command, synced_ids
-from ..core.link import Arrival, InboundSequence, LinkReport, LinkStatus, Outbox, queue_hash
+from ..core.link import (
+    Arrival,
+    InboundSequence,
+    LinkReport,
+    LinkStatus,
+    Outbox,
+    Outgoing,
+    queue_hash,
+)
 from ..core.radio import BEACON_PERIOD, ContactWatch
 from ..core.reconcile import RobotSkill
+from ..core.waiting import collapse
 from ..interface import ground_link
-from .command_queue import collapse
+from .command_records import command_record
 from .radio import GROUND, Radio, TopicListener, reconnect_in_background
 
 _log = logging.getLogger(__name__)
@@ -58,6 +68,9 @@ class LinkHost(Protocol):
 
     def record_report(self, msg: wire.RobotReport) -> None:
         """Journal a robot report for the audit trail."""
+
+    def record_command(self, msg: wire.CommandRecord) -> None:
+        """Journal a command asked, delivered or cancelled."""
 
 
 @dataclass
@@ -149,10 +162,22 @@ class GroundLink:
             barriers=[barrier_to_msg(b, lambda s: state.locate(s)[0]) for b in spec.barriers],
             argument=spec.argument,
         )
-        kept = collapse(link.outbox, msg)
-        if kept is not None:
-            link.outbox.enqueue(kept)
+        now = self._clock()
+        collapsed = collapse(link.outbox, msg)
+        for withdrawn in collapsed.withdrawn:
+            self._record(wire.CommandRecord.CANCELLED, withdrawn)
+        if collapsed.kept is None:
+            self._record(wire.CommandRecord.CANCELLED, link.outbox.prepare(msg, now))
+        else:
+            self._record(wire.CommandRecord.ASKED, link.outbox.enqueue(collapsed.kept, now))
         self._transmit(link)
+
+    def _record(self, event: int, item: Outgoing[wire.RobotCommand], result: int = 0) -> None:
+        """Journal ``item`` (times on the ground's wall clock)."""
+        wall = time.time()
+        asked = wall - (self._clock() - item.asked)
+        delivered = wall if event == wire.CommandRecord.DELIVERED else 0.0
+        self._host.record_command(command_record(event, item, asked, delivered, result))
 
     def unsent(self, agent: str) -> int:
         """How many commands wait, never transmitted, for ``agent``'s robot."""
@@ -225,6 +250,7 @@ class GroundLink:
         item = link.outbox.acknowledge(msg.seq, self._clock())
         if item is None:
             return  # the answer to a retransmission already processed
+        self._record(wire.CommandRecord.DELIVERED, item, msg.result)
         if msg.result != wire.RobotAck.ACCEPTED:
             link.last_error = msg.error or "; ".join(msg.rejection_reasons)
             _log.warning("link %s: command %d refused: %s", agent, msg.seq, link.last_error)

@@ -6,7 +6,8 @@ the operation through :meth:`MissionServer.apply` and answers with the new
 revision; a refused request answers with an error code and one sentence, and
 the mission is unchanged. No handler lets an exception reach rospy: a server
 fault is logged with its traceback and answered as an INTERNAL error.
-Services never wait for robots.
+Services never wait for robots: a command for a robot out of contact is accepted and
+waits for it (:mod:`rosmc_server.core.waiting`), and the answer's note says so.
 """
 
 from __future__ import annotations
@@ -46,7 +47,7 @@ from ..core.advice import unsynced_partners
 from ..core.commands import CommandKind, CommandSpec
 from ..core.link import LinkStatus
 from ..core.policy import options_argument
-from .command_queue import MAX_UNSENT
+from ..core.waiting import queued_note, refusal
 from .team_sync import synchronize_team
 from .whole_mission import WholeMissionServices
 
@@ -159,13 +160,10 @@ class OperatorServices:
         if agent not in self._server.library.dynamic_agents:
             self._server.library.agent(_text(agent, "the agent name"))
             raise RuleViolation(f"'{agent}' is a static agent and has no robot link")
-        if self._server.link.status(agent) is LinkStatus.DOWN:
-            raise Unavailable(f"{agent} cannot be reached (its link is down); try again later")
-        if self._server.link.unsent(agent) >= MAX_UNSENT:
-            raise Unavailable(
-                f"{agent} has {MAX_UNSENT} commands waiting for its first report; "
-                "wait until it is heard"
-            )
+        # Out of contact is no reason to refuse (the command waits); only the bound is.
+        sentence = refusal(agent, self._server.link.unsent(agent))
+        if sentence:
+            raise Unavailable(sentence)
 
     # -- blueprint ----------------------------------------------------------------
     def _add_skill(self, req: Any, resp: Any) -> MissionEvent:
@@ -240,7 +238,8 @@ class OperatorServices:
                 # An upload still unanswered (the robot may be out of reach) is cancelled:
                 # the operator can always take back what the robot has not confirmed.
                 base = req.base_revision
-                event = self._apply(lambda m: m.cancel_uploads(req.agent, base_revision=base))
+                upto = req.from_id or None
+                event = self._apply(lambda m: m.cancel_uploads(req.agent, upto, base_revision=base))
                 resp.skill_ids = [placed.skill.id for placed in event.change.put_skills]
                 return event
             self._require_link(req.agent)
@@ -254,14 +253,14 @@ class OperatorServices:
         return event
 
     def _queued_note(self, agents: list[str]) -> str:
-        """Say so when a command waits for robots never heard since the server started."""
-        unheard = [a for a in agents if self._server.link.status(a) is LinkStatus.UNKNOWN]
-        if not unheard:
-            return ""
-        who = ", ".join(unheard)
-        return (
-            f"queued for {who}: not heard since the server started; "
-            "it goes out when the robot first reports"
+        """Say so when a command waits for robots out of contact (never heard, or link down)."""
+        link = self._server.link
+        return notes(
+            *(
+                queued_note(agent, report.status is LinkStatus.UNKNOWN, report.last_heard)
+                for agent in agents
+                if (report := link.details(agent)[0]).status is not LinkStatus.UP
+            )
         )
 
     def _uploading(self, agent: str) -> bool:

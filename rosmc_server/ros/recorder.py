@@ -45,6 +45,7 @@ def state_key(state: wire.AgentState) -> tuple[Any, ...]:
     pose = telemetry.pose
     return (
         state.link.state,
+        state.link.commands_waiting,  # what waits for contact (its age is not worth a record)
         state.current_skill_id,
         state.current_status.value,
         state.executor_state,

@@ -31,6 +31,7 @@ TYPES: dict[str, Any] = {
     interface.EVENTS_TOPIC: wire.MissionEvent,
     interface.AGENT_STATES_TOPIC: wire.AgentStates,
     interface.ROBOT_REPORTS_TOPIC: wire.RobotReport,
+    interface.ROBOT_COMMANDS_TOPIC: wire.CommandRecord,
     interface.TF_TOPIC: TFMessage,
     interface.SCIENCE_TOPIC: wire.ScienceState,
     interface.WORLD_TOPIC: MarkerArray,

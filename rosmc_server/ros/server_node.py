@@ -12,7 +12,8 @@ Publishes:
     The robot links' command and report_ack topics (see :mod:`.ground_link`).
 
 Journals, beside every change: agent states on change, TF of the robots at 2 Hz, the
-simulator's science state and world markers on change (see :mod:`.recorder`).
+simulator's science state and world markers on change (see :mod:`.recorder`), and each
+command for a robot when asked and when delivered (``/rosmc/robot_commands``).
 
 Subscribes:
     ``/<agent>/telemetry`` (rosmc/Telemetry) and the robot links' ack, report and
@@ -256,6 +257,11 @@ class MissionServer:
     def record_report(self, msg: wire.RobotReport) -> None:
         """Journal a robot report (the audit trail of what robots said)."""
         self._journal.append_report(msg, time.time_ns())
+
+    def record_command(self, msg: wire.CommandRecord) -> None:
+        """Journal a command for a robot: asked, delivered or cancelled."""
+        if not self._journal.closed:
+            self._journal.append_command(msg, time.time_ns())
 
     def snapshot_msg(self) -> PackedMission:
         """The full mission as a message, stamped now.

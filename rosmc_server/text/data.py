@@ -92,6 +92,8 @@ def agent_status_to_json(status: AgentStatus) -> dict[str, Any]:
         "last_heard": status.last_heard,
         "round_trip": status.round_trip,
         "commands_in_flight": status.commands_in_flight,
+        "commands_waiting": status.commands_waiting,
+        "waiting_for": status.waiting_for,
         "hash_mismatch": status.hash_mismatch,
         "battery": status.battery,
         "wifi_signal": status.wifi_signal,

@@ -100,11 +100,13 @@ def format_agent_status(status: AgentStatus | None) -> str:
         details.append(f"heard {status.last_heard:.1f} s ago")
     if status.round_trip >= 0:
         details.append(f"round trip {status.round_trip * 1000:.0f} ms")
-    if status.commands_in_flight:
+    if status.commands_in_flight and not status.commands_waiting:
         details.append(f"{status.commands_in_flight} command(s) in flight")
     if status.hash_mismatch:
         details.append("repairing queue")
     parts = [f"{link} ({', '.join(details)})" if details else link]
+    if status.commands_waiting:
+        parts.append(status.waiting_text)
     if status.battery is not None:
         parts.append(f"battery {status.battery * 100:.0f}%")
     if status.wifi_signal is not None:

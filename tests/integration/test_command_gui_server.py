@@ -35,7 +35,8 @@ from python_qt_binding.QtWidgets import (
 )
 
 from rosmc_rqt_command.command_widget import CommandWidget
-from rosmc_rqt_command.legality import Action
+from rosmc_rqt_command.legality import Action, RobotAction
+from rosmc_rqt_command.schedule_model import STATUS
 from rosmc_rqt_command.science_strip import NO_SCORE
 from rosmc_rqt_command.standalone import build
 from rosmc_server.conversions.science import science_to_msg
@@ -450,3 +451,31 @@ def answer_file_dialog(path: str, timeout: float = 20.0) -> None:
         accept.click()
 
     QTimer.singleShot(20, choose)
+
+
+def test_a_send_to_a_robot_out_of_contact_is_shown_waiting(
+    start_server: StartServer, windows: Any
+) -> None:
+    start_server()  # no robot runs: none has been heard
+    window = windows()
+    shown(window)
+    window.add("drone", "take_off")
+    wait_until(lambda: window.ids("drone"), 10, "take_off shown")
+    column = window.w.schedule.columns["drone"]
+    send = column.buttons[RobotAction.SYNC_ALL]
+    wait_until(send.isEnabled, 10, "Sync all enabled")
+    QTest.mouseClick(send, Qt.LeftButton)
+    window.said("queued for drone: not heard since the server started")
+    model = column.blueprint_model
+    wait_until(
+        lambda: model.data(model.index(0, STATUS)) == "waiting for contact",
+        10,
+        "the row to say the send waits for contact",
+    )
+    header = wait_until(
+        lambda: (text := column.status_label.text()) and "waiting for contact" in text and text,
+        10,
+        "the header to say what waits",
+    )
+    assert "never heard · 1 command waiting for contact" in header, header
+    no_traceback(window)

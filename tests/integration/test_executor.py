@@ -35,6 +35,7 @@ from rosmc_server.core import (
 )
 from rosmc_server.core.commands import CommandKind
 from rosmc_server.core.link import queue_hash
+from rosmc_server.recording import read_journal
 from rosmc_server.ros.client import MissionClient
 from tests.conftest import wait_until
 from tests.integration.executor_fixtures import (
@@ -959,3 +960,67 @@ def test_synchronizing_a_barrier_member_alone_warns_and_shows_what_it_waits_on(
     )
     assert state.waiting_on == "r2 (not synchronized)"
     assert op.change("synchronize", agent="r2", upto_id="").note == ""
+
+
+def test_commands_for_a_robot_out_of_contact_wait_and_arrive_once_in_order(rosmc: Start) -> None:
+    """While r1's link is blacked out, every operator command is answered and waits for it."""
+    system, op = rosmc(agents=("r1",), emulated=("r1",), server_params=("_link_timeout:=1.0",))
+    robot = LinkEnd("r1", "robot", robot_names=True)  # hears what reaches the robot
+    ground = LinkEnd("r1", "robot")  # hears what the ground sends
+    wait_until(lambda: robot.connected() and ground.connected(), 10.0, "both ends of r1's link")
+    keep = op.add("r1", "wait", {"duration": 0.05})
+    drop = op.add("r1", "wait", {"duration": 0.05})
+    op.blackout("r1", True)
+    wait_until(
+        lambda: op.agent_state("r1").link.state == wire.LinkState.DOWN, 10.0, "the link DOWN"
+    )
+    sent_before = len(ground.received("command"))
+    reached_before = len(robot.received("command"))
+
+    answer = op.change("synchronize", agent="r1", upto_id="")
+    assert answer.note.startswith("queued for r1: out of contact"), answer.note
+    op.change("unsynchronize", agent="r1", from_id=drop)  # take the second one back
+    with MissionClient(timeout=20.0) as client:
+        client.set_robot_options("r1", LostLinkPolicy(LostLinkKind.HOLD, after=30.0))
+        client.set_robot_options("r1", LostLinkPolicy(LostLinkKind.HOLD, after=45.0))
+    state = op.mission()
+    assert state.skill(keep).transfer is Transfer.UPLOADING, describe(state)
+    assert state.skill(drop).is_editable, describe(state)
+    link = op.agent_state("r1").link
+    assert link.state == wire.LinkState.DOWN
+    assert link.commands_waiting == 2, "the upload of one skill and the last policy"
+    assert link.waiting_for >= 0.0
+    assert len(ground.received("command")) == sent_before, "nothing leaves while it waits"
+
+    op.blackout("r1", False)
+    op.wait_status([keep], S.IDLE_SYNCHRONIZED, timeout=20.0)
+    op.wait_mission(
+        lambda m: "hold after 45 s" in op.agent_state("r1").policy, 20.0, "the last policy"
+    )
+    reached = robot.received("command")[reached_before:]
+    once = {c.seq: c for c in reached}  # retransmissions carry the same number
+    assert [(K(c.type), [s.id for s in c.skills]) for c in once.values()] == [
+        (K.UPLOAD, [keep]),
+        (K.SET_OPTIONS, []),
+    ]
+    assert json.loads(list(once.values())[1].argument)["lost_link"]["after"] == 45.0
+    assert op.agent_state("r1").link.commands_waiting == 0
+    op.start("r1")
+    op.wait_status([keep], S.SUCCESS)
+    assert op.mission().skill(drop).status is S.IDLE
+    robot.close()
+    ground.close()
+
+    system.stop("server")
+    cancel = wire.CommandRecord.CANCELLED
+    records = read_journal(system.journal, [interface.ROBOT_COMMANDS_TOPIC]).records
+    delivered = [
+        (K(r.message.type), list(r.message.skill_ids), r.message.held)
+        for r in records
+        if r.message.event == wire.CommandRecord.DELIVERED and r.message.held
+    ]
+    assert delivered == [(K.UPLOAD, [keep], True), (K.SET_OPTIONS, [], True)]
+    late = [r.message for r in records if r.message.event == wire.CommandRecord.DELIVERED]
+    assert all(m.delivered >= m.asked for m in late)
+    cancelled = [K(m.type) for m in (r.message for r in records) if m.event == cancel]
+    assert cancelled.count(K.SET_OPTIONS) == 1, "the first policy change was replaced"

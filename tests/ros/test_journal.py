@@ -647,8 +647,27 @@ def test_journal_channels_are_the_graph_names() -> None:
         "/tf",
         "/rosmc/sim/science",
         "/rosmc/sim/world",
+        "/rosmc/robot_commands",  # added last: older journals keep their channel ids
     ]
     assert EVENTS_TOPIC == "/rosmc/mission_events" and MISSION_TOPIC == "/rosmc/mission"
+
+
+def test_commands_are_journaled_with_when_asked_and_when_delivered(tmp_path: Path) -> None:
+    asked = msg.CommandRecord(
+        event=msg.CommandRecord.ASKED, agent="rover", type=0, held=True, skill_ids=["a"]
+    )
+    asked.asked.secs = 100
+    delivered = msg.CommandRecord(event=msg.CommandRecord.DELIVERED, agent="rover", seq=4)
+    delivered.asked.secs, delivered.delivered.secs = 100, 160
+    with JournalWriter.create(tmp_path / "c.mcap", mission(0), T0) as writer:
+        writer.append_command(asked, T0 + 1)
+        writer.append_command(delivered, T0 + 2)
+    records = read_journal(tmp_path / "c.mcap").messages("/rosmc/robot_commands")
+    assert [(r.event, r.seq, r.asked.secs, r.delivered.secs) for r in records] == [
+        (msg.CommandRecord.ASKED, 0, 100, 0),
+        (msg.CommandRecord.DELIVERED, 4, 100, 160),
+    ]
+    assert records[0].held and records[0].skill_ids == ["a"]
 
 
 def test_telemetry_channels_take_their_own_types_only(tmp_path: Path) -> None:

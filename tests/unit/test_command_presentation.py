@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Iterator
+from dataclasses import replace
 
 import pytest
 from python_qt_binding.QtCore import Qt
@@ -169,3 +170,9 @@ def test_robot_headers_in_words() -> None:
     assert p.link_summary(up) == "link up · battery 72% · Wi-Fi -61 dBm (out of range)"
     down = AgentStatus("alpha", link="down", last_heard=42.0, in_coverage=True, wifi_signal=-90)
     assert p.link_summary(down).startswith("LINK DOWN, heard 42 s ago")
+    held = replace(down, commands_waiting=2, waiting_for=130.0)
+    assert p.link_summary(held).startswith(
+        "LINK DOWN, heard 42 s ago · 2 commands waiting for contact 2 min · "
+    )
+    never = AgentStatus("alpha", commands_waiting=1, waiting_for=3.0)
+    assert p.link_summary(never) == "never heard · 1 command waiting for contact 3 s"

@@ -191,6 +191,12 @@ def test_icon_thresholds() -> None:
     parts = {r.key: r for r in status_parts(status)}
     assert parts["battery"].color == WARN and parts["wifi"].color == WARN
     assert parts["link"].text == "LINK DOWN 12 s" and parts["link"].color == BAD
+    waiting = replace(status, commands_waiting=2, waiting_for=95.0)
+    link = {r.key: r for r in status_parts(waiting)}["link"]
+    assert link.text == "LINK DOWN 12 s, 2 WAITING 1 min"
+    never = AgentStatus("drone", commands_waiting=1, waiting_for=5.0)
+    row = {r.key: r for r in status_parts(never)}["link"]
+    assert (row.text, row.color) == ("link never heard, 1 WAITING 5 s", WARN)
     status = replace(status, battery=0.9, wifi_signal=-50.0, current_status=SkillStatus.FAILURE)
     parts = {r.key: r for r in status_parts(status)}
     assert parts["battery"].color == GOOD and parts["wifi"].color == GOOD

@@ -362,6 +362,18 @@ def test_cancelling_an_unanswered_upload_returns_the_skills_to_the_blueprint(
     mission.edit_skill(first, label="edited after the cancel")
 
 
+def test_taking_back_the_later_of_two_waiting_uploads_keeps_the_first(mission: Any) -> None:
+    first = mission.add_skill("alpha", "noop").change.put_skills[0].skill.id
+    second = mission.add_skill("alpha", "noop").change.put_skills[0].skill.id
+    mission.synchronize("alpha")
+    event = mission.cancel_uploads("alpha", second)
+    assert [p.skill.id for p in event.change.put_skills] == [second]
+    assert mission.state.skill(first).transfer is Transfer.UPLOADING
+    assert mission.state.skill(second).is_editable
+    mission.confirm_synchronized("alpha", [first])
+    assert mission.state.skill(first).status is SkillStatus.IDLE_SYNCHRONIZED
+
+
 def test_area_parameters_must_be_polygons(mission: Any) -> None:
     from rosmc_server.core import InvalidRequest
 

@@ -36,7 +36,7 @@ class MissionClient(ClientBase):
     Methods take core-level arguments (agent and skill names, parameter values as
     plain data checked against the library schema, marker bindings) and return a
     :class:`Result` or raise a core :class:`~rosmc_server.core.RosmcError`:
-    InvalidRequest, NotFound, RuleViolation, Unavailable (robot unreachable),
+    InvalidRequest, NotFound, RuleViolation, Unavailable (too many commands wait for a robot),
     :class:`RevisionConflict` (a StaleRevision) and :class:`ServerUnavailable`.
 
     ``revision`` is the latest mission revision the client knows (from
@@ -252,8 +252,9 @@ class MissionClient(ClientBase):
 
         The safe skill's parameters are checked against the library here and on the
         server (those not given take the default). The robot reports the policy in
-        force in its agent state (:attr:`AgentStatus.policy`). Refused (Unavailable)
-        while the robot cannot be reached.
+        force in its agent state (:attr:`AgentStatus.policy`). While the robot cannot be
+        reached the change waits for contact (a newer one replaces it); Unavailable when
+        too many commands already wait.
         """
         parameters = (
             self._parameters(agent, policy.skill, policy.params, {}) if policy.skill else []

@@ -1,0 +1,187 @@
+"""Commands for a robot out of contact wait, collapse and leave once, in order (core/waiting.py)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from rosmc_server.core.commands import CommandKind
+from rosmc_server.core.link import InboundSequence, LinkStatus, Outbox
+from rosmc_server.core.waiting import (
+    MAX_WAITING,
+    collapse,
+    duration_text,
+    queued_note,
+    refusal,
+    waiting_text,
+)
+
+TIMEOUT = 3.0
+
+
+@dataclass
+class Skill:
+    id: str
+
+
+@dataclass
+class Cmd:
+    """The fields of ``rosmc/RobotCommand`` the waiting rules read."""
+
+    type: int
+    skills: list[Skill] = field(default_factory=list)
+    skill_ids: list[str] = field(default_factory=list)
+    argument: str = ""
+
+
+def command(kind: CommandKind, skills: tuple[str, ...] = (), ids: tuple[str, ...] = ()) -> Cmd:
+    return Cmd(int(kind), [Skill(s) for s in skills], list(ids))
+
+
+def queue(outbox: Outbox[Cmd], msg: Cmd, now: float = 0.0) -> list[Cmd]:
+    """Queue ``msg`` as the ground link does; returns the commands it withdrew."""
+    result = collapse(outbox, msg)
+    if result.kept is not None:
+        outbox.enqueue(result.kept, now)
+    return [item.payload for item in result.withdrawn]
+
+
+def kinds(outbox: Outbox[Cmd]) -> list[tuple[CommandKind, list[str]]]:
+    return [
+        (CommandKind(i.payload.type), [s.id for s in i.payload.skills] + i.payload.skill_ids)
+        for i in outbox.pending()
+    ]
+
+
+def lost_outbox() -> Outbox[Cmd]:
+    """An outbox whose robot was heard at t=0 (numbering 0) and is silent since."""
+    outbox: Outbox[Cmd] = Outbox(timeout=TIMEOUT)
+    outbox.robot_numbering(0, now=0.0)
+    return outbox
+
+
+class Robot:
+    """The robot's end: executes each number once, in order, and acknowledges it."""
+
+    def __init__(self) -> None:
+        self.inbound = InboundSequence()
+        self.executed: list[Cmd] = []
+
+    def receive(self, outbox: Outbox[Cmd], now: float) -> None:
+        for item in outbox.due(now):
+            if self.inbound.classify(item.seq).value == "next":
+                self.inbound.accept(item.seq)
+                self.executed.append(item.payload)
+        for item in list(outbox.pending()):
+            if item.seq and item.seq <= self.inbound.last:
+                outbox.acknowledge(item.seq, now)
+
+
+def test_while_the_link_is_down_new_commands_wait_unnumbered_and_old_ones_retransmit() -> None:
+    outbox = lost_outbox()
+    sent = outbox.enqueue(command(CommandKind.START), now=1.0)
+    assert [i.seq for i in outbox.due(1.0)] == [1]  # the link is up: it leaves at once
+    later = 10.0
+    assert outbox.status(later) is LinkStatus.DOWN
+    queue(outbox, command(CommandKind.UPLOAD, ("a",)), now=later)
+    due = outbox.due(later)
+    assert [i.payload for i in due] == [sent.payload], "only the numbered one goes again"
+    assert [i.seq for i in outbox.unsent()] == [0], "the new command waits unnumbered"
+    assert outbox.unsent()[0].held
+    report = outbox.report(later + 120.0)
+    assert (report.waiting, report.waiting_for) == (2, later + 120.0 - 1.0)
+
+
+def test_what_waited_leaves_in_order_exactly_once_when_the_robot_is_heard() -> None:
+    outbox = lost_outbox()
+    robot = Robot()
+    now = 10.0  # out of contact
+    for kind, skills in ((CommandKind.UPLOAD, ("a",)), (CommandKind.UPLOAD, ("b",))):
+        queue(outbox, command(kind, skills), now)
+    queue(outbox, command(CommandKind.START), now)
+    for step in range(5):
+        robot.receive(outbox, now + step)
+    assert robot.executed == [], "nothing leaves while the robot cannot be heard"
+    outbox.heard(now + 5)
+    for step in range(5, 30):  # duplicates and retransmissions on the way
+        robot.receive(outbox, now + step)
+        outbox.heard(now + step)
+    executed = [(CommandKind(c.type), [s.id for s in c.skills]) for c in robot.executed]
+    assert executed == [
+        (CommandKind.UPLOAD, ["a"]),
+        (CommandKind.UPLOAD, ["b"]),
+        (CommandKind.START, []),
+    ]
+    assert outbox.pending() == () and outbox.report(now + 30).waiting == 0
+
+
+def test_a_take_back_cancels_what_a_waiting_send_would_have_brought() -> None:
+    outbox = lost_outbox()
+    queue(outbox, command(CommandKind.UPLOAD, ("a", "b", "c")), 10.0)
+    queue(outbox, command(CommandKind.UNSYNC, ids=("b", "c", "x")), 10.0)
+    assert kinds(outbox) == [(CommandKind.UPLOAD, ["a"]), (CommandKind.UNSYNC, ["x"])]
+    withdrawn = queue(outbox, command(CommandKind.UNSYNC, ids=("a",)), 10.0)
+    assert kinds(outbox) == [(CommandKind.UNSYNC, ["x"])]
+    assert [CommandKind(c.type) for c in withdrawn] == [CommandKind.UPLOAD]
+
+
+def test_a_second_policy_or_barrier_set_replaces_the_waiting_one() -> None:
+    outbox = lost_outbox()
+    queue(outbox, Cmd(int(CommandKind.SET_OPTIONS), argument="hold"), 10.0)
+    queue(outbox, command(CommandKind.BARRIERS), 10.0)
+    queue(outbox, Cmd(int(CommandKind.SET_OPTIONS), argument="return"), 10.0)
+    queue(outbox, command(CommandKind.BARRIERS), 10.0)
+    assert [(CommandKind(i.payload.type), i.payload.argument) for i in outbox.pending()] == [
+        (CommandKind.SET_OPTIONS, "return"),
+        (CommandKind.BARRIERS, ""),
+    ]
+
+
+def test_controls_repeat_once_cancel_in_pairs_and_stop_supersedes_what_waits_before_it() -> None:
+    outbox = lost_outbox()
+    queue(outbox, command(CommandKind.START), 10.0)
+    queue(outbox, command(CommandKind.START), 10.0)
+    assert kinds(outbox) == [(CommandKind.START, [])]
+    queue(outbox, command(CommandKind.PAUSE), 10.0)
+    queue(outbox, command(CommandKind.RESUME), 10.0)
+    assert kinds(outbox) == [(CommandKind.START, [])]
+    queue(outbox, command(CommandKind.PAUSE), 10.0)
+    queue(outbox, command(CommandKind.STOP), 10.0)
+    queue(outbox, command(CommandKind.STOP), 10.0)
+    assert kinds(outbox) == [(CommandKind.STOP, [])], "start then stop: only the stop is left"
+
+
+def test_commands_already_transmitted_are_never_touched() -> None:
+    outbox = lost_outbox()
+    queue(outbox, command(CommandKind.UPLOAD, ("a",)))
+    queue(outbox, command(CommandKind.START))
+    assert len(outbox.due(0.0)) == 2
+    queue(outbox, command(CommandKind.UNSYNC, ids=("a",)))
+    queue(outbox, command(CommandKind.STOP))
+    assert kinds(outbox) == [
+        (CommandKind.UPLOAD, ["a"]),
+        (CommandKind.START, []),
+        (CommandKind.UNSYNC, ["a"]),
+        (CommandKind.STOP, []),
+    ]
+
+
+def test_the_bound_is_refused_with_one_sentence() -> None:
+    assert refusal("rover", MAX_WAITING - 1) == ""
+    sentence = refusal("rover", MAX_WAITING)
+    assert sentence == (
+        f"rover already has {MAX_WAITING} commands waiting for contact; "
+        "take some back or wait until the robot is heard"
+    )
+    assert sentence.count(".") == 0 and "\n" not in sentence
+
+
+def test_waiting_reads_with_its_age() -> None:
+    assert waiting_text(0, -1.0) == ""
+    assert waiting_text(1, 42.0) == "1 command waiting for contact 42 s"
+    assert waiting_text(2, 150.0) == "2 commands waiting for contact 2 min"
+    assert duration_text(7300.0) == "2 h"
+    assert queued_note("rover", False, 95.0) == (
+        "queued for rover: out of contact (last heard 1 min ago); "
+        "it goes out when the robot is heard again"
+    )
+    assert queued_note("rover", True, -1.0).startswith("queued for rover: not heard since")
