@@ -1,4 +1,4 @@
-"""Skill barriers under radio cuts across real hosts: no member starts alone.
+"""Radio cuts across real hosts: no barrier member starts alone, no waiting work is lost.
 
 The ground (master, server, operator) and three robots each run in a network namespace of
 their own, every robot's executor talking to the server and to its partners over its
@@ -16,15 +16,20 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Iterator
-from pathlib import Path
 
 import pytest
+import rosmc.msg as wire
 
+from rosmc_server import interface
+from rosmc_server.core import SkillStatus
+from rosmc_server.core.commands import CommandKind
+from rosmc_server.recording import read_journal
 from tests.integration.barrier_cuts import (
     CutOutcome,
     every_radio_cut_during_release,
     partner_cut_before_arrival,
 )
+from tests.integration.executor_fixtures import journal_reports
 from tests.integration.multihost_fixtures import LabSystem, lab_base_env
 from tests.integration.netns import RadioLab, sweep, unavailable
 
@@ -38,15 +43,19 @@ ALL_CUT = 15.0  # seconds every radio is down
 TOGETHER = 2.0
 
 
-@pytest.fixture
-def team(tmp_path: Path) -> Iterator[LabSystem]:
-    """Master and server on the ground; r1..r3 on hosts of their own, default TCP settings."""
+@pytest.fixture(scope="module")
+def team(tmp_path_factory: pytest.TempPathFactory) -> Iterator[LabSystem]:
+    """Master and server on the ground; r1..r3 on hosts of their own, default TCP settings.
+
+    One lab for the module: each test plans skills of its own and leaves every radio up.
+    """
     reason = unavailable()
     if reason:
         pytest.skip(reason)
     sweep()
+    work = tmp_path_factory.mktemp("lab")
     with RadioLab(ROBOTS, subnet=(os.getpid() + 7) % 250) as lab:
-        system = LabSystem(lab_base_env(tmp_path / "home"), tmp_path, lab=lab)
+        system = LabSystem(lab_base_env(work / "home"), work, lab=lab)
         try:
             system.start_master()
             system.start_server("_link_timeout:=2.0")
@@ -100,3 +109,46 @@ def test_the_ground_sees_whom_a_member_waits_for_during_a_cut(team: LabSystem) -
         time.sleep(0.2)
     assert waiting.startswith(f"r2 at {barrier}"), waiting
     lab.restore(["r2"])
+
+
+OUT_OF_CONTACT = 60.0  # seconds r3's radio is down while the operator sends it work
+
+
+@pytest.mark.timeout(240)
+def test_work_sent_to_a_robot_out_of_contact_arrives_once_in_order_after_the_cut(
+    team: LabSystem,
+) -> None:
+    lab, op = team.radio, team.operator()
+    op("wait_links", list(ROBOTS), 60.0, timeout=70.0)
+    op("start")
+    lab.cut(["r3"])
+    cut = time.time()
+    deadline = cut + 30.0
+    while op("links", ["r3"])["r3"] != "DOWN":
+        assert time.time() < deadline, "the ground never saw r3's link go down"
+        time.sleep(0.2)
+    sent = []
+    for duration in (0.2, 0.3, 0.4):  # three sends, each answered at once, each waiting
+        sent.append(op("add", "r3", "wait", {"duration": duration}))
+        answer = op.call("sync", "r3", timeout=10.0)
+        assert answer.seconds < 5.0, "the send waited on the robot"
+    assert op("statuses")[sent[0]][0] == "IDLE"  # nothing reached the robot yet
+    time.sleep(max(0.0, cut + OUT_OF_CONTACT - time.time()))
+    restored = time.time()
+    lab.restore(["r3"])
+    op("wait_status", sent, "SUCCESS", 60.0, timeout=70.0)
+    assert team.stop("server") == 0  # the module's last test: its journal is complete
+
+    records = [
+        r.message
+        for r in read_journal(team.journal, [interface.ROBOT_COMMANDS_TOPIC]).records
+        if r.message.agent == "r3" and set(r.message.skill_ids) & set(sent)
+    ]
+    uploads = [r for r in records if r.type == CommandKind.UPLOAD]
+    delivered = [r for r in uploads if r.event == wire.CommandRecord.DELIVERED]
+    assert [r.skill_ids for r in delivered] == [[skill] for skill in sent]  # once, in order
+    assert all(r.held and r.delivered.to_sec() >= restored for r in delivered)
+    reports = [r for r in journal_reports(team.journal) if r.skill_id in sent]
+    started = dict.fromkeys(r.skill_id for r in reports if r.status.value == SkillStatus.RUNNING)
+    finished = [r.skill_id for r in reports if r.status.value == SkillStatus.SUCCESS]
+    assert list(started) == sent and finished == sent  # in order, each finished once
