@@ -263,3 +263,4 @@ def options_from_argument(text: str) -> tuple[LostLinkPolicy, bool]:
 def policy_from_argument(text: str) -> LostLinkPolicy:
     """The policy a SET_OPTIONS argument sets (see :func:`options_from_argument`)."""
     return options_from_argument(text)[0]
+

@@ -24,6 +24,7 @@ from rosmc_server.core.library import library_from_dict, load_library
 from rosmc_server.core.policy import options_argument, options_from_argument
 from rosmc_server.executor.core import Engine, SkillType
 from rosmc_server.executor.core.engine import Mode
+from rosmc_server.executor.core.lost_link import LINK_MARGIN
 from rosmc_server.executor.core.state_file import load_state, save_state
 
 from .test_executor_engine import SKILL_TYPES, FakeClock, Recorder, Robot, Timed, make_skill
@@ -150,15 +151,21 @@ def test_an_idle_policy_waits_for_the_robot_to_finish_and_then_returns(rover: Ro
     assert rover.engine.snapshot().policy.endswith("(done); holding")
 
 
-def test_the_last_link_position_follows_every_contact(rover: Rover) -> None:
+def test_the_robot_returns_to_where_it_was_a_margin_before_the_last_contact(
+    rover: Rover,
+) -> None:
     rover.set_policy(RETURN)
-    rover.pose = Pose(4.0, 5.0)
-    rover.engine.report_acknowledged(0)  # something from the ground
+    for x in range(20):  # driving out at 1 m/s, hearing the ground every second
+        rover.pose = Pose(float(x), 5.0)
+        rover.engine.report_acknowledged(0)
+        rover.clock.now += 1.0
+    # Last heard at x = 19 (perhaps already beyond the edge): it goes back LINK_MARGIN s.
+    back = Pose(19.0 - LINK_MARGIN, 5.0)
+    assert rover.engine.lost_link.last_link_pose == back
     rover.pose = Pose(30.0, 5.0)
     rover.run_for(61.0)
     ret = Timed.instances[-1]
-    assert ret.ctx is not None and ret.ctx.params["target"] == Pose(4.0, 5.0)
-    assert rover.engine.lost_link.last_link_pose == Pose(4.0, 5.0)
+    assert ret.ctx is not None and ret.ctx.params["target"] == back
 
 
 def test_without_a_known_position_the_robot_holds(rover: Rover) -> None:

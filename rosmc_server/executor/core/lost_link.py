@@ -5,12 +5,16 @@ shared with the server and the operators' tools; this module only runs it.
 
 Where the robot is comes from a :data:`PoseSource` that the robot's integration gives
 the executor (the simulator's robots read their odometry): the guard asks it each time
-the ground is heard, so ``return_to_link`` knows where the robot last had a link.
+the ground is heard, so ``return_to_link`` knows where the robot last had a link. It
+returns to where it was :data:`LINK_MARGIN` seconds before the last contact: a link is
+known lost only some time after it went, so the very last contact can lie beyond the
+edge of coverage.
 """
 
 from __future__ import annotations
 
 import logging
+from collections import deque
 from collections.abc import Callable, Mapping
 
 from rosmc_server.core import LostLinkKind, LostLinkPolicy, ParamType
@@ -20,6 +24,8 @@ from rosmc_server.core import LostLinkTrigger
 from .skills import SkillBehavior, SkillContext, SkillType
 
 _log = logging.getLogger(__name__)
+LINK_MARGIN = 10.0
+"""Seconds before the last ground contact where the robot returns to."""
 
 PoseSource = Callable[[], Pose | None]
 """Where the robot is now in the mission's map frame (None while it does not know)."""
@@ -50,7 +56,6 @@ class LostLinkGuard:
         is_default: Whether ``policy`` is the library's default (no operator chose one).
         note: What the policy did last, for operators ("" until it acted).
         contingency: The safe skill while it runs (the robot is held meanwhile).
-        last_link_pose: Where the robot was when it last heard the ground (None: unknown).
     """
 
     def __init__(
@@ -67,7 +72,7 @@ class LostLinkGuard:
         self.is_default = False
         self.note = ""
         self.contingency: SkillBehavior | None = None
-        self.last_link_pose: Pose | None = None
+        self._trail: deque[tuple[float, Pose]] = deque()  # contacts within the margin
         self._pose_source = pose_source
         self._last_contact = clock()
         self._idle_since: float | None = None
@@ -76,11 +81,14 @@ class LostLinkGuard:
     def adopt(self, policy: LostLinkPolicy, default: bool) -> bool:
         """Take ``policy`` (an operator's, or the library's ``default``); False if ignored.
 
-        A library default never replaces a policy an operator chose.
+        A library default never replaces a policy an operator chose. What the previous
+        policy did is forgotten, unless its skill still runs.
         """
         if default and self.policy_chosen:
             return False
         self.policy, self.is_default = policy, default
+        if self.contingency is None:
+            self.note = ""
         return True
 
     @property
@@ -90,15 +98,25 @@ class LostLinkGuard:
 
     def contact(self) -> bool:
         """The ground was heard; True if that ends a triggered policy (the note changed)."""
-        self._last_contact = self.clock()
+        now = self._last_contact = self.clock()
         pose = self._pose_source()
         if pose is not None:
-            self.last_link_pose = pose
+            self._trail.append((now, pose))
+            while len(self._trail) > 1 and self._trail[1][0] <= now - LINK_MARGIN:
+                self._trail.popleft()
         if not self._triggered:
             return False
         self._triggered = False
         self.note += "; ground contact is back"
         return True
+
+    @property
+    def last_link_pose(self) -> Pose | None:
+        """Where the robot returns to: its pose :data:`LINK_MARGIN` s before the last contact.
+
+        The oldest pose heard if it has not been in contact that long; None if none is known.
+        """
+        return self._trail[0][1] if self._trail else None
 
     def due(self, now: float, idle: bool) -> bool:
         """Whether the policy acts now (``idle``: the robot has nothing left to do).
