@@ -21,7 +21,9 @@ class AgentStatus:
     telemetry. ``queue_hash`` is the synchronized queue as the ground sees it and
     ``robot_queue_hash`` as the robot last reported it (``hash_mismatch``: a repair is under
     way). ``policy`` is the lost-link policy the robot reports in force (and whether it
-    triggered), as the robot words it; "" if the robot has not said.
+    triggered), as the robot words it; "" if the robot has not said. ``coverage_warning``
+    is the server's warning that the synchronized plan ends out of coverage under a policy
+    that would leave the robot there ("" if none).
     """
 
     agent: str
@@ -41,3 +43,4 @@ class AgentStatus:
     executor_state: str = ""
     waiting_on: str = ""
     policy: str = ""
+    coverage_warning: str = ""
