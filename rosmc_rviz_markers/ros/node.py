@@ -9,7 +9,9 @@ ROS interface (every name behind ``~ns``):
     Publishes ``/rosmc/markers/update`` (visualization_msgs/InteractiveMarkerUpdate),
     ``/rosmc/markers/update_full`` (InteractiveMarkerInit, latched),
     ``/rosmc/markers/icons`` (visualization_msgs/MarkerArray, latched: status icons),
-    ``/rosmc/selection`` (rosmc/Selection, latched: what the operator clicked).
+    ``/rosmc/selection`` (rosmc/Selection, latched: what the operator clicked),
+    ``/rosmc/coverage`` (visualization_msgs/MarkerArray, latched: radio coverage, see
+    :mod:`.coverage_layer`, which also subscribes ``/rosmc/sim/coverage``).
     Subscribes ``/rosmc/markers/feedback`` (InteractiveMarkerFeedback), ``/rosmc/selection``,
     ``/rosmc/markers/new_position`` (geometry_msgs/PointStamped, Publish Point tool),
     ``/rosmc/markers/new_pose`` (PoseStamped, 2D Nav Goal tool),
@@ -45,6 +47,7 @@ from ..core.icons import icon_levels, status_rows
 from ..core.scene import Scene, Touched
 from ..core.specs import MarkerSpec
 from .adapter import MarkerServer
+from .coverage_layer import CoverageLayer
 from .convert import icon_markers, interactive_marker_msg, pose_msg
 from .interaction import Interaction
 
@@ -96,6 +99,7 @@ class MarkerNode:
             topics.topic(topics.ICONS_TOPIC, config.ns), MarkerArray, queue_size=10, latch=True
         )
         self.interaction = Interaction(self, config)
+        self.coverage = CoverageLayer(config.ns)  # radio coverage and last-link marks
         self._worker = threading.Thread(target=self._run, name="rosmc-markers", daemon=True)
 
     # -- what the interaction layer reads ---------------------------------------------------------

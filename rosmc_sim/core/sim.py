@@ -253,6 +253,14 @@ class Simulation:
     # -- coverage ------------------------------------------------------------------
     def wifi(self, robot: Robot) -> tuple[float, bool]:
         """Signal strength (dBm) of the best source, and whether the robot is covered."""
+        return self.signal_at(robot.x, robot.y, robot.z + 0.5)
+
+    def signal_at(self, x: float, y: float, z: float = 0.5) -> tuple[float, bool]:
+        """Signal strength (dBm) of the best source at a point, and whether it is covered.
+
+        The lander's access point and every deployed Wi-Fi box are sources; an obstacle in
+        the line of sight costs 20 dB and leaves the point uncovered.
+        """
         sources = [(0.0, 0.0, self.scenario.lander_wifi_radius)]
         sources += [
             (b.x, b.y, b.spec.wifi_radius)
@@ -260,13 +268,20 @@ class Simulation:
             if b.deployed and b.spec.kind == "wifi"
         ]
         best_dbm, covered = -120.0, False
-        for x, y, radius in sources:
-            distance = max(1.0, robot.distance_to(x, y))
-            sight = self._sight((x, y, 2.0), (robot.x, robot.y, robot.z + 0.5))
+        for sx, sy, radius in sources:
+            distance = max(1.0, math.hypot(x - sx, y - sy))
+            sight = self._sight((sx, sy, 2.0), (x, y, z))
             dbm = -40.0 - 25.0 * math.log10(distance) - (0.0 if sight else 20.0)
             best_dbm = max(best_dbm, dbm)
             covered = covered or (distance <= radius and sight)
         return best_dbm, covered
+
+    def wifi_sources(self) -> tuple[tuple[float, float], ...]:
+        """Where the radio sources stand: the lander and each deployed Wi-Fi box."""
+        boxes = [
+            (b.x, b.y) for b in self.boxes.values() if b.deployed and b.spec.kind == "wifi"
+        ]
+        return ((0.0, 0.0), *boxes)
 
     def _sight(self, a: tuple[float, float, float], b: tuple[float, float, float]) -> bool:
         if self.world is not None:
