@@ -29,9 +29,9 @@ from python_qt_binding.QtWidgets import (
 from rosmc_server.core import AgentStatus, LostLinkPolicy
 
 from . import presentation
+from .coverage_warning import coverage_warning_label, show_coverage_warning
 from .legality import RobotAction
 from .mission_view import MissionView
-from .coverage_warning import coverage_warning_label, show_coverage_warning
 from .policy_dialog import ask_policy
 from .row_delegate import RowDelegate
 from .schedule_model import NUMBER, PARAMS, SKILL, STATUS, TAG, SectionModel

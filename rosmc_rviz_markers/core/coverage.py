@@ -1,9 +1,9 @@
 """How rviz shows radio coverage: cells shaded by signal, and each robot's last-link mark.
 
 Pure geometry and colour over a :class:`~rosmc_server.core.radio_map.RadioMap`: the radio
-model's prediction (faint, flat, only where it reaches), the robots' own readings (stronger, a little higher, faded
-once older than :data:`OLD_AFTER`), and where each robot last had a link, labelled with its
-reading and age ("-72 dBm 26 s ago").
+model's prediction (faint, flat, only where it reaches), the robots' own readings (stronger,
+a little higher, faded once older than :data:`OLD_AFTER`), and where each robot last had a
+link, labelled with its reading and age ("-72 dBm 26 s ago").
 """
 
 from __future__ import annotations
@@ -57,7 +57,8 @@ def model_cells(radio: RadioMap) -> list[Cell]:
         return []
     grid = prediction.grid
     cells = []
-    for index, (dbm, covered) in enumerate(zip(prediction.signal, prediction.covered)):
+    pairs = zip(prediction.signal, prediction.covered, strict=False)
+    for index, (dbm, covered) in enumerate(pairs):
         if covered:
             x, y = grid.centre(index)
             cells.append(Cell(x, y, grid.resolution, signal_color(dbm, True, MODEL_ALPHA)))
@@ -67,16 +68,16 @@ def model_cells(radio: RadioMap) -> list[Cell]:
 def measured_cells(radio: RadioMap, now: float) -> list[Cell]:
     """The robots' readings, the newest per cell; old ones fainter."""
     size = radio.resolution * 0.8
-    return [
-        Cell(r.x, r.y, size, signal_color(
-            r.dbm, r.covered, OLD_ALPHA if now - r.stamp > OLD_AFTER else MEASURED_ALPHA
-        ))  # fmt: skip
-        for r in radio.readings()
-    ]
+    cells = []
+    for r in radio.readings():
+        alpha = OLD_ALPHA if now - r.stamp > OLD_AFTER else MEASURED_ALPHA
+        cells.append(Cell(r.x, r.y, size, signal_color(r.dbm, r.covered, alpha)))
+    return cells
 
 
 def last_links(radio: RadioMap, now: float) -> list[LastLink]:
-    """Each robot's last position with a link, labelled ``<robot> last link: -72 dBm 26 s ago``."""
+    """Each robot's last position with a link, labelled ``<robot> last link: -72 dBm 26 s
+    ago``."""
     return [
         LastLink(
             agent,

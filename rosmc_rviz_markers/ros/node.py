@@ -47,8 +47,8 @@ from ..core.icons import icon_levels, status_rows
 from ..core.scene import Scene, Touched
 from ..core.specs import MarkerSpec
 from .adapter import MarkerServer
-from .coverage_layer import CoverageLayer
 from .convert import icon_markers, interactive_marker_msg, pose_msg
+from .coverage_layer import CoverageLayer
 from .interaction import Interaction
 
 _log = logging.getLogger(__name__)

@@ -246,9 +246,7 @@ def _read_agents(
 
 
 def _read_model(reader: DocumentReader, raw: object, key: str) -> dict[str, SkillSpec]:
-    body = reader.mapping(
-        raw, key, required={"skills"}, optional={"description", "lost_link"}
-    )
+    body = reader.mapping(raw, key, required={"skills"}, optional={"description", "lost_link"})
     skills: dict[str, SkillSpec] = {}
     for name, entry in reader.mapping(body["skills"], f"{key}.skills").items():
         skills[name] = _read_skill(reader, name, entry, f"{key}.skills.{name}")

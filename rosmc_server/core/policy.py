@@ -145,7 +145,8 @@ class LostLinkPolicy:
         if self.kind is LostLinkKind.HOLD:
             return f"on link loss: hold {wait}"
         if self.kind is LostLinkKind.RETURN_TO_LINK:
-            return f"on link loss: return to the last link position ({self.skill}) {wait}, then hold"
+            where = f"the last link position ({self.skill})"
+            return f"on link loss: return to {where} {wait}, then hold"
         return f"on link loss: run {self.skill} {wait}, then hold"
 
     def leaves_robot_out(self) -> bool:
@@ -263,4 +264,3 @@ def options_from_argument(text: str) -> tuple[LostLinkPolicy, bool]:
 def policy_from_argument(text: str) -> LostLinkPolicy:
     """The policy a SET_OPTIONS argument sets (see :func:`options_from_argument`)."""
     return options_from_argument(text)[0]
-

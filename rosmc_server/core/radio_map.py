@@ -115,11 +115,7 @@ class RadioMap:
     def estimate(self, x: float, y: float) -> Estimate | None:
         """Coverage at (x, y): the nearest reading within :data:`MEASURED_NEAR`, else the
         model's prediction, else None (nothing is known there)."""
-        near = [
-            r
-            for r in self._around(x, y)
-            if math.hypot(r.x - x, r.y - y) <= MEASURED_NEAR
-        ]
+        near = [r for r in self._around(x, y) if math.hypot(r.x - x, r.y - y) <= MEASURED_NEAR]
         if near:
             best = min(near, key=lambda r: (math.hypot(r.x - x, r.y - y), -r.stamp))
             return Estimate(best.covered, best.dbm, True)

@@ -25,9 +25,7 @@ def coverage_grid(sim: Simulation) -> GridSpec:
     resolution = max(RESOLUTION, math.sqrt(area / MAX_CELLS))
     width = max(1, int((x_max - x_min) / resolution))
     height = max(1, int((y_max - y_min) / resolution))
-    return GridSpec(
-        x_min + resolution / 2, y_min + resolution / 2, resolution, width, height
-    )
+    return GridSpec(x_min + resolution / 2, y_min + resolution / 2, resolution, width, height)
 
 
 def coverage_prediction(sim: Simulation) -> Prediction:

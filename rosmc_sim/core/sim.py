@@ -278,9 +278,7 @@ class Simulation:
 
     def wifi_sources(self) -> tuple[tuple[float, float], ...]:
         """Where the radio sources stand: the lander and each deployed Wi-Fi box."""
-        boxes = [
-            (b.x, b.y) for b in self.boxes.values() if b.deployed and b.spec.kind == "wifi"
-        ]
+        boxes = [(b.x, b.y) for b in self.boxes.values() if b.deployed and b.spec.kind == "wifi"]
         return ((0.0, 0.0), *boxes)
 
     def _sight(self, a: tuple[float, float, float], b: tuple[float, float, float]) -> bool:

@@ -25,7 +25,9 @@ class OdometryPose:
     def __init__(self, robot: str) -> None:
         self._lock = threading.Lock()
         self._pose: Pose | None = None
-        self._subscriber = rospy.Subscriber(odom_topic(robot), Odometry, self._on_odom, queue_size=1)
+        self._subscriber = rospy.Subscriber(
+            odom_topic(robot), Odometry, self._on_odom, queue_size=1
+        )
 
     def _on_odom(self, msg: Odometry) -> None:
         p, q = msg.pose.pose.position, msg.pose.pose.orientation

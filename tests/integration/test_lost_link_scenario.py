@@ -45,7 +45,8 @@ def op(ros_master: Any, tmp_path_factory: pytest.TempPathFactory) -> Iterator[Op
     """The operator of this module's team, its links up."""
     if not rospy.core.is_initialized():
         rospy.init_node("lost_link_tests", anonymous=True, disable_signals=True)
-    team = Team(dict(ros_master.env), tmp_path_factory.mktemp("team"), TeamSettings(real_time_factor=RTF))
+    settings = TeamSettings(real_time_factor=RTF)
+    team = Team(dict(ros_master.env), tmp_path_factory.mktemp("team"), settings)
     operator: Operator | None = None
     try:
         team.start()

@@ -21,10 +21,16 @@ import rospy
 from visualization_msgs.msg import MarkerArray
 
 from rosmc_server.interface import COVERAGE_MARKERS_TOPIC
-from tests.conftest import RosMaster, wait_until
 from rosmc_sim.core.world import COLORS
+from tests.conftest import RosMaster, wait_until
 from tests.integration.test_rviz import blended, gui_programs, load_tool, sim  # noqa: F401
-from tests.integration.test_rviz_operator import CONFIG, markers, near, project, server  # noqa: F401
+from tests.integration.test_rviz_operator import (  # noqa: F401
+    CONFIG,
+    markers,
+    near,
+    project,
+    server,
+)
 
 pytest_plugins = ["tests.integration.server_fixtures"]
 
@@ -63,16 +69,20 @@ def view_of(pixels: np.ndarray) -> np.ndarray:
     return pixels[rows[0] : rows[-1] + 1, columns[0] : columns[-1] + 1]
 
 
-@pytest.mark.usefixtures("gui_programs", "sim")
+@pytest.mark.usefixtures("gui_programs", "sim", "markers")
 def test_rviz_shades_the_radio_coverage_and_marks_last_links(
-    markers: Any, ros_master: RosMaster, tmp_path: Path
+    ros_master: RosMaster, tmp_path: Path
 ) -> None:
     if not rospy.core.is_initialized():
         rospy.init_node("rviz_coverage_test", anonymous=True, disable_signals=True)
     latest = LatestArray()
     layers = wait_until(
-        lambda: (n := latest.namespaces()) and {"coverage_model", "last_link_label"} <= n.keys()
-        and len(n["last_link_label"]) == len(ROBOTS) and n,
+        lambda: (
+            (n := latest.namespaces())
+            and {"coverage_model", "last_link_label"} <= n.keys()
+            and len(n["last_link_label"]) == len(ROBOTS)
+            and n
+        ),
         30.0,
         "the coverage layer with the model and every robot's last link",
     )

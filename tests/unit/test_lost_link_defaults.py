@@ -20,7 +20,7 @@ from rosmc_server.core import (
     SkillStatus,
 )
 from rosmc_server.core.commands import CommandKind
-from rosmc_server.core.library import library_from_dict, load_library
+from rosmc_server.core.library import library_from_dict
 from rosmc_server.core.policy import options_argument, options_from_argument
 from rosmc_server.executor.core import Engine, SkillType
 from rosmc_server.executor.core.engine import Mode
@@ -30,9 +30,7 @@ from rosmc_server.executor.core.state_file import load_state, save_state
 from .test_executor_engine import SKILL_TYPES, FakeClock, Recorder, Robot, Timed, make_skill
 
 K = CommandKind
-RETURN = LostLinkPolicy(
-    LostLinkKind.RETURN_TO_LINK, 60.0, "goto", when=LostLinkTrigger.IDLE
-)
+RETURN = LostLinkPolicy(LostLinkKind.RETURN_TO_LINK, 60.0, "goto", when=LostLinkTrigger.IDLE)
 
 
 # -- the policy and the library ---------------------------------------------------

@@ -17,9 +17,8 @@ import logging
 from collections import deque
 from collections.abc import Callable, Mapping
 
-from rosmc_server.core import LostLinkKind, LostLinkPolicy, ParamType
+from rosmc_server.core import LostLinkKind, LostLinkPolicy, LostLinkTrigger, ParamType
 from rosmc_server.core.params import Pose, value_to_data
-from rosmc_server.core import LostLinkTrigger
 
 from .skills import SkillBehavior, SkillContext, SkillType
 
@@ -148,8 +147,9 @@ class LostLinkGuard:
         policy = self.policy
         params: dict[str, object] = dict(policy.params)
         held = f"held after {silent:.0f} s without ground contact"
+        silent_kind = policy.when is LostLinkTrigger.SILENT
         just_hold = policy.kind is LostLinkKind.HOLD or (
-            policy.kind is LostLinkKind.SAFE_SKILL and idle and policy.when is LostLinkTrigger.SILENT
+            policy.kind is LostLinkKind.SAFE_SKILL and idle and silent_kind
         )
         if policy.kind is LostLinkKind.RETURN_TO_LINK:
             target = self._return_target()
