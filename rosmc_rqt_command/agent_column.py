@@ -29,6 +29,7 @@ from python_qt_binding.QtWidgets import (
 from rosmc_server.core import AgentStatus, LostLinkPolicy
 
 from . import presentation
+from .coverage_warning import coverage_warning_label, show_coverage_warning
 from .legality import RobotAction
 from .mission_view import MissionView
 from .policy_dialog import ask_policy
@@ -41,7 +42,7 @@ ROW_HEIGHT = 22
 # and at most that wide (few robots: the columns share the width).
 COLUMN_WIDTH = 330
 MAX_COLUMN_WIDTH = 460
-AskPolicy = Callable[[str, Sequence[str], QWidget], LostLinkPolicy | None]
+AskPolicy = Callable[[str, Sequence[str], QWidget, str], LostLinkPolicy | None]
 
 
 class SectionTable(QTableView):  # type: ignore[misc]
@@ -129,6 +130,8 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         self.status_label = QLabel(presentation.link_summary(None))
         self.status_label.setWordWrap(True)
         self.status_label.setObjectName(f"status_{agent}")
+        self.warning_label = coverage_warning_label(agent)
+        self.policy_in_force = ""
         self.skill_names: list[str] = []
         self.ask_policy: AskPolicy = ask_policy  # tests answer the dialog through this
         self.policy_button = self._tool(
@@ -160,6 +163,7 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         top.addWidget(self.policy_button)
         header.addLayout(top)
         header.addWidget(self.status_label)
+        header.addWidget(self.warning_label)
         bar = QHBoxLayout()
         bar.addWidget(self.add_button)
         for button in self.buttons.values():
@@ -206,6 +210,8 @@ class AgentColumn(QFrame):  # type: ignore[misc]
             self._out_of_contact = out_of_contact
             self.synced_model.refresh()
             self.blueprint_model.refresh()
+        self.policy_in_force = status.policy if status is not None else ""
+        show_coverage_warning(self.warning_label, status)
 
     def set_skills(self, names: Sequence[str]) -> None:
         """The skills the Add menu offers (the robot's skills)."""
@@ -225,6 +231,6 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         self.add_requested.emit(self.agent, action.text())  # type: ignore[attr-defined]
 
     def _on_policy_button_clicked(self) -> None:
-        policy = self.ask_policy(self.agent, self.skill_names, self)
+        policy = self.ask_policy(self.agent, self.skill_names, self, self.policy_in_force)
         if policy is not None:
             self.policy_chosen.emit(self.agent, policy)

@@ -1,9 +1,11 @@
 """The lost-link policy picker: what a robot does when it stops hearing the ground.
 
-:class:`PolicyDialog` offers the three choices of
-:class:`~rosmc_server.core.LostLinkPolicy`: keep going, hold after N seconds, or run a
-safe skill (one of that robot's skills) after N seconds and then hold. It only builds
-the typed policy; the robot's column sends it.
+:class:`PolicyDialog` offers the choices of :class:`~rosmc_server.core.LostLinkPolicy`:
+keep going, hold after N seconds, run a safe skill (one of that robot's skills) after N
+seconds and then hold, or return to where the robot last had a link (with a skill that
+goes to a pose) and then hold; the seconds count either from the link's loss or only
+while the robot is idle too. It shows the policy in force (perhaps the library's
+default) and only builds the typed policy; the robot's column sends it.
 """
 
 from __future__ import annotations
@@ -11,6 +13,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from python_qt_binding.QtWidgets import (
+    QCheckBox,
     QComboBox,
     QDialog,
     QDialogButtonBox,
@@ -20,14 +23,16 @@ from python_qt_binding.QtWidgets import (
     QWidget,
 )
 
-from rosmc_server.core import InvalidRequest, LostLinkKind, LostLinkPolicy
+from rosmc_server.core import InvalidRequest, LostLinkKind, LostLinkPolicy, LostLinkTrigger
 from rosmc_server.core.policy import DEFAULT_AFTER
 
 KIND_WORDS = {
     LostLinkKind.CONTINUE: "keep going",
     LostLinkKind.HOLD: "hold (pause) after a while",
     LostLinkKind.SAFE_SKILL: "run a safe skill after a while, then hold",
+    LostLinkKind.RETURN_TO_LINK: "return to where it last had a link, then hold",
 }
+RETURN_SKILL = "navigate_to"  # offered first for a return, if the robot has it
 
 
 class PolicyDialog(QDialog):  # type: ignore[misc]
@@ -37,6 +42,7 @@ class PolicyDialog(QDialog):  # type: ignore[misc]
         agent: The robot.
         skills: The skills the robot can run as its safe skill.
         preferred: The safe skill offered first if the robot has it.
+        in_force: The policy the robot reports in force, as it words it ("" if unknown).
     """
 
     def __init__(
@@ -45,6 +51,7 @@ class PolicyDialog(QDialog):  # type: ignore[misc]
         skills: Sequence[str],
         preferred: str = "return_to_lander",
         parent: QWidget | None = None,
+        in_force: str = "",
     ) -> None:
         super().__init__(parent)
         self.setWindowTitle(f"{agent}: when the link is lost")
@@ -62,17 +69,25 @@ class PolicyDialog(QDialog):  # type: ignore[misc]
         self.skill_combo.setObjectName("policy_skill")
         names = sorted(skills)
         self.skill_combo.addItems(names)
+        self._preferred = preferred
         if preferred in names:
             self.skill_combo.setCurrentIndex(names.index(preferred))
+        self.idle_check = QCheckBox("count only while the robot has nothing left to do")
+        self.idle_check.setObjectName("policy_idle")
+        self.in_force = QLabel(f"In force: {in_force or 'not reported yet'}")
+        self.in_force.setObjectName("policy_in_force")
+        self.in_force.setWordWrap(True)
         self.problem = QLabel("")
         self.problem.setStyleSheet("QLabel { color:#b00020; }")
         self.problem.setWordWrap(True)
         self.buttons = QDialogButtonBox(QDialogButtonBox.Ok | QDialogButtonBox.Cancel)
         form = QFormLayout(self)
         form.addRow(QLabel(f"What should <b>{agent}</b> do when it stops hearing the ground?"))
+        form.addRow(self.in_force)
         form.addRow("Then", self.kind_combo)
         form.addRow("After", self.after_spin)
-        form.addRow("Safe skill", self.skill_combo)
+        form.addRow("", self.idle_check)
+        form.addRow("Skill", self.skill_combo)
         form.addRow(self.problem)
         form.addRow(self.buttons)
         self.buttons.accepted.connect(self._on_buttons_accepted)
@@ -89,17 +104,26 @@ class PolicyDialog(QDialog):  # type: ignore[misc]
         kind = LostLinkKind(self.kind_combo.currentData())
         if kind is LostLinkKind.CONTINUE:
             return LostLinkPolicy()
+        when = LostLinkTrigger.IDLE if self.idle_check.isChecked() else LostLinkTrigger.SILENT
         if kind is LostLinkKind.HOLD:
-            return LostLinkPolicy(kind, self.after_spin.value())
+            return LostLinkPolicy(kind, self.after_spin.value(), when=when)
         skill = self.skill_combo.currentText()
         if not skill:
             raise InvalidRequest("this robot has no skill to run as its safe skill")
-        return LostLinkPolicy(kind, self.after_spin.value(), skill)
+        return LostLinkPolicy(kind, self.after_spin.value(), skill, when=when)
 
     def _on_kind_combo_current_index_changed(self, _index: int) -> None:
         kind = LostLinkKind(self.kind_combo.currentData())
         self.after_spin.setEnabled(kind is not LostLinkKind.CONTINUE)
-        self.skill_combo.setEnabled(kind is LostLinkKind.SAFE_SKILL)
+        self.idle_check.setEnabled(kind is not LostLinkKind.CONTINUE)
+        self.skill_combo.setEnabled(kind.runs_skill)
+        # A return goes to a pose: offer the skill that does, the safe skill otherwise.
+        wanted = RETURN_SKILL if kind is LostLinkKind.RETURN_TO_LINK else self._preferred
+        index = self.skill_combo.findText(wanted)
+        if kind.runs_skill and index >= 0:
+            self.skill_combo.setCurrentIndex(index)
+        if kind is LostLinkKind.RETURN_TO_LINK:
+            self.idle_check.setChecked(True)
 
     def _on_buttons_accepted(self) -> None:
         try:
@@ -111,10 +135,10 @@ class PolicyDialog(QDialog):  # type: ignore[misc]
 
 
 def ask_policy(
-    agent: str, skills: Sequence[str], parent: QWidget | None = None
+    agent: str, skills: Sequence[str], parent: QWidget | None = None, in_force: str = ""
 ) -> LostLinkPolicy | None:
     """Show the dialog; the chosen policy, or None if the operator cancels."""
-    dialog = PolicyDialog(agent, skills, parent=parent)
+    dialog = PolicyDialog(agent, skills, parent=parent, in_force=in_force)
     if dialog.exec_() != QDialog.Accepted:
         return None
     return dialog.policy()

@@ -34,6 +34,11 @@ WORLD_TOPIC = f"{NAMESPACE}/sim/world"  # visualization_msgs/MarkerArray, latche
 # Published latched by the site's map provider (the simulator, or a real site's mapping); the
 # mission server checks skill targets against the newest one.
 SITE_TOPIC = f"{NAMESPACE}/site"  # rosmc/SiteMap
+# rosmc/CoverageGrid, latched: the simulator's radio model (access point, deployed Wi-Fi
+# boxes, obstacles); the server's coverage estimate and rviz's coverage layer read it.
+COVERAGE_MODEL_TOPIC = f"{NAMESPACE}/sim/coverage"
+# visualization_msgs/MarkerArray: radio coverage shaded by signal, last-link marks.
+COVERAGE_MARKERS_TOPIC = f"{NAMESPACE}/coverage"
 
 # A replay (``rosmc replay``) is steered through one service and says where it is.
 REPLAY_CONTROL_SERVICE = f"{NAMESPACE}/replay/control"  # rosmc/ReplayControl

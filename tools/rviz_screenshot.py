@@ -63,6 +63,21 @@ POLL_PERIOD = 0.5
 RGB = tuple[int, int, int]
 
 
+CHROME_LEVEL = 200  # rviz's panels and bars: every channel lighter than this
+
+
+def _area(box: tuple[int, int, int, int]) -> int:
+    top, bottom, left, right = box
+    return (bottom - top + 1) * (right - left + 1)
+
+
+def _longest_run(indices: np.ndarray) -> np.ndarray:
+    """The longest run of consecutive numbers in sorted ``indices``."""
+    breaks = np.flatnonzero(np.diff(indices) != 1) + 1
+    runs = np.split(indices, breaks)
+    return max(runs, key=len)
+
+
 class ScreenshotError(RuntimeError):
     """A program the tool needs is missing or failed."""
 
@@ -105,13 +120,32 @@ class Screenshot:
         rviz's window around the view (panels, toolbars) never has the view's background
         in more than a few pixels of a row or column; what the view shows (markers, grid)
         covers less than half of it.
+
+        A layer that covers most of the view (the radio-coverage shading) hides the
+        background: then the view is where rviz's light window chrome is not, provided
+        the background shows in it at all.
         """
-        mask = self.near(background, tolerance)
+        by_background = self._box(self.near(background, tolerance))
+        if by_background is None:
+            return None
+        box = by_background
+        by_chrome = self._box(self.pixels.min(axis=2) <= CHROME_LEVEL, longest=True)
+        if by_chrome is not None and _area(by_chrome) * 0.9 > _area(by_background):
+            box = by_chrome
+        top, bottom, left, right = box
+        return Screenshot(self.pixels[top : bottom + 1, left : right + 1])
+
+    @staticmethod
+    def _box(mask: np.ndarray, longest: bool = False) -> tuple[int, int, int, int] | None:
+        """Top, bottom, left, right of the rows and columns mostly in ``mask`` (``longest``:
+        of their longest unbroken run only)."""
         rows = np.flatnonzero(mask.mean(axis=1) > 0.5)
         columns = np.flatnonzero(mask.mean(axis=0) > 0.5)
         if rows.size == 0 or columns.size == 0:
             return None
-        return Screenshot(self.pixels[rows[0] : rows[-1] + 1, columns[0] : columns[-1] + 1])
+        if longest:
+            rows, columns = _longest_run(rows), _longest_run(columns)
+        return int(rows[0]), int(rows[-1]), int(columns[0]), int(columns[-1])
 
     def ppm(self) -> bytes:
         """The screenshot as a binary PPM."""

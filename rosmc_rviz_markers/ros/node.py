@@ -9,7 +9,9 @@ ROS interface (every name behind ``~ns``):
     Publishes ``/rosmc/markers/update`` (visualization_msgs/InteractiveMarkerUpdate),
     ``/rosmc/markers/update_full`` (InteractiveMarkerInit, latched),
     ``/rosmc/markers/icons`` (visualization_msgs/MarkerArray, latched: status icons),
-    ``/rosmc/selection`` (rosmc/Selection, latched: what the operator clicked).
+    ``/rosmc/selection`` (rosmc/Selection, latched: what the operator clicked),
+    ``/rosmc/coverage`` (visualization_msgs/MarkerArray, latched: radio coverage, see
+    :mod:`.coverage_layer`, which also subscribes ``/rosmc/sim/coverage``).
     Subscribes ``/rosmc/markers/feedback`` (InteractiveMarkerFeedback), ``/rosmc/selection``,
     ``/rosmc/markers/new_position`` (geometry_msgs/PointStamped, Publish Point tool),
     ``/rosmc/markers/new_pose`` (PoseStamped, 2D Nav Goal tool),
@@ -46,6 +48,7 @@ from ..core.scene import Scene, Touched
 from ..core.specs import MarkerSpec
 from .adapter import MarkerServer
 from .convert import icon_markers, interactive_marker_msg, pose_msg
+from .coverage_layer import CoverageLayer
 from .interaction import Interaction
 
 _log = logging.getLogger(__name__)
@@ -96,6 +99,7 @@ class MarkerNode:
             topics.topic(topics.ICONS_TOPIC, config.ns), MarkerArray, queue_size=10, latch=True
         )
         self.interaction = Interaction(self, config)
+        self.coverage = CoverageLayer(config.ns)  # radio coverage and last-link marks
         self._worker = threading.Thread(target=self._run, name="rosmc-markers", daemon=True)
 
     # -- what the interaction layer reads ---------------------------------------------------------

@@ -11,6 +11,7 @@ from ..core import (
     InvalidRequest,
     LostLinkKind,
     LostLinkPolicy,
+    LostLinkTrigger,
     MarkerType,
     MissionFileError,
     SkillSpec,
@@ -144,16 +145,16 @@ def policy(ctx: Context) -> int:
     """Set a robot's lost-link policy."""
     args = ctx.args
     kind = LostLinkKind(args.kind)
-    if (kind is LostLinkKind.SAFE_SKILL) != bool(args.skill):
-        raise UsageError("--skill names the safe skill, and goes with safe_skill only")
+    if kind.runs_skill != bool(args.skill):
+        raise UsageError("--skill names the skill, and goes with safe_skill or return_to_link only")
     values: dict[str, object] = {}
     if args.params:
         if not args.skill:
-            raise UsageError("--param goes with safe_skill and its --skill only")
+            raise UsageError("--param goes with --skill only")
         values, bindings = _values(ctx.client.library().skill(args.agent, args.skill), args.params)
         if bindings:
             raise InvalidRequest("safe-skill parameters cannot be bound to task markers")
-    chosen = LostLinkPolicy(kind, args.after, args.skill, values)
+    chosen = LostLinkPolicy(kind, args.after, args.skill, values, LostLinkTrigger(args.when))
     result = ctx.client.set_robot_options(args.agent, chosen)
     return ctx.emit_result(result, f"{args.agent}: {chosen.describe()} (sent to the robot)")
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from collections.abc import Callable, Sequence
 
-from ..core.policy import DEFAULT_AFTER, LostLinkKind
+from ..core.policy import DEFAULT_AFTER, LostLinkKind, LostLinkTrigger
 from .replay import add_commands as _add_recording
 from .review import add_commands as _add_review
 
@@ -30,10 +30,13 @@ key=@@text is the text '@text'. See 'rosmc library' for every schema."""
 
 
 POLICY_HELP = """\
-continue (the default) keeps executing; hold pauses the robot after SECONDS
-without the ground; safe_skill pauses it and runs --skill with each
---param KEY=VALUE (read as in 'rosmc add'), then holds. The robot reports
-the policy in force ('rosmc status --json', "policy")."""
+continue keeps executing; hold pauses the robot after SECONDS without the
+ground; safe_skill pauses it and runs --skill with each --param KEY=VALUE
+(read as in 'rosmc add'), then holds; return_to_link runs --skill (one that
+goes to a pose, e.g. navigate_to) to where the robot last had a link, then
+holds. --when idle counts only the seconds the robot also has nothing left
+to do. Until an operator chooses, a robot follows its library default. The
+robot reports the policy in force ('rosmc status', "policy")."""
 
 
 def _positive(text: str) -> float:
@@ -195,7 +198,7 @@ def _add_execution(command: _Command) -> None:
     )
     policy.add_argument("agent", metavar="ROBOT")
     policy.add_argument("kind", choices=[kind.value for kind in LostLinkKind], metavar="POLICY",
-                        help="continue, hold or safe_skill")  # fmt: skip
+                        help="continue, hold, safe_skill or return_to_link")  # fmt: skip
     policy.add_argument(
         "--param",
         dest="params",
@@ -211,7 +214,16 @@ def _add_execution(command: _Command) -> None:
         metavar="SECONDS",
         help=f"silence before the policy acts (default {DEFAULT_AFTER:g})",
     )
-    policy.add_argument("--skill", default="", metavar="SKILL", help="the safe skill (safe_skill)")
+    policy.add_argument(
+        "--skill", default="", metavar="SKILL", help="the skill (safe_skill, return_to_link)"
+    )
+    policy.add_argument(
+        "--when",
+        choices=[trigger.value for trigger in LostLinkTrigger],
+        default=LostLinkTrigger.SILENT.value,
+        help="silent: count every second without the ground (default); idle: only those "
+        "with nothing left to do",
+    )
     retry = command("retry", "run a failed skill again (a new attempt after it)")
     retry.add_argument("skill_id", metavar="ID")
     skip = command("skip", "skip a failed skill; the robot continues after it")

@@ -47,6 +47,7 @@ def agent_status_from_msg(msg: wire.AgentState) -> AgentStatus:
         executor_state=msg.executor_state,
         waiting_on=msg.waiting_on,
         policy=msg.policy,
+        coverage_warning=msg.coverage_warning,
     )
 
 

@@ -12,7 +12,7 @@ from typing import Any
 
 import rosmc.msg as wire
 
-from ..core import InvalidRequest, LostLinkKind, LostLinkPolicy
+from ..core import InvalidRequest, LostLinkKind, LostLinkPolicy, LostLinkTrigger
 from .values import params_from_msgs
 
 
@@ -25,6 +25,7 @@ def policy_to_request(
         "after": policy.after,
         "safe_skill": policy.skill,
         "safe_skill_parameters": list(parameters),
+        "when": policy.when.value,
     }
 
 
@@ -42,4 +43,5 @@ def policy_from_request(request: Any) -> LostLinkPolicy:
     values, bindings = params_from_msgs(request.safe_skill_parameters)
     if bindings:
         raise InvalidRequest("safe-skill parameters cannot be bound to task markers")
-    return LostLinkPolicy(kind, request.after, request.safe_skill, values)
+    when = LostLinkTrigger.parse(request.when or LostLinkTrigger.SILENT.value)
+    return LostLinkPolicy(kind, request.after, request.safe_skill, values, when)

@@ -34,7 +34,7 @@ from .persistence import (
     parse_mission,
     save_mission,
 )
-from .policy import LostLinkKind, LostLinkPolicy
+from .policy import LostLinkKind, LostLinkPolicy, LostLinkTrigger
 from .state import MissionContent, MissionState
 
 __all__ = [
@@ -49,6 +49,7 @@ __all__ = [
     "LibraryError",
     "LostLinkKind",
     "LostLinkPolicy",
+    "LostLinkTrigger",
     "MarkerType",
     "Mission",
     "MissionContent",

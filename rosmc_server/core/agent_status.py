@@ -24,7 +24,8 @@ class AgentStatus:
     way). ``policy`` is the lost-link policy the robot reports in force (and whether it
     triggered), as the robot words it; "" if the robot has not said. ``commands_waiting``
     commands wait for contact with the robot, the oldest for ``waiting_for`` seconds (-1:
-    none waits).
+    none waits). ``coverage_warning`` is the server's warning that the synchronized plan ends
+    out of coverage under a policy that would leave the robot there ("" if none).
     """
 
     agent: str
@@ -46,6 +47,7 @@ class AgentStatus:
     policy: str = ""
     commands_waiting: int = 0
     waiting_for: float = -1.0
+    coverage_warning: str = ""
 
     @property
     def waiting_text(self) -> str:

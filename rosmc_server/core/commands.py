@@ -11,7 +11,9 @@ import enum
 from dataclasses import dataclass
 
 from .changes import EventKind, MissionEvent
+from .library import Library
 from .model import Barrier, SkillInstance
+from .policy import options_argument
 from .state import MissionState
 
 
@@ -110,3 +112,16 @@ def repair_command(state: MissionState, agent: str) -> CommandSpec:
     return CommandSpec(
         agent, CommandKind.SYNC_STATE, skills, barriers=queued_barriers(state, agent)
     )
+
+
+def default_policy_commands(library: Library) -> list[CommandSpec]:
+    """SET_OPTIONS commands that give each robot its model's default lost-link policy.
+
+    The server queues them at start, so each robot gets its default when it first
+    links; a robot whose operator chose a policy keeps that one.
+    """
+    return [
+        CommandSpec(agent, CommandKind.SET_OPTIONS, argument=options_argument(policy, True))
+        for agent in library.dynamic_agents
+        if (policy := library.default_policy(agent)) is not None
+    ]

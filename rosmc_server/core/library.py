@@ -26,6 +26,7 @@ from .params import (
     check_value,
     quick_value,
 )
+from .policy import LostLinkPolicy
 from .site import SiteCheck
 from .validation import excerpt
 
@@ -115,6 +116,12 @@ class Library:
     name: str
     agents: tuple[AgentSpec, ...]
     models: Mapping[str, Mapping[str, SkillSpec]] = field(default_factory=dict)
+    lost_link: Mapping[str, LostLinkPolicy] = field(default_factory=dict)
+    """The default lost-link policy of each model that declares one."""
+
+    def default_policy(self, agent: str) -> LostLinkPolicy | None:
+        """The lost-link policy the library declares for ``agent``'s model, if any."""
+        return self.lost_link.get(self.agent(agent).model)
 
     def agent(self, name: str) -> AgentSpec:
         """The agent called ``name``; NotFound otherwise."""
@@ -191,8 +198,31 @@ def library_from_dict(data: object, source: str = "<library>") -> Library:
         reader.text(model, f"models.{model}"): _read_model(reader, raw, f"models.{model}")
         for model, raw in models_data.items()
     }
+    policies = {
+        model: _read_policy(reader, models[model], raw["lost_link"], f"models.{model}.lost_link")
+        for model, raw in models_data.items()
+        if isinstance(raw, Mapping) and "lost_link" in raw
+    }
     agents = _read_agents(reader, top["agents"], models)
-    return Library(name=name, agents=agents, models=models)
+    return Library(name=name, agents=agents, models=models, lost_link=policies)
+
+
+def _read_policy(
+    reader: DocumentReader, skills: Mapping[str, SkillSpec], raw: object, key: str
+) -> LostLinkPolicy:
+    """A model's default lost-link policy, its skill checked against the model's skills."""
+    try:
+        policy = LostLinkPolicy.from_dict(raw)
+    except InvalidRequest as error:
+        reader.fail(key, str(error))
+    if not policy.kind.runs_skill:
+        return policy
+    if policy.skill not in skills:
+        reader.fail(f"{key}.skill", f"names no skill of this model ({policy.skill!r})")
+    try:
+        return policy.checked_against(skills[policy.skill])
+    except (InvalidRequest, NotFound) as error:
+        reader.fail(key, str(error))
 
 
 def _read_agents(
@@ -216,7 +246,7 @@ def _read_agents(
 
 
 def _read_model(reader: DocumentReader, raw: object, key: str) -> dict[str, SkillSpec]:
-    body = reader.mapping(raw, key, required={"skills"}, optional={"description"})
+    body = reader.mapping(raw, key, required={"skills"}, optional={"description", "lost_link"})
     skills: dict[str, SkillSpec] = {}
     for name, entry in reader.mapping(body["skills"], f"{key}.skills").items():
         skills[name] = _read_skill(reader, name, entry, f"{key}.skills.{name}")

@@ -1,7 +1,8 @@
 """The aggregated state of every agent, published at a steady rate.
 
 Publishes ``/rosmc/agent_states`` (rosmc/AgentStates); subscribes
-``/<agent>/telemetry`` (rosmc/Telemetry) for every agent of the library.
+``/<agent>/telemetry`` (rosmc/Telemetry) for every agent of the library, and through
+:class:`~.coverage_watch.CoverageWatch` the radio model ``/rosmc/sim/coverage``.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import rospy
 from .. import interface
 from ..core import SkillStatus
 from ..core.advice import waiting_on_unsynced
+from .coverage_watch import CoverageWatch
 
 if TYPE_CHECKING:
     from .server_node import MissionServer
@@ -50,6 +52,7 @@ class AgentStatePublisher:
             for agent in server.library.agents
         ]
         self._timer: rospy.Timer | None = None
+        self._coverage = CoverageWatch(server.library)
 
     def start(self) -> None:
         """Start publishing at the configured rate."""
@@ -58,6 +61,7 @@ class AgentStatePublisher:
     def _on_telemetry(self, msg: wire.Telemetry, agent: str) -> None:
         with self._telemetry_lock:
             self._telemetry[agent] = msg
+        self._coverage.telemetry(msg)
 
     def build(self) -> wire.AgentStates:
         """The current state of every dynamic agent."""
@@ -111,6 +115,7 @@ class AgentStatePublisher:
             state.executor_state = link.snapshot.state
             state.waiting_on = link.snapshot.waiting_on
             state.policy = link.snapshot.policy
+        state.coverage_warning = self._coverage.warning(server.mission.state, agent, state.policy)
         unsynced = waiting_on_unsynced(server.mission.state, agent)
         if unsynced and not state.waiting_on:
             # The robot cannot know: its partners' skills are still on the ground.

@@ -76,11 +76,12 @@ from ..core import (
     load_library,
 )
 from ..core.changes import EventKind
-from ..core.commands import commands_for_event
+from ..core.commands import commands_for_event, default_policy_commands
 from ..recording import JournalOptions, JournalWriter, default_journal_path, latest_state
 from ..recording.recovery import ResumeReport
 from .agent_states import AgentStatePublisher
 from .ground_link import GroundLink
+from .heartbeat import Heartbeat
 from .logging_bridge import bridge_logging_to_rosout
 from .operator_services import OperatorServices
 from .publishing import SnapshotPublisher
@@ -169,8 +170,11 @@ class MissionServer:
         """Start publishing, serving and talking to robots."""
         with self._lock:
             self.link.resend_pending_transfers()
+            for spec in default_policy_commands(self.library):  # out when each robot links
+                self.link.send(spec)
         self._snapshots.start()
         self._agent_states.start()
+        Heartbeat(self.library.dynamic_agents).start()  # idle robots in coverage hear the ground
         self._recorder.start()
         self._services.advertise()
         self._site = SiteListener(self)

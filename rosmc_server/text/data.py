@@ -104,6 +104,7 @@ def agent_status_to_json(status: AgentStatus) -> dict[str, Any]:
         "executor_state": status.executor_state,
         "waiting_on": status.waiting_on,
         "policy": status.policy,
+        "coverage_warning": status.coverage_warning,
     }
 
 

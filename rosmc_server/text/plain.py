@@ -119,6 +119,10 @@ def format_agent_status(status: AgentStatus | None) -> str:
         parts.append(f"executor {status.executor_state}")
     if status.waiting_on:
         parts.append(f"waiting on {status.waiting_on}")
+    if status.policy:
+        parts.append(status.policy)
+    if status.coverage_warning:
+        parts.append(f"WARNING: {status.coverage_warning}")
     return ", ".join(parts)
 
 

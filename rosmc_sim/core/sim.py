@@ -256,7 +256,11 @@ class Simulation:
         return self.signal_at(robot.x, robot.y, robot.z + 0.5)
 
     def signal_at(self, x: float, y: float, z: float = 0.5) -> tuple[float, bool]:
-        """Signal strength (dBm) and coverage at a point (``z``: the antenna's height)."""
+        """Signal strength (dBm) of the best source at a point, and whether it is covered.
+
+        The lander's access point and every deployed Wi-Fi box are sources; an obstacle in
+        the line of sight costs 20 dB and leaves the point uncovered.
+        """
         sources = [(0.0, 0.0, self.scenario.lander_wifi_radius)]
         sources += [
             (b.x, b.y, b.spec.wifi_radius)
@@ -271,6 +275,11 @@ class Simulation:
             best_dbm = max(best_dbm, dbm)
             covered = covered or (distance <= radius and sight)
         return best_dbm, covered
+
+    def wifi_sources(self) -> tuple[tuple[float, float], ...]:
+        """Where the radio sources stand: the lander and each deployed Wi-Fi box."""
+        boxes = [(b.x, b.y) for b in self.boxes.values() if b.deployed and b.spec.kind == "wifi"]
+        return ((0.0, 0.0), *boxes)
 
     def _sight(self, a: tuple[float, float, float], b: tuple[float, float, float]) -> bool:
         if self.world is not None:

@@ -8,7 +8,8 @@ real robot would register skills of the same names that call its own stack.
 
 Use one function per robot kind as the executor's ``~skills`` parameter:
 ``rosmc_sim.ros.robot_skills:drone_skills`` (or ``science_rover_skills``,
-``manipulator_rover_skills``).
+``manipulator_rover_skills``). The module's :func:`pose_source` (the robot's
+odometry) is the executor's default ``~pose_source``.
 """
 
 from __future__ import annotations
@@ -27,7 +28,10 @@ from rosmc_server.core import ParamType, Value
 from rosmc_server.executor.core import Outcome, SkillBehavior, SkillContext, SkillType
 
 from ..core.skills_registry import TASKS
+from .robot_pose import pose_source
 from .topics import task_status_topic, task_topic
+
+__all__ = ["drone_skills", "manipulator_rover_skills", "pose_source", "science_rover_skills"]
 
 RESEND_AFTER = 1.0  # wall seconds without any status before a START is sent again
 

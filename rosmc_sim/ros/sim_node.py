@@ -16,6 +16,8 @@ Topics (names in :mod:`rosmc_sim.ros.topics`; stamps are sim time):
 * ``/rosmc/sim/science`` (rosmc/ScienceState, latched) (:mod:`rosmc_sim.ros.science`);
 * ``/rosmc/sim/world`` (visualization_msgs/MarkerArray, latched)
   (:mod:`rosmc_sim.ros.world_markers`);
+* ``/rosmc/sim/coverage`` (rosmc/CoverageGrid, latched): the radio model over the site,
+  anew when a Wi-Fi box moves (:mod:`rosmc_sim.ros.coverage_publisher`);
 * ``/rosmc/site`` (rosmc/SiteMap, latched, once): the site the mission server checks skill
   targets against (:mod:`rosmc_sim.ros.site_publisher`).
 
@@ -49,6 +51,7 @@ from rosmc_server.ros.logging_bridge import bridge_logging_to_rosout
 from ..core.scenario import Scenario, ScenarioError, load_scenario
 from ..core.sim import Simulation
 from ..core.world import World
+from .coverage_publisher import CoveragePublisher
 from .robot_state import RobotStatePublisher
 from .science import SciencePublisher
 from .site_publisher import SitePublisher
@@ -150,6 +153,7 @@ class SimNode:
         self.science = SciencePublisher(self.sim)
         self.world_markers = WorldPublisher(self.sim)
         self.site = SitePublisher(self.sim)
+        self.coverage = CoveragePublisher(self.sim)
         self._clock = ClockSource()
         self.steps = 0
 
@@ -166,6 +170,7 @@ class SimNode:
         self.state.after_step(self.config.step, now)
         self.science.after_step(now)
         self.world_markers.after_step(now)
+        self.coverage.after_step(now)
 
     def run(self, stop: threading.Event) -> None:
         """Step until ``stop`` is set or ROS shuts down, paced by the real-time factor."""

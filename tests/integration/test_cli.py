@@ -477,16 +477,24 @@ def test_policy_is_checked_and_sent(server: Server) -> None:
             ["policy", "science_rover", "safe_skill", "--skill", "navigate_to", "--param",
              "speed=0.2", "--after", "30"],
             ["--json", "policy", "science_rover", "continue"],
+            # README, "Lost-link policy"
+            ["policy", "manipulator_rover", "return_to_link", "--skill", "navigate_to",
+             "--when", "idle", "--after", "90"],
         ],
     )  # fmt: skip
-    assert [result.returncode for result in sent] == [0, 0, 0], [r.stderr for r in sent]
+    assert [result.returncode for result in sent] == [0, 0, 0, 0], [r.stderr for r in sent]
     assert sent[0].stdout == "manipulator_rover: on link loss: hold after 5 s (sent to the robot)\n"
     assert "run navigate_to after 30 s, then hold" in sent[1].stdout
     assert set(json.loads(sent[2].stdout)) == {"revision"}
+    assert sent[3].stdout == (
+        "manipulator_rover: on link loss: return to the last link position (navigate_to) "
+        "after 90 s idle without a link, then hold (sent to the robot)\n"
+    )
     refused = {
         ("policy", "lander", "hold"): "static agent",
         ("policy", "drone", "safe_skill", "--skill", "teleport"): "no skill 'teleport'",
         ("policy", "drone", "safe_skill", "--skill", "navigate_to", "--param=speed=99"): "speed",
+        ("policy", "drone", "return_to_link", "--skill", "land"): "exactly one pose parameter",
     }
     for result, needle in zip(run_many(server.env, list(refused)), refused.values(), strict=True):
         assert_refused(result, needle)
@@ -498,9 +506,11 @@ def test_policy_is_checked_and_sent(server: Server) -> None:
             ["policy", "drone", "hold", "--param", "speed=1"],
             ["policy", "drone", "panic"],
             ["policy", "drone", "hold", "--after", "0"],
+            ["policy", "drone", "return_to_link"],
+            ["policy", "drone", "hold", "--when", "soon"],
         ],
     )
-    assert [result.returncode for result in usage] == [2] * 5, [r.stderr for r in usage]
+    assert [result.returncode for result in usage] == [2] * 7, [r.stderr for r in usage]
 
 
 def test_sync_shows_uploading(server: Server, fresh: MissionClient) -> None:

@@ -16,6 +16,7 @@ import io
 import math
 from typing import Any
 
+import genpy
 import pytest
 import rosmc.msg as wire
 
@@ -39,6 +40,11 @@ from rosmc_server.conversions import (
     site_to_msg,
     skill_from_msg,
     skill_to_msg,
+)
+from rosmc_server.conversions.coverage import (
+    prediction_from_msg,
+    prediction_to_msg,
+    reading_from_telemetry,
 )
 from rosmc_server.conversions.robot_link import (
     command_from_msg,
@@ -71,6 +77,7 @@ from rosmc_server.core import (
 )
 from rosmc_server.core.changes import SkillMove
 from rosmc_server.core.commands import CommandKind
+from rosmc_server.core.radio_map import GridSpec, Prediction, Reading
 from rosmc_server.core.science import RegionScience, Science
 from rosmc_server.core.site import Footprint, GroundRobot, Shape, SiteCheck, SiteModel
 from rosmc_server.executor.core import Signal, SignalKind
@@ -314,6 +321,7 @@ def test_every_agent_state_field_reaches_the_agent_status() -> None:
         executor_state="waiting",
         waiting_on="drone",
         policy="on link loss: hold after 30 s",
+        coverage_warning="the plan ends out of coverage",
     )
     status = agent_status_from_msg(over_the_wire(msg))
     assert_no_default_field(status)
@@ -337,6 +345,7 @@ def test_every_agent_state_field_reaches_the_agent_status() -> None:
         executor_state="waiting",
         waiting_on="drone",
         policy="on link loss: hold after 30 s",
+        coverage_warning="the plan ends out of coverage",
     )
     nan = wire.AgentState(agent="lander", telemetry=wire.Telemetry(battery=math.nan))
     assert agent_status_from_msg(nan).battery is None
@@ -379,3 +388,19 @@ def test_the_science_state_survives_and_reads_as_sentences() -> None:
         "  RSS A at (16, 9): identified by both rovers, 1 stone(s) left (best 1)",
         "  RSS B at (30, -16): not identified, 2 stone(s) left (best 0.8)",
     ]
+
+
+def test_a_coverage_grid_survives_with_every_field() -> None:
+    grid = GridSpec(-9.5, -4.5, 1.0, 3, 2)
+    prediction = Prediction(
+        grid, (-40.0, -50.5, -60.0, -70.0, -80.0, -95.0), (True,) * 4 + (False,) * 2
+    )
+    msg = prediction_to_msg(prediction, "map")
+    back = prediction_from_msg(msg)
+    assert back.grid == grid and back.covered == prediction.covered
+    assert back.signal == pytest.approx(prediction.signal)  # float32 on the wire
+    assert msg.frame_id == "map"
+    telemetry = wire.Telemetry(agent="rover", stamp=genpy.Time(26, 0), frame_id="map",
+                               pose=wire.Pose6D(3.0, 4.0, 0.0, 0.0, 0.0, 0.0),
+                               wifi_signal=-72.0, in_coverage=True)  # fmt: skip
+    assert reading_from_telemetry(telemetry) == Reading("rover", 3.0, 4.0, -72.0, True, 26.0)

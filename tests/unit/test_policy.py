@@ -37,7 +37,7 @@ def test_a_kind_given_by_name_is_read() -> None:
 @pytest.mark.parametrize(
     ("fields", "needle"),
     [
-        ({"kind": "panic"}, "must be one of continue, hold, safe_skill, got 'panic'"),
+        ({"kind": "panic"}, "hold, safe_skill, return_to_link, got 'panic'"),
         ({"after": 0.0}, "'after' must be a positive number"),
         ({"after": -1.0}, "'after' must be a positive number"),
         ({"after": float("nan")}, "'after' must be a positive number"),
@@ -95,7 +95,9 @@ def test_the_command_argument_keeps_its_wire_form() -> None:
         ("[1]", "must be an object with a 'lost_link' object"),
         ('{"lost_link": 3}', "must be an object with a 'lost_link' object"),
         ('{"lost_link": {"policy": 3}}', "given by name"),
-        ('{"lost_link": {"policy": "hold", "when": 3}}', "no field 'when'"),
+        ('{"lost_link": {"policy": "hold", "whence": 3}}', "no field 'whence'"),
+        ('{"lost_link": {"policy": "hold", "when": 3}}', "trigger must be given by name"),
+        ('{"lost_link": {"policy": "hold", "when": "soon"}}', "silent or idle"),
         ("[" * 100_000, "not valid JSON"),
     ],
 )

@@ -11,11 +11,12 @@ import functools
 from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING
 
-from rosmc_server.core import InvalidRequest, LostLinkKind, SkillInstance
+from rosmc_server.core import InvalidRequest, LostLinkKind, LostLinkPolicy, SkillInstance
 from rosmc_server.core.commands import CommandKind
-from rosmc_server.core.policy import policy_from_argument
+from rosmc_server.core.policy import options_from_argument
 
 from . import queueing
+from .lost_link import pose_parameter
 from .protocol import Ack, AckResult, Command
 
 if TYPE_CHECKING:
@@ -130,15 +131,25 @@ def _set_barriers(engine: Engine, cmd: Command) -> Ack:
 
 def _set_options(engine: Engine, cmd: Command) -> Ack:
     try:
-        policy = policy_from_argument(cmd.argument)
-        if policy.kind is LostLinkKind.SAFE_SKILL and policy.skill not in engine.skill_types:
-            raise InvalidRequest(
-                f"the safe skill {policy.skill!r} is not implemented on this robot"
-            )
+        policy, default = options_from_argument(cmd.argument)
+        check_policy_skill(engine, policy)
     except InvalidRequest as error:
         return ack(engine, cmd.seq, error=str(error), rejected_ids=("options",))
-    engine.lost_link.policy = policy
+    engine.lost_link.adopt(policy, default)  # a default never replaces an operator's choice
     return ack(engine, cmd.seq)
+
+
+def check_policy_skill(engine: Engine, policy: LostLinkPolicy) -> None:
+    """InvalidRequest unless the robot implements the skill ``policy`` runs, if any."""
+    if not policy.kind.runs_skill:
+        return
+    kind = engine.skill_types.get(policy.skill)
+    if kind is None:
+        raise InvalidRequest(f"the safe skill {policy.skill!r} is not implemented on this robot")
+    if policy.kind is LostLinkKind.RETURN_TO_LINK and not pose_parameter(kind):
+        raise InvalidRequest(
+            f"the return skill {policy.skill!r} takes no single pose parameter on this robot"
+        )
 
 
 def _sync_state(engine: Engine, cmd: Command) -> Ack:

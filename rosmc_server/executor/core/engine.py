@@ -24,7 +24,7 @@ from rosmc_server.core.link import queue_hash
 from . import commanding, queueing
 from .barrier_wait import ANNOUNCE_PERIOD, Announcements, BarrierWaits
 from .barriers import BarrierBoard
-from .lost_link import LostLinkGuard
+from .lost_link import LostLinkGuard, PoseSource, no_pose
 from .protocol import Ack, BarrierInfo, Command, Mode, Report, Signal, SignalKind, Snapshot
 from .skills import Outcome, SkillBehavior, SkillContext, SkillType
 
@@ -75,6 +75,7 @@ class Engine:
         skill_types: Mapping[str, SkillType],
         clock: Callable[[], float],
         outputs: EngineOutputs,
+        pose_source: PoseSource = no_pose,
     ) -> None:
         self.agent = agent
         self.skill_types = dict(skill_types)
@@ -88,7 +89,7 @@ class Engine:
         self.acks: OrderedDict[int, Ack] = OrderedDict()
         self.board = BarrierBoard(agent)
         self.waits = BarrierWaits(agent, self.board, clock, outputs.signal)
-        self.lost_link = LostLinkGuard(agent, clock, self.skill_types)
+        self.lost_link = LostLinkGuard(agent, clock, self.skill_types, pose_source)
         self._active: _Active | None = None
         # Progress texts from skill threads, applied by tick() (deque appends are atomic).
         self._progress_box: deque[tuple[str, str]] = deque()
@@ -152,8 +153,8 @@ class Engine:
         """Advance the active skill, timeouts, retries, announcements and the link policy."""
         now = self.clock()
         self._apply_progress()
-        if self.lost_link.due(now):
-            idle = self._active is None and not queueing.upcoming(self.queue)
+        idle = self.idle
+        if self.lost_link.due(now, idle):
             self.lost_link.trigger(now, idle, self.pause)
             self.outputs.changed()
         if self.lost_link.step(now):
@@ -186,6 +187,17 @@ class Engine:
             self._finish(active, outcome)
 
     # -- execution -------------------------------------------------------------------
+    @property
+    def idle(self) -> bool:
+        """Nothing left to do on its own: no active skill and none it will start.
+
+        That is: the queue is done, the robot holds at a failure, or it is not started.
+        """
+        if self._active is not None or self.lost_link.contingency is not None:
+            return False
+        upcoming = queueing.upcoming(self.queue)
+        return upcoming is None or upcoming.status is S.FAILURE or self.mode is not Mode.STARTED
+
     @property
     def active_skill_id(self) -> str:
         """The skill being worked on (at its barrier, running or paused); "" if none."""

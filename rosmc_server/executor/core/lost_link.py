@@ -2,18 +2,43 @@
 
 The policy itself (:class:`~rosmc_server.core.policy.LostLinkPolicy`) is the core's,
 shared with the server and the operators' tools; this module only runs it.
+
+Where the robot is comes from a :data:`PoseSource` that the robot's integration gives
+the executor (the simulator's robots read their odometry): the guard asks it each time
+the ground is heard, so ``return_to_link`` knows where the robot last had a link. It
+returns to where it was :data:`LINK_MARGIN` seconds before the last contact: a link is
+known lost only some time after it went, so the very last contact can lie beyond the
+edge of coverage.
 """
 
 from __future__ import annotations
 
 import logging
+from collections import deque
 from collections.abc import Callable, Mapping
 
-from rosmc_server.core import LostLinkKind, LostLinkPolicy
+from rosmc_server.core import LostLinkKind, LostLinkPolicy, LostLinkTrigger, ParamType
+from rosmc_server.core.params import Pose, value_to_data
 
 from .skills import SkillBehavior, SkillContext, SkillType
 
 _log = logging.getLogger(__name__)
+LINK_MARGIN = 10.0
+"""Seconds before the last ground contact where the robot returns to."""
+
+PoseSource = Callable[[], Pose | None]
+"""Where the robot is now in the mission's map frame (None while it does not know)."""
+
+
+def no_pose() -> Pose | None:
+    """The pose source of a robot that gives none: its position is never known."""
+    return None
+
+
+def pose_parameter(kind: SkillType) -> str:
+    """The one pose parameter of a return skill, or "" if it has not exactly one."""
+    poses = [name for name, ptype in kind.parameters.items() if ptype is ParamType.POSE]
+    return poses[0] if len(poses) == 1 else ""
 
 
 class LostLinkGuard:
@@ -23,56 +48,142 @@ class LostLinkGuard:
         agent: The robot.
         clock: Seconds (the engine's clock).
         skill_types: The skills the robot implements (the safe skill is one of them).
+        pose_source: Where the robot is (remembered whenever the ground is heard).
 
     Attributes:
         policy: The policy in force.
+        is_default: Whether ``policy`` is the library's default (no operator chose one).
         note: What the policy did last, for operators ("" until it acted).
         contingency: The safe skill while it runs (the robot is held meanwhile).
     """
 
     def __init__(
-        self, agent: str, clock: Callable[[], float], skill_types: Mapping[str, SkillType]
+        self,
+        agent: str,
+        clock: Callable[[], float],
+        skill_types: Mapping[str, SkillType],
+        pose_source: PoseSource = no_pose,
     ) -> None:
         self.agent = agent
         self.clock = clock
         self.skill_types = skill_types
         self.policy = LostLinkPolicy()
+        self.is_default = False
         self.note = ""
         self.contingency: SkillBehavior | None = None
+        self._trail: deque[tuple[float, Pose]] = deque()  # contacts within the margin
+        self._pose_source = pose_source
         self._last_contact = clock()
+        self._idle_since: float | None = None
         self._triggered = False
+
+    def adopt(self, policy: LostLinkPolicy, default: bool) -> bool:
+        """Take ``policy`` (an operator's, or the library's ``default``); False if ignored.
+
+        A library default never replaces a policy an operator chose. What the previous
+        policy did is forgotten, unless its skill still runs.
+        """
+        if default and self.policy_chosen:
+            return False
+        self.policy, self.is_default = policy, default
+        if self.contingency is None:
+            self.note = ""
+        return True
+
+    @property
+    def policy_chosen(self) -> bool:
+        """Whether an operator chose the policy in force (not the library, not the start)."""
+        return not self.is_default and self.policy != LostLinkPolicy()
 
     def contact(self) -> bool:
         """The ground was heard; True if that ends a triggered policy (the note changed)."""
-        self._last_contact = self.clock()
+        now = self._last_contact = self.clock()
+        pose = self._pose_source()
+        if pose is not None:
+            self._trail.append((now, pose))
+            while len(self._trail) > 1 and self._trail[1][0] <= now - LINK_MARGIN:
+                self._trail.popleft()
         if not self._triggered:
             return False
         self._triggered = False
         self.note += "; ground contact is back"
         return True
 
-    def due(self, now: float) -> bool:
-        """Whether the policy acts now: the link has been silent too long, and it has not yet."""
+    @property
+    def last_link_pose(self) -> Pose | None:
+        """Where the robot returns to: its pose :data:`LINK_MARGIN` s before the last contact.
+
+        The oldest pose heard if it has not been in contact that long; None if none is known.
+        """
+        return self._trail[0][1] if self._trail else None
+
+    def due(self, now: float, idle: bool) -> bool:
+        """Whether the policy acts now (``idle``: the robot has nothing left to do).
+
+        A ``silent`` policy counts the seconds without the ground; an ``idle`` one the
+        seconds both idle and without the ground. It acts once per outage.
+        """
+        if not idle:
+            self._idle_since = None
+        elif self._idle_since is None:
+            self._idle_since = now
         if self.policy.kind is LostLinkKind.CONTINUE or self._triggered:
             return False
-        return now - self._last_contact >= self.policy.after
+        since = self._last_contact
+        if self.policy.when is LostLinkTrigger.IDLE:
+            if self._idle_since is None:
+                return False
+            since = max(since, self._idle_since)
+        return now - since >= self.policy.after
 
     def trigger(self, now: float, idle: bool, pause: Callable[[str], None]) -> None:
-        """Act: hold the robot with ``pause``, then run the safe skill (unless ``idle``)."""
+        """Act: hold the robot with ``pause``, then run the policy's skill.
+
+        A ``silent`` safe_skill policy only holds a robot that is ``idle`` (it keeps its
+        meaning from before idle triggers existed).
+        """
         silent = now - self._last_contact
         self._triggered = True
         policy = self.policy
-        if policy.kind is LostLinkKind.HOLD or idle:
-            self.note = f"held after {silent:.0f} s without ground contact"
+        params: dict[str, object] = dict(policy.params)
+        held = f"held after {silent:.0f} s without ground contact"
+        silent_kind = policy.when is LostLinkTrigger.SILENT
+        just_hold = policy.kind is LostLinkKind.HOLD or (
+            policy.kind is LostLinkKind.SAFE_SKILL and idle and silent_kind
+        )
+        if policy.kind is LostLinkKind.RETURN_TO_LINK:
+            target = self._return_target()
+            if target is None:
+                just_hold, held = True, held + " (no position with a link is known)"
+            else:
+                params.update(target)
+        if just_hold:
+            self.note = held
             pause(self.note)
         else:
-            self.note = f"ran '{policy.skill}' after {silent:.0f} s without ground contact"
+            self.note = self._running_note(silent)
             pause(self.note)
             kind = self.skill_types[policy.skill]
             self.contingency = kind.create()
-            ctx = SkillContext(self.agent, "", kind.coerce(policy.params), 1, self.clock)
+            ctx = SkillContext(self.agent, "", kind.coerce(params), 1, self.clock)
             self.contingency.start(ctx)
         _log.warning("%s: %s", self.agent, self.note)
+
+    def _return_target(self) -> dict[str, object] | None:
+        """The return skill's pose parameter set to the last position with a link."""
+        name = pose_parameter(self.skill_types[self.policy.skill])
+        if self.last_link_pose is None or not name:
+            return None
+        return {name: value_to_data(self.last_link_pose)}
+
+    def _running_note(self, silent: float) -> str:
+        if self.policy.kind is LostLinkKind.RETURN_TO_LINK and self.last_link_pose is not None:
+            pose = self.last_link_pose
+            return (
+                f"returning to the last link position ({pose.x:.1f}, {pose.y:.1f}) "
+                f"after {silent:.0f} s without ground contact"
+            )
+        return f"ran '{self.policy.skill}' after {silent:.0f} s without ground contact"
 
     def step(self, now: float) -> bool:
         """Advance the safe skill; True once it has finished (the robot holds)."""
@@ -88,4 +199,5 @@ class LostLinkGuard:
 
     def describe(self) -> str:
         """The policy in force and what it did, in one line."""
-        return self.policy.describe() + (f"; {self.note}" if self.note else "")
+        text = self.policy.describe() + (" (library default)" if self.is_default else "")
+        return text + (f"; {self.note}" if self.note else "")

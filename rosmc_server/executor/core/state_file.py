@@ -47,6 +47,7 @@ def save_state(engine: Engine, path: Path) -> None:
         "board": engine.board.to_dict(),
         "policy": engine.lost_link.policy.to_dict(),
         "policy_note": engine.lost_link.note,
+        "policy_default": engine.lost_link.is_default,
     }
     path.parent.mkdir(parents=True, exist_ok=True)
     temporary = path.with_name(f".{path.name}.tmp")
@@ -88,6 +89,7 @@ def load_state(engine: Engine, path: Path) -> list[str]:
     except RosmcError as error:
         raise ValueError(f"{path}: {error}") from error
     engine.lost_link.note = str(data.get("policy_note", ""))
+    engine.lost_link.is_default = data.get("policy_default") is True
     mode = Mode(data["mode"])
     engine.mode = Mode.STOPPED if mode is Mode.STARTED else mode
     return engine.interrupted_by_restart()

@@ -19,6 +19,9 @@ Parameters (private):
         (default: the basic skills, ``rosmc_server.executor.basic_skills:skill_types``).
     ``~state_file`` (str): where the executor keeps its state across restarts
         (default ``$ROS_HOME/rosmc/<agent>_executor.json``; "" = keep nothing).
+    ``~pose_source`` (str): ``module:function`` returning the robot's pose source (where it
+        is, remembered at each ground contact for the ``return_to_link`` policy); default:
+        the skills module's ``pose_source`` if it has one, else none.
     ``~snapshot_period`` (float, s, 1.0), ``~report_retry`` (float, s, 0.5),
     ``~tick_rate`` (float, Hz, 50), ``~robot_side`` (bool, false).
     They are read once at start and deleted, so a later executor of the same name starts
@@ -37,6 +40,7 @@ import time
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import cast
 
 import rosmc.msg as wire
 import rospy
@@ -56,6 +60,7 @@ from ...core import RosmcError
 from ...core.radio import BEACON_PERIOD, ContactWatch
 from ...ros.radio import GROUND, Radio, TopicListener, reconnect_in_background
 from ..core import Command, Engine, Report, Signal, SkillType
+from ..core.lost_link import PoseSource, no_pose
 from ..core.state_file import load_state, save_state
 
 _log = logging.getLogger(__name__)
@@ -70,6 +75,17 @@ def load_skill_types(spec: str, agent: str) -> dict[str, SkillType]:
     return {kind.name: kind for kind in types}
 
 
+def load_pose_source(spec: str, skills: str, agent: str) -> PoseSource:
+    """The robot's pose source: ``spec`` (``module:function``), else the skills module's."""
+    if not spec:
+        module = importlib.import_module(skills.partition(":")[0])
+        factory = getattr(module, "pose_source", None)
+        return no_pose if factory is None else cast(PoseSource, factory(agent))
+    module_name, _, function = spec.partition(":")
+    factory = getattr(importlib.import_module(module_name), function or "pose_source")
+    return cast(PoseSource, factory(agent))
+
+
 class ExecutorNode:
     """Wires an :class:`Engine` to the robot link and the barrier topic."""
 
@@ -79,6 +95,7 @@ class ExecutorNode:
         skill_types: dict[str, SkillType],
         state_file: Path | None,
         robot_side: bool = False,
+        pose_source: PoseSource = no_pose,
     ) -> None:
         self.agent = agent
         self._lock = threading.RLock()
@@ -93,7 +110,7 @@ class ExecutorNode:
         self._barrier_pub = rospy.Publisher(
             interface.BARRIER_TOPIC, wire.BarrierSignal, queue_size=100
         )
-        self.engine = Engine(agent, skill_types, rospy.get_time, self)
+        self.engine = Engine(agent, skill_types, rospy.get_time, self, pose_source)
         if state_file is not None and state_file.exists():
             try:
                 interrupted = load_state(self.engine, state_file)
@@ -234,6 +251,7 @@ class ExecutorConfig:
 
     agent: str
     skills: str = DEFAULT_SKILLS
+    pose_source: str = ""
     state_file: Path | None = None
     robot_side: bool = False
     tick_rate: float = 50.0
@@ -254,6 +272,7 @@ class ExecutorConfig:
         config = cls(
             agent=agent,
             skills=str(rospy.get_param("~skills", DEFAULT_SKILLS)),
+            pose_source=str(rospy.get_param("~pose_source", "")),
             state_file=Path(state).expanduser() if state else None,
             robot_side=bool(rospy.get_param("~robot_side", False)),
             tick_rate=float(rospy.get_param("~tick_rate", 50.0)),
@@ -269,6 +288,7 @@ class ExecutorConfig:
 PRIVATE_PARAMS = (
     "agent",
     "skills",
+    "pose_source",
     "state_file",
     "robot_side",
     "tick_rate",
@@ -294,10 +314,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     try:
         skill_types = load_skill_types(config.skills, config.agent)
+        pose_source = load_pose_source(config.pose_source, config.skills, config.agent)
     except (ImportError, AttributeError, ValueError) as error:
         _log.critical("mission executor %s: cannot load skills: %s", config.agent, error)
         return 1
-    node = ExecutorNode(config.agent, skill_types, config.state_file, config.robot_side)
+    node = ExecutorNode(
+        config.agent, skill_types, config.state_file, config.robot_side, pose_source
+    )
     _log.info(
         "%s: mission executor ready with skills %s (%s link)",
         config.agent,

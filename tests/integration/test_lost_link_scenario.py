@@ -1,0 +1,114 @@
+"""A rover whose synchronized plan ends out of coverage, on the real simulated team.
+
+With its library default (``return_to_link`` after 60 s idle without a link) it drives
+back to where it last had a link, the ground hears it again, and it holds. With ``continue``
+(the old default) it stays out. The team is this module's own: the second test leaves the
+rover out of reach for good.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+import rospy
+
+from rosmc_server.core import LostLinkPolicy, SkillStatus
+from tests.conftest import wait_until
+from tests.integration.scenario_fixtures import Operator, Team, TeamSettings
+
+pytestmark = pytest.mark.integration
+
+RTF = 50.0
+ARM = "manipulator_rover"
+COVERAGE = 12.0  # the test scenario's lander reach (m)
+OUT = (17.0, 0.0)
+
+
+def out_of_coverage_plan(op: Operator) -> str:
+    """Send the rover 17 m out (5 m beyond the lander's reach); the skill's id."""
+    far = op.client.add_skill(ARM, "navigate_to", {"target": {"x": OUT[0], "y": OUT[1]}})
+    op.sync_and_start([ARM])
+    return far.skill_id
+
+
+def reached_out(telemetry: Any) -> bool:
+    """The rover stands at the far spot, out of coverage."""
+    return math.dist((telemetry.pose.x, telemetry.pose.y), OUT) < 0.3 and not telemetry.in_coverage
+
+
+@pytest.fixture(scope="module")
+def op(ros_master: Any, tmp_path_factory: pytest.TempPathFactory) -> Iterator[Operator]:
+    """The operator of this module's team, its links up."""
+    if not rospy.core.is_initialized():
+        rospy.init_node("lost_link_tests", anonymous=True, disable_signals=True)
+    settings = TeamSettings(real_time_factor=RTF)
+    team = Team(dict(ros_master.env), tmp_path_factory.mktemp("team"), settings)
+    operator: Operator | None = None
+    try:
+        team.start()
+        operator = Operator()
+        operator.wait_links_up(timeout=60.0)
+        team.wait_emulator()
+        yield operator
+        assert not team.dead(), f"{team.dead()} died:\n{team.log_tails()}"
+    finally:
+        if operator is not None:
+            operator.close()
+        team.close()
+        print(team.log_tails())
+
+
+def test_by_default_a_rover_left_out_of_coverage_returns_to_its_link_and_holds(
+    op: Operator,
+) -> None:
+    # The server gives each robot its library default when it first links.
+    state = wait_until(
+        lambda: (s := op.agent_state(ARM)) and "(library default)" in s.policy and s,
+        30.0,
+        "the robot reports its library default policy",
+    )
+    assert state.policy.startswith("on link loss: return to the last link position"), state
+    far = out_of_coverage_plan(op)
+    op.wait_link(ARM, "down", timeout=30.0)
+    op.wait_robot(ARM, reached_out, "it reaches the far spot", timeout=60.0)
+
+    # 60 sim seconds idle without a link later it drives back, and the ground hears it.
+    op.wait_link(ARM, "up", timeout=60.0)
+    op.wait_status([far], SkillStatus.SUCCESS, timeout=30.0)
+    held = wait_until(
+        lambda: (s := op.agent_state(ARM)) and "(done); holding" in s.policy and s,
+        30.0,
+        "the robot holds after its return",
+    )
+    assert held.executor_state == "paused", held
+    where = re.search(r"returning to the last link position \((\S+), (\S+)\)", held.policy)
+    assert where, held.policy
+    goal = (float(where[1]), float(where[2]))
+    assert math.hypot(*goal) < COVERAGE and goal[0] > 0.0, "where it had a link, not home"
+    op.wait_robot(
+        ARM,
+        lambda t: t.in_coverage and math.dist((t.pose.x, t.pose.y), goal) < 0.3,
+        "it stands at its last link position, in coverage",
+    )
+    assert op.agent_state(ARM).link == "up"  # type: ignore[union-attr]
+
+
+def test_with_policy_continue_the_rover_stays_out(op: Operator) -> None:
+    op.client.set_robot_options(ARM, LostLinkPolicy())
+    wait_until(
+        lambda: (s := op.agent_state(ARM)) and s.policy == "on link loss: continue",
+        30.0,
+        "the robot takes the continue policy",
+    )
+    out_of_coverage_plan(op)
+    op.wait_link(ARM, "down", timeout=30.0)
+    arrived = op.wait_robot(ARM, reached_out, "it reaches the far spot", timeout=60.0)
+    # Nothing happens: three times the default's minute of idleness, in sim time.
+    later = arrived.stamp.to_sec() + 180.0
+    op.wait_robot(ARM, lambda t: t.stamp.to_sec() > later, "three sim minutes", timeout=60.0)
+    assert reached_out(op.where(ARM)), "the rover stayed where its plan ended"
+    assert op.agent_state(ARM).link == "down"  # type: ignore[union-attr]
