@@ -267,16 +267,30 @@ def read_header(data: bytes, start: int) -> tuple[str, str, int]:
 
 
 def parse_schema(body: bytes) -> SchemaRecord:
-    """Decode a Schema record."""
+    """Decode a Schema record (FormatError unless its fields fill it exactly)."""
     cur = Cursor(body)
-    return SchemaRecord(cur.u16(), cur.string(), cur.string(), cur.take(cur.u32()))
+    rec = SchemaRecord(cur.u16(), cur.string(), cur.string(), cur.take(cur.u32()))
+    _filled(cur, body, "schema")
+    return rec
 
 
 def parse_channel(body: bytes) -> ChannelRecord:
-    """Decode a Channel record (its metadata is not needed and not read)."""
+    """Decode a Channel record (its metadata is skipped; FormatError unless filled exactly)."""
     cur = Cursor(body)
     id_, schema_id = cur.u16(), cur.u16()
-    return ChannelRecord(id_, schema_id, cur.string(), cur.string())
+    rec = ChannelRecord(id_, schema_id, cur.string(), cur.string())
+    cur.take(cur.u32())  # the metadata map, by its byte length
+    _filled(cur, body, "channel")
+    return rec
+
+
+def _filled(cur: Cursor, body: bytes, what: str) -> None:
+    """A declaration has no checksum: a record length that disagrees with its own fields
+    (a damaged length) would otherwise swallow the records after it."""
+    if cur.pos != len(body):
+        raise FormatError(
+            f"the {what} record's length says {len(body)} bytes, its fields {cur.pos}"
+        )
 
 
 def parse_message(body: bytes) -> MessageRecord:
