@@ -1,8 +1,9 @@
 """A rover whose synchronized plan ends out of coverage, on the real simulated team.
 
 With its library default (``return_to_link`` after 60 s idle without a link) it drives
-back to where it last had a link, the ground hears it again, and it holds. With ``continue``
-(the old default) it stays out. The team is this module's own: the second test leaves the
+back to where it last had a link, the ground hears it again, and it holds; work the operator
+sent while it was out of contact reaches it then. With ``continue`` (the old default) it
+stays out. The team is this module's own: the second test leaves the
 rover out of reach for good.
 """
 
@@ -16,7 +17,8 @@ from typing import Any
 import pytest
 import rospy
 
-from rosmc_server.core import LostLinkPolicy, SkillStatus
+from rosmc_server.core import LostLinkKind, LostLinkPolicy, SkillStatus
+from rosmc_server.ros.client import ControlCommand
 from tests.conftest import wait_until
 from tests.integration.scenario_fixtures import Operator, Team, TeamSettings
 
@@ -95,6 +97,48 @@ def test_by_default_a_rover_left_out_of_coverage_returns_to_its_link_and_holds(
         "it stands at its last link position, in coverage",
     )
     assert op.agent_state(ARM).link == "up"  # type: ignore[union-attr]
+
+
+def test_work_sent_while_out_of_contact_reaches_the_rover_when_its_default_brings_it_back(
+    op: Operator,
+) -> None:
+    """The operator adapts the plan of a rover that is out of contact; nothing is refused."""
+    c = op.client
+    far = out_of_coverage_plan(op)  # from where the previous test left it, holding
+    op.wait_link(ARM, "down", timeout=30.0)
+    home = c.add_skill(ARM, "navigate_to", {"target": {"x": 4.0, "y": 1.0}}).skill_id
+    extra = c.add_skill(ARM, "navigate_to", {"target": {"x": 3.0, "y": -1.0}}).skill_id
+    sent = c.synchronize(ARM)
+    assert set(sent.skill_ids) == {home, extra}
+    assert sent.note.startswith(f"queued for {ARM}: out of contact"), sent.note
+    c.unsynchronize(ARM, extra)  # take one back while it waits
+    c.set_robot_options(ARM, LostLinkPolicy(LostLinkKind.HOLD, after=600.0))
+    c.set_robot_options(ARM, LostLinkPolicy())  # a second change replaces the first
+    waiting = wait_until(  # one upload and one policy, shown with their age
+        lambda: (s := op.agent_state(ARM)) is not None and s.commands_waiting == 2 and s,
+        10.0,
+        "two commands shown waiting",
+    )
+    assert waiting.link == "down" and "waiting for contact" in waiting.waiting_text
+
+    # Its plan done, idle a minute without a link, the rover's library default drives it back
+    # into coverage; what waited reaches it there, once and in order.
+    op.wait_status([far], SkillStatus.SUCCESS, timeout=90.0)
+    op.wait_link(ARM, "up", timeout=60.0)
+    state = op.wait_stored(ARM)
+    assert state.skill(home).status is SkillStatus.IDLE_SYNCHRONIZED
+    assert state.skill(extra).is_editable, "the taken-back skill never went"
+    wait_until(
+        lambda: (s := op.agent_state(ARM)) and s.policy.startswith("on link loss: continue"),
+        30.0,
+        "the last policy in force",
+    )
+    assert op.agent_state(ARM).commands_waiting == 0  # type: ignore[union-attr]
+
+    # The operator resumes the held rover: the skill that waited runs, the mission completes.
+    c.control(ControlCommand.START, ARM)
+    op.wait_status([home], SkillStatus.SUCCESS, timeout=60.0)
+    c.delete_skills([extra])
 
 
 def test_with_policy_continue_the_rover_stays_out(op: Operator) -> None:
