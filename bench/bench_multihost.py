@@ -13,7 +13,8 @@ ground; no link emulator). Measured at full speed, then with every radio limited
 * ``barrier_skew``: max - min of the members' RUNNING stamps, per barrier of all robots,
   which arrive 20 ms apart (``bench_executor.barrier_rounds``);
 * ``idle_radio``: bytes per second each way on every robot's radio while nothing happens
-  (heartbeats and the robot's periodic snapshot), with the number of skills it holds.
+  (heartbeats, beacons and the robot's periodic snapshot, whose digest stands in for its
+  queue), with the number of skills it holds (the first robot: 100).
 
 Then, still at ``--rate`` and with the kernel's default TCP settings, the radio cuts of
 docs/barriers.md, ``--outages`` times each (``ip link set down``, back ``--outage`` s later):
@@ -84,6 +85,15 @@ def link_figures(
     if stall:
         figures["stalled"] = stall
     return figures
+
+
+def hold_skills(op: RemoteOperator, agent: str, total: int) -> None:
+    """Have ``agent``'s robot hold ``total`` skills (quick ones, run to the end)."""
+    held = sum(1 for _, _, owner in op("statuses").values() if owner == agent)
+    added = [op("add", agent, "wait", {"duration": 0.01}) for _ in range(total - held)]
+    if added:
+        op("sync", agent)
+        op("wait_status", added, "SUCCESS", 120.0, timeout=130.0)
 
 
 def idle_radio(
@@ -190,6 +200,7 @@ def measure(args: argparse.Namespace, work: Path) -> dict[str, Any]:
         }
         lab.shape(args.rate)
         figures[f"tbf_{args.rate}"] = link_figures(op, agents, args.samples, args.rounds)
+        hold_skills(op, agents[0], 100)  # the snapshot's digest stands in for the queue
         figures["idle_radio"] = idle_radio(op, lab, agents, 5.0)
         figures["radio_cuts"] = barrier_cut_figures(op, lab, agents, args.outages, args.outage)
     return figures

@@ -99,4 +99,6 @@ def snapshot_to_msg(agent: str, snapshot: Snapshot) -> wire.ExecutorSnapshot:
         active_skill_id=snapshot.active_skill_id,
         waiting_on=snapshot.waiting_on,
         policy=snapshot.policy,
+        queue_omitted=not snapshot.full,
+        status_digest=snapshot.status_digest,
     )

@@ -44,6 +44,18 @@ def queue_hash(skill_ids: Iterable[str]) -> str:
     return digest.hexdigest()[:12]
 
 
+def status_digest(statuses: Iterable[tuple[str, int]]) -> str:
+    """Short digest of a robot's queue with each skill's status, in order.
+
+    The robot's periodic snapshot carries it instead of the whole queue: the ground
+    compares it with its own and asks for the queue only when they differ.
+    """
+    digest = hashlib.sha1(usedforsecurity=False)
+    for skill_id, status in statuses:
+        digest.update(f"{skill_id}\t{status}\n".encode())
+    return digest.hexdigest()[:12]
+
+
 @dataclass
 class Outgoing(Generic[Payload]):
     """A command waiting for its acknowledgement."""

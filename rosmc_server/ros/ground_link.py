@@ -13,7 +13,8 @@ Commands are retransmitted with backoff until acknowledged; while a robot is out
 contact new commands wait unsent for it (:mod:`rosmc_server.core.waiting`); reports are
 applied once each and in order; the robot's periodic snapshot re-synchronizes
 numbering after restarts and reconciles statuses after outages, and its queue
-hash is checked against the ground's, with a repair sent on a mismatch.
+hash is checked against the ground's, with a repair sent on a mismatch
+(:mod:`.snapshot_sync`).
 
 Every method expects the server lock to be held; the subscriber callbacks take it.
 """
@@ -23,72 +24,31 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Callable, Iterable
-from contextlib import AbstractContextManager
-from dataclasses import dataclass, field
-from typing import Protocol
 
 import rosmc.msg as wire
 import rospy
 
 from ..conversions import barrier_to_msg, skill_to_msg, time_to_msg
-from ..core import Barrier, Mission, MissionEvent, RosmcError, SkillStatus, Transfer
-from ..core.commands import CommandKind, CommandSpec, queued_barriers, repair_command, synced_ids
+from ..core import Mission, RosmcError, SkillStatus, Transfer
+from ..core.commands import CommandKind, CommandSpec, queued_barriers
 from ..core.link import (
     Arrival,
-    InboundSequence,
     LinkReport,
     LinkStatus,
     Outbox,
     Outgoing,
-    queue_hash,
 )
 from ..core.radio import BEACON_PERIOD, ContactWatch
-from ..core.reconcile import RobotSkill
 from ..core.waiting import collapse
 from ..interface import ground_link
+from .agent_link import AgentLink, LinkHost, Operation
 from .command_records import command_record
 from .radio import GROUND, Radio, TopicListener, reconnect_in_background
+from .snapshot_sync import SnapshotSync
 
 _log = logging.getLogger(__name__)
 
-Operation = Callable[[Mission], MissionEvent | None]
 HEARTBEAT_PERIOD = 1.0  # seconds between report-ack heartbeats to each robot
-
-
-class LinkHost(Protocol):
-    """What the ground link needs from the mission server."""
-
-    mission: Mission
-
-    def apply(self, operation: Operation) -> MissionEvent | None:
-        """Run a mission operation and record its event; the lock is held by the caller."""
-
-    def locked(self) -> AbstractContextManager[object]:
-        """The server lock, as a context manager."""
-
-    def record_report(self, msg: wire.RobotReport) -> None:
-        """Journal a robot report for the audit trail."""
-
-    def record_command(self, msg: wire.CommandRecord) -> None:
-        """Journal a command asked, delivered or cancelled."""
-
-
-@dataclass
-class AgentLink:
-    """Everything the ground tracks about one agent's link."""
-
-    agent: str
-    outbox: Outbox[wire.RobotCommand]
-    command_pub: rospy.Publisher
-    report_ack_pub: rospy.Publisher
-    reports: InboundSequence | None = None  # None until the robot's numbering is known
-    snapshot: wire.ExecutorSnapshot | None = None
-    robot_hash: str = ""
-    mismatch: bool = False
-    barriers_sent: tuple[Barrier, ...] = ()
-    newest_stamp: float = 0.0  # robot clock of the newest message heard from it
-    last_error: str = ""
-    listeners: list[TopicListener] = field(default_factory=list)
 
 
 class GroundLink:
@@ -107,6 +67,14 @@ class GroundLink:
         self._links: dict[str, AgentLink] = {}
         self._next_heartbeat = self._next_beacon = 0.0
         self._contact = ContactWatch()
+        self._snapshots = SnapshotSync(
+            host,
+            clock,
+            self._started,
+            self.send,
+            lambda link, seq: link.report_ack_pub.publish(self._report_ack(link.agent, seq)),
+            self._transmit,
+        )
         for agent in agents:
             topics = ground_link(agent)
             link = AgentLink(
@@ -143,7 +111,7 @@ class GroundLink:
 
     def expected_hash(self, agent: str) -> str:
         """The queue hash the ground expects the robot to have."""
-        return queue_hash(synced_ids(self._mission.state, agent))
+        return self._snapshots.expected_hash(agent)
 
     # -- sending -------------------------------------------------------------
     def send(self, spec: CommandSpec) -> None:
@@ -262,7 +230,7 @@ class GroundLink:
             removed = [] if msg.result == wire.RobotAck.REJECTED else list(msg.accepted_ids)
             self._apply(lambda m: m.confirm_unsynchronized(agent, removed))
         link.robot_hash = msg.queue_hash
-        self._check_hash(link)
+        self._snapshots.check_hash(link)
 
     def _upload_answered(self, agent: str, command: wire.RobotCommand, ack: wire.RobotAck) -> None:
         sent = [s.id for s in command.skills]
@@ -319,86 +287,13 @@ class GroundLink:
             )
         )
 
+    def _on_snapshot(self, agent: str, msg: wire.ExecutorSnapshot) -> None:
+        self._snapshots.on_snapshot(self._links[agent], msg)
+
     def _report_ack(self, agent: str, seq: int) -> wire.ReportAck:
         """A report ack stamped with the ground's clock (echoed back for the round trip)."""
-        return wire.ReportAck(agent=agent, seq=seq, sent=self._clock())
-
-    def _measure_round_trip(self, link: AgentLink, msg: wire.ExecutorSnapshot) -> None:
-        """Time from a stamped report ack to its echo, less what the robot held it."""
-        if msg.echo_sent < self._started:
-            return  # none yet, or sent by an earlier server
-        sample = self._clock() - msg.echo_sent - max(0.0, msg.echo_held)
-        if sample >= 0.0:
-            link.outbox.round_trip_sample(sample)
-
-    def _on_snapshot(self, agent: str, msg: wire.ExecutorSnapshot) -> None:
-        link = self._links[agent]
-        self._measure_round_trip(link, msg)
-        stamp = msg.stamp.to_sec()
-        if stamp < link.newest_stamp:
-            # Older than something already heard (it queued behind newer reports): its
-            # numbers would look like a robot restart and rewind the report stream.
-            link.outbox.heard(self._clock())
-            return
-        link.newest_stamp = stamp
-        if link.outbox.robot_numbering(msg.last_command_seq, self._clock()):
-            _log.info("link %s: robot executed commands up to %d", agent, msg.last_command_seq)
-        fresh = link.reports is None or msg.last_report_seq < link.reports.last
-        if fresh:
-            # Every report up to last_report_seq is reflected in the snapshot itself.
-            link.reports = InboundSequence(msg.last_report_seq)
-            link.report_ack_pub.publish(self._report_ack(agent, msg.last_report_seq))
-        assert link.reports is not None
-        if fresh or msg.last_report_seq == link.reports.last:
-            self._reconcile(agent, msg)
-        link.snapshot = msg
-        link.robot_hash = msg.queue_hash
-        self._check_hash(link)
-        self._transmit(link)
-
-    def _reconcile(self, agent: str, msg: wire.ExecutorSnapshot) -> None:
-        queue = [
-            RobotSkill(
-                s.id,
-                SkillStatus(s.status.value),
-                max(1, s.attempt),
-                s.status_text,
-                s.started,
-                s.finished,
-            )
-            for s in msg.queue
-            if s.status.value in SkillStatus._value2member_map_
-        ]
-        conflicts: tuple[str, ...] = ()
-
-        def reconcile(mission: Mission) -> MissionEvent | None:
-            nonlocal conflicts
-            event, result = mission.reconcile(agent, queue)
-            conflicts = result.conflicts
-            return event
-
-        self._apply(reconcile)
-        for conflict in conflicts:
-            _log.warning("link %s: %s", agent, conflict)
-
-    def _check_hash(self, link: AgentLink) -> None:
-        if link.outbox.pending() or not link.robot_hash:
-            return  # commands in flight: the hashes may differ for now
-        expected = self.expected_hash(link.agent)
-        if expected == link.robot_hash:
-            if link.mismatch:
-                _log.info("link %s: queue hash agrees again (%s)", link.agent, expected)
-            link.mismatch = False
-            return
-        if not link.mismatch:
-            _log.warning(
-                "link %s: robot queue hash %s differs from the ground's %s; repairing",
-                link.agent,
-                link.robot_hash,
-                expected,
-            )
-        link.mismatch = True
-        self.send(repair_command(self._mission.state, link.agent))
+        want_full = self._links[agent].want_full
+        return wire.ReportAck(agent=agent, seq=seq, sent=self._clock(), want_full=want_full)
 
     def _apply(self, operation: Operation) -> None:
         """Apply a robot-driven change; a refusal is logged, never raised into rospy."""

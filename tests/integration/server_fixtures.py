@@ -441,8 +441,13 @@ class FakeRobot:
                 assert time.monotonic() < deadline, f"the server does not listen to {agent}"
                 time.sleep(0.01)
 
-    def announce(self, last_command_seq: int = 0, last_report_seq: int = 0) -> None:
-        """Publish one executor snapshot: the ground then knows this robot (link UP)."""
+    def announce(
+        self, last_command_seq: int = 0, last_report_seq: int = 0, digest: str | None = None
+    ) -> None:
+        """Publish one executor snapshot: the ground then knows this robot (link UP).
+
+        With ``digest``, the snapshot leaves its (empty) queue out and carries that digest.
+        """
         self._snapshot.publish(
             wire.ExecutorSnapshot(
                 agent=self.agent,
@@ -450,6 +455,8 @@ class FakeRobot:
                 last_command_seq=last_command_seq,
                 last_report_seq=last_report_seq,
                 state="idle",
+                queue_omitted=digest is not None,
+                status_digest=digest or "",
             )
         )
 

@@ -34,7 +34,7 @@ from rosmc_server.core import (
     Transfer,
 )
 from rosmc_server.core.commands import CommandKind
-from rosmc_server.core.link import queue_hash
+from rosmc_server.core.link import queue_hash, status_digest
 from rosmc_server.recording import read_journal
 from rosmc_server.ros.client import MissionClient
 from tests.conftest import wait_until
@@ -718,7 +718,12 @@ def test_bad_commands_over_the_link_are_refused_clearly(rosmc: Start) -> None:
     report = ground.wait_heard("report", lambda r: r.skill_id == "w8" and r.status.value == 5)
     assert report.seq > 2  # w3's reports were not dropped by the stray report ack
     snapshot = ground.wait_heard("snapshot", lambda s: s.last_command_seq == 8)
-    assert [s.id for s in snapshot.queue] == ["w3", "w8"]
+    assert snapshot.queue_omitted and not snapshot.queue  # the digest stands in for it
+    ground.publish("report_ack", wire.ReportAck(agent="r1", seq=0, want_full=True))
+    full = ground.wait_heard("snapshot", lambda s: s.last_command_seq == 8 and not s.queue_omitted)
+    assert [s.id for s in full.queue] == ["w3", "w8"]
+    statuses = [(s.id, s.status.value) for s in full.queue]
+    assert full.status_digest == snapshot.status_digest == status_digest(statuses)
     assert system.alive("r1")
     ground.close()
 

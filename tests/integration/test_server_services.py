@@ -21,6 +21,7 @@ import rosmc.msg as wire
 import yaml
 
 from rosmc_server import interface
+from rosmc_server.core.link import status_digest
 
 pytest.register_assert_rewrite("tests.integration.server_fixtures")
 
@@ -944,8 +945,11 @@ def test_synchronize_answers_at_once_and_uploads_when_the_robot_is_heard(
         )
         # The robot's numbering is unknown until it is heard; then the upload goes out.
         robot.announce()
+        default = robot.wait_command(wire.RobotCommand.SET_OPTIONS)  # the library's policy
+        assert (default.agent, default.seq) == ("drone", 1)
+        robot.ack(default)
         upload = robot.wait_command(wire.RobotCommand.UPLOAD)
-        assert (upload.agent, upload.seq) == ("drone", 1)
+        assert (upload.agent, upload.seq) == ("drone", 2)
         assert [s.id for s in upload.skills] == ids[:2]
         robot.ack(upload)
         recorder.wait_for(
@@ -971,7 +975,7 @@ def test_synchronize_answers_at_once_and_uploads_when_the_robot_is_heard(
         assert c.revision() == rev + 2
 
 
-def test_a_down_link_declines_execution_requests(
+def test_a_down_link_takes_execution_requests_and_holds_them_for_contact(
     start_server: Any, fake_robot: Any, client_node: Any
 ) -> None:
     start_server(link_timeout=0.5, agent_state_rate=10.0)
@@ -980,6 +984,8 @@ def test_a_down_link_declines_execution_requests(
         add(c, "science_rover", "explore")
         robot = fake_robot("drone")
         robot.announce()
+        robot.ack(robot.wait_command(wire.RobotCommand.SET_OPTIONS))  # the library's policy
+        heard = len(robot.commands.snapshot())
         states = Recorder(interface.AGENT_STATES_TOPIC, wire.AgentStates)
         try:
 
@@ -987,18 +993,20 @@ def test_a_down_link_declines_execution_requests(
                 return bool(messages) and messages[-1].agents[0].link.state == wire.LinkState.DOWN
 
             got = states.wait_for(drone_down, timeout=5.0)
+            assert [a.link.state for a in got[-1].agents[1:]] == [wire.LinkState.UNKNOWN] * 2
+            for response in (
+                do(c, "synchronize", agent="drone"),
+                accepted(c.call("control", agent="drone", command=0)),
+            ):
+                assert response.note.startswith("queued for drone: out of contact"), response
+
+            def two_waiting(messages: list[wire.AgentStates]) -> bool:
+                return bool(messages) and messages[-1].agents[0].link.commands_waiting == 2
+
+            states.wait_for(two_waiting, timeout=5.0)
         finally:
             states.close()
-        assert [a.link.state for a in got[-1].agents[1:]] == [wire.LinkState.UNKNOWN] * 2
-        rev = c.revision()
-        for operation, fields in (
-            ("synchronize", {"agent": "drone", "base_revision": rev}),
-            ("unsynchronize", {"agent": "drone", "base_revision": rev}),
-            ("control", {"agent": "drone", "command": 0}),
-            ("control", {"agent": "", "command": 3}),
-        ):
-            response = assert_rejected(c, operation, wire.ErrorCode.UNAVAILABLE, **fields)
-            assert "drone" in response.error
+        assert len(robot.commands.snapshot()) == heard, "nothing leaves while the link is down"
         # Other robots are not held up by the one that cannot be reached.
         assert list(do(c, "synchronize", agent="science_rover").skill_ids)
 
@@ -1062,3 +1070,27 @@ def test_mission_files_stay_inside_the_mission_directory(scene: Scene) -> None:
 def test_a_document_nested_too_deeply_is_invalid(scene: Scene) -> None:
     nested = "x: " + "[" * 5000 + "]" * 5000 + "\n"
     check_rejection(scene, "load_mission", {"document": nested}, E.INVALID)
+
+
+def test_the_ground_asks_for_a_robots_queue_only_when_it_needs_it(
+    start_server: Any, fake_robot: Any, client_node: Any
+) -> None:
+    """Snapshots leave the queue out; the ground asks (ReportAck.want_full) when a new
+    ground must reconcile, or when the robot's status digest differs from its own."""
+    start_server()
+    robot = fake_robot("drone")
+    acks = Recorder(interface.ground_link("drone").report_ack, wire.ReportAck)
+    try:
+        robot.announce(digest=status_digest([]))  # a robot this ground never heard
+        acks.wait_for(lambda ms: any(m.want_full for m in ms), 5.0)
+        robot.ack(robot.wait_command(wire.RobotCommand.SET_OPTIONS))  # the library's policy
+        robot.announce()  # its whole (empty) queue
+        asked = len(acks.wait_for(lambda ms: not ms[-1].want_full, 5.0))
+        for _ in range(3):  # a digest that agrees: nothing more is asked
+            robot.announce(digest=status_digest([]))
+            time.sleep(0.2)
+        assert not any(m.want_full for m in acks.snapshot()[asked:])
+        robot.announce(digest="0123456789ab")  # statuses that disagree
+        acks.wait_for(lambda ms: ms[-1].want_full, 5.0)
+    finally:
+        acks.close()

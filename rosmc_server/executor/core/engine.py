@@ -19,7 +19,7 @@ from dataclasses import dataclass, field, replace
 from typing import Protocol
 
 from rosmc_server.core import SkillInstance, SkillStatus
-from rosmc_server.core.link import queue_hash
+from rosmc_server.core.link import queue_hash, status_digest
 
 from . import commanding, queueing
 from .barrier_wait import ANNOUNCE_PERIOD, Announcements, BarrierWaits
@@ -452,8 +452,8 @@ class Engine:
             return "idle"
         return "waiting" if active.behavior is None else "running"
 
-    def snapshot(self) -> Snapshot:
-        """The whole state, for the periodic snapshot."""
+    def snapshot(self, full: bool = True) -> Snapshot:
+        """The state for the periodic snapshot: the queue only if ``full``, its digest always."""
         active = self._active
         waiting = ""
         if active is not None and active.barrier is not None and active.behavior is None:
@@ -463,9 +463,11 @@ class Engine:
             self.last_command_seq,
             self.last_report_seq,
             self.queue_hash(),
-            tuple(self.queue),
+            tuple(self.queue) if full else (),
             self.state_name(),
             active.skill_id if active else "",
             waiting,
             self.lost_link.describe(),
+            full,
+            status_digest((s.id, int(s.status)) for s in self.queue),
         )

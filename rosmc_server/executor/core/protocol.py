@@ -105,6 +105,8 @@ class Snapshot:
     active_skill_id: str
     waiting_on: str
     policy: str
+    full: bool = True  # ``queue`` holds every skill; False: it is left out (the digest stands)
+    status_digest: str = ""
 
 
 class Mode(enum.Enum):

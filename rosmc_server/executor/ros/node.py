@@ -5,7 +5,8 @@ Subscribes:
 Publishes:
     ``<link>/ack`` (rosmc/RobotAck), ``<link>/report`` (rosmc/RobotReport, retransmitted
     until acknowledged), ``<link>/snapshot`` (rosmc/ExecutorSnapshot, every
-    ``~snapshot_period``), ``/rosmc/barriers`` (rosmc/BarrierSignal, a copy for observers).
+    ``~snapshot_period``; the whole queue in the first and when the ground asks, its
+    digest always), ``/rosmc/barriers`` (rosmc/BarrierSignal, a copy for observers).
 Radio side channel (UDP, :mod:`rosmc_server.ros.radio`, registered as
     ``/rosmc/radio/<robot>``): barrier signals to and from the other robots, and beacons
     to and from the ground; a ground beacon after a silence reconnects the link's topics.
@@ -103,6 +104,9 @@ class ExecutorNode:
         self._dirty = False
         self._held_reports: list[Report] | None = None  # while a command is being answered
         self._echo: tuple[float, float] | None = None  # newest stamped report ack: sent, heard
+        # The whole queue goes in the first snapshot and again whenever the ground asks
+        # (a new ground, or one whose statuses disagree with the digest).
+        self._full_snapshot = True
         topics = interface.robot_link(agent) if robot_side else interface.ground_link(agent)
         self._ack_pub = rospy.Publisher(topics.ack, wire.RobotAck, queue_size=100)
         self._report_pub = rospy.Publisher(topics.report, wire.RobotReport, queue_size=1000)
@@ -182,11 +186,15 @@ class ExecutorNode:
         if msg.agent == self.agent:
             with self._lock:
                 self.engine.report_acknowledged(msg.seq)
+                self._full_snapshot |= msg.want_full
                 if msg.sent > 0.0:  # echoed in the next snapshot: the ground's round trip
                     self._echo = (msg.sent, time.monotonic())
 
     def _snapshot_msg(self) -> wire.ExecutorSnapshot:
-        msg = snapshot_to_msg(self.agent, self.engine.snapshot())
+        # Most snapshots leave the queue out (its digest stands in): listing every skill
+        # held, every second, would take much of a radio's bandwidth.
+        msg = snapshot_to_msg(self.agent, self.engine.snapshot(full=self._full_snapshot))
+        self._full_snapshot = False
         if self._echo is not None:
             sent, received = self._echo
             msg.echo_sent, msg.echo_held = sent, time.monotonic() - received
