@@ -26,6 +26,7 @@ from rosmc_server.core.model import SkillStatus
 from rosmc_server.core.waiting import duration_text
 
 from .geometry import Color, Point
+from .labels import Label
 
 GOOD = Color(0.30, 1.00, 0.35)
 WARN = Color(1.00, 0.85, 0.15)
@@ -190,3 +191,11 @@ def _close(a: Point | None, b: Point | None, near: float) -> bool:
 def block_height(level: int, rows: int = 2) -> float:
     """Height (m above the robot's frame) of the lowest line of a block at ``level``."""
     return ICON_BASE + level * (ICON_ROW * rows + ICON_GAP)
+
+
+def block_label(agent: str, position: Point, level: int, rows: Sequence[IconRow]) -> Label:
+    """A robot's status block at ``level`` over map ``position``, as a label to keep clear of."""
+    bottom = position[2] + block_height(level, len(rows))
+    centre = bottom + ICON_ROW * (len(rows) - 1) / 2
+    lines = tuple(row.text for row in rows)
+    return Label(agent, position[0], position[1], centre, lines, ICON_TEXT, ICON_ROW)

@@ -321,12 +321,12 @@ def test_scene_specs_follow_status() -> None:
     assert len(specs) == 5, "centre and four vertices"
     centre = specs[0]
     assert centre.controls[0].interaction is Interaction.MOVE_PLANE
-    assert "blueprint" in centre.description
+    assert "blueprint" in centre.label
     synced = replace(blueprint, status=SkillStatus.RUNNING)
     specs = scene.marker_specs(state_with(area, skills=(synced,)), "Area 1")
     assert len(specs) == 1, "locked: no vertex handles"
     assert specs[0].controls[0].interaction is Interaction.MENU
-    assert "running, locked" in specs[0].description
+    assert "running, locked" in specs[0].label
     done = replace(blueprint, status=SkillStatus.SUCCESS)
     assert len(scene.marker_specs(state_with(area, skills=(done,)), "Area 1")) == 5
     replay = Scene(LIBRARY, read_only=True)
