@@ -3,7 +3,7 @@
 rviz draws camera-facing text where it is told and never moves it out of the way, so at a
 busy place (a region with robots and task markers) the labels would pile up. Here every
 label is a box on the *view plane* of the shipped views ("Whole site", "Work area": both
-look north, about 1.2 rad below the horizon): horizontally its map ``x``, vertically
+look north, 1.2 and 1.25 rad below the horizon): horizontally its map ``x``, vertically
 ``y sin(pitch) + z cos(pitch)`` (metres, perspective ignored). :func:`layout` slides the
 movable labels south (down the screen) just as far as needed to clear every label above
 them and every fixed box (the robots' status blocks), so the labels stack in a column.
@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 CHAR_WIDTH = 0.62  # a character's width in letter heights (rviz's text font, generously)
 LINE_SPACING = 1.25  # from one line's centre to the next, in letter heights
-VIEW_PITCH = 1.2  # the shipped views look north, this far below the horizon (rad)
+VIEW_PITCH = 1.25  # the steepest shipped view looks north, this far below the horizon (rad)
 GAP = 0.15  # between two stacked labels (view-plane metres)
 
 

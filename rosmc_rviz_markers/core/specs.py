@@ -182,7 +182,7 @@ def task_label(marker: TaskMarker, text: str) -> Label:
 def _label_primitive(marker: TaskMarker, text: str, south: float, yaw: float) -> Primitive:
     # the marker frame turns with a pose marker's heading; the label must not
     distance = _label_below(marker) + south
-    position = (-distance * math.sin(-yaw), -distance * math.cos(-yaw), LABEL_Z)
+    position = (-distance * math.sin(yaw), -distance * math.cos(yaw), LABEL_Z)
     return geo.text(text, position, LABEL_TEXT, LABEL_COLOR)
 
 

@@ -250,8 +250,7 @@ class MarkerNode:
         agents = scene.library.dynamic_agents
         poses = {agent: statuses[agent].pose if agent in statuses else None for agent in agents}
         points = {a: (p.x, p.y, p.z) if p else None for a, p in poses.items()}
-        levels = icon_levels(points)
-        out = []
+        rows = {}
         for agent in agents:
             status = statuses.get(agent)
             label = ""
@@ -261,8 +260,9 @@ class MarkerNode:
                 and state.has_skill(status.current_skill)
             ):
                 label = state.skill(status.current_skill).label
-            out.append((agent, status_rows(status, label, agent), points[agent], levels[agent]))
-        return out
+            rows[agent] = status_rows(status, label, agent)
+        levels = icon_levels(points, {a: [row.text for row in r] for a, r in rows.items()})
+        return [(agent, rows[agent], points[agent], levels[agent]) for agent in agents]
 
     def _block_labels(
         self, scene: Scene, statuses: Mapping[str, AgentStatus], state: MissionState

@@ -51,9 +51,7 @@ T = TypeVar("T")
 
 def label_of(marker: InteractiveMarker) -> str:
     """The text an interactive marker shows: its description or the text it draws."""
-    drawn = (
-        m.text for c in marker.controls for m in c.markers if m.type == m.TEXT_VIEW_FACING
-    )
+    drawn = (m.text for c in marker.controls for m in c.markers if m.type == m.TEXT_VIEW_FACING)
     return str(marker.description or next(drawn, ""))
 
 

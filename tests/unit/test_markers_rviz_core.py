@@ -237,8 +237,13 @@ def test_icon_levels_stack_only_robots_standing_together() -> None:
     }
     assert icon_levels({"a": None, "b": None, "c": (0.0, 0.0, 0.0)}) == {"a": 0, "b": 1, "c": 0}
     # the robot further north (higher on screen in the default view) is the one lifted
-    assert icon_levels({"north": (0.0, 3.0, 0.0), "south": (1.0, 0.0, 0.0)}) == {
+    assert icon_levels({"north": (0.0, 0.8, 0.0), "south": (1.0, 0.0, 0.0)}) == {
         "north": 1,
+        "south": 0,
+    }
+    # 3 m further north, a block already shows above the other one: no lift
+    assert icon_levels({"north": (0.0, 3.0, 0.0), "south": (1.0, 0.0, 0.0)}) == {
+        "north": 0,
         "south": 0,
     }
     assert block_height(1) > block_height(0) + 2 * ICON_ROW
