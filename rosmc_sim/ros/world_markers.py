@@ -115,7 +115,8 @@ def _static_markers(sim: Simulation) -> list[Marker]:
 def _pick_ground(sim: Simulation) -> Marker:
     """A slab the size of the site just under the grid, for rviz's picking (Publish Point)."""
     x_min, x_max, y_min, y_max = sim.scenario.bounds
-    slab = _marker("pick_ground", 0, Marker.CUBE, (x_min + x_max) / 2, (y_min + y_max) / 2, -0.01)
+    slab = _marker("ground", 0, Marker.CUBE, (x_min + x_max) / 2, (y_min + y_max) / 2, -0.01)
+    slab.ns = "pick_ground"  # its own namespace: shown even where the ground is hidden
     slab.color = ColorRGBA(*COLORS["ground"][:3], PICK_GROUND_ALPHA)
     return _sized(slab, x_max - x_min, y_max - y_min, 0.02)
 
