@@ -247,16 +247,21 @@ def top_of(parts: Sequence[Primitive]) -> float:
 
 # A robot lower than the lander (the drone resting on it) would hide inside the lander's
 # shell and the world's lander: it gets a pin above, clickable wherever the robot stands.
-PIN_CLEARANCE = LANDER_SHELL_HEIGHT + 0.2
-PIN_SIZE = 0.55
+# The pin's flat head is seen well from the shipped views (they look steeply down) and
+# stays under the robot's status block (icons.ICON_BASE).
+PIN_CLEARANCE = LANDER_SHELL_HEIGHT + 0.1
+PIN_STEM = 0.22
+PIN_HEAD = (0.7, 0.7, 0.3)
+PIN_CENTRE = PIN_CLEARANCE + PIN_STEM + PIN_HEAD[2] / 2  # of the head, above the robot
 
 
-def pin(color: Color, bottom: float = PIN_CLEARANCE) -> tuple[Primitive, ...]:
-    """A map pin over a robot: a ball on a cone pointing down at it, its tip at ``bottom``."""
+def pin(color: Color) -> tuple[Primitive, ...]:
+    """A map pin over a robot: a flat head on a cone pointing down at the robot."""
     down = quaternion(pitch=math.pi / 2)
+    stem_top = PIN_CLEARANCE + PIN_STEM
     return (
-        Primitive(Shape.ARROW, color, (0.0, 0.0, bottom + 0.5), (0.5, 0.35, 0.35), down),
-        Primitive(Shape.SPHERE, color, (0.0, 0.0, bottom + 0.5 + PIN_SIZE / 2), (PIN_SIZE,) * 3),
+        Primitive(Shape.ARROW, color, (0.0, 0.0, stem_top), (PIN_STEM, 0.3, 0.3), down),
+        Primitive(Shape.SPHERE, color, (0.0, 0.0, PIN_CENTRE), PIN_HEAD),
     )
 
 

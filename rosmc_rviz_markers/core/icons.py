@@ -42,7 +42,7 @@ LINK_STALE = 5.0  # seconds since heard while up: yellow
 SEPARATOR = " | "
 
 # Where the block sits, in metres (the ROS layer turns rows into text markers).
-ICON_BASE = 1.9  # above the robot's frame: the lower line's centre, clear of mast and arm
+ICON_BASE = 2.15  # above the robot's frame: the lower line's centre, clear of mast, arm, pin
 ICON_ROW = 0.6  # from one line's centre to the next
 ICON_TEXT = 0.45  # letter height
 ICON_GAP = 0.2  # between two lifted blocks, as the view sees them

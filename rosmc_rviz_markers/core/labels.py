@@ -70,12 +70,16 @@ class Label:
 
 
 def layout(
-    labels: Sequence[Label], fixed: Iterable[Box] = (), pitch: float = VIEW_PITCH
+    labels: Sequence[Label],
+    fixed: Iterable[Box] = (),
+    pitch: float = VIEW_PITCH,
+    step: float = 0.0,
 ) -> dict[str, float]:
     """How far south (map metres, >= 0) to move each of ``labels`` so no two boxes overlap.
 
     Labels are taken from the top of the screen down; each moves the least that clears
     every box placed before it and every ``fixed`` box (a column of labels at one place).
+    With a ``step``, moves are whole steps (so that a small change moves no label).
     """
     placed = list(fixed)
     rise = math.sin(pitch)
@@ -91,6 +95,8 @@ def layout(
             # just below the lowest box it hits (the label only moves down the screen)
             lowest = min(other.bottom for other in hits)
             south += (box.top - lowest + GAP) / rise
+            if step > 0:
+                south = math.ceil(south / step - 1e-9) * step
         out[label.key] = south
         placed.append(box)
     return out

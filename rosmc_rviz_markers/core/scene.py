@@ -10,7 +10,6 @@ the markers whose label moved are republished.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
@@ -35,6 +34,8 @@ from .labels import Label, layout
 from .menus import flatten, robot_menu, static_agent_menu, task_marker_menu
 from .specs import MarkerSpec, agent_spec, describe, task_label, task_specs
 from .styling import is_locked, marker_use
+
+LABEL_STEP = 0.25  # task labels move south by whole steps (m)
 
 
 @dataclass(frozen=True)
@@ -168,11 +169,8 @@ class Scene:
             bound = state.bound_to(marker.name)
             text = describe(marker, marker_use(bound), is_locked(bound))
             labels.append(task_label(marker, text))
-        # rounded up to a quarter metre, so a robot creeping past does not redraw labels
-        new = {
-            name: math.ceil(south * 4 - 1e-9) / 4
-            for name, south in layout(labels, [block.box() for block in blocks]).items()
-        }
+        # whole quarter metres, so that a robot creeping past does not redraw labels
+        new = layout(labels, [block.box() for block in blocks], step=LABEL_STEP)
         old, self.label_south = self.label_south, new
         return {name for name in old.keys() | new.keys() if old.get(name) != new.get(name)}
 

@@ -4,8 +4,8 @@ One array holds everything (after a DELETEALL, so what disappeared goes): the
 ground, a pickable ground (a thin, all but invisible slab over the whole site, so that
 rviz's Publish Point tool hits something wherever an operator clicks on the site; the
 grid is pickable only on its lines), obstacles, slopes (flat, translucent), the lander,
-payload boxes, discovered regions (translucent discs with a label west of the disc saying how far
-their stones are identified and how many are left: west, so that it never covers the
+payload boxes, discovered regions (translucent discs with a label east of the disc saying how far
+their stones are identified and how many are left: east, so that it never covers the
 robots and task markers inside the region), the stones lying in them, the science score and the
 stones delivered (a text over the lander), and the Wi-Fi coverage circles of the lander
 and of deployed Wi-Fi boxes.
@@ -41,6 +41,7 @@ LANDER_HEIGHT = 1.2
 PICK_GROUND_ALPHA = 0.01  # drawn all but invisibly: rviz picks by depth, not by colour
 REGION_LABEL_HEIGHT = 0.8  # letter height of a region's label
 SCORE_HEIGHT = 8.0  # the score text floats this high over the lander (above the TF labels)
+SCORE_TEXT = 1.4  # its letter height: readable from the whole site, not a wall over the work
 IDENTIFIED = {
     LEVEL_SCIENCE: "identified by the science rover",
     LEVEL_COLLABORATIVE: "identified by both",
@@ -122,9 +123,9 @@ def _pick_ground(sim: Simulation) -> Marker:
 
 
 def region_label_x(x: float, radius: float, text: str) -> float:
-    """Where a region's label is centred: west of its disc, clear of what stands inside."""
+    """Where a region's label is centred: east of its disc, clear of what stands inside."""
     longest = max(len(line) for line in text.splitlines())
-    return x - radius - 0.5 - longest * REGION_LABEL_HEIGHT * CHAR_WIDTH / 2
+    return x + radius + 0.5 + longest * REGION_LABEL_HEIGHT * CHAR_WIDTH / 2
 
 
 def _box_markers(sim: Simulation) -> list[Marker]:
@@ -175,7 +176,7 @@ def _science_markers(sim: Simulation) -> list[Marker]:
         label.text = text
         out.append(label)
     score = _marker("score", 0, Marker.TEXT_VIEW_FACING, 0.0, 0.0, SCORE_HEIGHT)
-    score.scale.z = 2.5
+    score.scale.z = SCORE_TEXT
     score.text = f"science score {sim.score:.2f}\n{sim.delivered} stone(s) delivered"
     out.append(score)
     discovered = {name for name, r in sim.regions.items() if r.discovered}

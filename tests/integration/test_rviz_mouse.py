@@ -210,8 +210,7 @@ def test_the_drone_on_the_lander_opens_its_own_menu(screen: Screen, tmp_path: Pa
     feedback_topic = topics.topic(topics.MARKERS_NS, "") + "/feedback"
     subscriber = rospy.Subscriber(feedback_topic, InteractiveMarkerFeedback, on_feedback)
     try:
-        pin_top = geometry.PIN_CLEARANCE + 0.5 + geometry.PIN_SIZE / 2
-        screen.click((*DRONE_AT, pin_top), button=3)  # right click: the menu
+        screen.click((*DRONE_AT, geometry.PIN_CENTRE), button=3)  # right click: the menu
         time.sleep(1.0)
         screen.save(tmp_path / "menu.png")
         screen.xdotool("key", "Down", "Right", "Return")  # Add skill > its first skill
