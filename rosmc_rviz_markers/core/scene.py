@@ -167,8 +167,9 @@ class Scene:
         labels = []
         for marker in state.markers:
             bound = state.bound_to(marker.name)
-            text = describe(marker, marker_use(bound), is_locked(bound))
-            labels.append(task_label(marker, text))
+            locked = is_locked(bound)
+            text = describe(marker, marker_use(bound), locked)
+            labels.append(task_label(marker, text, movable=not locked and not self.read_only))
         # whole quarter metres, so that a robot creeping past does not redraw labels
         new = layout(labels, [block.box() for block in blocks], step=LABEL_STEP)
         old, self.label_south = self.label_south, new

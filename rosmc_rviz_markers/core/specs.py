@@ -168,20 +168,23 @@ LABEL_Z = 0.35
 LABEL_COLOR = Color(0.95, 0.95, 0.97)
 
 
-def _label_below(marker: TaskMarker) -> float:
-    """How far south of its marker's origin a label sits before any decluttering."""
-    return geo.TURN_RADIUS + 0.6 if marker.type is MarkerType.POSE else 1.3
+def _label_below(marker: TaskMarker, movable: bool) -> float:
+    """How far south of its marker's origin a label sits before any decluttering
+    (outside the turning ring of a pose marker that can turn)."""
+    return geo.TURN_RADIUS + 0.6 if marker.type is MarkerType.POSE and movable else 1.3
 
 
-def task_label(marker: TaskMarker, text: str) -> Label:
+def task_label(marker: TaskMarker, text: str, movable: bool = True) -> Label:
     """Where a task marker's label goes (map frame) before :func:`.labels.layout` moves it."""
-    below = _label_below(marker)
-    return Label(marker.name, marker.pose.x, marker.pose.y - below, LABEL_Z, (text,), LABEL_TEXT)
+    y = marker.pose.y - _label_below(marker, movable)
+    return Label(marker.name, marker.pose.x, y, LABEL_Z, (text,), LABEL_TEXT)
 
 
-def _label_primitive(marker: TaskMarker, text: str, south: float, yaw: float) -> Primitive:
+def _label_primitive(
+    marker: TaskMarker, text: str, south: float, yaw: float, movable: bool
+) -> Primitive:
     # the marker frame turns with a pose marker's heading; the label must not
-    distance = _label_below(marker) + south
+    distance = _label_below(marker, movable) + south
     position = (-distance * math.sin(yaw), -distance * math.cos(yaw), LABEL_Z)
     return geo.text(text, position, LABEL_TEXT, LABEL_COLOR)
 
@@ -214,7 +217,8 @@ def task_specs(
     menu_mode = Interaction.MENU if menu.entries else Interaction.NONE
     move_mode = Interaction.MOVE_PLANE if movable else menu_mode
     yaw = marker.pose.yaw if marker.type is MarkerType.POSE else 0.0
-    extra += (_label_primitive(marker, describe(marker, use, locked), label_south, yaw),)
+    text = describe(marker, use, locked)
+    extra += (_label_primitive(marker, text, label_south, yaw, movable),)
     x, y = marker.pose.x, marker.pose.y
     if marker.type is MarkerType.AREA:
         return _area_specs(marker, color, menu, move_mode, movable, extra)

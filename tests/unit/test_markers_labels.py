@@ -11,6 +11,8 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import pytest
+
 from rosmc_rviz_markers.core import geometry, labels
 from rosmc_rviz_markers.core.icons import block_label, icon_levels, status_rows
 from rosmc_rviz_markers.core.labels import Box, Label, layout, overlapping
@@ -75,10 +77,11 @@ def test_labels_at_a_busy_region_do_not_overlap() -> None:
     assert scene.relayout(state, blocks) == set()
 
 
-def test_the_label_drawn_is_where_the_layout_put_it() -> None:
+@pytest.mark.parametrize("read_only", [False, True])
+def test_the_label_drawn_is_where_the_layout_put_it(read_only: bool) -> None:
     state = MissionState(MissionContent.empty(LIBRARY))
     state.apply(Change(put_markers=MARKERS))
-    scene = Scene(LIBRARY)
+    scene = Scene(LIBRARY, read_only=read_only)
     scene.relayout(state, robot_blocks(ROBOTS))
     for marker in MARKERS:
         spec = scene.marker_specs(state, marker.name)[0]
@@ -90,10 +93,17 @@ def test_the_label_drawn_is_where_the_layout_put_it() -> None:
         yaw = spec.yaw
         map_x = marker.pose.x + x * math.cos(yaw) - y * math.sin(yaw)
         map_y = marker.pose.y + x * math.sin(yaw) + y * math.cos(yaw)
-        expected = task_label(marker, spec.label)
+        expected = task_label(marker, spec.label, movable=not read_only)
         south = scene.label_south.get(marker.name, 0.0)
         assert math.isclose(map_x, expected.x, abs_tol=1e-9)
         assert math.isclose(map_y, expected.y - south, abs_tol=1e-9)
+
+
+def test_a_pose_marker_that_cannot_turn_keeps_its_label_near() -> None:
+    pose = MARKERS[1]
+    turning, fixed = task_label(pose, "x"), task_label(pose, "x", movable=False)
+    assert pose.pose.y - turning.y > geometry.TURN_RADIUS, "outside the turning ring"
+    assert pose.pose.y - fixed.y < geometry.TURN_RADIUS / 2, "no ring: next to its flag"
 
 
 def test_twenty_robots_together_keep_their_blocks_apart() -> None:
