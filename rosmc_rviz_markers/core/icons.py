@@ -26,7 +26,7 @@ from rosmc_server.core.model import SkillStatus
 from rosmc_server.core.waiting import duration_text
 
 from .geometry import Color, Point
-from .labels import VIEW_PITCH, Box, Label
+from .labels import LINE_SPACING, VIEW_PITCH, Box, Label
 
 GOOD = Color(0.30, 1.00, 0.35)
 WARN = Color(1.00, 0.85, 0.15)
@@ -41,10 +41,13 @@ WIFI_FAIR = -60.0  # dBm, below: yellow
 LINK_STALE = 5.0  # seconds since heard while up: yellow
 SEPARATOR = " | "
 
-# Where the block sits, in metres (the ROS layer turns rows into text markers).
+# Where the block sits, in metres (the ROS layer turns rows into text markers). The rows
+# are lines of one camera-facing text (each row's marker blanks the others' lines), so
+# they stay apart on screen from every view; rows stacked in height would merge when seen
+# from above.
 ICON_BASE = 2.15  # above the robot's frame: the lower line's centre, clear of mast, arm, pin
-ICON_ROW = 0.6  # from one line's centre to the next
 ICON_TEXT = 0.45  # letter height
+ICON_ROW = ICON_TEXT * LINE_SPACING  # from one line's centre to the next, on screen
 ICON_GAP = 0.2  # between two lifted blocks, as the view sees them
 TYPICAL_LINE = 32  # characters in a health line (``BAT 97% | WiFi -54 dBm | link up``)
 
@@ -195,19 +198,18 @@ def icon_levels(
 
 
 def _block(agent: str, position: Point, level: int, texts: Sequence[str]) -> Label:
-    bottom = position[2] + block_height(level, len(texts))
-    centre = bottom + ICON_ROW * (len(texts) - 1) / 2
+    centre = position[2] + block_centre(level, len(texts))
     return Label(agent, position[0], position[1], centre, tuple(texts), ICON_TEXT, ICON_ROW)
 
 
-def block_height(level: int, rows: int = 2) -> float:
-    """Height (m above the robot's frame) of the lowest line of a block at ``level``.
+def block_centre(level: int, rows: int = 2) -> float:
+    """Height (m above the robot's frame) of the centre of a block of ``rows`` at ``level``.
 
     One level lifts a block just enough to clear the one below it as the steepest shipped
     view sees it (looking down, height shows foreshortened by ``cos(pitch)``).
     """
     on_screen = ICON_ROW * (rows - 1) + ICON_TEXT + ICON_GAP
-    return ICON_BASE + level * on_screen / math.cos(VIEW_PITCH)
+    return ICON_BASE + ICON_ROW * (rows - 1) / 2 + level * on_screen / math.cos(VIEW_PITCH)
 
 
 def block_label(agent: str, position: Point, level: int, rows: Sequence[IconRow]) -> Label:

@@ -20,7 +20,7 @@ from rosmc_rviz_markers.core.icons import (
     GOOD,
     ICON_ROW,
     WARN,
-    block_height,
+    block_centre,
     icon_levels,
     status_parts,
     status_rows,
@@ -246,7 +246,7 @@ def test_icon_levels_stack_only_robots_standing_together() -> None:
         "north": 0,
         "south": 0,
     }
-    assert block_height(1) > block_height(0) + 2 * ICON_ROW
+    assert block_centre(1) > block_centre(0) + 2 * ICON_ROW
 
 
 # -- menus --------------------------------------------------------------------------------------
