@@ -22,7 +22,7 @@ VENV := .venv
 BUILD := build
 
 # ROS 1 from Debian, message generation, Qt bindings; rviz, a virtual screen and imagemagick
-# for the GUIs and their screenshots.
+# for the GUIs and their screenshots; xdotool drives them with a real mouse in tests.
 APT_PACKAGES := \
 	python3-rospy python3-rosmaster python3-interactive-markers python3-visualization-msgs \
 	python3-geometry-msgs python3-std-msgs python3-std-srvs python3-rosbag python3-rostest \
@@ -31,7 +31,7 @@ APT_PACKAGES := \
 	ros-message-generation ros-message-runtime python3-tf2-ros python3-python-qt-binding \
 	ros-geometry-msgs ros-std-msgs ros-visualization-msgs ros-std-srvs rosbash \
 	python3-venv cmake make \
-	xvfb rviz python3-rviz imagemagick
+	xvfb rviz python3-rviz imagemagick xdotool
 
 # Everything the standalone message build reads. A new script, package or data folder at the
 # top also counts: catkin makes devel-space relays for scripts and top-level packages.

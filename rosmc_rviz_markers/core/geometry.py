@@ -206,11 +206,15 @@ def generic_body(color: Color) -> tuple[Primitive, ...]:
     )
 
 
+LANDER_SHELL_HEIGHT = 1.3
+
+
 def static_shell(kind: BodyKind) -> tuple[Primitive, ...]:
     """A translucent clickable shell around a static agent (the world draws the object)."""
     color = BODY_COLORS[kind].with_alpha(0.3)
     if kind is BodyKind.LANDER:
-        return (Primitive(Shape.CYLINDER, color, (0.0, 0.0, 0.65), (4.3, 4.3, 1.3)),)
+        height = LANDER_SHELL_HEIGHT
+        return (Primitive(Shape.CYLINDER, color, (0.0, 0.0, height / 2), (4.3, 4.3, height)),)
     return (_box(color, 0.0, 0.0, 0.27, 0.62, 0.62, 0.62),)
 
 
@@ -234,6 +238,31 @@ def scaled(parts: Sequence[Primitive], factor: float) -> tuple[Primitive, ...]:
         points = tuple(grow(p) for p in part.points)
         out.append(replace(part, position=grow(part.position), scale=scale, points=points))
     return tuple(out)
+
+
+def top_of(parts: Sequence[Primitive]) -> float:
+    """The highest point of ``parts`` (boxes, cylinders and spheres by their scale)."""
+    return max((p.position[2] + p.scale[2] / 2 for p in parts), default=0.0)
+
+
+# A robot lower than the lander (the drone resting on it) would hide inside the lander's
+# shell and the world's lander: it gets a pin above, clickable wherever the robot stands.
+# The pin's flat head is seen well from the shipped views (they look steeply down) and
+# stays under the robot's status block (icons.ICON_BASE).
+PIN_CLEARANCE = LANDER_SHELL_HEIGHT + 0.1
+PIN_STEM = 0.22
+PIN_HEAD = (0.7, 0.7, 0.3)
+PIN_CENTRE = PIN_CLEARANCE + PIN_STEM + PIN_HEAD[2] / 2  # of the head, above the robot
+
+
+def pin(color: Color) -> tuple[Primitive, ...]:
+    """A map pin over a robot: a flat head on a cone pointing down at the robot."""
+    down = quaternion(pitch=math.pi / 2)
+    stem_top = PIN_CLEARANCE + PIN_STEM
+    return (
+        Primitive(Shape.ARROW, color, (0.0, 0.0, stem_top), (PIN_STEM, 0.3, 0.3), down),
+        Primitive(Shape.SPHERE, color, (0.0, 0.0, PIN_CENTRE), PIN_HEAD),
+    )
 
 
 def agent_body(kind: BodyKind) -> tuple[Primitive, ...]:
@@ -277,6 +306,25 @@ def flag(color: Color) -> tuple[Primitive, ...]:
 def heading_arrow(color: Color) -> Primitive:
     """An arrow along the marker's x axis (its heading), lying on the ground."""
     return Primitive(Shape.ARROW, color.with_alpha(1.0), (0.0, 0.0, 0.1), (2.2, 0.3, 0.3))
+
+
+# The turning ring of a pose marker lies well outside the flag and the heading arrow
+# (2.2 m), so that grabbing the marker near its arrow moves it and only the ring turns it.
+TURN_RADIUS = 3.4
+
+
+def turn_handle(color: Color) -> tuple[Primitive, ...]:
+    """The ring that turns a pose marker, with a knob where the heading points."""
+    solid = color.with_alpha(1.0)
+    return (
+        ring(solid, TURN_RADIUS, z=0.08, width=0.3),
+        Primitive(Shape.SPHERE, solid, (TURN_RADIUS, 0.0, 0.15), (0.7, 0.7, 0.3)),
+    )
+
+
+def text(words: str, position: Point, height: float, color: Color) -> Primitive:
+    """Camera-facing text centred at ``position`` (``height``: the letters')."""
+    return Primitive(Shape.TEXT, color, position, (0.0, 0.0, height), text=words)
 
 
 def ring(color: Color, radius: float, z: float = 0.05, width: float = 0.12) -> Primitive:

@@ -10,9 +10,9 @@ without covering the others:
   yellow, red; the part past its threshold is written in capitals). Commands waiting
   for contact follow the link (``LINK DOWN 40 s, 2 WAITING 1 min``).
 
-No data is shown as such (``?``, "never heard"), never left out. Robots standing close
-together (at the lander, at one region) get their blocks lifted by whole blocks
-(:func:`icon_levels`), so they do not write over each other.
+No data is shown as such (``?``, "never heard"), never left out. Robots whose blocks
+would cover each other from the shipped views (at the lander, at one region, a row of
+robots) get their blocks lifted by whole blocks (:func:`icon_levels`).
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ from rosmc_server.core.model import SkillStatus
 from rosmc_server.core.waiting import duration_text
 
 from .geometry import Color, Point
+from .labels import LINE_SPACING, VIEW_PITCH, Box, Label
 
 GOOD = Color(0.30, 1.00, 0.35)
 WARN = Color(1.00, 0.85, 0.15)
@@ -40,12 +41,15 @@ WIFI_FAIR = -60.0  # dBm, below: yellow
 LINK_STALE = 5.0  # seconds since heard while up: yellow
 SEPARATOR = " | "
 
-# Where the block sits, in metres (the ROS layer turns rows into text markers).
-ICON_BASE = 1.9  # above the robot's frame: the lower line's centre, clear of mast and arm
-ICON_ROW = 0.6  # from one line's centre to the next
+# Where the block sits, in metres (the ROS layer turns rows into text markers). The rows
+# are lines of one camera-facing text (each row's marker blanks the others' lines), so
+# they stay apart on screen from every view; rows stacked in height would merge when seen
+# from above.
+ICON_BASE = 2.15  # above the robot's frame: the lower line's centre, clear of mast, arm, pin
 ICON_TEXT = 0.45  # letter height
-ICON_GAP = 0.35  # between two lifted blocks
-NEAR = 10.0  # robots closer than this (horizontally) stack their blocks
+ICON_ROW = ICON_TEXT * LINE_SPACING  # from one line's centre to the next, on screen
+ICON_GAP = 0.2  # between two lifted blocks, as the view sees them
+TYPICAL_LINE = 32  # characters in a health line (``BAT 97% | WiFi -54 dBm | link up``)
 
 _SEVERITY = {GOOD: 0, NEUTRAL: 0, DIM: 1, WARN: 2, BAD: 3}
 
@@ -161,32 +165,53 @@ def status_rows(
     )
 
 
-def icon_levels(positions: Mapping[str, Point | None], near: float = NEAR) -> dict[str, int]:
+def icon_levels(
+    positions: Mapping[str, Point | None], lines: Mapping[str, Sequence[str]] | None = None
+) -> dict[str, int]:
     """How many whole blocks to lift each robot's block (0 = right above the robot).
 
-    Robots are taken from south to north (the default view looks north, so a robot further
+    Robots are taken from south to north (the shipped views look north, so a robot further
     north stands higher on screen and its block goes higher still); each gets the lowest
-    level that no robot taken before within ``near`` metres (horizontally, at about the
-    same height) holds. Robots without a known position come last, in the order given,
-    and stack on each other as if together.
+    level at which its block, as the shipped views see it (:mod:`.labels`), covers no
+    block placed before. ``lines`` are each block's texts (default: two lines of
+    :data:`TYPICAL_LINE` characters). Robots without a known position come last, in the
+    order given, and stack on each other as if together.
     """
-    placed: list[tuple[Point | None, int]] = []
+    placed: list[Box] = []
+    unknown = 0
     out: dict[str, int] = {}
     order = sorted(positions.items(), key=lambda item: (item[1] is None, (item[1] or (0, 0))[1]))
     for agent, position in order:
-        taken = {level for other, level in placed if _close(position, other, near)}
-        level = next(n for n in range(len(placed) + 1) if n not in taken)
+        if position is None:
+            out[agent], unknown = unknown, unknown + 1
+            continue
+        texts = tuple((lines or {}).get(agent, ("x" * TYPICAL_LINE,) * 2))
+        level = 0
+        while True:
+            box = _block(agent, position, level, texts).box()
+            if not any(box.overlaps(other) for other in placed):
+                break
+            level += 1
         out[agent] = level
-        placed.append((position, level))
+        placed.append(box)
     return out
 
 
-def _close(a: Point | None, b: Point | None, near: float) -> bool:
-    if a is None or b is None:
-        return a is None and b is None
-    return math.hypot(a[0] - b[0], a[1] - b[1]) < near and abs(a[2] - b[2]) < ICON_ROW * 3
+def _block(agent: str, position: Point, level: int, texts: Sequence[str]) -> Label:
+    centre = position[2] + block_centre(level, len(texts))
+    return Label(agent, position[0], position[1], centre, tuple(texts), ICON_TEXT, ICON_ROW)
 
 
-def block_height(level: int, rows: int = 2) -> float:
-    """Height (m above the robot's frame) of the lowest line of a block at ``level``."""
-    return ICON_BASE + level * (ICON_ROW * rows + ICON_GAP)
+def block_centre(level: int, rows: int = 2) -> float:
+    """Height (m above the robot's frame) of the centre of a block of ``rows`` at ``level``.
+
+    One level lifts a block just enough to clear the one below it as the steepest shipped
+    view sees it (looking down, height shows foreshortened by ``cos(pitch)``).
+    """
+    on_screen = ICON_ROW * (rows - 1) + ICON_TEXT + ICON_GAP
+    return ICON_BASE + ICON_ROW * (rows - 1) / 2 + level * on_screen / math.cos(VIEW_PITCH)
+
+
+def block_label(agent: str, position: Point, level: int, rows: Sequence[IconRow]) -> Label:
+    """A robot's status block at ``level`` over map ``position``, as a label to keep clear of."""
+    return _block(agent, position, level, [row.text for row in rows])

@@ -3,12 +3,14 @@
 :class:`Scene` answers two questions for the node: *what does marker X look like now*
 (:meth:`Scene.specs_for`) and *which markers does this mirror update touch*
 (:meth:`Scene.touched`). The node republishes only the touched ones whose spec changed,
-so an event costs what it changes, not the size of the mission.
+so an event costs what it changes, not the size of the mission. Laying the labels out
+(:meth:`Scene.relayout`) looks at every task marker, but is plain arithmetic, and only
+the markers whose label moved are republished.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
 from rosmc_server.core.agent_status import AgentStatus
@@ -28,9 +30,12 @@ from rosmc_server.core.updates import (
 from rosmc_server.interface import MAP_FRAME
 
 from . import geometry as geo
+from .labels import Label, layout
 from .menus import flatten, robot_menu, static_agent_menu, task_marker_menu
-from .specs import MarkerSpec, agent_spec, task_specs
+from .specs import MarkerSpec, agent_spec, describe, task_label, task_specs
 from .styling import is_locked, marker_use
+
+LABEL_STEP = 0.25  # task labels move south by whole steps (m)
 
 
 @dataclass(frozen=True)
@@ -69,6 +74,7 @@ class Scene:
         self.read_only = read_only
         self.follow_tf = follow_tf
         self.selection = Selection()
+        self.label_south: dict[str, float] = {}  # task marker -> its label moved south (m)
 
     # -- which markers an update touches -------------------------------------------------------
     def touched(self, update: MirrorUpdate) -> Touched:
@@ -155,6 +161,20 @@ class Scene:
             yaw=yaw,
         )
 
+    def relayout(self, state: MissionState, blocks: Sequence[Label] = ()) -> set[str]:
+        """Lay the task markers' labels out clear of each other and of the robots' status
+        ``blocks``; returns the markers whose label moved (their specs changed)."""
+        labels = []
+        for marker in state.markers:
+            bound = state.bound_to(marker.name)
+            locked = is_locked(bound)
+            text = describe(marker, marker_use(bound), locked)
+            labels.append(task_label(marker, text, movable=not locked and not self.read_only))
+        # whole quarter metres, so that a robot creeping past does not redraw labels
+        new = layout(labels, [block.box() for block in blocks], step=LABEL_STEP)
+        old, self.label_south = self.label_south, new
+        return {name for name in old.keys() | new.keys() if old.get(name) != new.get(name)}
+
     def marker_specs(self, state: MissionState, name: str) -> list[MarkerSpec]:
         """The interactive markers of task marker ``name`` (none if it does not exist)."""
         if not state.has_marker(name):
@@ -173,6 +193,7 @@ class Scene:
             locked=locked,
             read_only=self.read_only,
             highlighted=self._highlighted(name, bound),
+            label_south=self.label_south.get(name, 0.0),
         )
 
     def _highlighted(self, name: str, bound: Iterable[SkillInstance]) -> bool:

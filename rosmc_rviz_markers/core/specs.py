@@ -20,6 +20,7 @@ from rosmc_server.interface import MAP_FRAME, base_link
 
 from . import geometry as geo
 from .geometry import Color, Point, Primitive
+from .labels import Label
 from .menus import FlatMenu
 from .styling import HIGHLIGHT, LOCK_COLOR, USE_COLORS, MarkerUse
 
@@ -64,6 +65,12 @@ class MarkerSpec:
     controls: tuple[ControlSpec, ...]
     menu: FlatMenu = field(default_factory=FlatMenu)
     scale: float = 1.0
+
+    @property
+    def label(self) -> str:
+        """The text the marker shows: its description, or the text it draws itself."""
+        drawn = (p.text for c in self.controls for p in c.primitives if p.shape is geo.Shape.TEXT)
+        return self.description or next(drawn, "")
 
     def same_but_pose(self, other: MarkerSpec) -> bool:
         """Whether ``other`` differs from this at most in position and heading."""
@@ -133,6 +140,8 @@ def agent_spec(
 ) -> MarkerSpec:
     """A robot or static agent: its body, clickable for its menu, following its TF frame."""
     body = geo.agent_body(kind)
+    if robot and geo.top_of(body) < geo.PIN_CLEARANCE:
+        body += geo.pin(geo.BODY_COLORS[kind])
     if highlighted:
         body = (*body, geo.ring(HIGHLIGHT, 1.8 if robot else 0.7))
     mode = Interaction.MENU if menu.entries else Interaction.NONE
@@ -148,9 +157,36 @@ def agent_spec(
     )
 
 
-def _describe(marker: TaskMarker, use: MarkerUse, locked: bool) -> str:
+def describe(marker: TaskMarker, use: MarkerUse, locked: bool) -> str:
+    """A task marker's label: its name and how it is used (``goal [blueprint]``)."""
     state = use.label + (", locked" if locked else "")
     return f"{marker.name} [{state}]"
+
+
+LABEL_TEXT = 0.55  # letter height of a task marker's label
+LABEL_Z = 0.35
+LABEL_COLOR = Color(0.95, 0.95, 0.97)
+
+
+def _label_below(marker: TaskMarker, movable: bool) -> float:
+    """How far south of its marker's origin a label sits before any decluttering
+    (outside the turning ring of a pose marker that can turn)."""
+    return geo.TURN_RADIUS + 0.6 if marker.type is MarkerType.POSE and movable else 1.3
+
+
+def task_label(marker: TaskMarker, text: str, movable: bool = True) -> Label:
+    """Where a task marker's label goes (map frame) before :func:`.labels.layout` moves it."""
+    y = marker.pose.y - _label_below(marker, movable)
+    return Label(marker.name, marker.pose.x, y, LABEL_Z, (text,), LABEL_TEXT)
+
+
+def _label_primitive(
+    marker: TaskMarker, text: str, south: float, yaw: float, movable: bool
+) -> Primitive:
+    # the marker frame turns with a pose marker's heading; the label must not
+    distance = _label_below(marker, movable) + south
+    position = (-distance * math.sin(yaw), -distance * math.cos(yaw), LABEL_Z)
+    return geo.text(text, position, LABEL_TEXT, LABEL_COLOR)
 
 
 def task_specs(
@@ -162,8 +198,14 @@ def task_specs(
     locked: bool,
     read_only: bool,
     highlighted: bool = False,
+    label_south: float = 0.0,
 ) -> list[MarkerSpec]:
-    """The interactive markers of one task marker: flag/arrow, or polygon + vertices."""
+    """The interactive markers of one task marker: flag/arrow, or polygon + vertices.
+
+    Its label is drawn by the marker itself (no rviz description), ``label_south`` metres
+    further south than usual when :func:`.labels.layout` moved it out of the way. A pose
+    marker moves by its flag and arrow and turns by a ring well outside them.
+    """
     del bound  # the colour and menu already say what the bound skills mean
     color = USE_COLORS[use]
     movable = not locked and not read_only
@@ -174,31 +216,21 @@ def task_specs(
         extra += (geo.ring(LOCK_COLOR, 0.6, width=0.08),)
     menu_mode = Interaction.MENU if menu.entries else Interaction.NONE
     move_mode = Interaction.MOVE_PLANE if movable else menu_mode
-    description = _describe(marker, use, locked)
+    yaw = marker.pose.yaw if marker.type is MarkerType.POSE else 0.0
+    text = describe(marker, use, locked)
+    extra += (_label_primitive(marker, text, label_south, yaw, movable),)
     x, y = marker.pose.x, marker.pose.y
     if marker.type is MarkerType.AREA:
-        return _area_specs(marker, color, menu, move_mode, movable, extra, description)
+        return _area_specs(marker, color, menu, move_mode, movable, extra)
     visuals = geo.flag(color) + extra
-    controls = [ControlSpec("flag", move_mode, visuals, UP if movable else IDENTITY)]
-    yaw = 0.0
     if marker.type is MarkerType.POSE:
-        yaw = marker.pose.yaw
-        arrow = geo.heading_arrow(color)
-        if movable:
-            ring = geo.ring(color.with_alpha(0.9), 2.3, z=0.06, width=0.12)
-            controls.append(ControlSpec("heading", Interaction.ROTATE_AXIS, (arrow, ring)))
-        else:
-            controls.append(ControlSpec("heading", menu_mode, (arrow,), IDENTITY))
+        visuals += (geo.heading_arrow(color),)
+    controls = [ControlSpec("flag", move_mode, visuals, UP if movable else IDENTITY)]
+    if marker.type is MarkerType.POSE and movable:
+        controls.append(ControlSpec("heading", Interaction.ROTATE_AXIS, geo.turn_handle(color)))
     return [
         MarkerSpec(
-            task_name(marker.name),
-            MAP_FRAME,
-            (x, y, 0.0),
-            yaw,
-            description,
-            tuple(controls),
-            menu,
-            scale=2.2,  # rviz writes the label 1.4 x scale up: just above the flag
+            task_name(marker.name), MAP_FRAME, (x, y, 0.0), yaw, "", tuple(controls), menu, 2.2
         )
     ]
 
@@ -210,7 +242,6 @@ def _area_specs(
     move_mode: Interaction,
     movable: bool,
     extra: tuple[Primitive, ...],
-    description: str,
 ) -> list[MarkerSpec]:
     cx, cy = marker.pose.x, marker.pose.y
     relative = [(v.x - cx, v.y - cy) for v in marker.vertices]
@@ -220,10 +251,10 @@ def _area_specs(
         MAP_FRAME,
         (cx, cy, 0.0),
         0.0,
-        description,
+        "",
         (ControlSpec("area", move_mode, visuals, UP if movable else IDENTITY),),
         menu,
-        scale=2.5,  # the label stays low, under what flies over the area
+        scale=2.5,
     )
     specs = [centre]
     if movable:

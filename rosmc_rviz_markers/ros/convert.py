@@ -17,7 +17,7 @@ from visualization_msgs.msg import (
 from rosmc_server.core.frames import quaternion_from_rpy, yaw_of
 
 from ..core import geometry as geo
-from ..core.icons import ICON_ROW, ICON_TEXT, IconRow, block_height
+from ..core.icons import ICON_TEXT, IconRow, block_centre
 from ..core.menus import FlatMenu
 from ..core.specs import ControlSpec, MarkerSpec
 
@@ -101,10 +101,12 @@ def icon_markers(
 
     ``level`` lifts the block by whole blocks, so that robots standing close together
     (at the lander, at one region) do not write over each other
-    (:func:`~rosmc_rviz_markers.core.icons.icon_levels`).
+    (:func:`~rosmc_rviz_markers.core.icons.icon_levels`). Every row is one marker in its
+    own colour, all at the block's centre: its text holds every line of the block, the
+    other rows' lines blank, so rviz spaces the lines on screen.
     """
     out = []
-    bottom = position[2] + block_height(level, len(rows))
+    centre = position[2] + block_centre(level, len(rows))
     for index, row in enumerate(rows):
         marker = Marker()
         marker.header.frame_id = frame
@@ -114,12 +116,11 @@ def icon_markers(
         marker.id = base_id + index
         marker.type = Marker.TEXT_VIEW_FACING
         marker.action = Marker.ADD
-        z = bottom + ICON_ROW * (len(rows) - 1 - index)
-        marker.pose.position = PointMsg(position[0], position[1], z)
+        marker.pose.position = PointMsg(position[0], position[1], centre)
         marker.pose.orientation.w = 1.0
         marker.scale.z = ICON_TEXT
         marker.color = color_msg(row.color)
-        marker.text = row.text
+        marker.text = "\n".join(r.text if i == index else " " for i, r in enumerate(rows))
         out.append(marker)
     return out
 

@@ -43,7 +43,9 @@ from rosmc_server.ros.client import MissionFollower, Outcome
 from rosmc_server.ros.logging_bridge import bridge_logging_to_rosout
 
 from .. import topics
-from ..core.icons import icon_levels, status_rows
+from ..core.geometry import Point
+from ..core.icons import IconRow, block_label, icon_levels, status_rows
+from ..core.labels import Label
 from ..core.scene import Scene, Touched
 from ..core.specs import MarkerSpec
 from .adapter import MarkerServer
@@ -204,6 +206,8 @@ class MarkerNode:
             statuses = self.mirror.agent_statuses
             names = set(touched.markers)
             agents = set(touched.agents)
+            if touched.everything or touched.markers or touched.icons:
+                names |= scene.relayout(state, self._block_labels(scene, statuses, state))
             if touched.everything:
                 names |= {m.name for m in state.markers}
                 with self._lock:
@@ -242,14 +246,16 @@ class MarkerNode:
             self.server.insert(interactive_marker_msg(spec))
         self._published[spec.name] = spec
 
-    def _icon_markers(
-        self, scene: Scene, statuses: Mapping[str, AgentStatus], state: MissionState
-    ) -> list[Marker]:
-        out: list[Marker] = []
+    @staticmethod
+    def _blocks(
+        scene: Scene, statuses: Mapping[str, AgentStatus], state: MissionState
+    ) -> list[tuple[str, tuple[IconRow, IconRow], Point | None, int]]:
+        """Every robot's status block: agent, rows, map position (None: unknown), level."""
         agents = scene.library.dynamic_agents
         poses = {agent: statuses[agent].pose if agent in statuses else None for agent in agents}
-        levels = icon_levels({a: (p.x, p.y, p.z) if p else None for a, p in poses.items()})
-        for index, agent in enumerate(agents):
+        points = {a: (p.x, p.y, p.z) if p else None for a, p in poses.items()}
+        rows = {}
+        for agent in agents:
             status = statuses.get(agent)
             label = ""
             if (
@@ -258,14 +264,31 @@ class MarkerNode:
                 and state.has_skill(status.current_skill)
             ):
                 label = state.skill(status.current_skill).label
+            rows[agent] = status_rows(status, label, agent)
+        levels = icon_levels(points, {a: [row.text for row in r] for a, r in rows.items()})
+        return [(agent, rows[agent], points[agent], levels[agent]) for agent in agents]
+
+    def _block_labels(
+        self, scene: Scene, statuses: Mapping[str, AgentStatus], state: MissionState
+    ) -> list[Label]:
+        """The status blocks of robots with a known position, for the label layout."""
+        return [
+            block_label(agent, point, level, rows)
+            for agent, rows, point, level in self._blocks(scene, statuses, state)
+            if point is not None
+        ]
+
+    def _icon_markers(
+        self, scene: Scene, statuses: Mapping[str, AgentStatus], state: MissionState
+    ) -> list[Marker]:
+        out: list[Marker] = []
+        for index, (agent, rows, point, level) in enumerate(self._blocks(scene, statuses, state)):
             frame, position = base_link(agent), (0.0, 0.0, 0.0)
-            pose = poses[agent]
             if not self.config.follow_tf:
                 frame = MAP_FRAME
-                if pose is not None:
-                    position = (pose.x, pose.y, pose.z)
-            rows = status_rows(status, label, agent)
-            out += icon_markers(agent, rows, frame, position, index * 10, levels[agent])
+                if point is not None:
+                    position = point
+            out += icon_markers(agent, rows, frame, position, index * 10, level)
         return out
 
     # -- feedback ---------------------------------------------------------------------------------

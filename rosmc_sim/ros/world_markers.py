@@ -1,9 +1,12 @@
 """The site's geometry for rviz: ``/rosmc/sim/world`` (visualization_msgs/MarkerArray, latched).
 
 One array holds everything (after a DELETEALL, so what disappeared goes): the
-ground, obstacles, slopes (flat, translucent), the lander, payload boxes,
-discovered regions (translucent discs with a label saying how far their stones are
-identified and how many are left), the stones lying in them, the science score and the
+ground, a pickable ground (a thin, all but invisible slab over the whole site, so that
+rviz's Publish Point tool hits something wherever an operator clicks on the site; the
+grid is pickable only on its lines), obstacles, slopes (flat, translucent), the lander,
+payload boxes, discovered regions (translucent discs with a label east of the disc saying how far
+their stones are identified and how many are left: east, so that it never covers the
+robots and task markers inside the region), the stones lying in them, the science score and the
 stones delivered (a text over the lander), and the Wi-Fi coverage circles of the lander
 and of deployed Wi-Fi boxes.
 Robot bodies are left to TF and the interactive markers. Namespaces are per
@@ -22,6 +25,7 @@ from geometry_msgs.msg import Point
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
+from rosmc_rviz_markers.core.labels import CHAR_WIDTH
 from rosmc_server.interface import MAP_FRAME
 
 from ..core.sim import LEVEL_COLLABORATIVE, LEVEL_SCIENCE, Simulation
@@ -34,7 +38,10 @@ CHECK_PERIOD = 0.1
 MIN_PERIOD = 0.5
 CIRCLE_POINTS = 72
 LANDER_HEIGHT = 1.2
+PICK_GROUND_ALPHA = 0.01  # drawn all but invisibly: rviz picks by depth, not by colour
+REGION_LABEL_HEIGHT = 0.8  # letter height of a region's label
 SCORE_HEIGHT = 8.0  # the score text floats this high over the lander (above the TF labels)
+SCORE_TEXT = 1.4  # its letter height: readable from the whole site, not a wall over the work
 IDENTIFIED = {
     LEVEL_SCIENCE: "identified by the science rover",
     LEVEL_COLLABORATIVE: "identified by both",
@@ -88,7 +95,7 @@ def _static_markers(sim: Simulation) -> list[Marker]:
     scenario = sim.scenario
     x_min, x_max, y_min, y_max = scenario.bounds
     ground = _marker("ground", 0, Marker.CUBE, (x_min + x_max) / 2, (y_min + y_max) / 2, -0.05)
-    out = [_sized(ground, x_max - x_min, y_max - y_min, 0.1)]
+    out = [_sized(ground, x_max - x_min, y_max - y_min, 0.1), _pick_ground(sim)]
     for i, o in enumerate(scenario.obstacles):
         if o.shape == "cylinder":
             m = _marker("obstacles", i, Marker.CYLINDER, o.x, o.y, o.height / 2)
@@ -104,6 +111,21 @@ def _static_markers(sim: Simulation) -> list[Marker]:
     lander = _marker("lander", 0, Marker.CUBE, 0.0, 0.0, LANDER_HEIGHT / 2)
     out.append(_sized(lander, side, side, LANDER_HEIGHT))
     return out
+
+
+def _pick_ground(sim: Simulation) -> Marker:
+    """A slab the size of the site just under the grid, for rviz's picking (Publish Point)."""
+    x_min, x_max, y_min, y_max = sim.scenario.bounds
+    slab = _marker("ground", 0, Marker.CUBE, (x_min + x_max) / 2, (y_min + y_max) / 2, -0.01)
+    slab.ns = "pick_ground"  # its own namespace: shown even where the ground is hidden
+    slab.color = ColorRGBA(*COLORS["ground"][:3], PICK_GROUND_ALPHA)
+    return _sized(slab, x_max - x_min, y_max - y_min, 0.02)
+
+
+def region_label_x(x: float, radius: float, text: str) -> float:
+    """Where a region's label is centred: east of its disc, clear of what stands inside."""
+    longest = max(len(line) for line in text.splitlines())
+    return x + radius + 0.5 + longest * REGION_LABEL_HEIGHT * CHAR_WIDTH / 2
 
 
 def _box_markers(sim: Simulation) -> list[Marker]:
@@ -145,14 +167,16 @@ def _science_markers(sim: Simulation) -> list[Marker]:
         spec = region.spec
         disc = _marker("regions", i, Marker.CYLINDER, spec.x, spec.y, 0.02)
         out.append(_sized(disc, 2 * spec.radius, 2 * spec.radius, 0.04))
-        label = _marker("region_labels", i, Marker.TEXT_VIEW_FACING, spec.x, spec.y, 1.5)
-        label.scale.z = 0.8
         how = IDENTIFIED.get(region.identified, "not identified")
         left = sim.stones_left(spec.name)
-        label.text = f"{spec.name} (max {spec.max_score:g})\n{how}, {left} left"
+        text = f"{spec.name} (max {spec.max_score:g})\n{how}, {left} left"
+        x = region_label_x(spec.x, spec.radius, text)
+        label = _marker("region_labels", i, Marker.TEXT_VIEW_FACING, x, spec.y, 0.5)
+        label.scale.z = REGION_LABEL_HEIGHT
+        label.text = text
         out.append(label)
     score = _marker("score", 0, Marker.TEXT_VIEW_FACING, 0.0, 0.0, SCORE_HEIGHT)
-    score.scale.z = 2.5
+    score.scale.z = SCORE_TEXT
     score.text = f"science score {sim.score:.2f}\n{sim.delivered} stone(s) delivered"
     out.append(score)
     discovered = {name for name, r in sim.regions.items() if r.discovered}

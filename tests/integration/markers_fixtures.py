@@ -49,6 +49,12 @@ CLIENT_ID = "/rviz_test/InteractiveMarkers"
 T = TypeVar("T")
 
 
+def label_of(marker: InteractiveMarker) -> str:
+    """The text an interactive marker shows: its description or the text it draws."""
+    drawn = (m.text for c in marker.controls for m in c.markers if m.type == m.TEXT_VIEW_FACING)
+    return str(marker.description or next(drawn, ""))
+
+
 def wait_for(condition: Callable[[], T], what: str, timeout: float = TIMEOUT) -> T:
     """Poll ``condition`` until it returns something true; fail after ``timeout`` seconds."""
     deadline = time.monotonic() + timeout

@@ -20,7 +20,7 @@ from visualization_msgs.msg import InteractiveMarkerFeedback as F
 
 from rosmc_server.core import MarkerType, Pose, SkillStatus, TaskMarker, Transfer
 from rosmc_server.ros.client import MissionClient
-from tests.integration.markers_fixtures import Rviz, current, wait_for
+from tests.integration.markers_fixtures import Rviz, current, label_of, wait_for
 
 pytest_plugins = ["tests.integration.server_fixtures", "tests.integration.markers_fixtures"]
 
@@ -53,7 +53,7 @@ def test_robot_menu_adds_the_skill_with_a_new_bound_marker(mission: Any, rviz: R
     # no telemetry here: the robot is taken at the origin, the marker 4 m ahead of it
     assert (marker.pose.x, marker.pose.y) == pytest.approx((4.0, 0.0))
     assert skill.params["target"] == marker.pose
-    rviz.marker(f"task/{marker.name}", lambda m: "blueprint" in m.description)
+    rviz.marker(f"task/{marker.name}", lambda m: "blueprint" in label_of(m))
     # a skill without marker parameters takes the library defaults
     rviz.select_menu("robot/drone", "Add skill", "take_off")
     (take_off,) = wait_for(lambda: skills_of(mission, "drone"), "take_off")
@@ -171,7 +171,7 @@ def test_locked_marker_is_refused_and_snaps_back(mission: Any, rviz: Rviz) -> No
     )  # no robot answers here: the upload stays under way
     state = current(mission)
     assert state.task("drone")[0].transfer is Transfer.UPLOADING
-    rviz.marker(f"task/{name}", lambda m: "locked" in m.description)
+    rviz.marker(f"task/{name}", lambda m: "locked" in label_of(m))
     assert "Rename" not in rviz.titles(f"task/{name}")
     rviz.drag(f"task/{name}", 9.0, 9.0)
     rviz.marker(f"task/{name}", at(2.0, 2.0))
@@ -235,7 +235,7 @@ def test_stock_tools_create_task_markers(mission: Any, rviz: Rviz, markers_node:
 def test_selection_both_ways(mission: Any, rviz: Rviz) -> None:
     name = add_marker(mission, rviz, TaskMarker("rock", MarkerType.POSITION, Pose(4.0, 4.0)))
     added = mission.add_skill("science_rover", "identify_stones", bindings={"position": name})
-    rviz.marker(f"task/{name}", lambda m: "blueprint" in m.description)
+    rviz.marker(f"task/{name}", lambda m: "blueprint" in label_of(m))
     rviz.feedback(f"task/{name}", F.MOUSE_DOWN, x=4.0, y=4.0)
     rviz.feedback(f"task/{name}", F.MOUSE_UP, x=4.0, y=4.0)
     selection = wait_for(

@@ -33,7 +33,7 @@ from rosmc_rviz_markers import topics
 from rosmc_server.core import MarkerType, TaskMarker
 from rosmc_server.core import Pose as MissionPose
 from rosmc_server.ros.client import MissionClient
-from tests.integration.markers_fixtures import MarkerNodeProcess, wait_for
+from tests.integration.markers_fixtures import MarkerNodeProcess, label_of, wait_for
 
 pytest_plugins = ["tests.integration.server_fixtures"]
 
@@ -145,7 +145,7 @@ def test_a_replay_shows_read_only_markers(
             modes = {c.interaction_mode for c in marker.controls}
             assert modes <= set(READ_ONLY_MODES), f"{name} is interactive: {modes}"
         assert not any("#v" in name for name in markers), "area vertices are draggable"
-        assert "[blueprint]" in markers["task/goal"].description
+        assert "[blueprint]" in label_of(markers["task/goal"])
 
         # feedback changes nothing: a drag and a menu click are refused with a warning
         fb = InteractiveMarkerFeedback

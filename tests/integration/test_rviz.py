@@ -194,6 +194,8 @@ def test_rviz_draws_the_site_under_xvfb(ros_master: RosMaster, tmp_path: Path) -
             "20",
             "--settle",
             "2",
+            "--expect-fraction",  # the score's letters are small (the whole site shows)
+            "0.0002",
             "--expect-color",
             ",".join(map(str, wifi)),
             "--expect-color",

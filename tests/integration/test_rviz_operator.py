@@ -21,7 +21,7 @@ import pytest
 import yaml
 
 from rosmc_rviz_markers.core import icons
-from rosmc_rviz_markers.core.icons import ICON_ROW, block_height
+from rosmc_rviz_markers.core.icons import block_centre
 from rosmc_server.core import MarkerType, Pose, TaskMarker
 from rosmc_server.ros.client import MissionClient
 from tests.conftest import LaunchProcess, RosMaster
@@ -129,9 +129,9 @@ def test_operator_rviz_shows_robots_markers_and_icons(
     flag = near(px, project((*POSE_MARKER, 0.8), w, h), 35)
     bluish = (flag[..., 2] > flag[..., 0] + 60) & (flag[..., 2] > 110)
     assert bluish.sum() > 30, "no blueprint task marker where it lies"
-    # the status icons above the drone: two lines, the block's centre half a row above its
-    # lower line (no robot reports a pose here, so the drone, first, stays at level 0)
-    centre = block_height(0) + ICON_ROW / 2
+    # the status icons above the drone: two lines around the block's centre
+    # (no robot reports a pose here, so the drone, first, stays at level 0)
+    centre = block_centre(0)
     block = near(px, project((*ROBOT_START["drone"], centre), w, h), 60)
     text = np.zeros(block.shape[:2], dtype=bool)
     for color in text_colors:

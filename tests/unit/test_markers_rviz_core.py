@@ -20,7 +20,7 @@ from rosmc_rviz_markers.core.icons import (
     GOOD,
     ICON_ROW,
     WARN,
-    block_height,
+    block_centre,
     icon_levels,
     status_parts,
     status_rows,
@@ -237,11 +237,16 @@ def test_icon_levels_stack_only_robots_standing_together() -> None:
     }
     assert icon_levels({"a": None, "b": None, "c": (0.0, 0.0, 0.0)}) == {"a": 0, "b": 1, "c": 0}
     # the robot further north (higher on screen in the default view) is the one lifted
-    assert icon_levels({"north": (0.0, 3.0, 0.0), "south": (1.0, 0.0, 0.0)}) == {
+    assert icon_levels({"north": (0.0, 0.8, 0.0), "south": (1.0, 0.0, 0.0)}) == {
         "north": 1,
         "south": 0,
     }
-    assert block_height(1) > block_height(0) + 2 * ICON_ROW
+    # 3 m further north, a block already shows above the other one: no lift
+    assert icon_levels({"north": (0.0, 3.0, 0.0), "south": (1.0, 0.0, 0.0)}) == {
+        "north": 0,
+        "south": 0,
+    }
+    assert block_centre(1) > block_centre(0) + 2 * ICON_ROW
 
 
 # -- menus --------------------------------------------------------------------------------------
@@ -321,12 +326,12 @@ def test_scene_specs_follow_status() -> None:
     assert len(specs) == 5, "centre and four vertices"
     centre = specs[0]
     assert centre.controls[0].interaction is Interaction.MOVE_PLANE
-    assert "blueprint" in centre.description
+    assert "blueprint" in centre.label
     synced = replace(blueprint, status=SkillStatus.RUNNING)
     specs = scene.marker_specs(state_with(area, skills=(synced,)), "Area 1")
     assert len(specs) == 1, "locked: no vertex handles"
     assert specs[0].controls[0].interaction is Interaction.MENU
-    assert "running, locked" in specs[0].description
+    assert "running, locked" in specs[0].label
     done = replace(blueprint, status=SkillStatus.SUCCESS)
     assert len(scene.marker_specs(state_with(area, skills=(done,)), "Area 1")) == 5
     replay = Scene(LIBRARY, read_only=True)

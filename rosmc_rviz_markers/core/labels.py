@@ -1,0 +1,112 @@
+"""Labels that do not write over each other, laid out as the shipped rviz views see them.
+
+rviz draws camera-facing text where it is told and never moves it out of the way, so at a
+busy place (a region with robots and task markers) the labels would pile up. Here every
+label is a box on the *view plane* of the shipped views ("Whole site", "Work area": both
+look north, 1.2 and 1.25 rad below the horizon): horizontally its map ``x``, vertically
+``y sin(pitch) + z cos(pitch)`` (metres, perspective ignored). :func:`layout` slides the
+movable labels south (down the screen) just as far as needed to clear every label above
+them and every fixed box (the robots' status blocks), so the labels stack in a column.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+CHAR_WIDTH = 0.62  # a character's width in letter heights (rviz's text font, generously)
+LINE_SPACING = 1.25  # from one line's centre to the next, in letter heights
+VIEW_PITCH = 1.25  # the steepest shipped view looks north, this far below the horizon (rad)
+GAP = 0.15  # between two stacked labels (view-plane metres)
+
+
+@dataclass(frozen=True)
+class Box:
+    """A label's rectangle on the view plane (metres)."""
+
+    left: float
+    right: float
+    bottom: float
+    top: float
+
+    def overlaps(self, other: Box) -> bool:
+        """Whether the two rectangles share more than an edge."""
+        return (
+            self.left < other.right
+            and other.left < self.right
+            and self.bottom < other.top
+            and other.bottom < self.top
+        )
+
+
+@dataclass(frozen=True)
+class Label:
+    """A camera-facing text block centred at map ``(x, y, z)``.
+
+    ``height`` is the letter height; ``spacing`` the distance between line centres
+    (default :data:`LINE_SPACING` letter heights).
+    """
+
+    key: str
+    x: float
+    y: float
+    z: float
+    lines: tuple[str, ...]
+    height: float
+    spacing: float = 0.0
+
+    @property
+    def width(self) -> float:
+        """The widest line's width (metres)."""
+        return max((len(line) for line in self.lines), default=0) * self.height * CHAR_WIDTH
+
+    def box(self, south: float = 0.0, pitch: float = VIEW_PITCH) -> Box:
+        """The label's box on the view plane when moved ``south`` metres (map -y)."""
+        spacing = self.spacing or self.height * LINE_SPACING
+        half = (spacing * (len(self.lines) - 1) + self.height) / 2
+        centre = (self.y - south) * math.sin(pitch) + self.z * math.cos(pitch)
+        return Box(self.x - self.width / 2, self.x + self.width / 2, centre - half, centre + half)
+
+
+def layout(
+    labels: Sequence[Label],
+    fixed: Iterable[Box] = (),
+    pitch: float = VIEW_PITCH,
+    step: float = 0.0,
+) -> dict[str, float]:
+    """How far south (map metres, >= 0) to move each of ``labels`` so no two boxes overlap.
+
+    Labels are taken from the top of the screen down; each moves the least that clears
+    every box placed before it and every ``fixed`` box (a column of labels at one place).
+    With a ``step``, moves are whole steps (so that a small change moves no label).
+    """
+    placed = list(fixed)
+    rise = math.sin(pitch)
+    out: dict[str, float] = {}
+    order = sorted(labels, key=lambda label: (-label.box(0.0, pitch).top, label.x, label.key))
+    for label in order:
+        south = 0.0
+        while True:
+            box = label.box(south, pitch)
+            hits = [other for other in placed if box.overlaps(other)]
+            if not hits:
+                break
+            # just below the lowest box it hits (the label only moves down the screen)
+            lowest = min(other.bottom for other in hits)
+            south += (box.top - lowest + GAP) / rise
+            if step > 0:
+                south = math.ceil(south / step - 1e-9) * step
+        out[label.key] = south
+        placed.append(box)
+    return out
+
+
+def overlapping(boxes: Sequence[Box]) -> list[tuple[int, int]]:
+    """The index pairs of the boxes that overlap (for checks and tests)."""
+    return [
+        (i, j)
+        for i in range(len(boxes))
+        for j in range(i + 1, len(boxes))
+        if boxes[i].overlaps(boxes[j])
+    ]
