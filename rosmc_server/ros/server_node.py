@@ -30,7 +30,7 @@ Parameters (private):
         ``journal_alert`` (``rosmc status``).
     ``~link_timeout`` (float, s): silence after which a robot link is DOWN (3.0).
     ``~agent_state_rate`` (float, Hz): rate of ``/rosmc/agent_states`` (2.0).
-    ``~fsync`` (bool): fsync the journal on every change (survives power loss).
+    ``~fsync`` (bool): fsync the journal on every change (survives power loss; true).
     ``~snapshot_every`` (int): mission events between two full snapshots in the journal (500).
     ``~mission_dir`` (str): the only directory (with its subdirectories) where SaveMission
         and LoadMission read or write files on the server's host (default ``missions/``);
@@ -106,7 +106,7 @@ class ServerConfig:
     resume: bool = False
     link_timeout: float = 3.0
     agent_state_rate: float = 2.0
-    fsync: bool = False
+    fsync: bool = True
     mission_dir: Path = DEFAULT_MISSION_DIR
     snapshot_every: int = JournalOptions.snapshot_every
 
@@ -130,7 +130,7 @@ class ServerConfig:
             resume=resume,
             link_timeout=float(rospy.get_param("~link_timeout", 3.0)),
             agent_state_rate=float(rospy.get_param("~agent_state_rate", 2.0)),
-            fsync=bool(rospy.get_param("~fsync", False)),
+            fsync=bool(rospy.get_param("~fsync", True)),
             mission_dir=Path(str(rospy.get_param("~mission_dir", str(DEFAULT_MISSION_DIR)))),
             snapshot_every=max(1, int(rospy.get_param("~snapshot_every", cls.snapshot_every))),
         )
