@@ -302,9 +302,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--events", type=int, default=10_000, help="events in the recovery journal")
     parser.add_argument("--appends", type=int, default=2_000, help="appends per latency run")
     parser.add_argument("--changes", type=int, default=100_000, help="changes of the memory run")
-    parser.add_argument(
-        "--only", choices=["memory", "append"], help="run only this measurement"
-    )
+    parser.add_argument("--only", choices=["memory", "append"], help="run only this measurement")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.ERROR)  # recovery warnings are expected here
     with tempfile.TemporaryDirectory(dir=args.dir) as tmp:

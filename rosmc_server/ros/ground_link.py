@@ -31,7 +31,15 @@ import rosmc.msg as wire
 import rospy
 
 from ..conversions import barrier_to_msg, skill_to_msg, time_to_msg
-from ..core import Barrier, Mission, MissionEvent, RosmcError, SkillStatus, Transfer
+from ..core import (
+    Barrier,
+    Mission,
+    MissionEvent,
+    RosmcError,
+    SkillStatus,
+    StorageFull,
+    Transfer,
+)
 from ..core.commands import CommandKind, CommandSpec, queued_barriers, repair_command, synced_ids
 from ..core.link import (
     Arrival,
@@ -295,8 +303,11 @@ class GroundLink:
         if link.reports.classify(msg.seq) is Arrival.NEXT:
             if msg.skill_id in self._uploading(agent):
                 return  # it overtook the upload's ack (another topic); the robot resends it
+            try:
+                self._host.record_report(msg)
+            except StorageFull:  # unacknowledged, the robot sends it again
+                return
             link.reports.accept(msg.seq)
-            self._host.record_report(msg)
             self._apply_report(msg)
         link.report_ack_pub.publish(self._report_ack(agent, link.reports.last))
 

@@ -143,12 +143,12 @@ class MissionServer:
         self.config = config
         self.library = library
         self._stopping = False  # first: robot-link callbacks may arrive during construction
+        self.failed = False  # the journal failed: the process exits with status 1
         self._lock = threading.RLock()
         self._packer = SnapshotPacker()
         self._snapshot: PackedMission | None = None  # the newest one built
         self._building = threading.Lock()  # one snapshot build at a time
-        self.journal_alert = ""
-        """What resuming the journal could not recover ("" if nothing), for GetMission."""
+        self._resume_alert = ""  # what resuming the journal could not recover
         self._snapshot_after_resume = False
         self.mission, self._journal = self._open_journal()
         if self._snapshot_after_resume:  # the file now written must start the mission
@@ -219,6 +219,7 @@ class MissionServer:
         with self._lock:
             if self._stopping:
                 raise Unavailable("the mission server is shutting down")
+            self._journal.require_space()  # a change the journal cannot hold is never applied
             event = operation(self.mission)
             if event is not None:
                 self._record(event)
@@ -240,8 +241,9 @@ class MissionServer:
                 self._journal.append_snapshot(snapshot, stamp_ns)
         except Exception:
             _log.critical("cannot write the journal; shutting down to protect the mission")
-            self._stopping = True
-            rospy.signal_shutdown("journal write failed")
+            self.failed = self._stopping = True  # a supervisor restarts it: exit status 1
+            # Shortly after, so that the caller hears this change failed (not a dropped link).
+            threading.Timer(0.5, rospy.signal_shutdown, ("journal write failed",)).start()
             raise
         self._events.publish(msg)
         self._snapshots.changed(urgent=event.kind is EventKind.MISSION_REPLACED)
@@ -255,8 +257,7 @@ class MissionServer:
         call may; the journal's reader accepts events written before a snapshot
         of an older revision.
         """
-        if self._journal.snapshot_due and not self._journal.closed:
-            self._journal.append_snapshot(snapshot, time.time_ns())
+        self._journal.append_due_snapshot(snapshot, time.time_ns())
 
     def record_report(self, msg: wire.RobotReport) -> None:
         """Journal a robot report (the audit trail of what robots said)."""
@@ -293,6 +294,11 @@ class MissionServer:
         self._packer.prepare(content)
 
     # -- journal -------------------------------------------------------------------
+    @property
+    def journal_alert(self) -> str:
+        """What resuming the journal lost and whether its disk is full ("" if neither)."""
+        return "; ".join(a for a in (self._resume_alert, self._journal.space.alert()) if a)
+
     def _open_journal(self) -> tuple[Mission, JournalWriter]:
         options = JournalOptions(fsync=self.config.fsync, snapshot_every=self.config.snapshot_every)
         clock = rospy.get_time
@@ -323,7 +329,7 @@ class MissionServer:
         report = ResumeReport.of(writer.path, writer.recovered.damage, latest, writer.part_path)
         if not report.clean:
             _log.error("%s", report.log_line())
-            self.journal_alert = report.alert()
+            self._resume_alert = report.alert()
         if latest.next_revision > mission.revision + 1:
             content = mission.state.content()
             mission = Mission(self.library, content, latest.next_revision - 1, clock=rospy.get_time)
@@ -412,4 +418,4 @@ def main(argv: Sequence[str] | None = None) -> int:
     rospy.on_shutdown(server.shutdown)
     server.start()
     rospy.spin()
-    return 0
+    return 1 if server.failed else 0
