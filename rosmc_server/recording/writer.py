@@ -246,6 +246,14 @@ class JournalWriter:
             raise JournalError(f"{topic} is not a telemetry channel of the journal")
         self._append(topic, msg, log_time_ns, sync=False)
 
+    def start_next_part(self) -> None:
+        """Go on in a new part file (after a resume that lost revisions, so that later
+        resumes start from its snapshot and do not count the loss again); on failure keep
+        writing this one."""
+        with self._lock:
+            self._part.open_fd()
+            self._rotate()
+
     def sync(self) -> None:
         """Flush everything appended so far to the disk (fdatasync)."""
         with self._lock:

@@ -46,6 +46,7 @@ from __future__ import annotations
 import argparse
 import ctypes
 import ctypes.util
+import dataclasses
 import logging
 import sys
 import threading
@@ -78,6 +79,7 @@ from ..core import (
 from ..core.changes import EventKind
 from ..core.commands import commands_for_event, default_policy_commands
 from ..recording import JournalOptions, JournalWriter, default_journal_path, latest_state
+from ..recording.high_water import RevisionMark, first_mark, read_mark, resumed_mark
 from ..recording.recovery import ResumeReport
 from .agent_states import AgentStatePublisher
 from .ground_link import GroundLink
@@ -193,6 +195,7 @@ class MissionServer:
             self._recorder.stop()
             if not self._journal.closed:
                 self._journal.close()
+            self._marks.close()
 
     def _tick_link(self) -> None:
         next_clock_check = 0.0
@@ -231,6 +234,7 @@ class MissionServer:
         stamp_ns = time.time_ns()
         try:
             self._journal.append_event(msg, stamp_ns)
+            self._marks.record(event.revision)  # the journal's high-water mark, kept apart
             if event.kind is EventKind.MISSION_REPLACED:
                 # The new mission is only in the snapshot: it must be durable now. Its
                 # skills were serialized ahead (prepare_snapshot), off the lock.
@@ -310,7 +314,9 @@ class MissionServer:
         mission = Mission(self.library, MissionContent.empty(self.library), clock=clock)
         path = self.config.journal or default_journal_path(self.config.journal_dir)
         snapshot = mission_to_msg(mission.state.content(), 0, time.time())
-        return mission, JournalWriter.create(path, snapshot, time.time_ns(), options)
+        writer = JournalWriter.create(path, snapshot, time.time_ns(), options)
+        self._marks = RevisionMark(path, first_mark(0), options.fsync)
+        return mission, writer
 
     def _resumed(self, writer: JournalWriter) -> Mission:
         """The mission a resumed journal holds; says once, loudly, what it could not recover.
@@ -326,14 +332,25 @@ class MissionServer:
         mission = Mission(self.library, content, revision, clock=rospy.get_time)
         for event_msg in latest.events:
             mission.replay(event_from_msg(event_msg))
-        report = ResumeReport.of(writer.path, writer.recovered.damage, latest, writer.part_path)
+        mark = read_mark(writer.path)
+        report = ResumeReport.of(
+            writer.path, writer.recovered.damage, latest, writer.part_path, mark
+        )
+        if report.lost and not writer.damaged:  # later resumes start after the loss
+            writer.start_next_part()
+            report = dataclasses.replace(report, written_to=writer.part_path)
         if not report.clean:
             _log.error("%s", report.log_line())
             self._resume_alert = report.alert()
-        if latest.next_revision > mission.revision + 1:
+        # After lost revisions the resumed mission is a revision of its own, so that a view
+        # that held lost changes is stale (refused, refetched) instead of taken as current.
+        revision = report.next_revision - (0 if report.lost else 1)
+        if revision > mission.revision:
             content = mission.state.content()
-            mission = Mission(self.library, content, latest.next_revision - 1, clock=rospy.get_time)
-        self._snapshot_after_resume = writer.needs_snapshot or latest.lost is not None
+            mission = Mission(self.library, content, revision, clock=rospy.get_time)
+        marked = resumed_mark(mark, mission.revision, report.lost > 0)  # new epoch if lost
+        self._marks = RevisionMark(writer.path, marked, self.config.fsync)
+        self._snapshot_after_resume = writer.needs_snapshot or not report.clean
         _log.info("resumed from %s at revision %d", writer.path, mission.revision)
         return mission
 
