@@ -141,6 +141,16 @@ def bench_appends(directory: Path, chunked: bool, fsync: bool, count: int) -> di
     }
 
 
+def bench_all_appends(directory: Path, count: int) -> dict[str, Any]:
+    """Append latency of both layouts with fsync (the default) and without (``fsync=False``)."""
+    figures: dict[str, Any] = {}
+    for chunked in (True, False):
+        layout = "chunked" if chunked else "bare"
+        figures[layout] = bench_appends(directory, chunked, False, count)
+        figures[f"{layout}_fsync"] = bench_appends(directory, chunked, True, max(count // 10, 50))
+    return figures
+
+
 def bench_snapshot(directory: Path) -> dict[str, Any]:
     """Size and cost of a 20 x 500 snapshot, compressed (default) and not."""
     mission = big_mission(1)
@@ -292,7 +302,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--events", type=int, default=10_000, help="events in the recovery journal")
     parser.add_argument("--appends", type=int, default=2_000, help="appends per latency run")
     parser.add_argument("--changes", type=int, default=100_000, help="changes of the memory run")
-    parser.add_argument("--only", choices=["memory"], help="run only this measurement")
+    parser.add_argument("--only", choices=["memory", "append"], help="run only this measurement")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.ERROR)  # recovery warnings are expected here
     with tempfile.TemporaryDirectory(dir=args.dir) as tmp:
@@ -300,15 +310,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.only == "memory":
             print(json.dumps({"memory": bench_memory(directory, args.changes)}, indent=2))
             return 0
+        if args.only == "append":
+            print(json.dumps({"append": bench_all_appends(directory, args.appends)}, indent=2))
+            return 0
         # First: the resident memory it reads must not include the other runs' heap.
         figures: dict[str, Any] = {"memory": bench_memory(directory, args.changes)}
-        figures.update(append={}, recovery={})
+        figures.update(append=bench_all_appends(directory, args.appends), recovery={})
         for chunked in (True, False):
             layout = "chunked" if chunked else "bare"
-            figures["append"][layout] = bench_appends(directory, chunked, False, args.appends)
-            figures["append"][f"{layout}_fsync"] = bench_appends(
-                directory, chunked, True, max(args.appends // 10, 50)
-            )
             figures["recovery"][layout] = bench_recovery(directory, args.events, chunked)
         figures["snapshot_20x500"] = bench_snapshot(directory)
         figures["damage"] = bench_damage(directory)

@@ -14,6 +14,7 @@ from .errors import (
     RosmcError,
     RuleViolation,
     StaleRevision,
+    StorageFull,
     Unavailable,
 )
 from .library import (
@@ -68,6 +69,7 @@ __all__ = [
     "SkillSpec",
     "SkillStatus",
     "StaleRevision",
+    "StorageFull",
     "TaskMarker",
     "Transfer",
     "Unavailable",

@@ -21,6 +21,7 @@ from .validation import (
     MAX_LABEL,
     MAX_RETRIES,
     check_one_line,
+    check_skill_count,
     check_whole,
     excerpt,
     finite_float,
@@ -42,6 +43,7 @@ def plan_add_skill(
 ) -> Proposal:
     """Add ``skill`` to ``agent``'s blueprint (appended, or inserted at ``index``)."""
     spec = library.skill(agent, skill)
+    check_skill_count(state.skill_count + 1)
     task = state.task(agent)
     editable_start = state.sections(agent).editable_start
     if index is None:

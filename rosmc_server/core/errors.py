@@ -60,6 +60,14 @@ class Unavailable(RosmcError):
     server is shutting down); out of contact alone is never the reason."""
 
 
+class StorageFull(Unavailable):
+    """The journal's disk lacks the room a change needs: refused until space returns."""
+
+    def __init__(self, free_bytes: int) -> None:
+        super().__init__(f"the journal's disk is full: {free_bytes} bytes free")
+        self.free_bytes = free_bytes
+
+
 class LibraryError(RosmcError):
     """A skill library file is malformed; the message names the file and the key."""
 

@@ -20,7 +20,7 @@ from .library import Library
 from .model import SkillInstance, TaskMarker
 from .params import MarkerType, Pose
 from .state import MissionState
-from .validation import MAX_NAME, check_one_line
+from .validation import MAX_NAME, check_corners, check_one_line
 
 _NAME_NUMBER = re.compile(r"(\d+)$")
 
@@ -28,6 +28,7 @@ _NAME_NUMBER = re.compile(r"(\d+)$")
 def check_marker(marker: TaskMarker) -> TaskMarker:
     """Check a marker's shape; return it with an AREA's pose set to its centroid."""
     name = check_one_line(marker.name, "a marker name", MAX_NAME)
+    check_corners(len(marker.vertices), name)
     pose = Pose.from_any(marker.pose, f"the pose of marker '{name}'")
     vertices = tuple(
         Pose.from_any(v, f"vertex {i} of marker '{name}'") for i, v in enumerate(marker.vertices)

@@ -23,6 +23,7 @@ from .reconcile import Reconciliation, RobotSkill, plan_reconcile
 from .site import SiteGuard
 from .state import MissionContent, MissionState
 from .updates import apply_event
+from .validation import check_skill_count
 
 IdFactory = Callable[[str], str]
 
@@ -232,6 +233,7 @@ class Mission:
         """Run a failed skill again as a fresh instance right after it."""
         self._check_revision(base_revision)
         agent, _ = self.state.locate(skill_id)
+        check_skill_count(self.state.skill_count + 1)
         return self._commit(execution.plan_retry(self.state, skill_id, self._unique_id(agent)))
 
     def skip(self, skill_id: str, *, base_revision: int | None = None) -> MissionEvent:

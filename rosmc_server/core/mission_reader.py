@@ -26,8 +26,10 @@ from .state import MissionContent
 from .validation import (
     MAX_ATTEMPT,
     MAX_STATUS_TEXT,
+    check_corners,
     check_id,
     check_one_line,
+    check_skill_count,
     check_time,
     check_whole,
 )
@@ -94,6 +96,7 @@ def _read_markers(reader: DocumentReader, raw: object) -> dict[str, TaskMarker]:
         marker_type = reader.enum(MarkerType, body["type"], f"{key}.type")
         vertices = reader.items(body.get("vertices", []), f"{key}.vertices")
         try:
+            check_corners(len(vertices), str(body["name"]))
             marker = check_marker(
                 TaskMarker(
                     reader.text(body["name"], f"{key}.name"),
@@ -254,6 +257,10 @@ def _read_tasks(
     body = reader.mapping(raw, "tasks", set(), None)
     tasks: dict[str, list[SkillInstance]] = {agent: [] for agent in library.dynamic_agents}
     skills = _TaskReader(reader, library, markers)
+    try:  # counted before any is read: a flood is refused at once
+        check_skill_count(sum(len(e) for e in body.values() if isinstance(e, list)))
+    except RosmcError as error:
+        reader.fail("tasks", str(error))
     seen: set[str] = set()
     for agent, entries in body.items():
         if agent not in tasks:

@@ -17,7 +17,7 @@ from typing import Any
 import yaml
 
 from .errors import InvalidRequest
-from .validation import excerpt, finite_float
+from .validation import MAX_TEXT, check_text, excerpt, finite_float
 
 _new_object = object.__new__  # an instance without running its constructor
 
@@ -175,7 +175,7 @@ def check_value(
     elif ptype is ParamType.STRING:
         if not isinstance(raw, str):
             raise InvalidRequest(f"{what} must be text, got {excerpt(raw)}")
-        value = raw
+        value = check_text(raw, what)
     elif ptype is ParamType.LIST:
         if not isinstance(raw, (list, tuple)):
             raise InvalidRequest(f"{what} must be a list, got {excerpt(raw)}")
@@ -215,6 +215,8 @@ def quick_value(
     if isinstance(raw, float) and not _isfinite(raw):
         return None
     if type(raw) is int and not INT_MIN <= raw <= INT_MAX:
+        return None
+    if type(raw) is str and len(raw) > MAX_TEXT:  # (a surrogate is found in the document)
         return None
     if not isinstance(raw, str) and (
         (minimum is not None and raw < minimum) or (maximum is not None and raw > maximum)

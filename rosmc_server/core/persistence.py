@@ -25,6 +25,7 @@ from .library import Library
 from .mission_reader import mission_from_dict
 from .mission_text import MISSION_VERSION, MissionDumper, mission_to_dict
 from .state import MissionContent
+from .validation import check_encodable, check_file_path
 
 __all__ = [
     "MISSION_VERSION",
@@ -52,6 +53,7 @@ def save_mission(path: str | Path, content: MissionContent, revision: int) -> No
 def write_document(path: str | Path, document: str) -> None:
     """Write a mission document to ``path`` atomically and durably (see :func:`write_durably`):
     after a crash or a power loss the file holds either the previous save or this one."""
+    check_file_path(str(path))
     try:
         write_durably(Path(path), document)
     except OSError as error:
@@ -60,6 +62,7 @@ def write_document(path: str | Path, document: str) -> None:
 
 def load_mission(path: str | Path, library: Library) -> tuple[MissionContent, int]:
     """Read and check a mission file; return its content and revision."""
+    check_file_path(str(path))
     try:
         text = Path(path).read_text(encoding="utf-8")
     except OSError as error:
@@ -72,6 +75,7 @@ def load_mission(path: str | Path, library: Library) -> tuple[MissionContent, in
 
 def parse_mission(text: str, library: Library, source: str) -> tuple[MissionContent, int]:
     """Parse and check a mission document; return its content and revision."""
+    check_encodable(text, f"the mission document {source}")
     try:
         data = read_document(text, source)
     except DuplicateKeyError as error:

@@ -126,6 +126,11 @@ class MissionState:
         for task in self._content.tasks.values():
             yield from task
 
+    @property
+    def skill_count(self) -> int:
+        """How many skills the mission holds."""
+        return len(self._agent_of)
+
     def has_skill(self, skill_id: str) -> bool:
         """Whether a skill with this id exists."""
         return skill_id in self._agent_of

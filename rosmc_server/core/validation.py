@@ -4,7 +4,24 @@ A mission file, a robot report and an operator's request can all put text and nu
 the mission. Whatever the way in, the same limits hold, so that what one path accepts
 another never refuses later (a saved mission loads again) and nothing the mission holds can
 flood a terminal or a log: text is one line, free of control characters (line breaks,
-terminal escape codes), and short; ids are plain tokens; counts are bounded.
+terminal escape codes) and of lone surrogates (not text: they cannot be sent or saved), and
+short; ids are plain tokens; counts are bounded. The limits, in one place:
+
+============================  =====================  =========================================
+limit                         value                  refused when
+============================  =====================  =========================================
+``MAX_LABEL``                 120 characters         a skill label is longer
+``MAX_NAME``                  80 characters          a task marker or barrier name is longer
+``MAX_ID``                    64 characters          a skill id is longer
+``MAX_STATUS_TEXT``           500 characters         (a robot's status text is cut, not refused)
+``MAX_TEXT``                  4,096 characters       a string parameter value is longer
+``MAX_PATH``                  1,024 characters       a mission file path is longer (or holds a
+                                                     control character, a line break say)
+``MAX_CORNERS``               1,000                  an area marker has more corners
+``MAX_SKILLS``                50,000                 a mission would hold more skills
+============================  =====================  =========================================
+
+Each is checked before anything is parsed further, so a refusal takes milliseconds.
 
 Errors quote offending input through :func:`excerpt`: short and escaped.
 """
@@ -22,6 +39,10 @@ MAX_NAME = 80  # task marker and barrier names
 MAX_ID = 64
 MAX_STATUS_TEXT = 500
 MAX_RETRIES = 100
+MAX_TEXT = 4096  # a string parameter value
+MAX_PATH = 1024  # a mission file path
+MAX_CORNERS = 1000  # corners of one area marker
+MAX_SKILLS = 50_000  # skills of one mission (20 robots x 500 skills is 10,000)
 MAX_ATTEMPT = 10_000
 EXCERPT = 40
 
@@ -40,7 +61,50 @@ def has_control_characters(text: str) -> bool:
     """Whether ``text`` holds a line break, tab, escape or other control/format character."""
     if text.isprintable():  # no Cc or Cf (nor spaces other than ' '): the common case, in C
         return False
-    return any(unicodedata.category(ch) in ("Cc", "Cf") for ch in text)
+    return any(unicodedata.category(ch) in ("Cc", "Cf", "Cs") for ch in text)
+
+
+def check_encodable(text: str, what: str) -> str:
+    """``text`` if it is text (UTF-8 can encode it): a lone surrogate is refused."""
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError as error:
+        raise InvalidRequest(
+            f"{what} holds a lone surrogate {text[error.start]!a} at character "
+            f"{error.start}, which is not text"
+        ) from None
+    return text
+
+
+def check_text(value: str, what: str) -> str:
+    """A string parameter value: text of at most MAX_TEXT characters."""
+    if len(value) > MAX_TEXT:
+        raise InvalidRequest(f"{what} holds at most {MAX_TEXT} characters, got {len(value)}")
+    return check_encodable(value, what)
+
+
+def check_corners(count: int, name: str) -> None:
+    """Refuse an area of more than MAX_CORNERS corners (before reading any of them)."""
+    if count > MAX_CORNERS:
+        raise InvalidRequest(
+            f"an area has at most {MAX_CORNERS} corners; marker {excerpt(name)} has {count}"
+        )
+
+
+def check_skill_count(count: int) -> None:
+    """Refuse a mission of more than MAX_SKILLS skills."""
+    if count > MAX_SKILLS:
+        raise InvalidRequest(f"a mission holds at most {MAX_SKILLS} skills, this one {count}")
+
+
+def check_file_path(path: str) -> str:
+    """A mission file path: one line of at most MAX_PATH characters, no control character."""
+    if not path or len(path) > MAX_PATH or has_control_characters(path):
+        raise InvalidRequest(
+            f"a mission file path must be one line of 1 to {MAX_PATH} printable characters, "
+            f"got {excerpt(path)}"
+        )
+    return path
 
 
 def check_one_line(text: object, what: str, max_length: int, *, empty: bool = False) -> str:

@@ -6,8 +6,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from rosmc_server.recording.damage import Damage, skipped_line
+from rosmc_server.recording.high_water import Mark, next_after_loss
 from rosmc_server.recording.reader import LatestState
-from rosmc_server.recording.revisions import Gap
+from rosmc_server.recording.revisions import Gap, RevisionRange
 
 SHOWN = 3
 """Revision ranges named in the status line; the rest are counted."""
@@ -25,6 +26,9 @@ class ResumeReport:
         next_revision: The revision the next change gets: above every revision the journal
             holds, so no number an operator has seen is handed out again.
         written_to: The file the journal goes on in.
+        lost_at_end: Acknowledged revisions missing from the journal's end: its revision
+            mark (:mod:`.high_water`) names a later one than any the journal holds.
+        acknowledged: The last revision acknowledged before, as that mark says (-1: none).
     """
 
     path: Path
@@ -33,29 +37,63 @@ class ResumeReport:
     resumed_at: int
     next_revision: int
     written_to: Path
+    lost_at_end: int = 0
+    acknowledged: int = -1
 
     @classmethod
     def of(
-        cls, path: Path, damage: tuple[Damage, ...], latest: LatestState, written_to: Path
+        cls,
+        path: Path,
+        damage: tuple[Damage, ...],
+        latest: LatestState,
+        written_to: Path,
+        mark: Mark | None = None,
     ) -> ResumeReport:
-        """The report of a resume that rebuilt ``latest`` from the journal at ``path``."""
-        return cls(path, damage, latest.gaps, latest.revision, latest.next_revision, written_to)
+        """The report of a resume that rebuilt ``latest`` from the journal at ``path``,
+        whose revision mark (:mod:`.high_water`) was ``mark``."""
+        end = latest.next_revision - 1  # the highest revision the journal holds
+        lost_at_end = max(0, mark.revision - end) if mark is not None else 0
+        next_revision = latest.next_revision
+        if lost_at_end:  # which revisions went out after the end is unknown: above the lease
+            next_revision = next_after_loss(mark, next_revision)
+        acknowledged = mark.revision if mark is not None else -1
+        return cls(
+            path, damage, latest.gaps, latest.revision, next_revision, written_to, lost_at_end,
+            acknowledged,
+        )  # fmt: skip
 
     @property
     def clean(self) -> bool:
         """Whether the journal was read without damage or lost revisions."""
-        return not self.damage and not self.gaps
+        return not self.damage and not self.gaps and not self.lost_at_end
 
     @property
     def lost(self) -> int:
         """How many revisions cannot be rebuilt."""
-        return sum(gap.revisions.count for gap in self.gaps)
+        return sum(gap.revisions.count for gap in self.gaps) + self.lost_at_end
+
+    def _end_line(self) -> str:
+        if not self.lost_at_end:
+            return ""
+        return (
+            f"{self._end_range()} lost from its end (the journal stops before the last "
+            f"acknowledged revision, r{self.acknowledged})"
+        )
+
+    def _end_range(self) -> RevisionRange:
+        return RevisionRange(self.acknowledged - self.lost_at_end + 1, self.acknowledged)
 
     def log_line(self) -> str:
         """The one ERROR line for the log: damaged offsets, lost revisions, where it goes on."""
         if self.clean:
             return ""
-        line = skipped_line(self.path, self.damage, self.gaps)
+        line = "; ".join(
+            part
+            for part in (skipped_line(self.path, self.damage, self.gaps), self._end_line())
+            if part
+        )
+        if not self.damage and not self.gaps:
+            line = f"journal {self.path}: {line}"
         if self._mission_lost():
             line += (
                 f"; the mission resumed at r{self.resumed_at}, next revision r{self.next_revision}"
@@ -66,14 +104,17 @@ class ResumeReport:
         """One line for ``rosmc status`` ("" if the resume recovered everything)."""
         if self.clean:
             return ""
-        if not self.gaps:
-            ranges = len(self.damage)
+        if not self.gaps and not self.lost_at_end:
+            count = len(self.damage)
             return (
-                f"journal: {ranges} damaged byte range{'s' if ranges > 1 else ''} skipped at "
+                f"journal: {count} damaged byte range{'s' if count > 1 else ''} skipped at "
                 f"resume, no revision lost, see {self.path}"
             )
-        shown = ", ".join(str(gap.revisions) for gap in self.gaps[:SHOWN])
-        if len(self.gaps) > SHOWN:
+        ranges = [str(gap.revisions) for gap in self.gaps]
+        if self.lost_at_end:
+            ranges.append(str(self._end_range()))
+        shown = ", ".join(ranges[:SHOWN])
+        if len(ranges) > SHOWN:
             shown += ", ..."
         if self._mission_lost():
             how = f"the mission resumed at r{self.resumed_at}, next revision r{self.next_revision}"
@@ -83,4 +124,4 @@ class ResumeReport:
         return f"journal: {lost} lost at resume ({shown}: {how}), see {self.path}"
 
     def _mission_lost(self) -> bool:
-        return bool(self.gaps) and self.gaps[-1].resumed_at is None
+        return bool(self.lost_at_end) or (bool(self.gaps) and self.gaps[-1].resumed_at is None)

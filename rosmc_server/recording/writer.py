@@ -7,6 +7,7 @@ from pathlib import Path
 from types import TracebackType
 from typing import Self
 
+from rosmc_server.core.errors import StorageFull
 from rosmc_server.interface import (
     AGENT_STATES_TOPIC,
     EVENTS_TOPIC,
@@ -22,6 +23,7 @@ from rosmc_server.recording._resume import reopen
 from rosmc_server.recording.channels import JOURNAL_TOPICS, TELEMETRY_TOPICS
 from rosmc_server.recording.errors import JournalError
 from rosmc_server.recording.reader import JournalResult
+from rosmc_server.recording.space import RESERVE_BYTES, DiskSpace
 
 _log = logging.getLogger(__name__)
 
@@ -31,8 +33,9 @@ class JournalOptions:
     """How a journal is written.
 
     Attributes:
-        fsync: fdatasync after every event and snapshot, so an acknowledged change also
-            survives a power loss (a process crash never loses one either way).
+        fsync: fdatasync after every event and snapshot (the default), so an acknowledged
+            change also survives a power loss; False keeps it from a process crash only,
+            for about 0.1 ms less per change (``bench/bench_journal.py``).
         chunked: One MCAP chunk (with its message index) per append, so the closed file is
             indexed and its snapshots compressed. False writes bare message records: 80 bytes
             less per event, but no compression, and indexed readers (Foxglove's among them)
@@ -44,13 +47,16 @@ class JournalOptions:
             next snapshot starts the next part file (any append does at twice the size), so
             the writer's memory and the reading a resume does stay bounded however long the
             journal grows.
+        reserve_bytes: Free bytes on the journal's disk below which :meth:`JournalWriter.
+            require_space` refuses changes (twice this stops telemetry), see :mod:`.space`.
     """
 
-    fsync: bool = False
+    fsync: bool = True
     chunked: bool = True
     snapshot_every: int = 500
     compress_from: int = 16384
     part_bytes: int = 32 * 1024 * 1024
+    reserve_bytes: int = RESERVE_BYTES
 
 
 class JournalWriter:
@@ -59,10 +65,12 @@ class JournalWriter:
     Every append reaches the operating system in a single ``write`` before it returns
     (and the disk, with ``fsync``), so a change acknowledged after ``append_event``
     survives a crash of the process. ``close`` adds the summary that makes the file a
-    complete, indexed MCAP file. A journal that grows past ``part_bytes`` goes on in
-    part files beside the first (see :mod:`._files`). Open one with :meth:`create` or
-    :meth:`resume`. Thread-safe: appends from several threads are written one after the
-    other. An advisory file lock keeps a second writer (in any process) off the same file.
+    complete, indexed MCAP file. Telemetry is skipped, and robot reports refused, near a
+    full disk (:mod:`.space`); ask :meth:`require_space` before applying a change. A
+    journal that grows past ``part_bytes`` goes on in part files beside the first (see
+    :mod:`._files`). Open one with :meth:`create` or :meth:`resume`. Thread-safe:
+    appends from several threads are written one after the other. An advisory file
+    lock keeps a second writer (in any process) off the same file.
     """
 
     def __init__(
@@ -80,7 +88,10 @@ class JournalWriter:
         self._channels = part.section.channel_ids()
         self._events_since_snapshot = 0
         self._rotation_failed = False
+        self._telemetry_skipped = False
         self._lock = threading.RLock()
+        self.space = DiskSpace(part.path.parent, options.reserve_bytes)
+        """The free space of the journal's disk."""
         self.recovered = recovered
         """What resume recovered from the journal (None for a new journal)."""
         self.damaged = damaged
@@ -187,6 +198,11 @@ class JournalWriter:
         append one before anything else so the file can start the mission on its own."""
         return self._part.snapshots == 0
 
+    def require_space(self) -> None:
+        """Raise StorageFull unless the journal's disk has room for a change: ask before
+        applying one, since a change applied and then not journaled would be lost."""
+        self.space.require()
+
     def append_event(self, event: RosMessage, log_time_ns: int) -> None:
         """Record one accepted change (``rosmc/MissionEvent``); durable when this returns."""
         self._append(EVENTS_TOPIC, event, log_time_ns, sync=True)
@@ -195,8 +211,21 @@ class JournalWriter:
         """Record a full ``rosmc/Mission`` snapshot; durable when this returns."""
         self._append(MISSION_TOPIC, mission, log_time_ns, sync=True)
 
+    def append_due_snapshot(self, mission: RosMessage, log_time_ns: int) -> bool:
+        """Record ``mission`` if a snapshot is due, the journal open and room left for it
+        (a periodic snapshot waits while the disk is nearly full); whether it did."""
+        if not self.snapshot_due or self.closed or not self._room_for_telemetry(MISSION_TOPIC):
+            return False
+        self.append_snapshot(mission, log_time_ns)
+        return True
+
     def append_report(self, report: RosMessage, log_time_ns: int) -> None:
-        """Record a ``rosmc/RobotReport`` (telemetry: written, never fsynced on its own)."""
+        """Record a ``rosmc/RobotReport`` (written, never fsynced on its own).
+
+        A report leads to a change, so it needs the room of one: StorageFull otherwise
+        (the robot, unanswered, sends it again).
+        """
+        self.space.require()
         self._append(ROBOT_REPORTS_TOPIC, report, log_time_ns, sync=False)
 
     def append_command(self, record: RosMessage, log_time_ns: int) -> None:
@@ -216,6 +245,14 @@ class JournalWriter:
         if topic not in TELEMETRY_TOPICS:
             raise JournalError(f"{topic} is not a telemetry channel of the journal")
         self._append(topic, msg, log_time_ns, sync=False)
+
+    def start_next_part(self) -> None:
+        """Go on in a new part file (after a resume that lost revisions, so that later
+        resumes start from its snapshot and do not count the loss again); on failure keep
+        writing this one."""
+        with self._lock:
+            self._part.open_fd()
+            self._rotate()
 
     def sync(self) -> None:
         """Flush everything appended so far to the disk (fdatasync)."""
@@ -247,6 +284,8 @@ class JournalWriter:
         expected = JOURNAL_TOPICS[topic]
         if getattr(msg, "_type", None) != expected:
             raise JournalError(f"{topic} records {expected}, not {type(msg).__name__}")
+        if not sync and not self._room_for_telemetry(topic):
+            return
         data = serialize(msg)  # outside the lock: a big snapshot takes a while
         with self._lock:
             self._part.open_fd()
@@ -268,6 +307,20 @@ class JournalWriter:
                 part.snapshots += 1
             elif topic == EVENTS_TOPIC:
                 self._events_since_snapshot += 1
+
+    def _room_for_telemetry(self, topic: str) -> bool:
+        """Whether telemetry may still be written; skipped (said once) near a full disk."""
+        try:
+            self.space.require(telemetry=True)
+        except StorageFull as full:
+            if not self._telemetry_skipped:
+                _log.warning(
+                    "journal %s: %s; telemetry (%s, ...) is not journaled", self._base, full, topic
+                )
+            self._telemetry_skipped = True
+            return False
+        self._telemetry_skipped = False
+        return True
 
     def _rotation_due(self, topic: str) -> bool:
         full = self._options.part_bytes

@@ -29,7 +29,7 @@ import rosmc.msg as wire
 import rospy
 
 from ..conversions import barrier_to_msg, skill_to_msg, time_to_msg
-from ..core import Mission, RosmcError, SkillStatus, Transfer
+from ..core import Mission, RosmcError, SkillStatus, StorageFull, Transfer
 from ..core.commands import CommandKind, CommandSpec, queued_barriers
 from ..core.link import (
     Arrival,
@@ -263,8 +263,11 @@ class GroundLink:
         if link.reports.classify(msg.seq) is Arrival.NEXT:
             if msg.skill_id in self._uploading(agent):
                 return  # it overtook the upload's ack (another topic); the robot resends it
+            try:
+                self._host.record_report(msg)
+            except StorageFull:  # unacknowledged, the robot sends it again
+                return
             link.reports.accept(msg.seq)
-            self._host.record_report(msg)
             self._apply_report(msg)
         link.report_ack_pub.publish(self._report_ack(agent, link.reports.last))
 

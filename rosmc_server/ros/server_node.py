@@ -30,7 +30,7 @@ Parameters (private):
         ``journal_alert`` (``rosmc status``).
     ``~link_timeout`` (float, s): silence after which a robot link is DOWN (3.0).
     ``~agent_state_rate`` (float, Hz): rate of ``/rosmc/agent_states`` (2.0).
-    ``~fsync`` (bool): fsync the journal on every change (survives power loss).
+    ``~fsync`` (bool): fsync the journal on every change (survives power loss; true).
     ``~snapshot_every`` (int): mission events between two full snapshots in the journal (500).
     ``~mission_dir`` (str): the only directory (with its subdirectories) where SaveMission
         and LoadMission read or write files on the server's host (default ``missions/``);
@@ -46,6 +46,7 @@ from __future__ import annotations
 import argparse
 import ctypes
 import ctypes.util
+import dataclasses
 import logging
 import sys
 import threading
@@ -78,6 +79,7 @@ from ..core import (
 from ..core.changes import EventKind
 from ..core.commands import commands_for_event, default_policy_commands
 from ..recording import JournalOptions, JournalWriter, default_journal_path, latest_state
+from ..recording.high_water import RevisionMark, first_mark, read_mark, resumed_mark
 from ..recording.recovery import ResumeReport
 from .agent_states import AgentStatePublisher
 from .ground_link import GroundLink
@@ -106,7 +108,7 @@ class ServerConfig:
     resume: bool = False
     link_timeout: float = 3.0
     agent_state_rate: float = 2.0
-    fsync: bool = False
+    fsync: bool = True
     mission_dir: Path = DEFAULT_MISSION_DIR
     snapshot_every: int = JournalOptions.snapshot_every
 
@@ -130,7 +132,7 @@ class ServerConfig:
             resume=resume,
             link_timeout=float(rospy.get_param("~link_timeout", 3.0)),
             agent_state_rate=float(rospy.get_param("~agent_state_rate", 2.0)),
-            fsync=bool(rospy.get_param("~fsync", False)),
+            fsync=bool(rospy.get_param("~fsync", True)),
             mission_dir=Path(str(rospy.get_param("~mission_dir", str(DEFAULT_MISSION_DIR)))),
             snapshot_every=max(1, int(rospy.get_param("~snapshot_every", cls.snapshot_every))),
         )
@@ -143,12 +145,12 @@ class MissionServer:
         self.config = config
         self.library = library
         self._stopping = False  # first: robot-link callbacks may arrive during construction
+        self.failed = False  # the journal failed: the process exits with status 1
         self._lock = threading.RLock()
         self._packer = SnapshotPacker()
         self._snapshot: PackedMission | None = None  # the newest one built
         self._building = threading.Lock()  # one snapshot build at a time
-        self.journal_alert = ""
-        """What resuming the journal could not recover ("" if nothing), for GetMission."""
+        self._resume_alert = ""  # what resuming the journal could not recover
         self._snapshot_after_resume = False
         self.mission, self._journal = self._open_journal()
         if self._snapshot_after_resume:  # the file now written must start the mission
@@ -193,6 +195,7 @@ class MissionServer:
             self._recorder.stop()
             if not self._journal.closed:
                 self._journal.close()
+            self._marks.close()
 
     def _tick_link(self) -> None:
         next_clock_check = 0.0
@@ -219,6 +222,7 @@ class MissionServer:
         with self._lock:
             if self._stopping:
                 raise Unavailable("the mission server is shutting down")
+            self._journal.require_space()  # a change the journal cannot hold is never applied
             event = operation(self.mission)
             if event is not None:
                 self._record(event)
@@ -230,6 +234,7 @@ class MissionServer:
         stamp_ns = time.time_ns()
         try:
             self._journal.append_event(msg, stamp_ns)
+            self._marks.record(event.revision)  # the journal's high-water mark, kept apart
             if event.kind is EventKind.MISSION_REPLACED:
                 # The new mission is only in the snapshot: it must be durable now. Its
                 # skills were serialized ahead (prepare_snapshot), off the lock.
@@ -240,8 +245,9 @@ class MissionServer:
                 self._journal.append_snapshot(snapshot, stamp_ns)
         except Exception:
             _log.critical("cannot write the journal; shutting down to protect the mission")
-            self._stopping = True
-            rospy.signal_shutdown("journal write failed")
+            self.failed = self._stopping = True  # a supervisor restarts it: exit status 1
+            # Shortly after, so that the caller hears this change failed (not a dropped link).
+            threading.Timer(0.5, rospy.signal_shutdown, ("journal write failed",)).start()
             raise
         self._events.publish(msg)
         self._snapshots.changed(urgent=event.kind is EventKind.MISSION_REPLACED)
@@ -255,8 +261,7 @@ class MissionServer:
         call may; the journal's reader accepts events written before a snapshot
         of an older revision.
         """
-        if self._journal.snapshot_due and not self._journal.closed:
-            self._journal.append_snapshot(snapshot, time.time_ns())
+        self._journal.append_due_snapshot(snapshot, time.time_ns())
 
     def record_report(self, msg: wire.RobotReport) -> None:
         """Journal a robot report (the audit trail of what robots said)."""
@@ -293,6 +298,11 @@ class MissionServer:
         self._packer.prepare(content)
 
     # -- journal -------------------------------------------------------------------
+    @property
+    def journal_alert(self) -> str:
+        """What resuming the journal lost and whether its disk is full ("" if neither)."""
+        return "; ".join(a for a in (self._resume_alert, self._journal.space.alert()) if a)
+
     def _open_journal(self) -> tuple[Mission, JournalWriter]:
         options = JournalOptions(fsync=self.config.fsync, snapshot_every=self.config.snapshot_every)
         clock = rospy.get_time
@@ -304,7 +314,9 @@ class MissionServer:
         mission = Mission(self.library, MissionContent.empty(self.library), clock=clock)
         path = self.config.journal or default_journal_path(self.config.journal_dir)
         snapshot = mission_to_msg(mission.state.content(), 0, time.time())
-        return mission, JournalWriter.create(path, snapshot, time.time_ns(), options)
+        writer = JournalWriter.create(path, snapshot, time.time_ns(), options)
+        self._marks = RevisionMark(path, first_mark(0), options.fsync)
+        return mission, writer
 
     def _resumed(self, writer: JournalWriter) -> Mission:
         """The mission a resumed journal holds; says once, loudly, what it could not recover.
@@ -320,14 +332,25 @@ class MissionServer:
         mission = Mission(self.library, content, revision, clock=rospy.get_time)
         for event_msg in latest.events:
             mission.replay(event_from_msg(event_msg))
-        report = ResumeReport.of(writer.path, writer.recovered.damage, latest, writer.part_path)
+        mark = read_mark(writer.path)
+        report = ResumeReport.of(
+            writer.path, writer.recovered.damage, latest, writer.part_path, mark
+        )
+        if report.lost and not writer.damaged:  # later resumes start after the loss
+            writer.start_next_part()
+            report = dataclasses.replace(report, written_to=writer.part_path)
         if not report.clean:
             _log.error("%s", report.log_line())
-            self.journal_alert = report.alert()
-        if latest.next_revision > mission.revision + 1:
+            self._resume_alert = report.alert()
+        # After lost revisions the resumed mission is a revision of its own, so that a view
+        # that held lost changes is stale (refused, refetched) instead of taken as current.
+        revision = report.next_revision - (0 if report.lost else 1)
+        if revision > mission.revision:
             content = mission.state.content()
-            mission = Mission(self.library, content, latest.next_revision - 1, clock=rospy.get_time)
-        self._snapshot_after_resume = writer.needs_snapshot or latest.lost is not None
+            mission = Mission(self.library, content, revision, clock=rospy.get_time)
+        marked = resumed_mark(mark, mission.revision, report.lost > 0)  # new epoch if lost
+        self._marks = RevisionMark(writer.path, marked, self.config.fsync)
+        self._snapshot_after_resume = writer.needs_snapshot or not report.clean
         _log.info("resumed from %s at revision %d", writer.path, mission.revision)
         return mission
 
@@ -412,4 +435,4 @@ def main(argv: Sequence[str] | None = None) -> int:
     rospy.on_shutdown(server.shutdown)
     server.start()
     rospy.spin()
-    return 0
+    return 1 if server.failed else 0

@@ -27,6 +27,7 @@ import rosmc.srv as srv
 from ..conversions.packing import PackedGetMissionResponse
 from ..core import InvalidRequest, MissionEvent, load_mission, parse_mission
 from ..core.persistence import MissionDumper, write_document
+from ..core.validation import check_file_path
 
 if TYPE_CHECKING:
     from .server_node import MissionServer
@@ -40,9 +41,7 @@ def host_path(path: str, mission_dir: Path) -> Path:
     Anybody on the ROS graph can call the services, so the server touches files
     only below one directory; relative paths are taken from there.
     """
-    # The operating system cannot take a NUL byte in a path; Python raises ValueError.
-    if "\0" in path:
-        raise InvalidRequest("a file path cannot contain a NUL character")
+    check_file_path(path)  # no NUL (the system refuses it), no line break, not too long
     root = mission_dir.expanduser().resolve()
     target = (root / Path(path).expanduser()).resolve()
     if not target.is_relative_to(root):

@@ -494,12 +494,18 @@ def test_a_torn_journal_tail_is_dropped_with_a_warning(
     server = start_server("torn", journal=journal, resume=True)
     assert f"dropped the last {size - intact} bytes" in server.log(), server.log()[-2000:]
     assert list(tmp_path.glob("torn.mcap.dropped-*")), "the dropped tail was not kept"
+    errors = [line for line in server.log().splitlines() if "[ERROR]" in line]
     with Client() as client:
         mission = client.mission()
-        assert mission.revision == survivor
+        if survivor == last:
+            assert mission.revision == survivor and not errors
+        else:  # an acknowledged change was cut off: a loss, said as one (revision mark)
+            assert len(errors) == 1 and f"r{last} lost from its end" in errors[0], errors
+            assert mission.revision > last  # a new revision: r{last} is never handed out again
+        expected = Expected(mission)
+        mission.revision = survivor
         assert mission_key(mission) == session.history[survivor]
         # The journal goes on after the cut: more changes, another crash, all there.
-        expected = Expected(mission)
         more = Session()
         operate(client, expected, rng, 30, -1, threading.Event(), more)
         assert more.error is None and more.acknowledged > 0
@@ -544,25 +550,25 @@ def test_a_damaged_journal_resumes_loudly_and_never_hands_out_a_revision_again(
     assert json.loads(_rosmc(server, "--json", "status", "--no-states"))["journal_alert"] == alert
     with Client() as client:
         mission = client.mission()
-        assert mission.revision == last  # what the operators saw last is never reused...
+        # The resumed mission is a revision of its own, above every one the operators saw...
+        assert mission.revision == last + 1
         mission.revision = middle - 1
         assert mission_key(mission) == session.history[middle - 1]  # ...the content is r-1's
-        rev = client.call(
-            "add_task_marker",
-            base_revision=last,
-            marker=wire.TaskMarker(name="After", type=1, pose=wire.Pose6D(x=1.0)),
-        ).revision
-        assert rev == last + 1
+        marker = wire.TaskMarker(name="After", type=1, pose=wire.Pose6D(x=1.0))
+        stale = client.call("add_task_marker", base_revision=last, marker=marker)
+        assert stale.error_code == wire.ErrorCode.CONFLICT  # a view of lost changes is stale
+        rev = client.call("add_task_marker", base_revision=last + 1, marker=marker).revision
+        assert rev == last + 2
     assert server.stop() == 0  # a clean stop closes the new part with its summary
     part = tmp_path / "damaged.part002.mcap"
     with part.open("rb") as file:  # the mcap package reads it: a valid, indexed MCAP file
         found = [m.log_time for _, _, m in SeekingReader(file, validate_crcs=True).iter_messages()]
-    assert len(found) >= 2  # the resume's snapshot (r{last}) and the new change
+    assert len(found) >= 2  # the resume's snapshot (r{last + 1}) and the new change
     result = read_journal(journal)  # the whole journal, both files
     assert result.files == (journal, part) and len(result.damage) == 1
     state = latest_state(result)
-    assert state.revision == last + 1 and state.next_revision == last + 2
-    assert [str(gap.revisions) for gap in state.gaps] == [f"r{middle}..r{last - 1}"]
+    assert state.revision == last + 2 and state.next_revision == last + 3
+    assert [str(gap.revisions) for gap in state.gaps] == [f"r{middle}..r{last}"]
 
 
 def _event_chunk(journal: Path, revision: int) -> tuple[int, int]:
