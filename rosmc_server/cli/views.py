@@ -7,6 +7,7 @@ import sys
 import time
 
 from ..core import AgentStatus, MissionEvent
+from ..core.site_source import site_line
 from ..ros.client import MissionWatch, ServerUnavailable, init_node
 from ..text import (
     agent_status_to_json,
@@ -19,26 +20,32 @@ from ..text import (
     library_to_json,
     marker_to_json,
     mission_to_json,
+    site_to_json,
 )
 from .context import Context
 
 
 def status(ctx: Context) -> int:
-    """Every robot's schedule with its link and telemetry line, the science score if published
-    (and a journal alert first)."""
+    """Every robot's schedule with its link and telemetry line, the science score if published,
+    the site map in force (and a journal alert first)."""
     state = ctx.client.get_mission()
     library = ctx.client.library()
     statuses = None if ctx.args.no_states else ctx.agent_states()
     alert = ctx.client.journal_alert
     science = None if ctx.args.no_states else ctx.science()
+    site = None if ctx.args.no_states else ctx.site()
     if ctx.json:
         data = {**mission_to_json(state, library, statuses), "journal_alert": alert}
+        data["site"] = site_to_json(site) if site else None
         ctx.emit("", {**data, "science": science.to_dict() if science else None})
         return 0
     text = format_schedule(state, statuses=statuses, verbose=ctx.args.verbose)
-    if science is not None:  # what the mission is for, under the schedule's first line
-        first, _, rest = text.partition("\n")
-        text = "\n".join([first, *science.lines(), rest])
+    # What the mission is for, and the map it is checked against, under the first line.
+    first, _, rest = text.partition("\n")
+    lines = [*science.lines()] if science is not None else []
+    if not ctx.args.no_states:
+        lines.append(site_line(site))
+    text = "\n".join([first, *lines, rest])
     if alert:  # first, where nobody misses it
         text = f"{alert}\n{text}"
     if state.markers:

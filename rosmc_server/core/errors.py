@@ -60,6 +60,10 @@ class Unavailable(RosmcError):
     server is shutting down); out of contact alone is never the reason."""
 
 
+class NotPermitted(RosmcError):
+    """The calling node is not on the mission server's operator allow-list."""
+
+
 class LibraryError(RosmcError):
     """A skill library file is malformed; the message names the file and the key."""
 

@@ -25,6 +25,7 @@ from .results import (
     Transferred,
 )
 from .science import ScienceWatch
+from .site import SiteWatch
 from .watch import MissionWatch, init_node
 from .worker import AsyncMissionClient, Outcome
 
@@ -43,6 +44,7 @@ __all__ = [
     "RevisionConflict",
     "ScienceWatch",
     "ServerUnavailable",
+    "SiteWatch",
     "SkillAdded",
     "SkillRetried",
     "TeamTransferred",
