@@ -26,7 +26,7 @@ from .results import (
 )
 from .science import ScienceWatch
 from .site import SiteWatch
-from .watch import MissionWatch, init_node
+from .watch import MissionWatch, identify, init_node
 from .worker import AsyncMissionClient, Outcome
 
 __all__ = [
@@ -51,6 +51,7 @@ __all__ = [
     "Transferred",
     "agent_status_from_msg",
     "agent_statuses_from_msg",
+    "identify",
     "init_node",
     "library_from_msg",
 ]
