@@ -131,11 +131,11 @@ print(MissionClient(timeout=10.0).add_skill("drone", "take_off").skill_id)
 """
 
 
-def call_as(env: dict[str, str], name: str, namespace: str = "") -> str:
-    """``add_skill`` from a node called ``name`` (in ``namespace``); its stdout."""
+def call_as(env: dict[str, str], name: str) -> str:
+    """``add_skill`` from a node called ``name``; the new skill's id."""
     done = subprocess.run(
         [sys.executable, "-c", ALLOWED_CLIENT, name],
-        env={**env, "ROS_NAMESPACE": namespace} if namespace else env,
+        env=env,
         capture_output=True,
         text=True,
         timeout=60,
@@ -147,7 +147,8 @@ def call_as(env: dict[str, str], name: str, namespace: str = "") -> str:
 def test_only_nodes_on_the_operator_allow_list_change_the_mission(
     start_server: StartServer, client_node: Any
 ) -> None:
-    start_server(operators=["/trusted_operator", "/ops/"])
+    # README, "Deployment security": _operators:="[/station/, /trusted_operator]"
+    start_server(operators="[/station/, /trusted_operator]")
     env = dict(client_node.env)
     client = MissionClient(timeout=10.0)
     revision = client.get_mission().revision  # reading stays open to every node
@@ -155,7 +156,7 @@ def test_only_nodes_on_the_operator_allow_list_change_the_mission(
     me = rospy.get_name()
     assert refused(NotPermitted, client.add_skill, "drone", "take_off") == (
         f"node '{me}' may not call add_skill: it is not on the mission server's operator "
-        "allow-list (~operators: /trusted_operator, /ops/)"
+        "allow-list (~operators: /station/, /trusted_operator)"
     )
     cli = rosmc(env, "add", "drone", "take_off")
     assert cli.returncode == 1 and "rosmc: node '/rosmc_cli_" in cli.stderr, cli
@@ -163,7 +164,9 @@ def test_only_nodes_on_the_operator_allow_list_change_the_mission(
     assert client.get_mission().revision == revision  # nothing changed
 
     by_name = call_as(env, "trusted_operator")
-    by_prefix = call_as(env, "console", namespace="/ops")
+    # README: ROS_NAMESPACE=/station rosmc add drone take_off
+    station = rosmc({**env, "ROS_NAMESPACE": "/station"}, "add", "drone", "take_off")
+    assert station.returncode == 0, station.stderr
     mission = client.get_mission()
-    assert [s.id for s in mission.task("drone")] == [by_name, by_prefix]
-    assert mission.revision == revision + 2
+    first, _second = (s.id for s in mission.task("drone"))
+    assert first == by_name and mission.revision == revision + 2
