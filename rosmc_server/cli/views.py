@@ -40,17 +40,16 @@ def status(ctx: Context) -> int:
         ctx.emit("", {**data, "science": science.to_dict() if science else None})
         return 0
     text = format_schedule(state, statuses=statuses, verbose=ctx.args.verbose)
-    # What the mission is for, and the map it is checked against, under the first line.
-    first, _, rest = text.partition("\n")
-    lines = [*science.lines()] if science is not None else []
-    if not ctx.args.no_states:
-        lines.append(site_line(site))
-    text = "\n".join([first, *lines, rest])
+    if science is not None:  # what the mission is for, under the schedule's first line
+        first, _, rest = text.partition("\n")
+        text = "\n".join([first, *science.lines(), rest])
     if alert:  # first, where nobody misses it
         text = f"{alert}\n{text}"
     if state.markers:
         markers = format_markers(state.markers).splitlines()
         text += "\n  task markers\n" + "\n".join(f"    {line}" for line in markers)
+    if not ctx.args.no_states:  # the map targets are checked against, and who sent it
+        text += f"\n{site_line(site)}"
     ctx.emit(text, None)
     return 0
 
