@@ -40,6 +40,7 @@ from .parameter_panel import ParameterPanel
 from .requests import Answer, Backend, Request
 from .schedule_widget import ScheduleWidget
 from .science_strip import ScienceStrip
+from .site_strip import SiteStrip
 from .team_dialog import ask_team_send
 from .view_state import ViewUpdate
 
@@ -119,6 +120,8 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         left_layout.setSpacing(2)
         self.science = ScienceStrip()
         left_layout.addWidget(self.science)
+        self.site = SiteStrip()
+        left_layout.addWidget(self.site)
         left_layout.addWidget(self.schedule, 1)
         left_layout.addWidget(self.legend)
         self.splitter = QSplitter(Qt.Horizontal)

@@ -12,7 +12,8 @@ per-batch work, not one per event.
 ROS interface (each name behind ``prefix``, e.g. ``/replay``):
     Subscribes ``/rosmc/mission_events`` (rosmc/MissionEvent) and ``/rosmc/agent_states``
     (rosmc/AgentStates) through the follower, ``/rosmc/selection`` (rosmc/Selection) and
-    ``/rosmc/sim/science`` (rosmc/ScienceState, through a ScienceWatch).
+    ``/rosmc/sim/science`` (rosmc/ScienceState, through a ScienceWatch) and
+    ``/rosmc/site_in_force`` (rosmc/SiteInForce, through a SiteWatch).
     Publishes ``/rosmc/selection`` (rosmc/Selection, latched; live server only).
     Calls the operator services ``/rosmc/<operation>`` (rosmc_server.interface.SERVICES).
 """
@@ -40,6 +41,7 @@ from rosmc_server.ros.client import (
     RevisionConflict,
     ScienceWatch,
     ServerUnavailable,
+    SiteWatch,
 )
 
 from .requests import MUTATING, Answer, Request
@@ -79,6 +81,7 @@ class RosBridge(QObject):  # type: ignore[misc]
     connection_changed = Signal(bool)
     selection_received = Signal(list, list)  # skill ids, marker names
     science_received = Signal(object)  # rosmc_server.core.science.Science
+    site_received = Signal(object)  # rosmc_server.core.site_source.SiteInForce | None
 
     def __init__(self, prefix: str = "", timeout: float = 5.0) -> None:
         super().__init__()
@@ -100,6 +103,7 @@ class RosBridge(QObject):  # type: ignore[misc]
         )
         self._selection_sub = rospy.Subscriber(topic, wire.Selection, self._on_selection)
         self._science = ScienceWatch(prefix, self.science_received.emit)
+        self._site = SiteWatch(prefix, self.site_received.emit)
 
     @property
     def mirror_revision(self) -> int | None:
@@ -116,6 +120,7 @@ class RosBridge(QObject):  # type: ignore[misc]
         self._unsubscribe()
         self._selection_sub.unregister()
         self._science.close()
+        self._site.close()
         if self._selection_pub is not None:
             self._selection_pub.unregister()
         self._follower.close()

@@ -32,6 +32,7 @@ def connect(widget: CommandWidget, bridge: RosBridge) -> None:
     bridge.connection_changed.connect(widget.on_connection)
     bridge.selection_received.connect(widget.on_remote_selection)
     bridge.science_received.connect(widget.science.show_science)
+    bridge.site_received.connect(widget.site.show_site)
 
 
 class CommandWindow(QMainWindow):  # type: ignore[misc]

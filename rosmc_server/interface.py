@@ -34,6 +34,8 @@ WORLD_TOPIC = f"{NAMESPACE}/sim/world"  # visualization_msgs/MarkerArray, latche
 # Published latched by the site's map provider (the simulator, or a real site's mapping); the
 # mission server checks skill targets against the newest one.
 SITE_TOPIC = f"{NAMESPACE}/site"  # rosmc/SiteMap
+# Published latched and journaled by the mission server: the map in force, who sent it, when.
+SITE_IN_FORCE_TOPIC = f"{NAMESPACE}/site_in_force"  # rosmc/SiteInForce
 # rosmc/CoverageGrid, latched: the simulator's radio model (access point, deployed Wi-Fi
 # boxes, obstacles); the server's coverage estimate and rviz's coverage layer read it.
 COVERAGE_MODEL_TOPIC = f"{NAMESPACE}/sim/coverage"

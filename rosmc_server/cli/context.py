@@ -10,7 +10,9 @@ from typing import Any, TextIO
 
 from ..core import AgentStatus
 from ..core.science import Science
-from ..ros.client import MissionClient, MissionWatch, Result, ScienceWatch, init_node
+from ..core.site_source import SiteInForce
+from ..ros.client import MissionClient, MissionWatch, Result, ScienceWatch, SiteWatch, init_node
+from ..ros.client.latched import LatchedWatch, T
 
 # How long `rosmc status` waits for the robots' states (the server publishes at 2 Hz).
 STATES_WAIT = 1.5
@@ -66,7 +68,14 @@ class Context:
     def science(self) -> Science | None:
         """The science state if someone publishes it (waiting briefly for it); else None."""
         init_node()
-        watch = ScienceWatch()
+        return self._latched(ScienceWatch())
+
+    def site(self) -> SiteInForce | None:
+        """The site map in force if the server publishes it (waiting briefly); else None."""
+        init_node()
+        return self._latched(SiteWatch())
+
+    def _latched(self, watch: LatchedWatch[T]) -> T | None:
         try:
             return watch.wait(min(self.client.timeout, STATES_WAIT))
         finally:

@@ -24,10 +24,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         # Imported late: rospy and the generated messages load slowly, and --help needs neither.
         from ..core import RosmcError
-        from ..ros.client import MissionClient, ServerUnavailable
+        from ..ros.client import MissionClient, ServerUnavailable, identify
+        from . import edits
         from .context import Context, UsageError
     except ImportError as error:
         return _fail(f"cannot load ROS or the rosmc messages ({error}); source env.sh", 1)
+    if args.command in edits.COMMANDS:  # the operator allow-list knows a change by its node
+        identify()
     client = MissionClient(timeout=args.timeout)
     try:
         return _command(args.command)(Context(args, client))

@@ -7,6 +7,7 @@ import sys
 import time
 
 from ..core import AgentStatus, MissionEvent
+from ..core.site_source import site_line
 from ..ros.client import MissionWatch, ServerUnavailable, init_node
 from ..text import (
     agent_status_to_json,
@@ -19,20 +20,23 @@ from ..text import (
     library_to_json,
     marker_to_json,
     mission_to_json,
+    site_to_json,
 )
 from .context import Context
 
 
 def status(ctx: Context) -> int:
-    """Every robot's schedule with its link and telemetry line, the science score if published
-    (and a journal alert first)."""
+    """Every robot's schedule with its link and telemetry line, the science score if published,
+    the site map in force (and a journal alert first)."""
     state = ctx.client.get_mission()
     library = ctx.client.library()
     statuses = None if ctx.args.no_states else ctx.agent_states()
     alert = ctx.client.journal_alert
     science = None if ctx.args.no_states else ctx.science()
+    site = None if ctx.args.no_states else ctx.site()
     if ctx.json:
         data = {**mission_to_json(state, library, statuses), "journal_alert": alert}
+        data["site"] = site_to_json(site) if site else None
         ctx.emit("", {**data, "science": science.to_dict() if science else None})
         return 0
     text = format_schedule(state, statuses=statuses, verbose=ctx.args.verbose)
@@ -44,6 +48,8 @@ def status(ctx: Context) -> int:
     if state.markers:
         markers = format_markers(state.markers).splitlines()
         text += "\n  task markers\n" + "\n".join(f"    {line}" for line in markers)
+    if not ctx.args.no_states:  # the map targets are checked against, and who sent it
+        text += f"\n{site_line(site)}"
     ctx.emit(text, None)
     return 0
 

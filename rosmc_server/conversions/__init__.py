@@ -44,7 +44,7 @@ from .mission import (
     skill_to_msg,
 )
 from .policy import policy_from_request, policy_to_request
-from .site import site_from_msg, site_to_msg
+from .site import site_from_msg, site_in_force_from_msg, site_in_force_to_msg, site_to_msg
 from .values import (
     MAX_JSON_NESTING,
     param_from_msg,
@@ -81,6 +81,8 @@ __all__ = [
     "pose_from_msg",
     "pose_to_msg",
     "site_from_msg",
+    "site_in_force_from_msg",
+    "site_in_force_to_msg",
     "site_to_msg",
     "skill_from_msg",
     "skill_to_msg",

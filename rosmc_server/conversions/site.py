@@ -10,6 +10,7 @@ import rosmc.msg as wire
 
 from ..core import InvalidRequest
 from ..core.site import Footprint, GroundRobot, Shape, SiteModel, check_site
+from ..core.site_source import SiteInForce
 from ..interface import MAP_FRAME
 from .values import time_to_msg
 
@@ -64,3 +65,22 @@ def site_from_msg(msg: wire.SiteMap) -> SiteModel:
     robots = tuple(GroundRobot(r.agent, r.kind, r.clearance, r.edge_margin) for r in msg.robots)
     bounds = (msg.x_min, msg.x_max, msg.y_min, msg.y_max)
     return check_site(SiteModel(msg.name, bounds, obstacles, robots))
+
+
+def site_in_force_to_msg(source: SiteInForce) -> wire.SiteInForce:
+    """The site map in force, its sender and when the server took it, as a message."""
+    return wire.SiteInForce(
+        received=time_to_msg(source.received),
+        sender=source.sender,
+        site=site_to_msg(source.site, source.received),
+    )
+
+
+def site_in_force_from_msg(msg: wire.SiteInForce) -> SiteInForce | None:
+    """``rosmc/SiteInForce`` as core; None for the empty message (no map in force yet).
+
+    InvalidRequest if its map is not one a mission would take.
+    """
+    if not msg.sender and not msg.site.name and not msg.site.obstacles:
+        return None
+    return SiteInForce(site_from_msg(msg.site), msg.sender, msg.received.to_sec())

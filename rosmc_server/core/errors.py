@@ -68,6 +68,10 @@ class StorageFull(Unavailable):
         self.free_bytes = free_bytes
 
 
+class NotPermitted(RosmcError):
+    """The calling node is not on the mission server's operator allow-list."""
+
+
 class LibraryError(RosmcError):
     """A skill library file is malformed; the message names the file and the key."""
 

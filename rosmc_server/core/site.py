@@ -117,11 +117,12 @@ class SiteModel:
                 f"lies {edge:.1f} m from the site's edge, closer than {agent} keeps "
                 f"({robot.edge_margin:.1f} m); pick a point farther inside"
             )
-        distances = sorted((o.distance(x, y), o.name) for o in self.obstacles)
-        if distances and distances[0][0] <= 0.0:
-            return f"lies inside obstacle '{distances[0][1]}'; pick a point outside it"
-        if distances and distances[0][0] < robot.clearance:
-            distance, name = distances[0]
+        if not self.obstacles:
+            return ""
+        distance, name = min((o.distance(x, y), o.name) for o in self.obstacles)
+        if distance <= 0.0:
+            return f"lies inside obstacle '{name}'; pick a point outside it"
+        if distance < robot.clearance:
             return (
                 f"lies {distance:.1f} m from obstacle '{name}', closer than {agent} keeps "
                 f"({robot.clearance:.1f} m); pick a point farther from it"
@@ -129,25 +130,59 @@ class SiteModel:
         return ""
 
 
+MAX_COORDINATE = 100_000.0
+"""Largest magnitude, in metres, of any bound, position, size or distance of a site map.
+
+No robot team works on a site 100 km across; a number beyond it is a mistake (one obstacle of
+radius 1e308 once refused every ground target)."""
+MAX_OBSTACLES = 2_000
+"""Most obstacles a site map may hold: every checked target is measured against each one."""
+MAX_ROBOTS = 200
+"""Most ground robots a site map may describe."""
+
+
 def check_site(site: SiteModel) -> SiteModel:
-    """Return ``site`` if a mission can check targets against it; InvalidRequest otherwise."""
+    """Return ``site`` if a mission can check targets against it; InvalidRequest otherwise.
+
+    A sane map has finite numbers within :data:`MAX_COORDINATE`, no negative sizes, bounds
+    with an area, at most :data:`MAX_OBSTACLES` obstacles and :data:`MAX_ROBOTS` robots.
+    """
+    if len(site.obstacles) > MAX_OBSTACLES:
+        raise InvalidRequest(
+            f"site '{site.name}' has {len(site.obstacles)} obstacles, more than the "
+            f"{MAX_OBSTACLES} a mission checks targets against"
+        )
+    if len(site.robots) > MAX_ROBOTS:
+        raise InvalidRequest(
+            f"site '{site.name}' describes {len(site.robots)} robots, more than {MAX_ROBOTS}"
+        )
     x_min, x_max, y_min, y_max = site.bounds
-    numbers = [*site.bounds]
+    numbers = [("its bounds", n) for n in site.bounds]
     for o in site.obstacles:
-        numbers += [o.x, o.y, o.radius, o.size_x, o.size_y, o.yaw, o.height]
+        numbers += [(f"obstacle '{o.name}'", n) for n in _obstacle_numbers(o)]
         if min(o.radius, o.size_x, o.size_y, o.height) < 0:
             raise InvalidRequest(f"obstacle '{o.name}' of site '{site.name}' has a negative size")
     for r in site.robots:
-        numbers += [r.clearance, r.edge_margin]
+        numbers += [(f"robot '{r.agent}'", r.clearance), (f"robot '{r.agent}'", r.edge_margin)]
         if min(r.clearance, r.edge_margin) < 0:
             raise InvalidRequest(
                 f"robot '{r.agent}' of site '{site.name}' keeps a negative distance"
             )
-    if not all(math.isfinite(n) for n in numbers):
-        raise InvalidRequest(f"site '{site.name}' holds a number that is not finite")
+    for what, number in numbers:
+        if not math.isfinite(number):
+            raise InvalidRequest(f"{what} of site '{site.name}' holds a number that is not finite")
+        if abs(number) > MAX_COORDINATE:
+            raise InvalidRequest(
+                f"{what} of site '{site.name}' holds {number:g}, beyond the "
+                f"{MAX_COORDINATE:g} m a site map may use"
+            )
     if not (x_min < x_max and y_min < y_max):
         raise InvalidRequest(f"site '{site.name}' has bounds with no area")
     return site
+
+
+def _obstacle_numbers(o: Footprint) -> tuple[float, ...]:
+    return (o.x, o.y, o.radius, o.size_x, o.size_y, o.yaw, o.height)
 
 
 class SiteGuard:

@@ -16,6 +16,7 @@ from rosmc_server.interface import (
     ROBOT_COMMANDS_TOPIC,
     ROBOT_REPORTS_TOPIC,
     SCIENCE_TOPIC,
+    SITE_IN_FORCE_TOPIC,
     TF_TOPIC,
     WORLD_TOPIC,
 )
@@ -31,6 +32,7 @@ JOURNAL_TOPICS: Final[Mapping[str, str]] = MappingProxyType(
         WORLD_TOPIC: "visualization_msgs/MarkerArray",  # the simulated site, on change
         # Added later, so last: older journals lack it and keep their channel ids.
         ROBOT_COMMANDS_TOPIC: "rosmc/CommandRecord",  # commands for robots: asked, delivered
+        SITE_IN_FORCE_TOPIC: "rosmc/SiteInForce",  # the site map in force, its sender, when
     }
 )
 """Every journal channel with the ROS message type it carries, in channel-id order."""
@@ -42,10 +44,11 @@ TELEMETRY_TOPICS: Final = (
     SCIENCE_TOPIC,
     WORLD_TOPIC,
     ROBOT_COMMANDS_TOPIC,
+    SITE_IN_FORCE_TOPIC,
 )
 """Channels of what the robots and the site did: written, never fsynced on their own."""
 
-LATCHED_TOPICS: Final = (MISSION_TOPIC, SCIENCE_TOPIC, WORLD_TOPIC)
+LATCHED_TOPICS: Final = (MISSION_TOPIC, SCIENCE_TOPIC, WORLD_TOPIC, SITE_IN_FORCE_TOPIC)
 """Channels whose live publishers latch them (a replay and a converted bag latch them too)."""
 
 LIBRARY: Final = "rosmc-journal/1"

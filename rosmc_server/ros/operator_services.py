@@ -37,6 +37,7 @@ from ..core import (
     MissionEvent,
     MissionFileError,
     NotFound,
+    NotPermitted,
     RosmcError,
     RuleViolation,
     StaleRevision,
@@ -48,6 +49,7 @@ from ..core.commands import CommandKind, CommandSpec
 from ..core.link import LinkStatus
 from ..core.policy import options_argument
 from ..core.waiting import queued_note, refusal
+from .caller_id import caller_id
 from .team_sync import synchronize_team
 from .whole_mission import WholeMissionServices
 
@@ -59,6 +61,7 @@ _log = logging.getLogger(__name__)
 _CODES: tuple[tuple[type[RosmcError], int], ...] = (
     (StaleRevision, ErrorCode.CONFLICT),
     (NotFound, ErrorCode.NOT_FOUND),
+    (NotPermitted, ErrorCode.FORBIDDEN),
     (RuleViolation, ErrorCode.RULE),
     (Unavailable, ErrorCode.UNAVAILABLE),
     (InvalidRequest, ErrorCode.INVALID),
@@ -72,6 +75,10 @@ _CONTROL = {
     srv.ControlRequest.RESUME: CommandKind.RESUME,
     srv.ControlRequest.STOP: CommandKind.STOP,
 }
+
+
+READ_ONLY = frozenset({"get_mission", "get_library"})
+"""Operations every node may call, whatever the operator allow-list says."""
 
 
 def error_code(error: RosmcError) -> int:
@@ -130,6 +137,8 @@ class OperatorServices:
         def callback(request: Any) -> Any:
             response = response_class()
             try:
+                if name not in READ_ONLY:
+                    self._server.config.operators.check(caller_id(request), name)
                 event = handler(request, response)
             except RosmcError as error:
                 self._fail(response, error_code(error), one_line(str(error)))

@@ -35,6 +35,7 @@ TYPES: dict[str, Any] = {
     interface.TF_TOPIC: TFMessage,
     interface.SCIENCE_TOPIC: wire.ScienceState,
     interface.WORLD_TOPIC: MarkerArray,
+    interface.SITE_IN_FORCE_TOPIC: wire.SiteInForce,
 }
 """Every recorded topic with its message class."""
 
@@ -43,6 +44,7 @@ CURRENT_AT_START = (
     interface.TF_TOPIC,
     interface.SCIENCE_TOPIC,
     interface.WORLD_TOPIC,
+    interface.SITE_IN_FORCE_TOPIC,
 )
 """Topics whose newest message before the position is published at the start and on a seek."""
 
@@ -55,6 +57,7 @@ EMPTY: dict[str, Callable[[], Any]] = {
     interface.AGENT_STATES_TOPIC: wire.AgentStates,
     interface.SCIENCE_TOPIC: wire.ScienceState,
     interface.WORLD_TOPIC: _cleared_site,
+    interface.SITE_IN_FORCE_TOPIC: wire.SiteInForce,
 }
 """What a seek back to before a topic's first record publishes: nothing known yet."""
 

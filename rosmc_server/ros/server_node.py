@@ -32,6 +32,10 @@ Parameters (private):
     ``~agent_state_rate`` (float, Hz): rate of ``/rosmc/agent_states`` (2.0).
     ``~fsync`` (bool): fsync the journal on every change (survives power loss; true).
     ``~snapshot_every`` (int): mission events between two full snapshots in the journal (500).
+    ``~operators`` (list of str, or one string of names): nodes (full names, or prefixes
+        ending in ``/`` or ``*``) that may call the operator services; empty (the default)
+        lets every node in. Guards against mistakes, not attackers (see
+        :mod:`rosmc_server.core.operators`).
     ``~mission_dir`` (str): the only directory (with its subdirectories) where SaveMission
         and LoadMission read or write files on the server's host (default ``missions/``);
         elsewhere, clients pass the document itself.
@@ -53,7 +57,7 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 from contextlib import AbstractContextManager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import rosmc.msg as wire
@@ -78,6 +82,7 @@ from ..core import (
 )
 from ..core.changes import EventKind
 from ..core.commands import commands_for_event, default_policy_commands
+from ..core.operators import OperatorAllowList
 from ..recording import JournalOptions, JournalWriter, default_journal_path, latest_state
 from ..recording.high_water import RevisionMark, first_mark, read_mark, resumed_mark
 from ..recording.recovery import ResumeReport
@@ -111,6 +116,7 @@ class ServerConfig:
     fsync: bool = True
     mission_dir: Path = DEFAULT_MISSION_DIR
     snapshot_every: int = JournalOptions.snapshot_every
+    operators: OperatorAllowList = field(default_factory=OperatorAllowList)
 
     @classmethod
     def from_params(cls) -> ServerConfig:
@@ -135,6 +141,7 @@ class ServerConfig:
             fsync=bool(rospy.get_param("~fsync", True)),
             mission_dir=Path(str(rospy.get_param("~mission_dir", str(DEFAULT_MISSION_DIR)))),
             snapshot_every=max(1, int(rospy.get_param("~snapshot_every", cls.snapshot_every))),
+            operators=OperatorAllowList.of(rospy.get_param("~operators", [])),
         )
 
 
@@ -179,7 +186,7 @@ class MissionServer:
         Heartbeat(self.library.dynamic_agents).start()  # idle robots in coverage hear the ground
         self._recorder.start()
         self._services.advertise()
-        self._site = SiteListener(self)
+        self._site = SiteListener(self, lambda: self._journal)
         threading.Thread(target=self._tick_link, name="link", daemon=True).start()
         _log.info(
             "mission server ready: library %s, %d agents, revision %d, journal %s",

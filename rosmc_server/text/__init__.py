@@ -12,6 +12,7 @@ from .data import (
     library_to_json,
     marker_to_json,
     mission_to_json,
+    site_to_json,
     skill_to_json,
 )
 from .plain import (
@@ -39,5 +40,6 @@ __all__ = [
     "library_to_json",
     "marker_to_json",
     "mission_to_json",
+    "site_to_json",
     "skill_to_json",
 ]

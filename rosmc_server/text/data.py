@@ -17,6 +17,7 @@ from ..core import (
 )
 from ..core.agent_status import AgentStatus
 from ..core.params import value_to_data
+from ..core.site_source import SiteInForce
 
 
 def mission_to_json(
@@ -157,4 +158,17 @@ def event_to_json(event: MissionEvent) -> dict[str, Any]:
         "agent": event.agent,
         "summary": event.summary,
         "stamp": event.stamp,
+    }
+
+
+def site_to_json(source: SiteInForce) -> dict[str, Any]:
+    """The site map in force as JSON data: its name, sender, when taken, and what it holds."""
+    x_min, x_max, y_min, y_max = source.site.bounds
+    return {
+        "name": source.site.name,
+        "sender": source.sender,
+        "received": source.received,
+        "bounds": {"x_min": x_min, "x_max": x_max, "y_min": y_min, "y_max": y_max},
+        "obstacles": len(source.site.obstacles),
+        "robots": len(source.site.robots),
     }

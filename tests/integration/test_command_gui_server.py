@@ -38,11 +38,14 @@ from rosmc_rqt_command.command_widget import CommandWidget
 from rosmc_rqt_command.legality import Action, RobotAction
 from rosmc_rqt_command.schedule_model import STATUS
 from rosmc_rqt_command.science_strip import NO_SCORE
+from rosmc_rqt_command.site_strip import NO_SITE
 from rosmc_rqt_command.standalone import build
 from rosmc_server.conversions.science import science_to_msg
+from rosmc_server.conversions.site import site_to_msg
 from rosmc_server.core import LostLinkKind, LostLinkPolicy
 from rosmc_server.core.science import RegionScience, Science
-from rosmc_server.interface import SCIENCE_TOPIC
+from rosmc_server.core.site import Footprint, Shape, SiteModel
+from rosmc_server.interface import SCIENCE_TOPIC, SITE_TOPIC
 from rosmc_server.ros.client import MissionClient
 from tests import conftest
 from tests.integration.server_fixtures import ServerProcess, StartServer
@@ -379,6 +382,26 @@ def test_the_science_score_is_in_view_once_published(
     assert "RSS A (16, 9): identified by both rovers, 1 left" in text, text
     assert "RSS B (30, -16): not identified, 2 left" in text, text
     assert "RSS B at (30, -16): not identified, 2 stone(s) left (best 0.8)" in strip.toolTip()
+
+
+def test_the_site_map_in_force_and_its_sender_are_in_view(
+    start_server: StartServer, windows: Any
+) -> None:
+    start_server()
+    window = windows()
+    shown(window)
+    line = window.w.site
+    wait_until(lambda: line.text() == NO_SITE, 10, "no map in force yet")
+    assert line.isVisible()
+    publisher = rospy.Publisher(SITE_TOPIC, wire.SiteMap, queue_size=1, latch=True)
+    try:
+        rock = Footprint("rock", Shape.CYLINDER, 9.0, 6.0, radius=1.6)
+        publisher.publish(site_to_msg(SiteModel("quarry", (-40, 40, -40, 40), (rock,)), 0.0))
+        wait_until(lambda: line.source is not None, 10, "the map in force")
+    finally:
+        publisher.unregister()
+    assert line.text().startswith(f"site 'quarry' from {rospy.get_name()} at "), line.text()
+    assert line.text().endswith(": 1 obstacles, 0 ground robots"), line.text()
 
 
 def test_save_to_a_local_file_and_open_it_again(

@@ -24,10 +24,18 @@ from geometry_msgs.msg import TransformStamped
 from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import Marker, MarkerArray
 
-from rosmc_server.conversions import event_to_msg, mission_to_msg
+from rosmc_server.conversions import event_to_msg, mission_to_msg, site_to_msg
 from rosmc_server.core import Mission, Pose, TaskMarker, load_library
 from rosmc_server.core.params import MarkerType
-from rosmc_server.interface import MAP_FRAME, SCIENCE_TOPIC, TF_TOPIC, WORLD_TOPIC, base_link
+from rosmc_server.core.site import SiteModel
+from rosmc_server.interface import (
+    MAP_FRAME,
+    SCIENCE_TOPIC,
+    SITE_IN_FORCE_TOPIC,
+    TF_TOPIC,
+    WORLD_TOPIC,
+    base_link,
+)
 from rosmc_server.recording import JournalWriter
 from rosmc_server.ros.client.graph_names import taken_names
 from tests.conftest import free_port
@@ -66,6 +74,9 @@ def journal(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return path
 
 
+SITE_SENDERS = {1: "/rosmc/sim", 13: "/site_mapper"}
+
+
 def telemetry_at(index: int) -> list[tuple[str, Any]]:
     """What the server journals beside the changes: the drone climbing, the site, the score."""
     transform = TransformStamped()
@@ -78,6 +89,10 @@ def telemetry_at(index: int) -> list[tuple[str, Any]]:
         marker = Marker(ns="site", id=index, type=Marker.CYLINDER, action=Marker.ADD)
         records.append((WORLD_TOPIC, MarkerArray(markers=[marker])))
         records.append((SCIENCE_TOPIC, wire.ScienceState(score=index / 10)))
+    if index in SITE_SENDERS:  # the map in force, and who sent it
+        sender = SITE_SENDERS[index]
+        site = site_to_msg(SiteModel(f"site {index}", (-40.0, 40.0, -40.0, 40.0)), index)
+        records.append((SITE_IN_FORCE_TOPIC, wire.SiteInForce(sender=sender, site=site)))
     return records
 
 
@@ -237,7 +252,11 @@ def test_replay_shows_the_robots_the_site_and_the_score_under_its_prefix(
     heights: list[float] = []
     world: list[int] = []
     science: list[float] = []
+    sites: list[str] = []
     subscribers = [
+        rospy.Subscriber(
+            f"/replay{SITE_IN_FORCE_TOPIC}", wire.SiteInForce, lambda m: sites.append(m.sender)
+        ),
         rospy.Subscriber(
             f"/replay{TF_TOPIC}",
             TFMessage,
@@ -257,6 +276,7 @@ def test_replay_shows_the_robots_the_site_and_the_score_under_its_prefix(
         assert heights == [float(i) for i in range(1, EVENTS + 1)], "every TF record, in order"
         assert world == [1, 7, 13, 19]
         assert science == pytest.approx([0.1, 0.7, 1.3, 1.9])
+        assert sites == list(SITE_SENDERS.values())
     finally:
         for subscriber in subscribers:
             subscriber.unregister()

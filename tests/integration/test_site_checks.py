@@ -37,7 +37,7 @@ LIBRARY = REPO / "rosmc_server" / "config" / "mars_team.yaml"
 MARS = REPO / "rosmc_sim" / "scenarios" / "mars_sample_return.yaml"
 SCIENCE, ARM, DRONE = "science_rover", "manipulator_rover", "drone"
 UNCHECKED = "skill targets are not checked against the site: no site map is known yet"
-SITE_KNOWN = "site 'mars_sample_return' from /rosmc/site"
+SITE_KNOWN = "site 'mars_sample_return' from /rosmc/sim at "
 
 
 def target(x: float, y: float) -> dict[str, object]:

@@ -37,6 +37,8 @@ from rosmc_server.conversions import (
     pose_from_msg,
     pose_to_msg,
     site_from_msg,
+    site_in_force_from_msg,
+    site_in_force_to_msg,
     site_to_msg,
     skill_from_msg,
     skill_to_msg,
@@ -80,6 +82,7 @@ from rosmc_server.core.commands import CommandKind
 from rosmc_server.core.radio_map import GridSpec, Prediction, Reading
 from rosmc_server.core.science import RegionScience, Science
 from rosmc_server.core.site import Footprint, GroundRobot, Shape, SiteCheck, SiteModel
+from rosmc_server.core.site_source import SiteInForce
 from rosmc_server.executor.core import Signal, SignalKind
 
 
@@ -267,6 +270,9 @@ def test_the_site_map_survives_with_every_field() -> None:
     msg = over_the_wire(site_to_msg(site, 12.5))
     assert (msg.frame_id, msg.stamp.to_sec()) == ("map", 12.5)
     assert site_from_msg(msg) == site
+    source = SiteInForce(site, "/rosmc/sim", 12.5)
+    assert site_in_force_from_msg(over_the_wire(site_in_force_to_msg(source))) == source
+    assert site_in_force_from_msg(wire.SiteInForce()) is None  # what the server says first
 
 
 @pytest.mark.parametrize(

@@ -37,6 +37,7 @@ from rosmc_server.core.site import (
     SiteModel,
     check_site,
 )
+from rosmc_server.core.site_source import NO_SITE, SiteInForce, site_line
 
 ON_SITE, GROUND = SiteCheck.ON_SITE, SiteCheck.REACHABLE_GROUND
 ROCK = Footprint("rock_3", Shape.CYLINDER, 12.0, 3.5, radius=2.0, height=2.5)
@@ -112,11 +113,28 @@ def test_problems_name_the_place_and_what_to_pick(
         (SiteModel("s", (0.0, math.inf, 0.0, 5.0)), "not finite"),
         (SiteModel("s", (0.0, 5.0, 0.0, 5.0), (Footprint("r", Shape.CYLINDER, 1, 1, -1),)), "r'"),
         (SiteModel("s", (0.0, 5.0, 0.0, 5.0), (), (GroundRobot("a", clearance=-1.0),)), "'a'"),
+        (  # one obstacle this wide once refused every ground target
+            SiteModel("s", (0.0, 5.0, 0.0, 5.0), (Footprint("r", Shape.CYLINDER, 1, 1, 1e308),)),
+            "obstacle 'r' of site 's' holds 1e[+]308, beyond the 100000 m a site map may use",
+        ),
+        (SiteModel("s", (-1e6, 5.0, 0.0, 5.0)), "its bounds of site 's' holds -1e[+]06"),
+        (SiteModel("s", (0.0, 5.0, 0.0, 5.0), (), (GroundRobot("a", clearance=2e5),)), "'a'"),
+        (
+            SiteModel("s", (0.0, 5.0, 0.0, 5.0), (Footprint("r", Shape.BOX, 1, 1),) * 2001),
+            "site 's' has 2001 obstacles, more than the 2000 a mission checks targets against",
+        ),
+        (SiteModel("s", (0.0, 5.0, 0.0, 5.0), (), (GroundRobot("a"),) * 201), "201 robots"),
     ],
 )
 def test_a_site_no_check_can_trust_is_refused(site: SiteModel, fragment: str) -> None:
     with pytest.raises(InvalidRequest, match=fragment):
         check_site(site)
+
+
+def test_a_site_at_the_limits_is_taken() -> None:
+    box = Footprint("r", Shape.BOX, 1e5, -1e5, size_x=1e5, size_y=1.0)
+    site = SiteModel("s", (-1e5, 1e5, -1e5, 1e5), (box,) * 2000, (GroundRobot("a"),) * 200)
+    assert check_site(site) is site
 
 
 # -- the library's check key ------------------------------------------------------------------
@@ -250,3 +268,17 @@ def test_without_a_site_the_checks_are_skipped_and_that_is_said_once(
         "skill targets are not checked against the site: no site map is known yet "
         "(the simulator or a map provider publishes one)"
     ]
+
+
+def test_the_map_in_force_says_whose_it_is_and_since_when() -> None:
+    site = SiteModel("mars", (0.0, 5.0, 0.0, 5.0), (Footprint("r", Shape.BOX, 1, 1),))
+    assert site_line(None) == NO_SITE
+    wall = SiteInForce(site, "/rosmc/sim", 1_700_000_000.0)  # 2023-11-14 22:13:20 UTC
+    assert site_line(wall) == (
+        "site 'mars' from /rosmc/sim at 22:13:20 UTC: 1 obstacles, 0 ground robots"
+    )
+    assert (
+        SiteInForce(site, "", 12.25)
+        .line()
+        .startswith("site 'mars' from an unknown node at t=12.2 s")
+    )

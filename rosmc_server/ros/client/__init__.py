@@ -25,7 +25,8 @@ from .results import (
     Transferred,
 )
 from .science import ScienceWatch
-from .watch import MissionWatch, init_node
+from .site import SiteWatch
+from .watch import MissionWatch, identify, init_node
 from .worker import AsyncMissionClient, Outcome
 
 __all__ = [
@@ -43,12 +44,14 @@ __all__ = [
     "RevisionConflict",
     "ScienceWatch",
     "ServerUnavailable",
+    "SiteWatch",
     "SkillAdded",
     "SkillRetried",
     "TeamTransferred",
     "Transferred",
     "agent_status_from_msg",
     "agent_statuses_from_msg",
+    "identify",
     "init_node",
     "library_from_msg",
 ]

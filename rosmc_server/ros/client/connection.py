@@ -27,6 +27,7 @@ from ...conversions.unpacking import UnpackedGetMission
 from ...core import (
     InvalidRequest,
     NotFound,
+    NotPermitted,
     RosmcError,
     RuleViolation,
     Unavailable,
@@ -41,6 +42,7 @@ _ERRORS: Mapping[int, type[RosmcError]] = {
     ErrorCode.RULE: RuleViolation,
     ErrorCode.UNAVAILABLE: Unavailable,
     ErrorCode.INTERNAL: RosmcError,
+    ErrorCode.FORBIDDEN: NotPermitted,
 }
 # Services whose answers are read straight into core objects rather than genpy messages.
 _ANSWERED_AS: Mapping[str, Any] = {"get_mission": UnpackedGetMission}

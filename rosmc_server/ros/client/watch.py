@@ -13,6 +13,7 @@ import queue
 import threading
 import time
 
+import rosgraph
 import rosmc.msg as wire
 import rospy
 
@@ -38,6 +39,16 @@ def init_node(name: str | None = None) -> str:
             disable_rosout=True,
         )
     return str(rospy.get_name())
+
+
+def identify() -> None:
+    """Make this process a node if the ROS master answers, so that services know the caller.
+
+    Without a node, rospy calls services as ``/unnamed``, a name the mission server's
+    operator allow-list (``~operators``) cannot tell apart from any other tool's.
+    """
+    if not rospy.core.is_initialized() and rosgraph.is_master_online():
+        init_node()
 
 
 class MissionWatch:
