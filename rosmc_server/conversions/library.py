@@ -6,6 +6,8 @@ messages and the core.
 
 from __future__ import annotations
 
+import json
+
 import rosmc.msg as wire
 import yaml
 
@@ -14,6 +16,7 @@ from ..core import (
     AgentSpec,
     InvalidRequest,
     Library,
+    LostLinkPolicy,
     MarkerType,
     ParameterSpec,
     ParamType,
@@ -51,7 +54,11 @@ def library_to_msg(library: Library) -> wire.Library:
             for a in library.agents
         ],
         skill_sets=[
-            wire.SkillSet(model=model, skills=[_skill_spec_to_msg(s) for s in skills.values()])
+            wire.SkillSet(
+                model=model,
+                skills=[_skill_spec_to_msg(s) for s in skills.values()],
+                lost_link=_policy_to_text(library.lost_link.get(model)),
+            )
             for model, skills in library.models.items()
         ],
     )
@@ -76,9 +83,20 @@ def library_from_msg(msg: wire.Library) -> Library:
             skill_set.model: {s.name: _skill_spec_from_msg(s) for s in skill_set.skills}
             for skill_set in msg.skill_sets
         }
+        policies = {
+            s.model: LostLinkPolicy.from_dict(json.loads(s.lost_link))
+            for s in msg.skill_sets
+            if s.lost_link
+        }
     except (ValueError, KeyError, yaml.YAMLError) as error:
         raise InvalidRequest(f"the server sent a malformed library ({error})") from error
-    return Library(msg.name, agents, models)
+    return Library(msg.name, agents, models, lost_link=policies)
+
+
+def _policy_to_text(policy: LostLinkPolicy | None) -> str:
+    if policy is None:
+        return ""
+    return json.dumps(policy.to_dict(), separators=(",", ":"))
 
 
 def _skill_spec_from_msg(msg: wire.SkillSpec) -> SkillSpec:

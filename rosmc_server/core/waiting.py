@@ -23,6 +23,7 @@ numbers are given out. At most :data:`MAX_WAITING` commands wait per robot;
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any, Protocol, TypeVar
 
@@ -144,6 +145,17 @@ def waiting_text(count: int, seconds: float) -> str:
     what = "1 command" if count == 1 else f"{count} commands"
     age = f" {duration_text(seconds)}" if seconds >= 0 else ""
     return f"{what} waiting for contact{age}"
+
+
+def queued_notes(waiting: Iterable[tuple[str, bool, float]]) -> list[str]:
+    """Notes for a command that waits for several robots: ``(agent, never heard, last heard)``.
+
+    Robots never heard share one note; each robot out of contact has its own (its age).
+    """
+    waiting = list(waiting)
+    unheard = [agent for agent, never_heard, _ in waiting if never_heard]
+    notes = [queued_note(", ".join(unheard), True, -1.0)] if unheard else []
+    return notes + [queued_note(a, False, last) for a, never, last in waiting if not never]
 
 
 def queued_note(agent: str, never_heard: bool, last_heard: float) -> str:

@@ -48,7 +48,7 @@ from ..core.advice import unsynced_partners
 from ..core.commands import CommandKind, CommandSpec
 from ..core.link import LinkStatus
 from ..core.policy import options_argument
-from ..core.waiting import queued_note, refusal
+from ..core.waiting import queued_notes, refusal
 from .caller_id import caller_id
 from .team_sync import synchronize_team
 from .whole_mission import WholeMissionServices
@@ -263,14 +263,13 @@ class OperatorServices:
 
     def _queued_note(self, agents: list[str]) -> str:
         """Say so when a command waits for robots out of contact (never heard, or link down)."""
-        link = self._server.link
-        return notes(
-            *(
-                queued_note(agent, report.status is LinkStatus.UNKNOWN, report.last_heard)
-                for agent in agents
-                if (report := link.details(agent)[0]).status is not LinkStatus.UP
-            )
-        )
+        reports = [(agent, self._server.link.details(agent)[0]) for agent in agents]
+        waiting = [
+            (agent, report.status is LinkStatus.UNKNOWN, report.last_heard)
+            for agent, report in reports
+            if report.status is not LinkStatus.UP
+        ]
+        return notes(*queued_notes(waiting))
 
     def _uploading(self, agent: str) -> bool:
         state = self._server.mission.state

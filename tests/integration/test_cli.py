@@ -529,16 +529,17 @@ def test_sync_shows_uploading(server: Server, fresh: MissionClient) -> None:
         "queued for drone: not heard since the server started; "
         "it goes out when the robot first reports\n"
     ), (started.stdout, started.stderr)
-    # What waits for the robot, and since when, in the status line and its JSON.
+    # What waits for the robot, and since when, in the status line and its JSON: the
+    # library's default lost-link policy, the upload and the start.
     lines = rosmc(server, "status").splitlines()
     line = lines[lines.index("  drone") + 1]
     assert re.fullmatch(
         r"    link never heard since the server started \(commands wait for it\), "
-        r"2 commands waiting for contact \d+ s",
+        r"3 commands waiting for contact \d+ s",
         line,
     ), line
     link = next(a["link"] for a in status(server)["agents"] if a["name"] == "drone")
-    assert link["commands_waiting"] == 2 and link["waiting_for"] >= 0.0, link
+    assert link["commands_waiting"] == 3 and link["waiting_for"] >= 0.0, link
     fresh.get_mission()
     with pytest.raises(RuleViolation, match="cannot start a new mission while drone holds"):
         fresh.new_mission()

@@ -11,6 +11,7 @@ from rosmc_server.core.waiting import (
     collapse,
     duration_text,
     queued_note,
+    queued_notes,
     refusal,
     waiting_text,
 )
@@ -185,3 +186,13 @@ def test_waiting_reads_with_its_age() -> None:
         "it goes out when the robot is heard again"
     )
     assert queued_note("rover", True, -1.0).startswith("queued for rover: not heard since")
+
+
+def test_robots_never_heard_share_one_note_and_lost_ones_keep_their_age() -> None:
+    notes = queued_notes([("a", True, -1.0), ("b", False, 75.0), ("c", True, -1.0)])
+    assert notes == [
+        "queued for a, c: not heard since the server started; "
+        "it goes out when the robot first reports",
+        "queued for b: out of contact (last heard 1 min ago); "
+        "it goes out when the robot is heard again",
+    ]
