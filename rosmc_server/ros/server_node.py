@@ -312,6 +312,7 @@ class MissionServer:
             return self._resumed(writer), writer
         mission = Mission(self.library, MissionContent.empty(self.library), clock=clock)
         path = self.config.journal or default_journal_path(self.config.journal_dir)
+        path.parent.mkdir(parents=True, exist_ok=True)
         snapshot = mission_to_msg(mission.state.content(), 0, time.time())
         return mission, JournalWriter.create(path, snapshot, time.time_ns(), options)
 

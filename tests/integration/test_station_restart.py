@@ -25,7 +25,7 @@ from typing import Any
 
 import pytest
 
-from tests.conftest import LOOPBACK, LaunchProcess, free_port, wait_until
+from tests.conftest import LOOPBACK, LaunchProcess, free_port, stop_process, wait_until
 
 pytestmark = pytest.mark.integration
 
@@ -183,3 +183,36 @@ def test_a_killed_server_comes_back_on_its_journal_and_the_team_goes_on(
     assert {node: station.pid(node) for node in KEPT_NODES} == kept
     died = [line for line in launch.log().splitlines() if "has died" in line]
     assert died and all("mission_server" in line for line in died), died  # only the server
+
+
+# As the README shows it (Crash recovery); the first run writes the journal it names.
+README_RESUME = "roslaunch rosmc mission_server.launch journal:=bags/mission_X.mcap resume:=true"
+
+
+def typed_in(directory: Path, command: str) -> list[str]:
+    """``command`` as a user types it in a shell after ``cd directory`` (which sets PWD)."""
+    return ["bash", "-c", f"cd '{directory}' && exec {command}"]
+
+
+def test_the_readme_resume_command_reads_the_journal_where_it_was_typed(
+    station: Station, launch_process: LaunchProcess, tmp_path: Path
+) -> None:
+    work = tmp_path / "work"
+    work.mkdir()
+    first_run = README_RESUME.replace(" resume:=true", "")
+    server = launch_process(typed_in(work, first_run), env=station.env, name="first_run")
+
+    def serving() -> bool:
+        assert server.poll() is None, server.log()[-4000:]
+        return station.pid(SERVER) is not None
+
+    wait_until(serving, START_TIMEOUT, "the server is up", period=0.5)
+    station.rosmc("add", "drone", "take_off")
+    stop_process(server)
+    assert (work / "bags" / "mission_X.mcap").is_file()
+    assert not list(Path(station.env["ROS_HOME"]).rglob("*.mcap"))
+
+    server = launch_process(typed_in(work, README_RESUME), env=station.env, name="resume")
+    wait_until(serving, START_TIMEOUT, "the server is up again", period=0.5)
+    assert [s["skill"] for s in skills(station.status(), "drone")] == ["take_off"]
+    assert f"resumed from {work / 'bags' / 'mission_X.mcap'}" in server.log()
