@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -80,6 +81,19 @@ class Station:
         """The mission as ``rosmc --json status`` prints it."""
         data: dict[str, Any] = json.loads(self.rosmc("--json", "status").stdout)
         return data
+
+    def server_note(self) -> str | None:
+        """The marker node's "mission server restarted ..." text in rviz, if it shows one."""
+        result = subprocess.run(
+            ["rostopic", "echo", "-n", "1", "/rosmc/markers/icons"],
+            env=dict(self.env),
+            capture_output=True,
+            text=True,
+            timeout=60,
+            check=False,
+        )
+        found = re.search(r'text: "(mission server restarted [^"]*)"', result.stdout)
+        return found.group(1) if found else None
 
     def pid(self, node: str) -> int | None:
         """The process id of ``node`` (None if the master does not know it or it is gone)."""
@@ -173,6 +187,10 @@ def test_a_killed_server_comes_back_on_its_journal_and_the_team_goes_on(
     assert [s["skill"] for s in skills(after, "science_rover")] == ["explore"]
     assert sorted(journal_dir.glob("*.mcap")) == journals  # the same journal, resumed
     assert "resumed from" in launch.log()
+
+    # rviz: the marker node's status text says so (on the icons topic rviz shows).
+    note = wait_until(station.server_note, 60, "the restart shown in rviz", period=1.0)
+    assert int(note.rsplit(" ", 1)[1]) >= acknowledged, note
 
     wait_until(
         lambda: statuses(station, "drone") == ["SUCCESS"] * 3,
