@@ -223,6 +223,14 @@ class CommandWidget(QWidget):  # type: ignore[misc]
             self.banner.show()
             self.messages.say("Lost the mission server; waiting for it to come back.", "error")
 
+    def on_server_restarted(self, revision: int) -> None:
+        """A new mission server process took over (a restart); say from which revision."""
+        self.messages.say(
+            f"The mission server restarted from revision {revision}; robot states are "
+            "shown again as it hears the robots.",
+            "warning",
+        )
+
     def on_answer(self, answer: Answer) -> None:
         """Say how a request ended."""
         what = answer.request.what or answer.request.operation.replace("_", " ")

@@ -79,6 +79,7 @@ class RosBridge(QObject):  # type: ignore[misc]
     library_ready = Signal(object)  # Library
     answered = Signal(object)  # Answer
     connection_changed = Signal(bool)
+    server_restarted = Signal(int)  # the revision a new server process resumed at
     selection_received = Signal(list, list)  # skill ids, marker names
     science_received = Signal(object)  # rosmc_server.core.science.Science
     site_received = Signal(object)  # rosmc_server.core.site_source.SiteInForce | None
@@ -87,7 +88,12 @@ class RosBridge(QObject):  # type: ignore[misc]
         super().__init__()
         self.prefix = prefix
         self.read_only = bool(prefix.strip().strip("/"))
-        self._follower = MissionFollower(prefix, timeout=timeout, on_connection=self._on_connection)
+        self._follower = MissionFollower(
+            prefix,
+            timeout=timeout,
+            on_connection=self._on_connection,
+            on_restart=self.server_restarted.emit,
+        )
         self._have_library = False
         self._queue: deque[ViewUpdate] = deque()
         self._queue_lock = threading.Lock()

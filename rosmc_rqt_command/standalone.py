@@ -30,6 +30,7 @@ def connect(widget: CommandWidget, bridge: RosBridge) -> None:
     bridge.library_ready.connect(widget.on_library)
     bridge.answered.connect(widget.on_answer)
     bridge.connection_changed.connect(widget.on_connection)
+    bridge.server_restarted.connect(widget.on_server_restarted)
     bridge.selection_received.connect(widget.on_remote_selection)
     bridge.science_received.connect(widget.science.show_science)
     bridge.site_received.connect(widget.site.show_site)

@@ -45,6 +45,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import xmlrpc.client
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
@@ -253,6 +254,8 @@ def take(args: argparse.Namespace) -> int:
             silenced = out_of_contact.silence_executor(args.out_of_contact, "/rviz_operator_shot")
             stack.callback(out_of_contact.resume_executor, silenced)
             waiting_for_contact(watch, client, args.out_of_contact)
+        if ready and args.restart_server:
+            restart_server()
         if ready:
             time.sleep(args.settle)  # rviz draws the last updates; the state lasts minutes
             shot = shots.grab(display)
@@ -284,6 +287,30 @@ def waiting_for_contact(watch: Any, client: object, agent: str) -> None:
     wait_for(lambda: shown(lambda s: s.commands_waiting >= 2), f"work waiting for {agent}", 30.0)
 
 
+def server_pid() -> int | None:
+    """The mission server's process id (None while it is not registered or not answering)."""
+    import rosgraph
+
+    from rosmc_server.interface import SERVER_NODE
+
+    master = rosgraph.Master("/rviz_operator_shot")
+    try:
+        pid = xmlrpc.client.ServerProxy(master.lookupNode(SERVER_NODE)).getPid("/shot")[2]
+    except (rosgraph.MasterException, OSError, xmlrpc.client.Error):
+        return None
+    return int(pid)
+
+
+def restart_server() -> None:
+    """kill -9 the mission server; return once roslaunch started it again and it serves."""
+    first = server_pid()
+    if first is None:
+        raise shots.ScreenshotError("the mission server is not running")
+    os.kill(first, signal.SIGKILL)
+    wait_for(lambda: server_pid() not in (None, first), "the mission server back", 60.0)
+    print("rviz_operator_screenshot: mission server killed (-9) and restarted by roslaunch")
+
+
 def _raise_keyboard_interrupt(_signum: int, _frame: object) -> None:
     raise KeyboardInterrupt
 
@@ -302,6 +329,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("-v", "--verbose", action="store_true", help="say what is missing")
     parser.add_argument("--view", help="a saved view of operator.rviz (default: its current)")
     parser.add_argument("--out-of-contact", default="", help="a robot cut off, work waiting")
+    parser.add_argument(
+        "--restart-server", action="store_true", help="kill -9 the server first (it comes back)"
+    )
     args = parser.parse_args(argv)
     signal.signal(signal.SIGTERM, _raise_keyboard_interrupt)
     try:

@@ -8,7 +8,8 @@ become mission server calls (see :mod:`.interaction`).
 ROS interface (every name behind ``~ns``):
     Publishes ``/rosmc/markers/update`` (visualization_msgs/InteractiveMarkerUpdate),
     ``/rosmc/markers/update_full`` (InteractiveMarkerInit, latched),
-    ``/rosmc/markers/icons`` (visualization_msgs/MarkerArray, latched: status icons),
+    ``/rosmc/markers/icons`` (visualization_msgs/MarkerArray, latched: status icons, and
+    a text above the origin once the mission server restarted, naming its revision),
     ``/rosmc/selection`` (rosmc/Selection, latched: what the operator clicked),
     ``/rosmc/coverage`` (visualization_msgs/MarkerArray, latched: radio coverage, see
     :mod:`.coverage_layer`, which also subscribes ``/rosmc/sim/coverage``).
@@ -29,6 +30,7 @@ import logging
 import os
 import sys
 import threading
+import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
@@ -44,7 +46,7 @@ from rosmc_server.ros.logging_bridge import bridge_logging_to_rosout
 
 from .. import topics
 from ..core.geometry import Point
-from ..core.icons import IconRow, block_label, icon_levels, status_rows
+from ..core.icons import WARN, IconRow, block_label, icon_levels, status_rows
 from ..core.labels import Label
 from ..core.scene import Scene, Touched
 from ..core.specs import MarkerSpec
@@ -54,6 +56,9 @@ from .coverage_layer import CoverageLayer
 from .interaction import Interaction
 
 _log = logging.getLogger(__name__)
+SERVER_ICON = "mission_server"  # the status text of the server itself (icons/mission_server)
+SERVER_NOTE_AT = (0.0, 0.0, 3.0)  # just above the lander (the map origin), below its score
+SERVER_NOTE_TEXT = 0.8  # letter height (m): as large as the site's region labels
 DEFAULT_LIBRARY = os.path.join(
     os.path.dirname(__file__), "..", "..", "rosmc_server", "config", "mars_team.yaml"
 )
@@ -87,7 +92,8 @@ class MarkerNode:
 
     def __init__(self, config: MarkerNodeConfig) -> None:
         self.config = config
-        self.follower = MissionFollower(prefix=config.ns)
+        self.follower = MissionFollower(prefix=config.ns, on_restart=self._on_server_restart)
+        self._server_note = ""  # said in rviz above the origin: the server restarted
         self._lock = threading.Lock()  # published specs, groups and the server
         self._published: dict[str, MarkerSpec] = {}
         self._groups: dict[str, set[str]] = {}  # task marker -> its interactive markers
@@ -170,6 +176,13 @@ class MarkerNode:
         )
         self._unsubscribe.append(self.mirror.subscribe(self._on_update))
         _log.info("markers for library '%s' (%d agents)", library.name, len(library.agents))
+
+    def _on_server_restart(self, revision: int) -> None:
+        self._server_note = (
+            f"mission server restarted {time.strftime('%H:%M:%S')} from revision {revision}"
+        )
+        _log.warning("%s", self._server_note)
+        self.mark(Touched(icons={SERVER_ICON}))
 
     def _on_update(self, update: MirrorUpdate) -> None:
         # Called with the mirror lock held: only note what changed; the worker does the rest.
@@ -289,6 +302,11 @@ class MarkerNode:
                 if point is not None:
                     position = point
             out += icon_markers(agent, rows, frame, position, index * 10, level)
+        if self._server_note:
+            note = (IconRow("server", self._server_note, WARN),)
+            for marker in icon_markers(SERVER_ICON, note, MAP_FRAME, SERVER_NOTE_AT, 0):
+                marker.scale.z = SERVER_NOTE_TEXT
+                out.append(marker)
         return out
 
     # -- feedback ---------------------------------------------------------------------------------

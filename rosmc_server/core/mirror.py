@@ -123,11 +123,13 @@ class MissionMirror:
         The mirror keeps ``state`` (do not change it afterwards). Held events after its
         revision are applied on top of it. ``restarted``: the snapshot comes from a server
         that started anew (its revisions may have begun again), so it is taken whatever its
-        revision, and held events are dropped.
+        revision, and held events are dropped, as are the robot statuses the old server
+        gave (listeners hear each robot as unknown until the new server speaks of it).
         """
         with self.lock:
             if restarted:
                 self._pending.clear()
+                self._forget_statuses()
             stale = self._state is not None and state.revision < self._state.revision
             if not stale or restarted:
                 self._state = state
@@ -182,6 +184,17 @@ class MissionMirror:
                 self._notify(MirrorUpdate(self.revision or 0, tuple(changes)))
 
     # -- internals ---------------------------------------------------------------------------
+    def _forget_statuses(self) -> None:
+        """Drop every robot status heard so far; listeners hear them unknown (lock held)."""
+        changes = tuple(
+            AgentStatusChanged(old, AgentStatus(agent))
+            for agent, old in self._statuses.items()
+            if old != AgentStatus(agent)
+        )
+        self._statuses.clear()
+        if changes:
+            self._notify(MirrorUpdate(self.revision or 0, changes))
+
     def _apply_pending(self) -> bool:
         """Apply held events in order; True if a snapshot must be requested (lock held)."""
         state = self._state

@@ -39,6 +39,10 @@ Parameters (private):
     ``~mission_dir`` (str): the only directory (with its subdirectories) where SaveMission
         and LoadMission read or write files on the server's host (default ``missions/``);
         elsewhere, clients pass the document itself.
+    ``~cwd`` (str): relative paths above are resolved against it (launch files pass the
+        directory the user typed the command in; see :mod:`.station`).
+    ``~station_journal`` (str): set by a launch file that restarts the server: a server that
+        finds a journal there resumes it (see :mod:`.station`).
 
 Every accepted change is journaled (and flushed) before its service answers.
 If the journal cannot be written, the change is reported as failed and the
@@ -86,6 +90,7 @@ from ..core.operators import OperatorAllowList
 from ..recording import JournalOptions, JournalWriter, default_journal_path, latest_state
 from ..recording.high_water import RevisionMark, first_mark, read_mark, resumed_mark
 from ..recording.recovery import ResumeReport
+from . import station
 from .agent_states import AgentStatePublisher
 from .ground_link import GroundLink
 from .heartbeat import Heartbeat
@@ -131,15 +136,22 @@ class ServerConfig:
         for once in ("~journal", "~resume"):
             if rospy.has_param(once):
                 rospy.delete_param(once)
+        previous = station.previous_journal()
+        if previous is not None:  # restarted by roslaunch: go on where the last server was
+            journal, resume = str(previous), True
         return cls(
-            library=Path(str(rospy.get_param("~library", str(DEFAULT_LIBRARY)))).expanduser(),
-            journal=Path(journal).expanduser() if journal else None,
-            journal_dir=Path(str(rospy.get_param("~journal_dir", str(DEFAULT_JOURNAL_DIR)))),
+            library=station.launch_path(str(rospy.get_param("~library", str(DEFAULT_LIBRARY)))),
+            journal=station.launch_path(journal) if journal else None,
+            journal_dir=station.launch_path(
+                str(rospy.get_param("~journal_dir", str(DEFAULT_JOURNAL_DIR)))
+            ),
             resume=resume,
             link_timeout=float(rospy.get_param("~link_timeout", 3.0)),
             agent_state_rate=float(rospy.get_param("~agent_state_rate", 2.0)),
             fsync=bool(rospy.get_param("~fsync", True)),
-            mission_dir=Path(str(rospy.get_param("~mission_dir", str(DEFAULT_MISSION_DIR)))),
+            mission_dir=station.launch_path(
+                str(rospy.get_param("~mission_dir", str(DEFAULT_MISSION_DIR)))
+            ),
             snapshot_every=max(1, int(rospy.get_param("~snapshot_every", cls.snapshot_every))),
             operators=OperatorAllowList.of(rospy.get_param("~operators", [])),
         )
@@ -160,6 +172,7 @@ class MissionServer:
         self._resume_alert = ""  # what resuming the journal could not recover
         self._snapshot_after_resume = False
         self.mission, self._journal = self._open_journal()
+        station.remember_journal(self._journal.path)
         if self._snapshot_after_resume:  # the file now written must start the mission
             self._journal.append_snapshot(self.snapshot_msg(), time.time_ns())
         self._events = rospy.Publisher(interface.EVENTS_TOPIC, wire.MissionEvent, queue_size=1000)
@@ -320,6 +333,7 @@ class MissionServer:
             return self._resumed(writer), writer
         mission = Mission(self.library, MissionContent.empty(self.library), clock=clock)
         path = self.config.journal or default_journal_path(self.config.journal_dir)
+        path.parent.mkdir(parents=True, exist_ok=True)
         snapshot = mission_to_msg(mission.state.content(), 0, time.time())
         writer = JournalWriter.create(path, snapshot, time.time_ns(), options)
         self._marks = RevisionMark(path, first_mark(0), options.fsync)

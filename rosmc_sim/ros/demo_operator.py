@@ -25,7 +25,6 @@ import threading
 import time
 from collections import Counter
 from collections.abc import Callable, Sequence
-from pathlib import Path
 from typing import TypeVar
 
 import rosmc.msg as wire
@@ -34,6 +33,7 @@ import rospy
 from rosmc_server.core import MarkerType, Pose, RosmcError, SkillStatus, TaskMarker
 from rosmc_server.core.changes import EventKind
 from rosmc_server.ros.client import ControlCommand, MissionClient, MissionWatch
+from rosmc_server.ros.station import launch_path
 
 from .topics import SCIENCE_TOPIC
 
@@ -254,5 +254,5 @@ def main(argv: Sequence[str] | None = None) -> int:
     print(operator.summary(), flush=True)
     result_file = str(rospy.get_param("~result_file", ""))
     if result_file:
-        Path(result_file).write_text(f"{code}\n")
+        launch_path(result_file).write_text(f"{code}\n")
     return code

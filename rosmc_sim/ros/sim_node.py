@@ -47,6 +47,7 @@ import rospy.rostime
 from rosgraph_msgs.msg import Clock
 
 from rosmc_server.ros.logging_bridge import bridge_logging_to_rosout
+from rosmc_server.ros.station import CWD_PARAM, resolve_against
 
 from ..core.scenario import Scenario, ScenarioError, load_scenario
 from ..core.sim import Simulation
@@ -86,7 +87,10 @@ class SimConfig:
         """Read ``~scenario``, ``~real_time_factor``, ``~step``, ``~gui`` and ``~seed`` once."""
         try:
             config = cls(
-                scenario=resolve_scenario(str(rospy.get_param("~scenario", DEFAULT_SCENARIO))),
+                scenario=resolve_scenario(
+                    str(rospy.get_param("~scenario", DEFAULT_SCENARIO)),
+                    str(rospy.get_param(CWD_PARAM, "")),
+                ),
                 real_time_factor=float(rospy.get_param("~real_time_factor", 1.0)),
                 step=float(rospy.get_param("~step", 0.05)),
                 gui=bool(rospy.get_param("~gui", False)),
@@ -104,16 +108,18 @@ class SimConfig:
         return config
 
 
-def resolve_scenario(path: str) -> Path:
+def resolve_scenario(path: str, cwd: str = "") -> Path:
     """An absolute scenario path.
 
     A relative path is looked up in the ``rosmc_sim`` package (``scenarios/x.yaml``), then
-    next to it (``rosmc_sim/scenarios/x.yaml``), then in the working directory.
+    next to it (``rosmc_sim/scenarios/x.yaml``), then in ``cwd`` (where the user launched
+    from; "" = the working directory).
     """
     given = Path(path).expanduser()
     if given.is_absolute():
         return given
-    candidates = [PACKAGE_DIR / given, PACKAGE_DIR.parent / given, Path.cwd() / given]
+    here = resolve_against(given, cwd) if cwd else Path.cwd() / given
+    candidates = [PACKAGE_DIR / given, PACKAGE_DIR.parent / given, here]
     return next((c for c in candidates if c.is_file()), candidates[0])
 
 

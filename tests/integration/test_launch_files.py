@@ -27,12 +27,18 @@ VARIANTS = [
 ]
 
 
-def node_names(path: Path, args: list[str]) -> list[str]:
+def loaded(path: Path | str, args: list[str]) -> roslaunch.config.ROSLaunchConfig:
+    """The launch file (a path, or a name in launch/) as roslaunch loads it with ``args``."""
+    path = REPO / "launch" / path if isinstance(path, str) else path
     config = roslaunch.config.ROSLaunchConfig()
     loader = roslaunch.xmlloader.XmlLoader()
     loader.ignore_unset_args = False  # roslaunch's own CLI sets it; a missing arg is an error
     loader.load(str(path), config, argv=["roslaunch", str(path), *args], verbose=False)
-    return [f"{node.namespace}{node.name}" for node in config.nodes]
+    return config
+
+
+def node_names(path: Path, args: list[str]) -> list[str]:
+    return [f"{node.namespace}{node.name}" for node in loaded(path, args).nodes]
 
 
 @pytest.mark.parametrize("path", LAUNCH_FILES, ids=lambda p: p.name)
@@ -49,3 +55,19 @@ def test_the_documented_variants_load(name: str, args: list[str]) -> None:
         assert {"/rosmc/mission_server", "/rosmc/markers", "/rosmc/sim"} <= set(nodes)
     if name == "demo.launch":
         assert any(n.endswith("command_gui") for n in nodes)
+
+
+def test_relative_paths_are_taken_from_where_roslaunch_was_typed(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    # roslaunch starts nodes in ROS_HOME; the shell's PWD is where the user typed the command.
+    monkeypatch.setenv("PWD", str(tmp_path))
+    rviz = loaded("rviz.launch", ["rviz_config:=views/mine.rviz"])
+    assert [node.args for node in rviz.nodes] == [f"-d {tmp_path}/views/mine.rviz"]
+    team = loaded("operator.launch", ["sim:=true"])
+    with_cwd = {"/rosmc/mission_server", "/rosmc/sim", "/drone/mission_executor"}
+    for node in with_cwd:
+        assert team.params[f"{node}/cwd"].value == str(tmp_path), node
+    # the launch's server notes its journal there, so that a respawned one resumes it
+    assert team.params["/rosmc/mission_server/station_journal"].value == ""
+    assert "station_journal" not in str(loaded("mission_server.launch", []).params)

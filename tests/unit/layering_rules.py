@@ -140,6 +140,7 @@ FOR_APPS = (
     "rosmc_server.ros.client",
     "rosmc_server.ros.replayer",
     "rosmc_server.ros.logging_bridge",
+    "rosmc_server.ros.station",  # where a launched node's relative paths point
 )
 CONVERSIONS = "rosmc_server.conversions"
 # Dynamic imports with a literal module name are checked too.

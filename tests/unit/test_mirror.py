@@ -289,6 +289,22 @@ def test_agent_statuses_are_reported_when_they_change() -> None:
     assert mirror.agent_status("rover") is None
 
 
+def test_a_restarted_server_s_robots_start_unknown() -> None:
+    mission = make_mission()
+    mirror = MissionMirror()
+    mirror.on_snapshot(snapshot_of(mission))
+    up = AgentStatus("drone", link="up", battery=0.5)
+    mirror.on_agent_statuses({"drone": up, "rover": AgentStatus("rover")})
+    view = View()
+    mirror.subscribe(view)
+    mirror.on_snapshot(snapshot_of(mission))  # the same server again: nothing forgotten
+    assert mirror.agent_status("drone") == up
+    mirror.on_snapshot(snapshot_of(mission), restarted=True)
+    statuses = [c for u in view.updates for c in u.changes if isinstance(c, AgentStatusChanged)]
+    assert statuses == [AgentStatusChanged(up, AgentStatus("drone"))]
+    assert mirror.agent_statuses == {}
+
+
 def test_a_late_listener_starts_from_the_current_mission_and_can_leave() -> None:
     mission = make_mission()
     mirror = MissionMirror()

@@ -25,6 +25,8 @@ Parameters (private):
         the skills module's ``pose_source`` if it has one, else none.
     ``~snapshot_period`` (float, s, 1.0), ``~report_retry`` (float, s, 0.5),
     ``~tick_rate`` (float, Hz, 50), ``~robot_side`` (bool, false).
+    ``~cwd`` (str): a relative ``~state_file`` is taken from there (launch files pass the
+    directory roslaunch was typed in).
     They are read once at start and deleted, so a later executor of the same name starts
     from its own settings, never from a previous run's.
 """
@@ -48,6 +50,7 @@ import rospy
 
 from rosmc_server import interface
 from rosmc_server.ros.logging_bridge import bridge_logging_to_rosout
+from rosmc_server.ros.station import launch_path
 
 from ...conversions.robot_link import (
     ack_to_msg,
@@ -281,7 +284,7 @@ class ExecutorConfig:
             agent=agent,
             skills=str(rospy.get_param("~skills", DEFAULT_SKILLS)),
             pose_source=str(rospy.get_param("~pose_source", "")),
-            state_file=Path(state).expanduser() if state else None,
+            state_file=launch_path(state) if state else None,
             robot_side=bool(rospy.get_param("~robot_side", False)),
             tick_rate=float(rospy.get_param("~tick_rate", 50.0)),
             snapshot_period=float(rospy.get_param("~snapshot_period", 1.0)),
@@ -302,6 +305,7 @@ PRIVATE_PARAMS = (
     "tick_rate",
     "snapshot_period",
     "report_retry",
+    "cwd",
 )
 
 

@@ -11,15 +11,19 @@ Calls (on its own worker thread, never the caller's):
     ``/rosmc/get_mission`` (rosmc/GetMission): the snapshot, at start, after a revision gap,
     after a replaced mission, after the server restarted and after a replay was moved.
 
-Watches ``/rosmc/get_mission`` on the master once per ``check_period`` to tell when the
-server went away or came back as a new process (then the mirror starts from its snapshot).
+Watches ``/rosmc/get_mission`` on the master at start and once per ``check_period`` to tell
+when the server went away or came back as a new process (then the mirror starts from its
+snapshot; a process is told by its address and process id).
 """
 
 from __future__ import annotations
 
 import logging
 import threading
+import xmlrpc.client
 from collections.abc import Callable
+from typing import Any
+from xmlrpc.client import ServerProxy
 
 import rosgraph
 import rosmc.msg as wire
@@ -50,6 +54,8 @@ class MissionFollower:
         retry_period: Seconds between attempts while the server does not answer.
         check_period: Seconds between checks that the server is still the same process.
         on_connection: Called with True/False when the server appears or goes away.
+        on_restart: Called with the revision a new server process is at, once the mirror
+            holds its mission (on the worker thread).
     """
 
     def __init__(
@@ -59,6 +65,7 @@ class MissionFollower:
         retry_period: float = 2.0,
         check_period: float = 1.0,
         on_connection: ConnectionListener | None = None,
+        on_restart: Callable[[int], None] | None = None,
     ) -> None:
         self.prefix = prefix
         self.mirror = MissionMirror(self._request_snapshot)
@@ -66,6 +73,7 @@ class MissionFollower:
         self._retry_period = retry_period
         self._check_period = check_period
         self._on_connection = on_connection
+        self._on_restart = on_restart
         self._server_uri: str | None = None  # who answers now (None: nobody)
         self._known_uri: str | None = None  # who answered last
         self._restarted = False
@@ -131,6 +139,8 @@ class MissionFollower:
         if outcome.value is not None:
             restarted, self._restarted = self._restarted, False
             self.mirror.on_snapshot(outcome.value, restarted=restarted)
+            if restarted and self._on_restart is not None:
+                self._on_restart(outcome.value.revision)
             return
         _log.warning("cannot fetch the mission (%s); trying again", outcome.error)
         if not self._closed.is_set():
@@ -177,20 +187,38 @@ class MissionFollower:
     def _watch(self) -> None:
         name = interface.service_name("get_mission", self.prefix)
         master = rosgraph.Master(rospy.get_name())
-        while not self._closed.wait(self._check_period):
-            try:
-                uri: str | None = master.lookupService(name)
-            except (rosgraph.MasterException, OSError):
-                uri = None
-            if uri == self._server_uri:
-                continue
-            previous, self._server_uri = self._server_uri, uri
-            if uri is not None:
-                # A new process answers at a new address: its revisions may have begun anew.
-                if self._known_uri is not None and uri != self._known_uri:
-                    _log.info("the mission server restarted; fetching its mission")
-                    self._restarted = True
-                    self._request_snapshot()
-                self._known_uri = uri
-            if (previous is None) != (uri is None) and self._on_connection is not None:
-                self._on_connection(uri is not None)
+        while True:  # look at once: a server that restarts soon must be told from this one
+            uri = server_process(master, name)
+            if uri != self._server_uri:
+                self._server_changed(uri)
+            if self._closed.wait(self._check_period):
+                return
+
+    def _server_changed(self, uri: str | None) -> None:
+        previous, self._server_uri = self._server_uri, uri
+        if uri is not None:
+            # A new process answers: its revisions may have begun anew.
+            if self._known_uri is not None and uri != self._known_uri:
+                _log.info("the mission server restarted; fetching its mission")
+                self._restarted = True
+                self._request_snapshot()
+            self._known_uri = uri
+        if (previous is None) != (uri is None) and self._on_connection is not None:
+            self._on_connection(uri is not None)
+
+
+def server_process(master: rosgraph.Master, service: str) -> str | None:
+    """Who answers ``service`` now: its address and process id (None: nobody).
+
+    The address alone does not tell a restarted server from the old one: a process
+    started after a ``kill -9`` may be given the very port its predecessor had.
+    """
+    try:
+        uri = str(master.lookupService(service))
+        providers = dict(master.getSystemState()[2]).get(service) or []
+        node_api = master.lookupNode(providers[0]) if providers else ""
+        answer: Any = ServerProxy(node_api).getPid(master.caller_id) if node_api else None
+    except (rosgraph.MasterException, OSError, xmlrpc.client.Error):
+        return None
+    pid = int(answer[2]) if isinstance(answer, list) and len(answer) == 3 else -1
+    return f"{uri} pid {pid}"
