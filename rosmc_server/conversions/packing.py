@@ -164,13 +164,14 @@ class PackedMission(wire.Mission):  # type: ignore[misc]
 class PackedGetMissionResponse(srv.GetMissionResponse):  # type: ignore[misc]
     """A ``rosmc/GetMission`` answer holding a :class:`PackedMission`."""
 
-    def __init__(self, mission: PackedMission, journal_alert: str = "") -> None:
-        super().__init__(mission=mission, journal_alert=journal_alert)
+    def __init__(self, mission: PackedMission, journal_alert: str = "", epoch: str = "") -> None:
+        super().__init__(mission=mission, journal_alert=journal_alert, epoch=epoch)
 
     def serialize(self, buff: Any) -> None:
-        """Write the message's wire bytes to ``buff``: the packed mission, then the alert."""
+        """Write the message's wire bytes to ``buff``: the packed mission, alert and epoch."""
         self.mission.serialize(buff)
         buff.write(_string(self.journal_alert))
+        buff.write(_string(self.epoch))
 
 
 @dataclass(frozen=True)

@@ -59,7 +59,8 @@ _MARKER_TYPE = struct.Struct("<B").unpack_from
 
 
 class UnpackedGetMissionResponse(srv.GetMissionResponse):  # type: ignore[misc]
-    """A ``rosmc/GetMission`` answer read into ``content``, ``revision`` and ``journal_alert``.
+    """A ``rosmc/GetMission`` answer read into ``content``, ``revision``, ``journal_alert``
+    and ``epoch``.
 
     ``mission`` stays empty: the answer never becomes genpy messages (but when the
     definition changed, see the module's docstring).
@@ -80,6 +81,7 @@ class UnpackedGetMissionResponse(srv.GetMissionResponse):  # type: ignore[misc]
         with _reading():
             self.content, self.revision, end = _read_mission(data, 0)
             self.journal_alert, end = _text(data, end)
+            self.epoch, end = _text(data, end)
         if end != len(data):
             raise genpy.DeserializationError(f"{len(data) - end} bytes after the answer")
         return self

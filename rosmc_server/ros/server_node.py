@@ -251,6 +251,7 @@ class MissionServer:
     def _record(self, event: MissionEvent) -> None:
         state = self.mission.state
         msg = event_to_msg(event, lambda skill_id: state.locate(skill_id)[0])
+        msg.epoch = self.epoch
         stamp_ns = time.time_ns()
         try:
             self._journal.append_event(msg, stamp_ns)
@@ -318,6 +319,11 @@ class MissionServer:
         self._packer.prepare(content)
 
     # -- journal -------------------------------------------------------------------
+    @property
+    def epoch(self) -> str:
+        """The mission's history: new whenever a resume lost history."""
+        return self._marks.epoch
+
     @property
     def journal_alert(self) -> str:
         """What resuming the journal lost and whether its disk is full ("" if neither)."""

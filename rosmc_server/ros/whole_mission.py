@@ -62,7 +62,10 @@ class WholeMissionServices:
     def get_mission(self, req: Any) -> Any:
         """The mission snapshot of the current revision, serialized once and shared."""
         try:
-            return PackedGetMissionResponse(self._server.snapshot_msg(), self._server.journal_alert)
+            server = self._server
+            return PackedGetMissionResponse(
+                server.snapshot_msg(), server.journal_alert, server.epoch
+            )
         except Exception:  # a server fault must not reach the caller as a stack trace
             _log.exception("service get_mission failed")
             return srv.GetMissionResponse()

@@ -100,6 +100,27 @@ def test_a_revision_gap_fetches_one_snapshot(follower: MissionFollower) -> None:
             forger.unregister()
 
 
+def test_an_event_of_another_history_fetches_the_mission(server: ServerProcess) -> None:
+    """A server that resumed with lost history names a new epoch in its events: a mirror of
+    the old history takes the server's mission whatever its revision."""
+    restarts: list[int] = []
+    follower = MissionFollower(check_period=0.2, retry_period=0.2, on_restart=restarts.append)
+    follower.start()
+    forger = rospy.Publisher(interface.EVENTS_TOPIC, wire.MissionEvent, queue_size=1)
+    try:
+        with MissionClient(timeout=10.0) as client:
+            client.add_skill("drone", "land")
+            wait_until(lambda: mirrored(follower, client), 10.0, "the mirror to catch up")
+            wait_until(lambda: forger.get_num_connections() > 0, 10.0, "the follower")
+            revision = client.fetch_mission().revision  # its events named its history
+            forger.publish(wire.MissionEvent(revision=revision + 5, kind=0, epoch="another"))
+            wait_until(lambda: restarts == [revision], 10.0, "the mission of the new history")
+            assert follower.mirror.revision == revision
+    finally:
+        forger.unregister()
+        follower.close()
+
+
 def test_a_restarted_server_is_followed_from_its_new_mission(
     start_server: StartServer, server: ServerProcess
 ) -> None:
@@ -120,7 +141,7 @@ def test_a_restarted_server_is_followed_from_its_new_mission(
             client.add_skill("science_rover", "explore")
             wait_until(lambda: mirrored(follower, client), 15.0, "the mirror of the new server")
         assert follower.mirror.revision == 1
-        assert connection == [True, False, True]
+        wait_until(lambda: connection == [True, False, True], 10.0, "the new server seen")
     finally:
         follower.close()
 

@@ -23,7 +23,7 @@ from rosmc_server import interface  # noqa: E402
 from rosmc_server.recording import _scan  # noqa: E402
 from rosmc_server.recording.high_water import read_mark  # noqa: E402
 from tests.conftest import wait_until  # noqa: E402
-from tests.integration.server_fixtures import Client, ServerProcess  # noqa: E402
+from tests.integration.server_fixtures import Client, Recorder, ServerProcess  # noqa: E402
 from tests.integration.test_server_crash import Expected, Session, _rosmc, operate  # noqa: E402
 
 pytest_plugins = ["tests.integration.server_fixtures"]
@@ -91,5 +91,12 @@ def test_a_journal_that_lost_its_end_resumes_loudly_and_never_reuses_a_revision(
         marker = wire.TaskMarker(name="After", type=1, pose=wire.Pose6D(x=1.0))
         stale = client.call("add_task_marker", base_revision=last, marker=marker)
         assert stale.error_code == wire.ErrorCode.CONFLICT, stale.error  # held lost changes
-        fresh = client.call("add_task_marker", base_revision=resumed, marker=marker)
-        assert fresh.error_code == wire.ErrorCode.NONE and fresh.revision == resumed + 1
+        events = Recorder(interface.EVENTS_TOPIC, wire.MissionEvent)
+        try:
+            fresh = client.call("add_task_marker", base_revision=resumed, marker=marker)
+            assert fresh.error_code == wire.ErrorCode.NONE and fresh.revision == resumed + 1
+            # Answers and events name the new history, so a mirror of the old one refetches.
+            event = events.wait_for(lambda ms: any(m.revision == resumed + 1 for m in ms))[-1]
+        finally:
+            events.close()
+        assert event.epoch == mark.epoch == client.call("get_mission").epoch

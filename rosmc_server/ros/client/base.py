@@ -29,6 +29,9 @@ class ClientBase:
         self.journal_alert = ""
         """What the server's last resume could not recover from its journal, as of the last
         mission fetched ("" if nothing)."""
+        self.epoch = ""
+        """The mission's history as of the last mission fetched (new when a resume lost
+        history)."""
         self._library: Library | None = None
         self._kinds: dict[str, tuple[str, str]] = {}
         self._lock = threading.RLock()
@@ -72,6 +75,7 @@ class ClientBase:
         """The current mission, leaving the client's known revision as it was."""
         response = self._caller.call("get_mission")  # an UnpackedGetMissionResponse
         self.journal_alert = str(response.journal_alert)
+        self.epoch = str(response.epoch)
         state = MissionState(response.content, response.revision)
         self._kinds.update({s.id: (s.agent, s.skill) for s in state.skills()})
         return state

@@ -77,6 +77,7 @@ class MissionFollower:
         self._server_uri: str | None = None  # who answers now (None: nobody)
         self._known_uri: str | None = None  # who answered last
         self._restarted = False
+        self._epoch = ""  # of the events heard so far
         self._seeks: int | None = None  # moves of the replay followed (None: none heard yet)
         self._closed = threading.Event()
         self._retry: threading.Timer | None = None
@@ -150,6 +151,16 @@ class MissionFollower:
 
     # -- ROS callbacks -----------------------------------------------------------------------
     def _on_event(self, msg: wire.MissionEvent) -> None:
+        epoch = str(getattr(msg, "epoch", ""))  # absent from events of older recordings
+        if epoch and self._epoch and epoch != self._epoch:
+            # The server resumed with lost history: revisions this mirror holds may hold
+            # changes that are gone. Take its mission whatever its revision.
+            _log.warning("the mission's history changed (epoch %s); fetching it", epoch)
+            self._epoch = epoch
+            self._restarted = True
+            self._request_snapshot()
+            return
+        self._epoch = epoch or self._epoch
         try:
             event = event_from_msg(msg)
         except Exception:  # a malformed event must not kill the subscriber thread
