@@ -104,7 +104,12 @@ def test_work_sent_while_out_of_contact_reaches_the_rover_when_its_default_bring
 ) -> None:
     """The operator adapts the plan of a rover that is out of contact; nothing is refused."""
     c = op.client
-    far = out_of_coverage_plan(op)  # from where the previous test left it, holding
+    # From where the previous test left it, holding: out, then on slowly (80 sim seconds),
+    # so the operator's changes below all happen while the rover is out of contact.
+    c.add_skill(ARM, "navigate_to", {"target": {"x": OUT[0], "y": OUT[1]}})
+    slow = {"target": {"x": OUT[0] + 4.0, "y": OUT[1]}, "speed": 0.05}
+    far = c.add_skill(ARM, "navigate_to", slow).skill_id
+    op.sync_and_start([ARM])
     op.wait_link(ARM, "down", timeout=30.0)
     home = c.add_skill(ARM, "navigate_to", {"target": {"x": 4.0, "y": 1.0}}).skill_id
     extra = c.add_skill(ARM, "navigate_to", {"target": {"x": 3.0, "y": -1.0}}).skill_id
