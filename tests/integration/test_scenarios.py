@@ -26,8 +26,6 @@ import pytest
 import rospy
 
 from rosmc_server.core import (
-    AgentStatus,
-    LostLinkKind,
     LostLinkPolicy,
     MarkerType,
     Pose,
@@ -41,7 +39,7 @@ from rosmc_server.recording import read_journal
 from rosmc_server.ros.client import ControlCommand
 from rosmc_sim.ros.demo_operator import OPERATOR_KINDS, WIFI_SPOT_ADAPTED
 from tests.conftest import wait_until
-from tests.integration.scenario_fixtures import Operator, Team, TeamSettings, describe
+from tests.integration.scenario_fixtures import Operator, Team, TeamSettings
 
 pytestmark = pytest.mark.integration
 
@@ -375,73 +373,6 @@ def test_out_of_coverage_the_robot_goes_on_and_a_wifi_box_brings_it_back(op: Ope
     placed = state.skill(deploy[1]).finished
     assert state.skill(out[1]).finished < placed, "it finished out of coverage"
     assert state.skill(home).started > placed, "home left only once the rover could be heard"
-
-
-def test_out_of_contact_commands_wait_until_a_lost_link_policy_brings_the_rover_back(
-    op: Operator,
-) -> None:
-    c = op.client
-    # Out of contact for long enough, the rover drives back to (6, 0) on its own. After is in
-    # sim seconds: 2.5 wall seconds, well after the server (1 wall second) calls the link down,
-    # and before the slow drive out (12.5 m beyond coverage) ends.
-    come_back = LostLinkPolicy(
-        LostLinkKind.SAFE_SKILL, after=250.0, skill="navigate_to", params=target(6.0, 0.0)
-    )
-    c.set_robot_options(SCIENCE, come_back)
-    op.wait_mission(
-        lambda _m: "run navigate_to" in (op.agent_state(SCIENCE) or AgentStatus("")).policy,
-        20.0,
-        "the return policy in force",
-    )
-    drive = [
-        c.add_skill(SCIENCE, "navigate_to", target(10.0, 0.0)).skill_id,
-        c.add_skill(SCIENCE, "navigate_to", target(29.0, 0.0, speed=0.05)).skill_id,
-    ]
-    op.sync_and_start([SCIENCE])
-
-    down = op.wait_link(SCIENCE, "down", timeout=30.0)
-    assert down.commands_waiting == 0
-    home = c.add_skill(SCIENCE, "navigate_to", target(6.0, 1.0)).skill_id
-    extra = c.add_skill(SCIENCE, "return_to_lander").skill_id
-    sent = c.synchronize(SCIENCE)
-    assert set(sent.skill_ids) == {home, extra}
-    assert sent.note.startswith(f"queued for {SCIENCE}: out of contact"), sent.note
-    c.unsynchronize(SCIENCE, extra)  # take one back while it waits
-    c.set_robot_options(SCIENCE, LostLinkPolicy(LostLinkKind.CONTINUE))
-    waiting = wait_until(  # the upload of one skill and the new policy
-        lambda: (s := op.agent_state(SCIENCE)) is not None and s.commands_waiting == 2 and s,
-        10.0,
-        "two commands shown waiting",
-    )
-    assert waiting.link == "down", "the operator was quick enough"
-    assert "waiting for contact" in waiting.waiting_text
-    state = op.mission()
-    assert state.skill(home).transfer is Transfer.UPLOADING and state.skill(extra).is_editable
-
-    # The policy drives the rover back into coverage; what waited reaches it there.
-    op.wait_robot(SCIENCE, lambda t: t.in_coverage and t.pose.x < 12.0, "back in coverage")
-    op.wait_link(SCIENCE, "up", timeout=30.0)
-    state = op.wait_stored(SCIENCE)
-    assert state.skill(home).status is S.IDLE_SYNCHRONIZED
-    state = op.wait_status([drive[1]], S.PAUSED, timeout=30.0)  # held by the policy
-    assert "without ground contact" in state.skill(drive[1]).status_text, describe(state)
-    back = op.wait_mission(
-        lambda _m: (op.agent_state(SCIENCE) or AgentStatus("")).policy.startswith(
-            "on link loss: continue"
-        ),
-        20.0,
-        "the new policy in force",
-    )
-    assert back.skill(extra).is_editable, "the taken-back skill never went"
-    assert (op.agent_state(SCIENCE) or AgentStatus("")).commands_waiting == 0
-
-    # The operator lets it finish: the held drive again from the start (the return drive took
-    # over the rover's motion), out to the far end, and home (out of coverage meanwhile).
-    c.control(ControlCommand.STOP, SCIENCE)
-    op.wait_status([drive[1]], S.IDLE_SYNCHRONIZED, timeout=30.0)
-    c.control(ControlCommand.START, SCIENCE)
-    op.wait_status([*drive, home], S.SUCCESS, timeout=120.0)
-    c.delete_skills([extra])
 
 
 # -- 4. battery ----------------------------------------------------------------------------------
