@@ -42,6 +42,10 @@ ROW_HEIGHT = 22
 # and at most that wide (few robots: the columns share the width).
 COLUMN_WIDTH = 330
 MAX_COLUMN_WIDTH = 460
+# Compact mode (a large team): narrower columns without the number and parameter cells.
+COMPACT_WIDTH = 190
+COMPACT_MAX_WIDTH = 210
+STATUS_WIDTH = 174
 AskPolicy = Callable[[str, Sequence[str], QWidget, str], LostLinkPolicy | None]
 
 
@@ -70,9 +74,10 @@ class SectionTable(QTableView):  # type: ignore[misc]
         rows.setDefaultSectionSize(ROW_HEIGHT)
         columns = self.horizontalHeader()
         columns.setHighlightSections(False)
-        for column, width in ((TAG, 26), (NUMBER, 22), (SKILL, 100), (STATUS, 174)):
+        for column, width in ((TAG, 26), (NUMBER, 22), (SKILL, 100), (STATUS, STATUS_WIDTH)):
             columns.resizeSection(column, width)
         columns.setSectionResizeMode(PARAMS, QHeaderView.Stretch)
+        self.compact = False
         if model.blueprint:
             self.setDragEnabled(True)
             self.setAcceptDrops(True)
@@ -85,6 +90,18 @@ class SectionTable(QTableView):  # type: ignore[misc]
         """The model shown."""
         model: SectionModel = self.model()
         return model
+
+    def set_compact(self, compact: bool) -> None:
+        """Compact: no number or parameter cells; the status takes the rest of the width."""
+        self.compact = compact
+        self.setColumnHidden(NUMBER, compact)
+        self.setColumnHidden(PARAMS, compact)
+        columns = self.horizontalHeader()
+        status_mode = QHeaderView.Stretch if compact else QHeaderView.Interactive
+        columns.setSectionResizeMode(STATUS, status_mode)
+        columns.setSectionResizeMode(PARAMS, QHeaderView.Stretch)
+        if not compact:
+            columns.resizeSection(STATUS, STATUS_WIDTH)
 
     def mousePressEvent(self, event: object) -> None:
         """Clicking below the rows clears the selection (of every column)."""
@@ -194,6 +211,23 @@ class AgentColumn(QFrame):  # type: ignore[misc]
     def tables(self) -> tuple[SectionTable, SectionTable]:
         """The synchronized table and the blueprint table."""
         return self.synced_table, self.blueprint_table
+
+    @property
+    def compact(self) -> bool:
+        """The column is in compact mode."""
+        return self.synced_table.compact
+
+    def set_compact(self, compact: bool) -> None:
+        """Narrow the column and drop its number and parameter cells (or bring them back)."""
+        if compact == self.compact:
+            return
+        self.setMinimumWidth(COMPACT_WIDTH if compact else COLUMN_WIDTH)
+        self.setMaximumWidth(COMPACT_MAX_WIDTH if compact else MAX_COLUMN_WIDTH)
+        for table in self.tables:
+            table.set_compact(compact)
+        self.add_button.setText("Add" if compact else "Add skill")
+        self.buttons[RobotAction.SYNC_ALL].setText("Sync" if compact else "Sync all")
+        self.policy_button.setText("Link…" if compact else "Link loss…")
 
     def show_task(self, task: AgentView) -> None:
         """Show the robot's task (only rows that changed are touched)."""
