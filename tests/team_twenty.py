@@ -27,6 +27,8 @@ MODELS = {"drone": "drone_scout", "science_rover": "rover_science"}
 MODELS["manipulator_rover"] = "rover_manipulator"
 FIRST_SKILL = {"drone": "take_off", "science_rover": "explore"}
 FIRST_SKILL["manipulator_rover"] = "pick_box"
+# The robots :func:`stage` leaves waiting (at a barrier, or with commands for a cut-off robot).
+WAITING = ["drone_5", "science_rover_3", "manipulator_rover_3", "manipulator_rover_6"]
 
 
 @dataclass(frozen=True)
