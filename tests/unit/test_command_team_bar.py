@@ -8,20 +8,28 @@ and by status; the test checks which columns are on screen after each click.
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
 from python_qt_binding.QtCore import QPoint, QRect, Qt
+from python_qt_binding.QtGui import QColor, QImage
 from python_qt_binding.QtTest import QTest
 from python_qt_binding.QtWidgets import QApplication
 
 from rosmc_rqt_command.agent_column import COLUMN_WIDTH, COMPACT_WIDTH, AgentColumn
+from rosmc_rqt_command.presentation import STATUS_COLOURS
 from rosmc_rqt_command.team_bar import TeamBar
 from rosmc_server.core import SkillStatus
 from tests import conftest
 from tests.team_twenty import WAITING, Staged, stage, twenty_robot_library
 from tests.unit.conftest import make_mission
 from tests.unit.test_command_harness import Gui
+
+REPO = Path(__file__).resolve().parents[2]
+TOOL = REPO / "tools" / "command_gui_team_screenshot.py"
 
 
 @pytest.fixture
@@ -182,3 +190,36 @@ def test_status_filter_follows_the_mission_live(big: tuple[Gui, Staged]) -> None
     gui.feed("retry", failed.id)
     settle(gui)
     assert team(gui).visible() == ["drone_4"]
+
+
+def row_pixels(picture: Path, status: SkillStatus) -> int:
+    """Pixels of ``status``'s row colour above the colour key (the key has one swatch)."""
+    image = QImage(str(picture))
+    assert (image.width(), image.height()) == (1600, 1000)
+    colour = QColor(STATUS_COLOURS[status]).rgb()
+    legend_top = 940  # the colour key sits in the bottom rows of the window
+    return sum(
+        image.pixel(x, y) == colour for x in range(0, 1200, 2) for y in range(100, legend_top, 2)
+    )
+
+
+def test_the_readme_screenshot_command_shows_the_filtered_team(tmp_path: Path) -> None:
+    """``tools/command_gui_team_screenshot.py``, as the README shows it, with two filters.
+
+    Unfiltered, the first columns hold the failed drone and no barrier wait.
+    """
+    shots = {}
+    for status in ("waiting", "failed"):
+        shots[status] = tmp_path / f"{status}.png"
+        subprocess.run(
+            [sys.executable, str(TOOL), "--compact", "--status", status, "-o", str(shots[status])],
+            check=True,
+            cwd=REPO,
+            capture_output=True,
+            timeout=120,
+        )
+    waiting, failure = SkillStatus.SYNCWAITING, SkillStatus.FAILURE
+    assert row_pixels(shots["waiting"], waiting) > 0  # the rovers waiting at their barrier
+    assert row_pixels(shots["waiting"], failure) == 0
+    assert row_pixels(shots["failed"], failure) > 0  # only the failed drone's column
+    assert row_pixels(shots["failed"], waiting) == 0
