@@ -203,23 +203,24 @@ def row_pixels(picture: Path, status: SkillStatus) -> int:
     )
 
 
-def test_the_readme_screenshot_command_shows_the_filtered_team(tmp_path: Path) -> None:
-    """``tools/command_gui_team_screenshot.py``, as the README shows it, with two filters.
+def test_the_readme_screenshot_commands_show_the_team(tmp_path: Path) -> None:
+    """``tools/command_gui_team_screenshot.py`` as the README shows it, then filtered.
 
-    Unfiltered, the first columns hold the failed drone and no barrier wait.
+    All robots: the first columns hold the failed drone, the barrier waits are off screen.
+    Waiting only: the rovers waiting at their barrier come on screen, the failed drone goes.
     """
     shots = {}
-    for status in ("waiting", "failed"):
-        shots[status] = tmp_path / f"{status}.png"
+    for name, extra in (("all", []), ("waiting", ["--status", "waiting"])):
+        shots[name] = tmp_path / f"{name}.png"
         subprocess.run(
-            [sys.executable, str(TOOL), "--compact", "--status", status, "-o", str(shots[status])],
+            [sys.executable, str(TOOL), "--compact", *extra, "-o", str(shots[name])],
             check=True,
             cwd=REPO,
             capture_output=True,
             timeout=120,
         )
     waiting, failure = SkillStatus.SYNCWAITING, SkillStatus.FAILURE
-    assert row_pixels(shots["waiting"], waiting) > 0  # the rovers waiting at their barrier
+    assert row_pixels(shots["all"], failure) > 0
+    assert row_pixels(shots["all"], waiting) == 0
+    assert row_pixels(shots["waiting"], waiting) > 0
     assert row_pixels(shots["waiting"], failure) == 0
-    assert row_pixels(shots["failed"], failure) > 0  # only the failed drone's column
-    assert row_pixels(shots["failed"], waiting) == 0
