@@ -14,16 +14,14 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from python_qt_binding.QtCore import QPoint, QRect, Qt
+from python_qt_binding.QtCore import Qt
 from python_qt_binding.QtGui import QColor, QImage
 from python_qt_binding.QtTest import QTest
-from python_qt_binding.QtWidgets import QApplication
 
-from rosmc_rqt_command.agent_column import COLUMN_WIDTH, COMPACT_WIDTH, AgentColumn
+from rosmc_rqt_command.agent_column import COLUMN_WIDTH, COMPACT_WIDTH
 from rosmc_rqt_command.presentation import STATUS_COLOURS
-from rosmc_rqt_command.team_bar import TeamBar
 from rosmc_server.core import SkillStatus
-from tests import conftest
+from tests.team_gui import click, columns, on_screen, settle, step_right, team, tick
 from tests.team_twenty import WAITING, Staged, stage, twenty_robot_library
 from tests.unit.conftest import make_mission
 from tests.unit.test_command_harness import Gui
@@ -39,157 +37,97 @@ def big() -> Iterator[tuple[Gui, Staged]]:
     gui = Gui(make_mission(library), library)
     gui.widget.resize(1600, 1000)
     staged = stage(gui.feed)
-    settle(gui)
+    settle(gui.widget)
     yield gui, staged
     gui.close()
-
-
-def settle(gui: Gui) -> None:
-    """Let Qt lay the columns out (and show the robots' reports)."""
-    timer = gui.widget._status_timer
-    conftest.wait_until(lambda: not timer.isActive(), 10, "reports shown", pause=conftest.qt_pause)
-    for _ in range(3):
-        QApplication.processEvents()
-
-
-def on_screen(gui: Gui) -> list[str]:
-    """Robots whose whole column is inside the schedule's viewport now."""
-    schedule = gui.widget.schedule
-    viewport = schedule.viewport().rect()
-    shown = []
-    for agent, column in schedule.columns.items():
-        if column.isVisible():
-            top_left = column.mapTo(schedule.viewport(), QPoint(0, 0))
-            if viewport.contains(QRect(top_left, column.size())):
-                shown.append(agent)
-    return shown
-
-
-def step_right(gui: Gui) -> None:
-    """Click the scroll bar's right arrow, as with the mouse."""
-    bar = gui.widget.schedule.horizontalScrollBar()
-    arrow = bar.height()  # the arrow buttons are square
-    arrow_centre = QPoint(bar.width() - arrow // 2, arrow // 2)
-    QTest.mouseClick(bar, Qt.LeftButton, Qt.NoModifier, arrow_centre)
-    QApplication.processEvents()
-
-
-def team(gui: Gui) -> TeamBar:
-    bar: TeamBar = gui.widget.team
-    return bar
-
-
-def click(gui: Gui, name: str) -> None:
-    widget = gui.widget.findChild(object, name)
-    assert widget is not None, name
-    QTest.mouseClick(widget, Qt.LeftButton)
-    settle(gui)
-
-
-def tick(gui: Gui, agent: str) -> None:
-    """Open the robot list with the mouse and click ``agent``'s entry."""
-    click(gui, "team_robots")
-    menu = team(gui).robot_menu
-    conftest.wait_until(menu.isVisible, 5, "the robot list open", pause=conftest.qt_pause)
-    action = next(a for a in menu.actions() if a.text() == agent)
-    QTest.mouseClick(menu, Qt.LeftButton, Qt.NoModifier, menu.actionGeometry(action).center())
-    # A robot's entry toggles and the list stays open; "Show all robots" closes it.
-    assert menu.isVisible() is action.isCheckable()
-    menu.hide()
-    settle(gui)
-
-
-def columns(gui: Gui) -> dict[str, AgentColumn]:
-    cols: dict[str, AgentColumn] = gui.widget.schedule.columns
-    return cols
 
 
 def test_every_robot_is_reachable_by_scrolling_at_a_readable_width(
     big: tuple[Gui, Staged],
 ) -> None:
     gui, staged = big
-    assert list(columns(gui)) == list(staged.robots)
-    assert team(gui).count.text() == "20 of 20 robots shown"
-    first = on_screen(gui)
+    assert list(columns(gui.widget)) == list(staged.robots)
+    assert team(gui.widget).count.text() == "20 of 20 robots shown"
+    first = on_screen(gui.widget)
     assert first[0] == "drone_1" and len(first) < len(staged.robots)
     seen = list(first)
     bar = gui.widget.schedule.horizontalScrollBar()
     while bar.value() < bar.maximum():
         before = bar.value()
-        step_right(gui)
+        step_right(gui.widget)
         assert bar.value() > before, "a click on the scroll bar moves the schedule"
-        seen += [agent for agent in on_screen(gui) if agent not in seen]
+        seen += [agent for agent in on_screen(gui.widget) if agent not in seen]
     assert seen == list(staged.robots)
-    assert all(c.width() >= COLUMN_WIDTH for c in columns(gui).values())
+    assert all(c.width() >= COLUMN_WIDTH for c in columns(gui.widget).values())
 
 
 def test_compact_mode_fits_more_columns_and_drops_cells(big: tuple[Gui, Staged]) -> None:
     gui, _staged = big
-    wide = on_screen(gui)
-    click(gui, "team_compact")
-    compact = on_screen(gui)
+    wide = on_screen(gui.widget)
+    click(gui.widget, "team_compact")
+    compact = on_screen(gui.widget)
     assert len(compact) > len(wide)
     assert compact[: len(wide)] == wide
-    for column in columns(gui).values():
+    for column in columns(gui.widget).values():
         assert column.width() >= COMPACT_WIDTH
         assert column.width() < COLUMN_WIDTH
         assert column.synced_table.isColumnHidden(1) and column.blueprint_table.isColumnHidden(4)
-    click(gui, "team_compact")  # and back
-    assert on_screen(gui) == wide
-    assert not columns(gui)["drone_1"].blueprint_table.isColumnHidden(4)
+    click(gui.widget, "team_compact")  # and back
+    assert on_screen(gui.widget) == wide
+    assert not columns(gui.widget)["drone_1"].blueprint_table.isColumnHidden(4)
 
 
 def test_filters_show_exactly_the_chosen_robots(big: tuple[Gui, Staged]) -> None:
     gui, staged = big
-    bar = team(gui)
+    bar = team(gui.widget)
     # By name: typed into the filter field.
     QTest.mouseClick(bar.text, Qt.LeftButton)
     QTest.keyClicks(bar.text, "science")
-    settle(gui)
+    settle(gui.widget)
     science = [f"science_rover_{n}" for n in range(1, 8)]
     assert bar.visible() == science
-    assert on_screen(gui) == science[: len(on_screen(gui))]
+    assert on_screen(gui.widget) == science[: len(on_screen(gui.widget))]
     # By the robot list: untick two, tick one back.
-    tick(gui, "science_rover_2")
-    tick(gui, "science_rover_5")
+    tick(gui.widget, "science_rover_2")
+    tick(gui.widget, "science_rover_5")
     assert bar.visible() == [r for r in science if r not in ("science_rover_2", "science_rover_5")]
-    tick(gui, "science_rover_2")
+    tick(gui.widget, "science_rover_2")
     assert bar.visible() == [r for r in science if r != "science_rover_5"]
     assert bar.count.text() == "6 of 20 robots shown"
     # By status, with the name filter cleared.
     bar.text.clear()
-    settle(gui)
-    click(gui, "team_status_failed")
+    settle(gui.widget)
+    click(gui.widget, "team_status_failed")
     assert bar.visible() == list(staged.failed)
-    click(gui, "team_status_out_of_contact")
+    click(gui.widget, "team_status_out_of_contact")
     assert bar.visible() == list(staged.out_of_contact)
-    click(gui, "team_status_waiting")
+    click(gui.widget, "team_status_waiting")
     assert bar.visible() == WAITING
-    click(gui, "team_compact")
-    assert on_screen(gui) == bar.visible()  # compact, the four fit: no scrolling needed
-    click(gui, "team_compact")
-    click(gui, "team_status_all")
+    click(gui.widget, "team_compact")
+    assert on_screen(gui.widget) == bar.visible()  # compact, the four fit: no scrolling needed
+    click(gui.widget, "team_compact")
+    click(gui.widget, "team_status_all")
     assert bar.visible() == [r for r in staged.robots if r != "science_rover_5"]
-    tick(gui, "Show all robots")
+    tick(gui.widget, "Show all robots")
     assert bar.visible() == list(staged.robots)
     assert gui.backend.requests == []  # filtering never changes the mission
 
 
 def test_status_filter_follows_the_mission_live(big: tuple[Gui, Staged]) -> None:
     gui, _staged = big
-    click(gui, "team_status_failed")
+    click(gui.widget, "team_status_failed")
     running = next(
         s for s in gui.widget.view.view("drone_4").skills if s.status is SkillStatus.RUNNING
     )
     gui.feed("report_status", running.id, SkillStatus.FAILURE, text="lost the horizon")
-    settle(gui)
-    assert team(gui).visible() == ["drone_2", "drone_4"]
+    settle(gui.widget)
+    assert team(gui.widget).visible() == ["drone_2", "drone_4"]
     failed = next(
         s for s in gui.widget.view.view("drone_2").skills if s.status is SkillStatus.FAILURE
     )
     gui.feed("retry", failed.id)
-    settle(gui)
-    assert team(gui).visible() == ["drone_4"]
+    settle(gui.widget)
+    assert team(gui.widget).visible() == ["drone_4"]
 
 
 def row_pixels(picture: Path, status: SkillStatus) -> int:
