@@ -43,6 +43,11 @@ class Staged:
 
 def twenty_robot_library() -> Library:
     """The Mars library with the 20-robot scenario's robots (and the lander)."""
+    return library_from_dict(twenty_robot_library_data(), "mars_twenty_robots.yaml")
+
+
+def twenty_robot_library_data() -> dict[str, Any]:
+    """:func:`twenty_robot_library` as library file data (for a server to load)."""
     data: dict[str, Any] = copy.deepcopy(yaml.safe_load(MARS_LIBRARY.read_text()))
     agents = {
         robot.name: {"kind": "dynamic", "model": MODELS[robot.kind]}
@@ -51,7 +56,7 @@ def twenty_robot_library() -> Library:
     agents["lander"] = data["agents"]["lander"]
     data["agents"] = agents
     data["name"] = "mars_twenty_robots"
-    return library_from_dict(data, "mars_twenty_robots.yaml")
+    return data
 
 
 def stage(feed: Any) -> Staged:
