@@ -9,6 +9,7 @@ narrower. Which robots pass is decided by :mod:`.team_filter` (no Qt there).
 
 from __future__ import annotations
 
+from python_qt_binding.QtCore import Qt
 from python_qt_binding.QtWidgets import (
     QAction,
     QButtonGroup,
@@ -55,6 +56,8 @@ class TeamBar(QWidget):  # type: ignore[misc]
         self.text.setClearButtonEnabled(True)
         self.text.setToolTip("Names or parts of names, separated by commas: drone, rover_3")
         self.text.setMaximumWidth(220)
+        # Not the window's first focus: the schedule's shortcuts (Delete, arrows) stay live.
+        self.text.setFocusPolicy(Qt.ClickFocus)
         self.text.textChanged.connect(self._on_text_text_changed)
         self.robot_menu = StayOpenMenu(self)
         self.robot_menu.triggered.connect(self._on_robot_menu_triggered)
