@@ -11,6 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 
 from python_qt_binding.QtCore import QSize, Qt, Signal
+from python_qt_binding.QtGui import QIcon
 from python_qt_binding.QtWidgets import (
     QAbstractItemView,
     QFrame,
@@ -42,6 +43,18 @@ ROW_HEIGHT = 22
 # and at most that wide (few robots: the columns share the width).
 COLUMN_WIDTH = 330
 MAX_COLUMN_WIDTH = 460
+# Compact mode (a large team): narrower columns without the number and parameter cells.
+COMPACT_WIDTH = 222
+COMPACT_MAX_WIDTH = 226
+SKILL_WIDTH = 100
+STATUS_WIDTH = 174
+WIDTHS = ((TAG, 26), (NUMBER, 22), (SKILL, SKILL_WIDTH), (STATUS, STATUS_WIDTH))
+# The robot's name and the blueprint's caption, by compact or not.
+NAME_STYLE = {
+    False: "<b style='font-size:13pt'>{agent}</b>",
+    True: "<b style='font-size:10.5pt'>{agent}</b>",
+}
+BLUEPRINT_CAPTION = {False: "<i>Blueprint (planned, editable)</i>", True: "<i>Blueprint</i>"}
 AskPolicy = Callable[[str, Sequence[str], QWidget, str], LostLinkPolicy | None]
 
 
@@ -70,9 +83,10 @@ class SectionTable(QTableView):  # type: ignore[misc]
         rows.setDefaultSectionSize(ROW_HEIGHT)
         columns = self.horizontalHeader()
         columns.setHighlightSections(False)
-        for column, width in ((TAG, 26), (NUMBER, 22), (SKILL, 100), (STATUS, 174)):
+        for column, width in WIDTHS:
             columns.resizeSection(column, width)
         columns.setSectionResizeMode(PARAMS, QHeaderView.Stretch)
+        self.compact = False
         if model.blueprint:
             self.setDragEnabled(True)
             self.setAcceptDrops(True)
@@ -85,6 +99,19 @@ class SectionTable(QTableView):  # type: ignore[misc]
         """The model shown."""
         model: SectionModel = self.model()
         return model
+
+    def set_compact(self, compact: bool) -> None:
+        """Compact: no number or parameter cells; skill and status share the width."""
+        self.compact = compact
+        self.setColumnHidden(NUMBER, compact)
+        self.setColumnHidden(PARAMS, compact)
+        columns = self.horizontalHeader()
+        mode = QHeaderView.Stretch if compact else QHeaderView.Interactive
+        for column in (SKILL, STATUS):
+            columns.setSectionResizeMode(column, mode)
+        if not compact:
+            for column, width in WIDTHS[2:]:
+                columns.resizeSection(column, width)
 
     def mousePressEvent(self, event: object) -> None:
         """Clicking below the rows clears the selection (of every column)."""
@@ -126,7 +153,8 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         self.synced_table.setObjectName(f"synced_{agent}")
         self.blueprint_table.setObjectName(f"blueprint_{agent}")
 
-        self.name_label = QLabel(f"<b style='font-size:13pt'>{agent}</b>")
+        self.name_label = QLabel(NAME_STYLE[False].format(agent=agent))
+        self.name_label.setToolTip(agent)
         self.status_label = QLabel(presentation.link_summary(None))
         self.status_label.setWordWrap(True)
         self.status_label.setObjectName(f"status_{agent}")
@@ -138,6 +166,7 @@ class AgentColumn(QFrame):  # type: ignore[misc]
             "Link loss…", "", "Choose what the robot does when it loses contact with the ground"
         )
         self.policy_button.setObjectName(f"policy_{agent}")
+        self._link_icon = self.style().standardIcon(QStyle.SP_DriveNetIcon)
         self.policy_button.clicked.connect(self._on_policy_button_clicked)
 
         self.add_menu = QMenu(self)
@@ -164,7 +193,7 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         header.addLayout(top)
         header.addWidget(self.status_label)
         header.addWidget(self.warning_label)
-        bar = QHBoxLayout()
+        bar = self._bar = QHBoxLayout()
         bar.addWidget(self.add_button)
         for button in self.buttons.values():
             bar.addWidget(button)
@@ -172,9 +201,10 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         layout = QVBoxLayout(self)
         layout.setContentsMargins(4, 4, 4, 4)
         layout.addLayout(header)
+        self.blueprint_caption = QLabel(BLUEPRINT_CAPTION[False])
         layout.addWidget(QLabel("<i>On the robot</i>"))
         layout.addWidget(self.synced_table, 2)
-        layout.addWidget(QLabel("<i>Blueprint (planned, editable)</i>"))
+        layout.addWidget(self.blueprint_caption)
         layout.addWidget(self.blueprint_table, 3)
         layout.addLayout(bar)
 
@@ -194,6 +224,31 @@ class AgentColumn(QFrame):  # type: ignore[misc]
     def tables(self) -> tuple[SectionTable, SectionTable]:
         """The synchronized table and the blueprint table."""
         return self.synced_table, self.blueprint_table
+
+    @property
+    def compact(self) -> bool:
+        """The column is in compact mode."""
+        return self.synced_table.compact
+
+    def set_compact(self, compact: bool) -> None:
+        """Narrow the column and drop its number and parameter cells (or bring them back)."""
+        if compact == self.compact:
+            return
+        self.setMinimumWidth(COMPACT_WIDTH if compact else COLUMN_WIDTH)
+        self.setMaximumWidth(COMPACT_MAX_WIDTH if compact else MAX_COLUMN_WIDTH)
+        for table in self.tables:
+            table.set_compact(compact)
+        self.add_button.setText("+" if compact else "Add skill")
+        self.buttons[RobotAction.SYNC_ALL].setText("Sync" if compact else "Sync all")
+        # Compact, the robot's name needs the room: the policy button shows an icon only.
+        self.policy_button.setText("" if compact else "Link loss…")
+        self.policy_button.setIcon(self._link_icon if compact else QIcon())
+        self.policy_button.setToolButtonStyle(
+            Qt.ToolButtonIconOnly if compact else Qt.ToolButtonTextBesideIcon
+        )
+        self.name_label.setText(NAME_STYLE[compact].format(agent=self.agent))
+        self.blueprint_caption.setText(BLUEPRINT_CAPTION[compact])
+        self._bar.setSpacing(1 if compact else -1)  # -1: the style's spacing
 
     def show_task(self, task: AgentView) -> None:
         """Show the robot's task (only rows that changed are touched)."""

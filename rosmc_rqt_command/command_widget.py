@@ -41,6 +41,7 @@ from .requests import Answer, Backend, Request
 from .schedule_widget import ScheduleWidget
 from .science_strip import ScienceStrip
 from .site_strip import SiteStrip
+from .team_bar import TeamBar
 from .team_dialog import ask_team_send
 from .view_state import ViewUpdate
 
@@ -122,6 +123,8 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         left_layout.addWidget(self.science)
         self.site = SiteStrip()
         left_layout.addWidget(self.site)
+        self.team = TeamBar(self.schedule, self.view)
+        left_layout.addWidget(self.team)
         left_layout.addWidget(self.schedule, 1)
         left_layout.addWidget(self.legend)
         self.splitter = QSplitter(Qt.Horizontal)
@@ -194,6 +197,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
             self.messages.say(f"Mission shown (revision {self.view.revision}).", "ok")
         if reset:
             self.banner.hide()
+        self.team.refresh()
         if self._pending_statuses and not self._status_timer.isActive():
             self._status_timer.start()
         if (agents or reset) and not self._warn_timer.isActive():
@@ -386,6 +390,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
     def _on_status_timer_timeout(self) -> None:
         statuses, self._pending_statuses = self._pending_statuses, {}
         self.schedule.show_statuses(statuses.values())
+        self.team.refresh()
         self._update_legal(statuses)
         if not self._warn_timer.isActive():
             self._warn_timer.start(300)
