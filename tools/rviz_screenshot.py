@@ -115,7 +115,16 @@ class Screenshot:
         return float(self.near(color, tolerance).mean())
 
     def view(self, background: RGB, tolerance: int = 3) -> Screenshot | None:
-        """The 3D view: the rows and columns mostly of the ``background`` colour, or None.
+        """The 3D view (see :meth:`view_box`), or None."""
+        box = self.view_box(background, tolerance)
+        if box is None:
+            return None
+        left, top, width, height = box
+        return Screenshot(self.pixels[top : top + height, left : left + width])
+
+    def view_box(self, background: RGB, tolerance: int = 3) -> tuple[int, int, int, int] | None:
+        """Left, top, width and height of the 3D view, or None: the rows and columns mostly
+        of the ``background`` colour.
 
         rviz's window around the view (panels, toolbars) never has the view's background
         in more than a few pixels of a row or column; what the view shows (markers, grid)
@@ -133,7 +142,7 @@ class Screenshot:
         if by_chrome is not None and _area(by_chrome) * 0.9 > _area(by_background):
             box = by_chrome
         top, bottom, left, right = box
-        return Screenshot(self.pixels[top : bottom + 1, left : right + 1])
+        return left, top, right - left + 1, bottom - top + 1
 
     @staticmethod
     def _box(mask: np.ndarray, longest: bool = False) -> tuple[int, int, int, int] | None:

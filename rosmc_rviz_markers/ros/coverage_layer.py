@@ -82,10 +82,13 @@ class CoverageLayer:
             measured = measured_cells(self._radio, self._now)
             marks = last_links(self._radio, self._now)
         out = MarkerArray()
+        # Under the site's pick ground (its top at z = 0) and every interactive marker: rviz
+        # picks the nearest surface, so shading above them would take the operator's clicks
+        # (Publish Point, drags) for itself. The readings lie above the model.
         if model:
-            out.markers.append(_cubes("coverage_model", model, 0.01, 0.02))
+            out.markers.append(_cubes("coverage_model", model, -0.045, 0.01))
         if measured:
-            out.markers.append(_cubes("coverage_measured", measured, 0.03, 0.05))
+            out.markers.append(_cubes("coverage_measured", measured, -0.03, 0.01))
         for index, mark in enumerate(marks):
             out.markers += _last_link(index, mark)
         self._publisher.publish(out)

@@ -24,7 +24,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pytest
 import rospy
 from visualization_msgs.msg import InteractiveMarkerFeedback
@@ -96,16 +95,9 @@ class Screen:
 
 def view_box(shot: Any, background: tuple[int, int, int]) -> tuple[int, int, int, int]:
     """Left, top, width and height of the 3D view in a screenshot (as Screenshot.view)."""
-    mask = shot.near(background, 3)
-    rows = np.flatnonzero(mask.mean(axis=1) > 0.5)
-    columns = np.flatnonzero(mask.mean(axis=0) > 0.5)
-    assert rows.size and columns.size, "no 3D view on the screen"
-    return (
-        int(columns[0]),
-        int(rows[0]),
-        int(columns[-1] - columns[0] + 1),
-        int(rows[-1] - rows[0] + 1),
-    )
+    box = shot.view_box(background)
+    assert box is not None, "no 3D view on the screen"
+    return tuple(box)
 
 
 @pytest.fixture
