@@ -84,13 +84,13 @@ class TickSlider(QWidget):  # type: ignore[misc]
 
     def x_of(self, seconds: float) -> int:
         """The x pixel of a time on the track."""
-        span = max(1, self.width() - 2 * MARGIN)
+        span = max(1, int(self.width()) - 2 * MARGIN)
         share = seconds / self.duration if self.duration > 0 else 0.0
         return MARGIN + round(min(max(share, 0.0), 1.0) * span)
 
     def time_at(self, x: int) -> float:
         """The time under an x pixel (clamped to the recording)."""
-        span = max(1, self.width() - 2 * MARGIN)
+        span = max(1, int(self.width()) - 2 * MARGIN)
         return min(max((x - MARGIN) / span, 0.0), 1.0) * self.duration
 
     def tick_at(self, x: int) -> ReplayTick | None:

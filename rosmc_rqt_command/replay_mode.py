@@ -206,4 +206,3 @@ class ReplayMode(QObject):  # type: ignore[misc]
         if failure is not None:
             self._widget.messages.say(f"The replay stopped: {failure}", "error")
             self.return_to_live()
-

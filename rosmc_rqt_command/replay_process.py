@@ -35,7 +35,8 @@ class ReplayProcess:
     def __init__(self, path: str | Path, prefix: str) -> None:
         self.path = Path(path)
         self.prefix = prefix
-        self._log = tempfile.TemporaryFile(mode="w+", prefix="rosmc-replay-")
+        # The replay's stderr, kept while it runs (closed by stop()).
+        self._log = tempfile.TemporaryFile(mode="w+", prefix="rosmc-replay-")  # noqa: SIM115
         self._children: list[subprocess.Popen[bytes]] = []
 
     def start(self) -> None:

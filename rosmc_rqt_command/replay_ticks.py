@@ -57,7 +57,10 @@ def outline_of(path: str | Path) -> RecordingOutline:
         RosmcError: The file is not a readable recording (the reader's error).
     """
     history, timeline = timeline_with_overlays(path)
-    ticks = [ReplayTick(m.time, TickKind.OPERATOR, f"operator: {m.summary}") for m in timeline.marks]
+    ticks = [
+        ReplayTick(mark.time, TickKind.OPERATOR, f"operator: {mark.summary}")
+        for mark in timeline.marks
+    ]
     for interval in timeline.intervals:
         kind = _OUTCOMES.get(interval.outcome) if interval.outcome else None
         if kind is not None:

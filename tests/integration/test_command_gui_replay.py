@@ -194,8 +194,18 @@ def test_following_a_replay_greys_out_what_cannot_act(
     client_node: Any, launch_process: Any
 ) -> None:
     launch_process(
-        [sys.executable, os.path.join(REPO, "scripts", "rosmc"), "replay", str(SAMPLE),
-         "--prefix", "/following", "--start", "2", "--paused", "--hold"],
+        [
+            sys.executable,
+            os.path.join(REPO, "scripts", "rosmc"),
+            "replay",
+            str(SAMPLE),
+            "--prefix",
+            "/following",
+            "--start",
+            "2",
+            "--paused",
+            "--hold",
+        ],
         name="replay",
     )
     rospy.wait_for_service("/following/rosmc/replay/control", timeout=30.0)
