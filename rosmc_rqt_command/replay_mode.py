@@ -193,6 +193,8 @@ class ReplayMode(QObject):  # type: ignore[misc]
     def _on_link_state_received(self, shown: ShownStatus) -> None:
         if not self.active:
             return
+        if self.bar.shown is None and self._backend is not None:
+            self._backend.refresh()  # the replay is up: fetch its mission now, not on a retry
         self.bar.show_status(shown)
         ended = shown.status.ended
         if ended and not self._ended_said:
