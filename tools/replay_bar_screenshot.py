@@ -53,7 +53,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         ros_master(Path(tmp)) as env,
     ):
         os.environ.update(env, DISPLAY=display, QT_QPA_PLATFORM="xcb")
-        server = launch(env, Path(tmp) / "server.log", str(REPO / "launch" / "mission_server.launch"), f"journal_dir:={tmp}")
+        server_launch = str(REPO / "launch" / "mission_server.launch")
+        server = launch(env, Path(tmp) / "server.log", server_launch, f"journal_dir:={tmp}")
         try:
             return run(args, display, (width, height))
         finally:
@@ -94,8 +95,10 @@ def run(args: argparse.Namespace, display: str, size: tuple[int, int]) -> int:
         wait(lambda: bar.play_button.isEnabled(), "the replay answers")
         outcomes = (TickKind.SUCCESS, TickKind.FAILURE)
         tick = next(t for t in bar.slider.ticks if t.kind in outcomes and t.time >= args.at)
-        QTest.mouseClick(bar.slider, Qt.LeftButton, Qt.NoModifier, QPoint(bar.slider.x_of(tick.time), 6))
-        wait(lambda: bar.shown and bar.shown.status.position == tick.time, f"the replay at {tick.text}")
+        point = QPoint(bar.slider.x_of(tick.time), 6)
+        QTest.mouseClick(bar.slider, Qt.LeftButton, Qt.NoModifier, point)
+        there = f"the replay at {tick.text}"
+        wait(lambda: bar.shown and bar.shown.status.position == tick.time, there)
         revision = MissionHistory.from_journal(args.recording).revision_at(tick.time).revision
         wait(lambda: widget.view.revision == revision, f"the mission at r{revision}")
         wait(lambda: widget.view.statuses, "the robots reported")
