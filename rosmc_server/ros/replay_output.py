@@ -10,7 +10,8 @@ Publishes (each name behind the prefix): every topic of :data:`TYPES`, latched a
 publishers latch them (:data:`~rosmc_server.recording.channels.LATCHED_TOPICS`), and the
 robots' agent states and TF latched too (:data:`STANDING`): a paused replay sends them once,
 and a GUI or rviz that joins later must still see where the robots stand. A robot the
-server had not heard from yet is reported where it was first heard (its first telemetry).
+server had not heard from yet is reported, once the replay stood paused, where it was first
+heard (its first telemetry).
 """
 
 from __future__ import annotations
@@ -97,31 +98,37 @@ class ReplayOutput:
         }
         self._tf = StampShift()
         self._standing = standing or {}  # first telemetry by robot: see first_telemetry
+        self._stand = False  # robots not heard yet are shown where first heard (once paused)
         self._shown: set[str] = set()  # topics of CURRENT_AT_START published so far
 
     def publish(self, topic: str, msg: Any) -> None:
         """Publish one recorded message on its topic (TF with the current stamp shift)."""
         if topic == interface.TF_TOPIC:
             msg = self._shifted(msg)
-        elif topic == interface.AGENT_STATES_TOPIC:
+        elif topic == interface.AGENT_STATES_TOPIC and self._stand:
             msg = self._standing_robots(msg)
         self._publishers[topic].publish(msg)
         if topic in CURRENT_AT_START:
             self._shown.add(topic)
 
-    def publish_state_at(self, playlist: Playlist, position: float, *, moved: bool) -> None:
+    def publish_state_at(
+        self, playlist: Playlist, position: float, *, moved: bool, paused: bool = False
+    ) -> None:
         """Publish the newest agent states, TF, site and score recorded until ``position``.
 
-        Before their first record, the robots stand where that record puts them
-        (:data:`STANDING`). Any other topic with nothing recorded until then that was
-        published before (a seek back) gets its empty form: no score, a site cleared.
-        ``moved``: after a seek.
+        A topic with nothing recorded until then that was published before (a seek back)
+        gets its empty form: no score, a site cleared. ``moved``: after a seek.
+        ``paused``: the replay stands at ``position``; then robots stand where they were
+        first recorded (:data:`STANDING`) even before their first record, and from now on
+        robots the server had not heard from yet are reported where they were first heard.
+        (A replay that plays on republishes the records exactly as recorded.)
         """
         if moved:
             self._tf.moved()
+        self._stand = self._stand or paused
         for topic in CURRENT_AT_START:
             record = playlist.latest(topic, position)
-            if record is None and topic in STANDING:
+            if record is None and topic in STANDING and paused:
                 record = playlist.earliest(topic)
             if record is not None:
                 self.publish(topic, record.message)

@@ -299,7 +299,9 @@ class RecordingReplayer:
             self._current = self._history.revision_at(position).revision
             self._stamp = self._mission_stamp(position)
             self._publish_snapshot(self._current, position)
-            self._out().publish_state_at(self._playlist, position, moved=status.seeks > 0)
+            self._out().publish_state_at(
+                self._playlist, position, moved=status.seeks > 0, paused=status.paused
+            )
             self._handled_seeks = status.seeks
             self._handled.notify_all()
         self._announce()
