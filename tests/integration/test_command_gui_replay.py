@@ -15,6 +15,7 @@ from collections.abc import Iterator
 from typing import Any
 
 import pytest
+import rosgraph
 import rospy
 
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
@@ -76,6 +77,12 @@ def first_poses() -> dict[str, tuple[float, float]]:
                 if status.pose is not None:
                     found.setdefault(agent, (status.pose.x, status.pose.y))
     return found
+
+
+def marker_topics() -> set[str]:
+    """The topics published on the master right now."""
+    publishers, _subscribers, _services = rosgraph.Master("/test").getSystemState()
+    return {topic for topic, _nodes in publishers}
 
 
 def skill_statuses(window: Window) -> dict[str, str]:
@@ -143,6 +150,12 @@ def test_open_a_recording_seek_to_an_event_play_to_the_end_and_return_to_live(
     expected = first_poses()
     assert len(expected) == 3 and len(set(expected.values())) == 3, expected
     wait_until(lambda: statuses(window) == expected, 20, "the robots where they stood")
+    # rviz follows the same replay: the marker node the GUI started serves under /replay.
+    wait_until(
+        lambda: "/replay/rosmc/markers/update_full" in marker_topics(),
+        30,
+        "the replay's marker node for rviz",
+    )
 
     # Clicking the tick of an event moves the replay there: the mission as it was then.
     tick = next(t for t in bar.slider.ticks if t.kind is TickKind.SUCCESS)
