@@ -281,6 +281,7 @@ class AgentColumn(QFrame):  # type: ignore[misc]
             button.setEnabled(not read_only and action in legal)
         self.add_button.setEnabled(not read_only and not self.add_menu.isEmpty())
         self.policy_button.setEnabled(not read_only and bool(self.skill_names))
+        self.blueprint_table.setDragEnabled(not read_only)  # no reordering a replay
 
     def _on_add_menu_triggered(self, action: object) -> None:
         self.add_requested.emit(self.agent, action.text())  # type: ignore[attr-defined]

@@ -84,7 +84,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self._status_timer.setInterval(STATUS_REPAINT_MS)
         self._status_timer.timeout.connect(self._on_status_timer_timeout)
         self.banner.setText("Waiting for the mission server…")
-        self._update_legal()
+        self.set_backend(backend)
 
     # -- layout ---------------------------------------------------------------------------
     def _build_layout(self) -> None:
@@ -271,6 +271,13 @@ class CommandWidget(QWidget):  # type: ignore[misc]
                     ids.append(bound[0].id)
         if ids != self.schedule.selected_ids:
             self.schedule.select_ids(ids)
+
+    def set_backend(self, backend: Backend) -> None:
+        """Talk to ``backend`` from now on (a replay's, or the live one again)."""
+        self.backend = backend
+        self.view.statuses = {}  # the robots as the new backend reports them
+        self.parameters.set_read_only(backend.read_only)
+        self._update_legal()
 
     # -- sending ------------------------------------------------------------------------------
     def send(self, request: Request) -> None:

@@ -33,6 +33,7 @@ class CommandPlugin(_RqtPlugin):  # type: ignore[misc]
 
     def shutdown_plugin(self) -> None:
         """Stop following the mission and calling the server."""
+        self._widget.replay.close()
         self._bridge.close()
 
     def save_settings(self, plugin_settings: Any, instance_settings: Any) -> None:

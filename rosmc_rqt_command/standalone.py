@@ -12,6 +12,7 @@ import os
 import signal
 import sys
 from collections.abc import Sequence
+from typing import Any
 
 import rospy
 from python_qt_binding.QtCore import QTimer
@@ -20,20 +21,53 @@ from python_qt_binding.QtWidgets import QApplication, QMainWindow, QWidget
 from rosmc_server.ros.client import init_node
 
 from .command_widget import CommandWidget
+from .replay_mode import ReplayHooks, ReplayMode
 from .ros_bridge import RosBridge
+from .ros_replay import ReplayLink
 from .view_state import ViewUpdate
+
+
+def _wiring(widget: CommandWidget, bridge: RosBridge) -> list[tuple[Any, Any]]:
+    """Each bridge signal with the widget slot it feeds."""
+    return [
+        (bridge.updated, widget.on_updates),
+        (bridge.library_ready, widget.on_library),
+        (bridge.answered, widget.on_answer),
+        (bridge.connection_changed, widget.on_connection),
+        (bridge.server_restarted, widget.on_server_restarted),
+        (bridge.selection_received, widget.on_remote_selection),
+        (bridge.science_received, widget.science.show_science),
+        (bridge.site_received, widget.site.show_site),
+    ]
 
 
 def connect(widget: CommandWidget, bridge: RosBridge) -> None:
     """Route the bridge's signals to the widget's slots (queued across threads)."""
-    bridge.updated.connect(widget.on_updates)
-    bridge.library_ready.connect(widget.on_library)
-    bridge.answered.connect(widget.on_answer)
-    bridge.connection_changed.connect(widget.on_connection)
-    bridge.server_restarted.connect(widget.on_server_restarted)
-    bridge.selection_received.connect(widget.on_remote_selection)
-    bridge.science_received.connect(widget.science.show_science)
-    bridge.site_received.connect(widget.site.show_site)
+    for signal_, slot in _wiring(widget, bridge):
+        signal_.connect(slot)
+
+
+def disconnect(widget: CommandWidget, bridge: RosBridge) -> None:
+    """Stop routing the bridge's signals to the widget."""
+    for signal_, slot in _wiring(widget, bridge):
+        signal_.disconnect(slot)
+
+
+def replay_hooks(widget: CommandWidget, timeout: float) -> ReplayHooks:
+    """The ROS side of File > Open recording… for ``widget``."""
+
+    def follow(prefix: str) -> RosBridge:
+        bridge = RosBridge(prefix, timeout)
+        bridge.start()
+        return bridge
+
+    return ReplayHooks(
+        follow=follow,
+        attach=lambda bridge: connect(widget, bridge),
+        detach=lambda bridge: disconnect(widget, bridge),
+        close=lambda bridge: bridge.close(),
+        steer=ReplayLink,
+    )
 
 
 class CommandWindow(QMainWindow):  # type: ignore[misc]
@@ -75,6 +109,7 @@ def build(
     connect(widget, bridge)
     bridge.updated.connect(freeze_after_reset)
     bridge.start()
+    widget.replay = ReplayMode(widget, replay_hooks(widget, timeout))
     return widget, bridge
 
 
@@ -100,5 +135,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(app.exec_())
     finally:
+        widget.replay.close()
         bridge.close()
         rospy.signal_shutdown("command window closed")

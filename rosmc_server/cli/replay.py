@@ -57,6 +57,9 @@ def add_commands(command: _Command) -> None:
         action="store_true",
         help="stay at the end until stopped (always so when keys steer it from a terminal)",
     )
+    replay.add_argument(
+        "--paused", action="store_true", help="begin paused (resume with space or the service)"
+    )
     at = command("at", "print the mission as it was at a time or revision of a recording", AT_HELP)
     at.add_argument("file", metavar="FILE", help="a mission journal (.mcap)")
     at.add_argument("when", metavar="WHEN", help="seconds since the start, or rN for revision N")
@@ -85,7 +88,11 @@ def replay(ctx: Context) -> int:
     history = _history(MissionHistory(result))
     keys = sys.stdin if not ctx.json and keys_from(sys.stdin) else None
     config = ReplayConfig(
-        rate=args.rate, start=args.start, prefix=args.prefix, hold=args.hold or keys is not None
+        rate=args.rate,
+        start=args.start,
+        prefix=args.prefix,
+        hold=args.hold or keys is not None,
+        paused=args.paused,
     )
     session = ReplaySession(ctx.out, is_terminal(ctx.out), keys, progress=not ctx.json)
     player = RecordingReplayer(history, result.records, config, session.event)

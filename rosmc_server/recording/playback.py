@@ -265,6 +265,15 @@ class Playlist:
         count = bisect.bisect_right(indexes, self.index_after(seconds) - 1)
         return self.records[indexes[count - 1]] if count else None
 
+    def earliest(self, topic: str) -> JournalRecord | None:
+        """The first record of ``topic`` (None if the recording has none)."""
+        indexes = self._by_topic.get(topic)
+        return self.records[indexes[0]] if indexes else None
+
+    def records_of(self, topic: str) -> list[JournalRecord]:
+        """Every record of ``topic``, in time order."""
+        return [self.records[index] for index in self._by_topic.get(topic, [])]
+
     def _seconds(self, log_time: int) -> float:
         return (log_time - self._start) / 1e9
 

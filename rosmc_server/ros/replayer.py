@@ -56,7 +56,7 @@ from ..recording.playback import PlaybackClock, PlaybackStatus, Playlist
 from .client import init_node
 from .client.graph_names import taken_names
 from .replay_control import ReplayControl
-from .replay_output import TYPES, ReplayOutput
+from .replay_output import TYPES, ReplayOutput, first_telemetry
 
 _log = logging.getLogger(__name__)
 
@@ -91,12 +91,14 @@ class ReplayConfig:
         start: Seconds since the recording started to begin at.
         prefix: Put before every topic name ("" = the live names, e.g. ``/replay``).
         hold: At the end, stay (and keep serving) until stopped, instead of leaving.
+        paused: Begin paused at ``start`` (the command GUI opens a recording so).
     """
 
     rate: float = 1.0
     start: float = 0.0
     prefix: str = ""
     hold: bool = False
+    paused: bool = False
 
     def topic(self, name: str) -> str:
         """A recorded topic's name in this replay."""
@@ -130,6 +132,8 @@ class RecordingReplayer:
         self._on_event = on_event
         self._playlist = Playlist(records, history.start)
         self._clock = PlaybackClock(history.duration, config.start, config.rate)
+        if config.paused:
+            self._clock.pause()
         self._stop = threading.Event()
         self._lock = threading.RLock()  # the history, and what was published
         self._handled = threading.Condition(self._lock)  # a seek's state is out
@@ -220,7 +224,7 @@ class RecordingReplayer:
         """
         self.check_names()
         init_node(f"rosmc_replay_{os.getpid()}")
-        self._output = ReplayOutput(self._config.prefix)
+        self._output = ReplayOutput(self._config.prefix, first_telemetry(self._playlist))
         service = rospy.Service(
             self._config.topic(GET_MISSION), wire_srv.GetMission, self._on_get_mission
         )
@@ -295,7 +299,9 @@ class RecordingReplayer:
             self._current = self._history.revision_at(position).revision
             self._stamp = self._mission_stamp(position)
             self._publish_snapshot(self._current, position)
-            self._out().publish_state_at(self._playlist, position, moved=status.seeks > 0)
+            self._out().publish_state_at(
+                self._playlist, position, moved=status.seeks > 0, paused=status.paused
+            )
             self._handled_seeks = status.seeks
             self._handled.notify_all()
         self._announce()
