@@ -468,6 +468,25 @@ def test_unbarrier_is_delete_barrier(server: Server, fresh: MissionClient) -> No
     assert fresh.get_mission().barriers == ()
 
 
+def test_undo_walks_back_and_redoes(server: Server, fresh: MissionClient) -> None:
+    skill_id = rosmc(server, "add", "drone", "take_off", "altitude=12").strip()
+    fresh.get_mission()
+    edited = fresh.edit_skill(skill_id, {"altitude": 20.0}).revision
+    out = rosmc(server, "undo")  # README, "Undo and redo"
+    assert out.startswith(f"revision {edited + 1}: undo of revision {edited} (")
+    assert fresh.skill(skill_id).params["altitude"] == 12.0
+    rosmc(server, "undo")  # the edit before: the add
+    assert fresh.get_mission().task("drone") == []
+    rosmc(server, "undo", str(edited + 2))  # undoing that undo redoes the add
+    assert fresh.skill(skill_id).params["altitude"] == 12.0
+    fresh.get_mission()
+    fresh.edit_skill(skill_id, {"altitude": 30.0})
+    (refused,) = run_many(server.env, [["undo", str(edited + 1)]])
+    assert_refused(refused, f"skill '{skill_id}' was changed since revision {edited + 1}")
+    (refused,) = run_many(server.env, [["undo", "1"]])
+    assert_refused(refused, "revision 1 is not one of the last")
+
+
 def test_policy_is_checked_and_sent(server: Server) -> None:
     """The robots never answer here: the server sends the policy (exit 0) or refuses it."""
     sent = run_many(
