@@ -363,7 +363,7 @@ class MissionClient(ClientBase):
     def undo(
         self, revision: int = 0, *, base_revision: int | None = None, retry_on_conflict: bool = False
     ) -> EditUndone:
-        """Undo the edit that produced ``revision`` (0: the latest not undone); see UndoEdit."""
+        """Undo the edit that produced ``revision`` (0: the latest edit not undone)."""
         response = self._mutate(
             "undo_edit", base_revision, retry_on_conflict, undo_revision=revision
         )
