@@ -361,7 +361,11 @@ class MissionClient(ClientBase):
         )
 
     def undo(
-        self, revision: int = 0, *, base_revision: int | None = None, retry_on_conflict: bool = False
+        self,
+        revision: int = 0,
+        *,
+        base_revision: int | None = None,
+        retry_on_conflict: bool = False,
     ) -> EditUndone:
         """Undo the edit that produced ``revision`` (0: the latest edit not undone)."""
         response = self._mutate(
