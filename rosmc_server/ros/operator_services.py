@@ -350,9 +350,7 @@ class OperatorServices:
         return self._apply(lambda m: m.delete_marker(name, base_revision=req.base_revision))
 
     def _undo_edit(self, req: Any, resp: Any) -> MissionEvent:
-        event = self._apply(
-            lambda m: m.undo(req.undo_revision, base_revision=req.base_revision)
-        )
+        event = self._apply(lambda m: m.undo(req.undo_revision, base_revision=req.base_revision))
         resp.summary = event.summary
         return event
 
