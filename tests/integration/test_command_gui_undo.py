@@ -48,7 +48,10 @@ def click_menu_item(window: Window, menu_title: str, item: str) -> None:
     QTest.mouseClick(menu, Qt.LeftButton, Qt.NoModifier, menu.actionGeometry(action).center())
 
 
-def test_undo_and_redo_with_keys_and_mouse(start_server: StartServer, windows: Any) -> None:
+def test_undo_and_redo_with_keys_and_mouse(
+    start_server: StartServer,
+    windows: Any,  # noqa: F811 (the fixture imported above)
+) -> None:
     start_server()
     window = windows()
     shown(window)
