@@ -399,7 +399,7 @@ def test_save_and_load_on_the_servers_host(server: Server, fresh: MissionClient)
     ids = build_mission(fresh)
     before = mission_to_json(fresh.get_mission())
     target = server.log_dir / "missions" / "team" / "plan.yaml"
-    target.parent.mkdir(parents=True, exist_ok=True)
+    assert not target.parent.exists()  # the server makes the folder
     out = rosmc(server, "save", "--on-server", "team/plan.yaml")
     assert out == f"saved revision {before['revision']} to {target} on the server\n"
     assert target.read_text().startswith("rosmc_mission: 1\n")
