@@ -361,9 +361,9 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         skill = self.view.skill(skill_id)
         name = f"'{skill.label or skill.skill}'" if skill is not None else skill_id
         changed = ", ".join(fields.get("params", {}) or fields.get("bindings", {}) or fields)
-        self.dispatcher.request(
-            "edit_skill", skill_id, what=f"change {changed} of {name}", **fields
-        )
+        revert = self.parameters.reverter(skill_id)  # a refused value leaves the field
+        what = f"change {changed} of {name}"
+        self.send(Request("edit_skill", (skill_id,), fields, what, self.view.revision, revert))
 
     def _on_parameters_rename_requested(self, old: str, new: str) -> None:
         self.dispatcher.request("rename_marker", old, new, what=f"rename marker {old} to {new}")
