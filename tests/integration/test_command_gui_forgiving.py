@@ -1,9 +1,11 @@
-"""Undo and redo in the command GUI against a real mission server.
+"""Editing that forgives, in the command GUI against a real mission server.
 
 A real master and ``mission_server`` process, the real widget and ROS bridge
 (offscreen Qt). The operator adds and deletes a skill with the mouse, takes the
 delete back with Ctrl+Z, redoes it with Ctrl+Shift+Z, undoes through the Edit menu
 with the mouse, and sees a refusal when another operator changed the skill since.
+Closing with unsaved changes and choosing Save keeps the window open until the
+save is confirmed, and says why when it fails.
 """
 
 from __future__ import annotations
@@ -13,10 +15,13 @@ from typing import Any
 
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
+from pathlib import Path
+
 from python_qt_binding.QtCore import Qt
 from python_qt_binding.QtTest import QTest
 from python_qt_binding.QtWidgets import QApplication, QMenu
 
+from rosmc_rqt_command.standalone import CommandWindow
 from rosmc_server.ros.client import MissionClient
 from tests.integration.server_fixtures import StartServer
 from tests.integration.test_command_gui_server import (  # noqa: F401 (the fixture)
@@ -99,3 +104,36 @@ def test_undo_and_redo_with_keys_and_mouse(
     assert window.ids("drone") == [take_off]
     assert window.w.view.skill(take_off).params["altitude"] == 23.0
     no_traceback(window)
+
+
+def test_close_with_save_waits_for_the_save(
+    start_server: StartServer,
+    windows: Any,  # noqa: F811 (the fixture imported above)
+    tmp_path: Path,
+) -> None:
+    start_server()
+    window = windows()
+    shown(window)
+    main = CommandWindow(window.w, "ROSMC command")
+    main.show()
+    window.add("drone", "take_off")
+    wait_until(lambda: window.ids("drone"), 10, "take_off shown")
+    assert window.w.files.dirty
+    window.w.files.ask = lambda doing: "save"  # the operator's answer to "Save them first?"
+
+    # The first save cannot be written: the window stays open and says why.
+    window.w.files.location = ("local", str(tmp_path / "no such folder" / "plan.yaml"))
+    assert not main.close()
+    assert main.isVisible()
+    window.said("Cannot write")
+    window.said("Not closed: the mission was not saved")
+    assert main.isVisible()
+
+    # Saved where it can be: the window closes once the save is confirmed, not before.
+    target = tmp_path / "plan.yaml"
+    window.w.files.location = ("local", str(target))
+    assert not main.close()
+    assert main.isVisible() and not target.exists()
+    wait_until(lambda: not main.isVisible(), 10, "the window closed after the save")
+    assert "take_off" in target.read_text()
+    main.takeCentralWidget()  # the fixture closes the widget itself
