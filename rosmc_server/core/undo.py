@@ -136,6 +136,13 @@ class UndoHistory:
                     f"skill '{skill_id}' joined barrier '{barrier.id}' since revision "
                     f"{revision}; remove the barrier first"
                 )
+        for barrier in entry.inverse.put_barriers:  # a barrier back: its members must be too
+            for member in barrier.skill_ids:
+                if state.has_skill(member) and not state.skill(member).is_editable:
+                    raise RuleViolation(
+                        f"skill '{member}' of barrier '{barrier.id}' has been sent since "
+                        f"revision {revision}, so the barrier cannot come back"
+                    )
         inverse = _placed_in_blueprint(state, entry.inverse)
         _check_no_deadlock(state, inverse)
         return Proposal(

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import random
 from typing import Any
 
 from rosmc_server.core import (
@@ -10,6 +11,7 @@ from rosmc_server.core import (
     InvalidRequest,
     MarkerType,
     Pose,
+    RosmcError,
     RuleViolation,
     StaleRevision,
     TaskMarker,
@@ -99,6 +101,16 @@ def test_undo_refused_once_the_skill_was_sent(mission: Any, drv: Any, rejected: 
     rejected(mission, RuleViolation, mission.undo, edit.revision, match="has been sent to alpha")
 
 
+def test_undo_refused_when_a_barrier_partner_was_sent(
+    mission: Any, drv: Any, rejected: Any
+) -> None:
+    a, b = drv.add("alpha"), drv.add("bravo")
+    mission.add_barrier([a, b])
+    deleted = mission.delete_skills([a])  # the barrier dissolves
+    drv.sync("bravo")
+    rejected(mission, RuleViolation, mission.undo, deleted.revision, match="cannot come back")
+
+
 def test_undo_refused_when_changed_since(mission: Any, drv: Any, rejected: Any) -> None:
     skill_id = drv.add("alpha")
     first = mission.edit_skill(skill_id, {"speed": 0.5})
@@ -158,3 +170,52 @@ def test_journal_replay_keeps_undo(mission: Any, drv: Any, new_mission_factory: 
     first_id = events[0].change.put_skills[0].skill.id
     assert copy_of.undo().change.removed_skill_ids == (first_id,)
     assert list(copy_of.state.task("alpha")) == []
+
+
+def test_undoing_every_edit_in_turn_walks_back_through_each_state(
+    mission: Any, drv: Any, snap: Any
+) -> None:
+    rng = random.Random(7)
+    states = []
+    for _ in range(60):
+        before = _plan(snap(mission))
+        try:
+            _random_edit(mission, rng)
+        except RosmcError:
+            continue  # refused: nothing changed, nothing to undo
+        states.append(before)
+    assert len(states) > 30
+    for before in reversed(states):
+        mission.undo()
+        assert _plan(snap(mission)) == before
+    assert mission.history.latest() == 0
+
+
+def _plan(data: dict[str, Any]) -> dict[str, Any]:
+    return {key: value for key, value in data.items() if key != "revision"}
+
+
+def _random_edit(mission: Any, rng: random.Random) -> None:
+    agents = ["alpha", "bravo", "charlie"]
+    agent = rng.choice(agents)
+    ids = [s.id for s in mission.state.task(agent)]
+    choice = rng.randrange(7)
+    if choice <= 1 or not ids:
+        index = rng.randrange(len(ids) + 1)
+        mission.add_skill(agent, rng.choice(["move", "scan", "wait"]), index=index)
+    elif choice == 2:
+        mission.delete_skills(rng.sample(ids, rng.randint(1, min(2, len(ids)))))
+    elif choice == 3:
+        mission.reorder(agent, rng.sample(ids, len(ids)))
+    elif choice == 4:
+        mission.edit_skill(rng.choice(ids), label=f"step {rng.randrange(100)}")
+    elif choice == 5:
+        other = rng.choice([a for a in agents if a != agent])
+        partners = [s.id for s in mission.state.task(other)]
+        mission.add_barrier([rng.choice(ids), rng.choice(partners or ["none"])])
+    else:
+        barriers = mission.state.barriers
+        if barriers:
+            mission.delete_barrier(rng.choice(barriers).id)
+        else:
+            mission.add_marker(TaskMarker("", MarkerType.POSITION, Pose(rng.random(), 1.0)))
