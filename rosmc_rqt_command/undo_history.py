@@ -77,13 +77,13 @@ class UndoHistory(QObject):  # type: ignore[misc]
         """Ask the server to undo this window's newest edit."""
         if self._undo and not self._waiting and not self.read_only:
             revision, what = self._undo.pop()
-            self._ask(revision, f"undo '{what}'", self._redo, self._undo, what)
+            self._ask(revision, f"undo {what}", self._redo, self._undo, what)
 
     def redo(self) -> None:
         """Ask the server to undo this window's newest undo (the edit comes back)."""
         if self._redo and not self._waiting and not self.read_only:
             revision, what = self._redo.pop()
-            self._ask(revision, f"redo '{what}'", self._undo, self._redo, what)
+            self._ask(revision, f"redo {what}", self._undo, self._redo, what)
 
     def _ask(
         self,

@@ -71,10 +71,10 @@ def test_undo_and_redo_with_keys_and_mouse(
     wait_until(lambda: window.ids("drone") == [], 10, "the delete shown")
 
     press(window, Qt.Key_Z)
-    window.said("Done: undo 'delete 'take_off''")
+    window.said("Done: undo delete 'take_off'")
     wait_until(lambda: window.ids("drone") == [take_off], 10, "the skill back")
     press(window, Qt.Key_Z, Qt.ControlModifier | Qt.ShiftModifier)
-    window.said("Done: redo 'delete 'take_off''")
+    window.said("Done: redo delete 'take_off'")
     wait_until(lambda: window.ids("drone") == [], 10, "deleted again")
     press(window, Qt.Key_Z)
     wait_until(lambda: window.ids("drone") == [take_off], 10, "back again")
