@@ -188,15 +188,23 @@ def inverse_change(before: MissionState, change: Change) -> Change:
 def _inverse_moves(
     before: MissionState, agent: str, moves: tuple[SkillMove, ...]
 ) -> tuple[SkillMove, ...]:
-    """Moves that undo ``moves`` (applied one after the other), last one first."""
+    """Moves that undo ``moves`` (applied one after the other), last one first.
+
+    Only the moved skills' indexes are followed, so the cost is the moves', not the task's.
+    """
     if not agent or not moves:
         return ()
-    order = [skill.id for skill in before.task(agent)]
+    where = {move.skill_id: before.locate(move.skill_id)[1] for move in moves}
     back = []
     for move in moves:
-        was = order.index(move.skill_id)
+        was, now = where[move.skill_id], move.index
         back.append(SkillMove(move.skill_id, was))
-        order.insert(move.index, order.pop(was))
+        for skill_id, index in where.items():  # the skills between shift by one
+            if was < index <= now:
+                where[skill_id] = index - 1
+            elif now <= index < was:
+                where[skill_id] = index + 1
+        where[move.skill_id] = now
     return tuple(reversed(back))
 
 
