@@ -82,8 +82,8 @@ class UndoHistory:
             self._entries.clear()
             self._undone.clear()
             return None
-        if kind not in _INVERSE_KIND:
-            return None
+        if kind not in _INVERSE_KIND or (change.blueprint_order and not change.moves):
+            return None  # not an edit (or a reorder journaled as a whole order, before moves)
         return inverse_change(state, change)
 
     def keep(self, state: MissionState, event: MissionEvent, inverse: Change | None) -> None:
