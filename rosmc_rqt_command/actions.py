@@ -80,18 +80,19 @@ class CommandActions(QObject):  # type: ignore[misc]
         self.all_robots: dict[RobotAction, QAction] = {}
         self.file: dict[str, QAction] = {}
         for action, (text, keys, tip) in SKILL_ACTIONS.items():
-            self.skill[action] = self._make(owner, text, keys, tip, action.value)
+            self.skill[action] = self.make(owner, text, keys, tip, action.value)
         for robot_action, (text, keys, tip) in ALL_ROBOT_ACTIONS.items():
-            self.all_robots[robot_action] = self._make(
+            self.all_robots[robot_action] = self.make(
                 owner, text, keys, tip, f"{robot_action.value}_all"
             )
         for name, (text, keys, tip) in FILE_ACTIONS.items():
-            self.file[name] = self._make(owner, text, keys, tip, name)
-        self.refresh = self._make(owner, "Refresh", "F5", "Fetch the mission again", "refresh")
-        self.clear_selection = self._make(owner, "Select nothing", "Escape", "", "clear")
+            self.file[name] = self.make(owner, text, keys, tip, name)
+        self.refresh = self.make(owner, "Refresh", "F5", "Fetch the mission again", "refresh")
+        self.clear_selection = self.make(owner, "Select nothing", "Escape", "", "clear")
 
     @staticmethod
-    def _make(owner: QWidget, text: str, keys: str, tip: str, name: str) -> QAction:
+    def make(owner: QWidget, text: str, keys: str, tip: str, name: str) -> QAction:
+        """A QAction of ``owner`` with its shortcuts ("A|B": either), tooltip and name."""
         action = QAction(text, owner)
         action.setObjectName(f"action_{name}")
         if keys:

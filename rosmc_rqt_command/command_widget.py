@@ -43,6 +43,7 @@ from .science_strip import ScienceStrip
 from .site_strip import SiteStrip
 from .team_bar import TeamBar
 from .team_dialog import ask_team_send
+from .undo_history import UndoHistory
 from .view_state import ViewUpdate
 
 # Robot headers and robot buttons follow live reports at most this often (ms): robots
@@ -70,6 +71,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.dispatcher = Dispatcher(
             self.view, self.send, self._confirm, self._robot_legal.any, self._confirm_team
         )
+        self.history = UndoHistory(self, self.view, self.send)
         self._select_when_seen: list[str] = []
         self._pending_statuses: dict[str, AgentStatus] = {}
         self.connected = False
@@ -95,6 +97,9 @@ class CommandWidget(QWidget):  # type: ignore[misc]
                 file_menu.addSeparator()
             else:
                 file_menu.addAction(self.actions_.file[name])
+        self.menu_bar.addMenu("&Edit").addActions(
+            [self.history.undo_action, self.history.redo_action]
+        )
         mission_menu = self.menu_bar.addMenu("&Mission")
         for action in self.actions_.skill.values():
             mission_menu.addAction(action)
@@ -240,7 +245,9 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         what = answer.request.what or answer.request.operation.replace("_", " ")
         if answer.ok:
             revision = getattr(answer.value, "revision", None)
-            suffix = f" (revision {revision})" if revision is not None else ""
+            hint = self.history.note(answer)  # "Ctrl+Z undoes it" after this window's edits
+            extra = f"; {hint}" if hint else ""
+            suffix = f" (revision {revision}{extra})" if revision is not None else ""
             note = getattr(answer.value, "note", "")
             if note:  # accepted, but the operator should know (queued, a barrier partner)
                 self.messages.say(f"Done: {what}{suffix}; {note}.", "warning")
@@ -373,9 +380,9 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         skill = self.view.skill(skill_id)
         name = f"'{skill.label or skill.skill}'" if skill is not None else skill_id
         changed = ", ".join(fields.get("params", {}) or fields.get("bindings", {}) or fields)
-        self.dispatcher.request(
-            "edit_skill", skill_id, what=f"change {changed} of {name}", **fields
-        )
+        revert = self.parameters.reverter(skill_id)  # a refused value leaves the field
+        what = f"change {changed} of {name}"
+        self.send(Request("edit_skill", (skill_id,), fields, what, self.view.revision, revert))
 
     def _on_parameters_rename_requested(self, old: str, new: str) -> None:
         self.dispatcher.request("rename_marker", old, new, what=f"rename marker {old} to {new}")
@@ -406,6 +413,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
     def _update_legal(self, agents: Iterable[str] | None = None) -> None:
         """Enable what is legal now; only ``agents``' robot actions are recomputed."""
         read_only = self.backend.read_only
+        self.history.set_read_only(read_only)
         agents = None if agents is None else list(agents)
         self._robot_legal.update(self.view, agents)
         selected = self.view.skills(self.schedule.selected_ids)

@@ -69,6 +69,7 @@ class FileController:
         self._send = send
         self.location: tuple[str, str] | None = None  # ("local" | "server", path)
         self._saved: Plan | None = None
+        self._after_save: Callable[[], None] | None = None  # closes the window once saved
         self.ask: Callable[[str], str] = self._ask_save_changes
         handlers = {
             "new": self.new_mission,
@@ -102,6 +103,23 @@ class FileController:
         if answer == "save":
             self.save()
             return True
+        return answer == "discard"
+
+    def may_close(self, close: Callable[[], None]) -> bool:
+        """Whether the window may close now (asking about unsaved changes first).
+
+        Save keeps the window open until the server's answer: ``close`` is called once
+        the mission is saved; if saving fails (or no file is chosen) the window stays
+        open and the message area says why.
+        """
+        if not self.dirty:
+            return True
+        answer = self.ask("closing")
+        if answer == "save":
+            self._after_save = close
+            if not self.save():
+                self._after_save = None
+                self._messages.say("Not closed: the mission was not saved.", "warning")
         return answer == "discard"
 
     def _ask_save_changes(self, doing: str) -> str:
@@ -156,14 +174,15 @@ class FileController:
             )
         )
 
-    def save(self) -> None:
-        """Save where the mission was last saved or opened (else ask where)."""
+    def save(self) -> bool:
+        """Save where the mission was last saved or opened (else ask where); False if not sent."""
         if self.location is None:
-            self._on_save_as_triggered()
-        elif self.location[0] == "local":
+            return self._on_save_as_triggered()
+        if self.location[0] == "local":
             self.save_local(self.location[1])
         else:
             self.save_server(self.location[1])
+        return True
 
     def save_local(self, path: str) -> None:
         """Save the mission to a file on this computer."""
@@ -212,20 +231,30 @@ class FileController:
             self.mark_saved()
 
     def _on_saved_document(self, answer: Answer, path: str, fingerprint: Plan) -> None:
-        if not answer.ok:
-            return
-        try:
-            Path(path).write_text(answer.value.document, encoding="utf-8")
-        except OSError as error:
-            self._messages.say(f"Cannot write {path}: {error}.", "error")
-            return
-        self._messages.say(f"Saved the mission to {path}.", "ok")
+        if answer.ok:
+            try:
+                Path(path).write_text(answer.value.document, encoding="utf-8")
+            except OSError as error:
+                self._messages.say(f"Cannot write {path}: {error}.", "error")
+                self._closing_failed()
+                return
+            self._messages.say(f"Saved the mission to {path}.", "ok")
         self._on_saved(answer, ("local", path), fingerprint)
 
     def _on_saved(self, answer: Answer, location: tuple[str, str], fingerprint: Plan) -> None:
-        if answer.ok:
-            self.location = location
-            self._saved = fingerprint
+        if not answer.ok:
+            self._closing_failed()
+            return
+        self.location = location
+        self._saved = fingerprint
+        close, self._after_save = self._after_save, None
+        if close is not None:
+            close()
+
+    def _closing_failed(self) -> None:
+        if self._after_save is not None:
+            self._after_save = None
+            self._messages.say("Not closed: the mission was not saved (see above).", "warning")
 
     # -- dialogs ----------------------------------------------------------------------------
     def _on_open_triggered(self) -> None:
@@ -244,10 +273,11 @@ class FileController:
         if ok and path.strip():
             self.open_server(path.strip())
 
-    def _on_save_as_triggered(self) -> None:
+    def _on_save_as_triggered(self) -> bool:
         path, _ = QFileDialog.getSaveFileName(self._parent, "Save mission file", "", FILTER)
         if path:
             self.save_local(path if Path(path).suffix else f"{path}.yaml")
+        return bool(path)
 
     def _on_save_server_triggered(self) -> None:
         path, ok = QInputDialog.getText(

@@ -94,16 +94,17 @@ class NumberEditor(Editor):
         self.spin: Any = QSpinBox() if whole else QDoubleSpinBox()
         low = spec.minimum if spec.minimum is not None else -BIG
         high = spec.maximum if spec.maximum is not None else BIG
-        if whole:
-            self.spin.setRange(int(max(low, -(2**31))), int(min(high, 2**31 - 1)))
-        else:
+        # The box takes any number: one outside the bounds is refused with them when sent
+        # (a box kept to the bounds turns "-5" into 5 and "99999" into 9 without a word).
+        wide_range(self.spin)
+        if not whole:
             self.spin.setDecimals(3)
-            self.spin.setRange(low, high)
             self.spin.setSingleStep(0.1 if high - low <= 10 else 1.0)
         if spec.unit:
             self.spin.setSuffix(f" {spec.unit}")
+        self.allowed = allowed_range(spec)
+        self.spin.setToolTip(f"allowed: {self.allowed}")
         self.spin.setKeyboardTracking(False)
-        self.spin.setCorrectionMode(QAbstractSpinBox.CorrectToNearestValue)
         layout = QHBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
         layout.addWidget(self.spin)
@@ -116,6 +117,28 @@ class NumberEditor(Editor):
 
     def set_value(self, value: Value) -> None:
         self.spin.setValue(value)
+
+
+def wide_range(spin: Any) -> None:
+    """Let a spin box hold any number its type can (the mission rules check the bounds)."""
+    if isinstance(spin, QSpinBox):
+        spin.setRange(-(2**31), 2**31 - 1)
+    else:
+        spin.setRange(-BIG, BIG)
+    spin.setCorrectionMode(QAbstractSpinBox.CorrectToPreviousValue)
+
+
+def allowed_range(spec: ParameterSpec) -> str:
+    """The numbers ``spec`` allows, in words, e.g. "1 to 30 m" or "at least 0"."""
+    unit = f" {spec.unit}" if spec.unit else ""
+    low, high = spec.minimum, spec.maximum
+    if low is not None and high is not None:
+        return f"{low:g} to {high:g}{unit}"
+    if low is not None:
+        return f"at least {low:g}{unit}"
+    if high is not None:
+        return f"at most {high:g}{unit}"
+    return f"any number{unit}"
 
 
 class ChoiceEditor(Editor):

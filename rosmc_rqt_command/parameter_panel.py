@@ -9,6 +9,7 @@ read-only unless the skill is in the editable blueprint.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 from python_qt_binding.QtCore import Qt, Signal
@@ -25,9 +26,12 @@ from python_qt_binding.QtWidgets import (
 )
 
 from rosmc_server.core import InvalidRequest, RosmcError, SkillInstance, SkillSpec
+from rosmc_server.core.editing import check_retries, check_timeout
+from rosmc_server.core.validation import MAX_RETRIES
 
 from .mission_view import MissionView
-from .param_editors import Editor, MarkerPicker, make_editor
+from .param_editors import INVALID_STYLE, Editor, MarkerPicker, make_editor, wide_range
+from .requests import Answer
 
 
 class ParameterPanel(QScrollArea):  # type: ignore[misc]
@@ -63,20 +67,20 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
         self.label_edit.setObjectName("label_edit")
         self.timeout_spin = QDoubleSpinBox()
         self.timeout_spin.setObjectName("timeout_spin")
-        self.timeout_spin.setRange(0.0, 86400.0)
         self.timeout_spin.setSuffix(" s")
-        self.timeout_spin.setSpecialValueText("no time limit")
-        self.timeout_spin.setKeyboardTracking(False)
+        self.timeout_spin.setToolTip("Seconds the skill may run; 0 s: no time limit")
         self.retries_spin = QSpinBox()
         self.retries_spin.setObjectName("retries_spin")
-        self.retries_spin.setRange(0, 100)
-        self.retries_spin.setKeyboardTracking(False)
+        self.retries_spin.setToolTip(f"Automatic retries after a failure: 0 to {MAX_RETRIES}")
+        for spin in (self.timeout_spin, self.retries_spin):
+            wide_range(spin)  # out-of-range input is refused with the range, not changed
+            spin.setKeyboardTracking(False)
         for name in ("ID", "Robot", "Skill"):
             form.addRow(name, self.facts[name])
         form.addRow("Label", self.label_edit)
         for name in ("Status", "Attempt", "Status text"):
             form.addRow(name, self.facts[name])
-        form.addRow("Time limit", self.timeout_spin)
+        form.addRow("Time limit (0: none)", self.timeout_spin)
         form.addRow("Retries", self.retries_spin)
         layout.addWidget(details)
         self.params_box = QGroupBox("Parameters")
@@ -220,7 +224,8 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
             value = spec.parameter(name).check(editor.value(), skill.skill)
         except InvalidRequest as error:
             editor.mark_invalid(True)
-            self.problem.emit(f"Not sent: {error}.")
+            allowed = getattr(editor, "allowed", "")  # a number's range, said with the refusal
+            self.problem.emit(f"Not sent: {error}{f' (allowed: {allowed})' if allowed else ''}.")
             return
         editor.mark_invalid(False)
         if skill.params.get(name) != value or name in skill.bindings:
@@ -233,7 +238,13 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
     def _on_label_edit_editing_finished(self) -> None:
         skill = self.skill
         text = self.label_edit.text().strip()
-        if skill is not None and self.editable and text and text != skill.label:
+        if skill is None or not self.editable or text == skill.label:
+            return
+        invalid = not text
+        self.label_edit.setStyleSheet(INVALID_STYLE if invalid else "")
+        if invalid:
+            self.problem.emit(f"Not sent: a label cannot be empty (it stays '{skill.label}').")
+        else:
             self._send({"label": text})
 
     def _on_options_editing_finished(self) -> None:
@@ -241,8 +252,45 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
         if skill is None or not self.editable:
             return
         timeout, retries = self.timeout_spin.value(), self.retries_spin.value()
+        for spin in (self.timeout_spin, self.retries_spin):
+            spin.setStyleSheet("")
+        try:
+            checked = {"timeout": check_timeout(timeout)}
+        except InvalidRequest as error:
+            self.timeout_spin.setStyleSheet(INVALID_STYLE)
+            self.problem.emit(f"Not sent: {error} (0 s: no time limit).")
+            return
+        try:
+            checked["max_retries"] = check_retries(int(retries))
+        except InvalidRequest as error:
+            self.retries_spin.setStyleSheet(INVALID_STYLE)
+            self.problem.emit(f"Not sent: {error}.")
+            return
         if timeout != skill.timeout or retries != skill.max_retries:
-            self._send({"timeout": float(timeout), "max_retries": int(retries)})
+            self._send(checked)
+
+    def reverter(self, skill_id: str) -> Callable[[Answer], None]:
+        """A callback for the answer to an edit of ``skill_id``: refused, show the server's
+        values again (even in the field that has the focus, so it is not sent again)."""
+
+        def revert(answer: Answer) -> None:
+            newest = self._view.skill(skill_id)
+            if answer.ok or newest is None or self.skill is None or self.skill.id != skill_id:
+                return
+            self.skill = newest
+            self.label_edit.setText(newest.label)
+            self.timeout_spin.setValue(newest.timeout)
+            self.retries_spin.setValue(newest.max_retries)
+            for widget in (self.label_edit, self.timeout_spin, self.retries_spin):
+                widget.setStyleSheet("")
+            for name, editor in self.editors.items():
+                if name in newest.params:
+                    editor.blockSignals(True)
+                    editor.set_value(newest.params[name])
+                    editor.mark_invalid(False)
+                    editor.blockSignals(False)
+
+        return revert
 
     def _send(self, fields: dict[str, Any]) -> None:
         assert self.skill is not None

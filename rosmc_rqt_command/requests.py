@@ -28,6 +28,7 @@ MUTATING = frozenset(
         "rename_marker",
         "new_mission",
         "load_mission",
+        "undo",
     }
 )
 

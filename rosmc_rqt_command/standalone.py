@@ -81,8 +81,8 @@ class CommandWindow(QMainWindow):  # type: ignore[misc]
         self.resize(1560, 920)
 
     def closeEvent(self, event: object) -> None:
-        """Offer to save first; Cancel keeps the window open."""
-        if self.widget.backend.read_only or self.widget.files.confirm_discard("closing"):
+        """Offer to save first; Cancel keeps the window open, Save until the save is done."""
+        if self.widget.backend.read_only or self.widget.files.may_close(self.close):
             event.accept()  # type: ignore[attr-defined]
         else:
             event.ignore()  # type: ignore[attr-defined]

@@ -65,6 +65,7 @@ SERVICES = {
     "move_task_marker": "MoveTaskMarker",
     "rename_task_marker": "RenameTaskMarker",
     "delete_task_marker": "DeleteTaskMarker",
+    "undo_edit": "UndoEdit",
     "new_mission": "NewMission",
     "save_mission": "SaveMission",
     "load_mission": "LoadMission",

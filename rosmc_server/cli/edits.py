@@ -89,6 +89,12 @@ def delete_barrier(ctx: Context) -> int:
     return ctx.emit_result(result)
 
 
+def undo(ctx: Context) -> int:
+    """Undo an edit (the latest not undone, or the one that produced REVISION)."""
+    result = ctx.client.undo(ctx.args.undo_revision, **ctx.against())
+    return ctx.emit_result(result, f"revision {result.revision}: {result.summary}")
+
+
 def sync(ctx: Context) -> int:
     """Upload a robot's blueprint (up to --upto), or every robot's at once (--all)."""
     args = ctx.args
@@ -239,6 +245,7 @@ COMMANDS: dict[str, Callable[[Context], int]] = {
     "barrier": barrier,
     "delete-barrier": delete_barrier,
     "unbarrier": delete_barrier,
+    "undo": undo,
     "sync": sync,
     "unsync": unsync,
     "start": control,

@@ -150,6 +150,21 @@ def _add_editing(command: _Command) -> None:
         "delete-barrier", "remove a barrier whose skills have not started", aliases=["unbarrier"]
     )
     delete_barrier.add_argument("barrier_id", metavar="BARRIER_ID")
+    undo = command(
+        "undo",
+        "take back a blueprint, barrier or marker edit as a new revision",
+        epilog="Without REVISION, the latest edit not undone yet; again and again, the ones "
+        "before it. Give an undo's revision to redo what it undid. Refused once a skill it "
+        "touches was sent to its robot, or when someone changed it since.",
+    )
+    undo.add_argument(
+        "undo_revision",
+        nargs="?",
+        type=int,
+        default=0,
+        metavar="REVISION",
+        help="the revision the edit produced",
+    )
 
 
 def _add_options(parser: argparse.ArgumentParser) -> None:

@@ -22,6 +22,7 @@ from .params import Pose
 from .reconcile import Reconciliation, RobotSkill, plan_reconcile
 from .site import SiteGuard
 from .state import MissionContent, MissionState
+from .undo import UndoHistory
 from .updates import apply_event
 from .validation import check_skill_count
 
@@ -65,6 +66,7 @@ class Mission:
         self.operator_revision = revision
         # The site skill targets are checked against (the server hands it each new map).
         self.site = SiteGuard()
+        self.history = UndoHistory()
 
     @property
     def revision(self) -> int:
@@ -353,19 +355,27 @@ class Mission:
             )
         )
 
+    def undo(self, revision: int = 0, *, base_revision: int | None = None) -> MissionEvent:
+        """Take back the edit made at ``revision`` (0: the latest) as a new change."""
+        self._check_revision(base_revision)
+        return self._commit(self.history.plan_undo(self.state, revision or self.history.latest()))
+
     def replay(self, event: MissionEvent) -> None:
         """Apply a journaled event; it must be the next revision (see :func:`apply_event`)."""
+        inverse = self.history.inverse(self.state, event.kind, event.change)
         apply_event(self.state, event)
+        self.history.keep(self.state, event, inverse)
         if event.kind not in ROBOT_EVENTS:
             self.operator_revision = event.revision
 
     # -- internals ---------------------------------------------------------------
     def _commit(self, proposal: Proposal) -> MissionEvent:
+        inverse = self.history.inverse(self.state, proposal.kind, proposal.change)
         self.state.apply(proposal.change)
         self.state.revision += 1
         if proposal.kind not in ROBOT_EVENTS:
             self.operator_revision = self.state.revision
-        return MissionEvent(
+        event = MissionEvent(
             self.state.revision,
             proposal.kind,
             proposal.agent,
@@ -373,6 +383,8 @@ class Mission:
             self._clock(),
             proposal.change,
         )
+        self.history.keep(self.state, event, inverse)
+        return event
 
     def _on_site(self, proposal: Proposal) -> Proposal:
         """``proposal`` if the targets it sets suit the known site; RuleViolation if not."""

@@ -348,6 +348,11 @@ class OperatorServices:
         name = _text(req.name, "the marker name")
         return self._apply(lambda m: m.delete_marker(name, base_revision=req.base_revision))
 
+    def _undo_edit(self, req: Any, resp: Any) -> MissionEvent:
+        event = self._apply(lambda m: m.undo(req.undo_revision, base_revision=req.base_revision))
+        resp.summary = event.summary
+        return event
+
     # -- whole missions -------------------------------------------------------------
     def _new_mission(self, req: Any, resp: Any) -> MissionEvent:
         return self._apply(

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 import rosmc.srv as srv
 
 from ..conversions.packing import PackedGetMissionResponse
-from ..core import InvalidRequest, MissionEvent, load_mission, parse_mission
+from ..core import InvalidRequest, MissionEvent, MissionFileError, load_mission, parse_mission
 from ..core.persistence import MissionDumper, write_document
 from ..core.validation import check_file_path
 
@@ -50,6 +50,16 @@ def host_path(path: str, mission_dir: Path) -> Path:
             "pass the document itself to save or load elsewhere"
         )
     return target
+
+
+def make_folder(folder: Path) -> None:
+    """Create ``folder`` (and its parents) for a mission file; MissionFileError if it cannot."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise MissionFileError(
+            f"{folder}: cannot create the folder for the mission file ({error.strerror})"
+        ) from error
 
 
 class WholeMissionServices:
@@ -79,8 +89,7 @@ class WholeMissionServices:
         if req.path:
             mission_dir = self._server.config.mission_dir
             target = host_path(req.path, mission_dir)
-            if target.parent == mission_dir.expanduser().resolve():
-                target.parent.mkdir(parents=True, exist_ok=True)  # the mission folder itself
+            make_folder(target.parent)  # "team/plan.yaml" may name a folder not made yet
             write_document(target, document)
             resp.path_written = str(target)
         if req.return_document or not req.path:

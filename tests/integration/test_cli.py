@@ -399,7 +399,7 @@ def test_save_and_load_on_the_servers_host(server: Server, fresh: MissionClient)
     ids = build_mission(fresh)
     before = mission_to_json(fresh.get_mission())
     target = server.log_dir / "missions" / "team" / "plan.yaml"
-    target.parent.mkdir(parents=True, exist_ok=True)
+    assert not target.parent.exists()  # the server makes the folder
     out = rosmc(server, "save", "--on-server", "team/plan.yaml")
     assert out == f"saved revision {before['revision']} to {target} on the server\n"
     assert target.read_text().startswith("rosmc_mission: 1\n")
@@ -466,6 +466,25 @@ def test_unbarrier_is_delete_barrier(server: Server, fresh: MissionClient) -> No
     barrier = fresh.add_barrier([first, second]).barrier_id
     rosmc(server, "unbarrier", barrier)
     assert fresh.get_mission().barriers == ()
+
+
+def test_undo_walks_back_and_redoes(server: Server, fresh: MissionClient) -> None:
+    skill_id = rosmc(server, "add", "drone", "take_off", "altitude=12").strip()
+    fresh.get_mission()
+    edited = fresh.edit_skill(skill_id, {"altitude": 20.0}).revision
+    out = rosmc(server, "undo")  # README, "Undo and redo"
+    assert out.startswith(f"revision {edited + 1}: undo of revision {edited} (")
+    assert fresh.skill(skill_id).params["altitude"] == 12.0
+    rosmc(server, "undo")  # the edit before: the add
+    assert fresh.get_mission().task("drone") == []
+    rosmc(server, "undo", str(edited + 2))  # undoing that undo redoes the add
+    assert fresh.skill(skill_id).params["altitude"] == 12.0
+    fresh.get_mission()
+    fresh.edit_skill(skill_id, {"altitude": 30.0})
+    (refused,) = run_many(server.env, [["undo", str(edited + 1)]])
+    assert_refused(refused, f"skill '{skill_id}' was changed since revision {edited + 1}")
+    (refused,) = run_many(server.env, [["undo", "1"]])
+    assert_refused(refused, "revision 1 is not one of the last")
 
 
 def test_policy_is_checked_and_sent(server: Server) -> None:

@@ -71,6 +71,8 @@ def test_shortcuts_fire_in_a_real_window(tmp_path: Path) -> None:
         "Ctrl+N": "asked: starting a new mission",
         "F5": "refreshed",
         "Escape": [],
+        "Ctrl+Z": [["undo", [41]]],
+        "Ctrl+Shift+Z": [["undo", [42]]],
     }
 
 
@@ -78,13 +80,14 @@ def test_shortcuts_fire_in_a_real_window(tmp_path: Path) -> None:
 def drive() -> None:
     """Press every shortcut in a real window; print what each sent as JSON."""
     import copy
+    from types import SimpleNamespace
 
     from python_qt_binding.QtCore import Qt, QTimer
     from python_qt_binding.QtGui import QKeySequence
     from python_qt_binding.QtTest import QTest
 
     from rosmc_rqt_command.legality import RobotAction
-    from rosmc_rqt_command.requests import Answer
+    from rosmc_rqt_command.requests import Answer, Request
     from rosmc_server.core import AgentStatus, SkillStatus
     from rosmc_server.core.library import library_from_dict
     from tests.unit.conftest import TEST_LIBRARY, make_mission
@@ -194,6 +197,19 @@ def drive() -> None:
         gui.table("alpha", True).setFocus()
         press(keys)
         report[keys] = titles[0] if titles else "no dialog"
+    # Undo and redo: an edit of this window the server accepted (revision 41), then the
+    # answer to its undo (revision 42), which redo undoes in turn.
+    for request in backend.requests:
+        widget.on_answer(Answer(request, error="not served here"))
+    deleted = Request("delete_skills", ([alpha[1]],), what="delete")
+    widget.on_answer(Answer(deleted, value=SimpleNamespace(revision=41)))
+    widget.activateWindow()
+    QTest.qWaitForWindowActive(widget, 5000)
+    gui.table("alpha", True).setFocus()
+    press("Ctrl+Z")
+    for request in backend.requests:
+        widget.on_answer(Answer(request, value=SimpleNamespace(revision=42)))
+    press("Ctrl+Shift+Z")
     for request in backend.requests:
         widget.on_answer(Answer(request, error="not served here"))
     print(json.dumps(report))

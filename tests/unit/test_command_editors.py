@@ -25,7 +25,7 @@ from rosmc_rqt_command.param_editors import (
     VertexEditor,
     make_editor,
 )
-from rosmc_rqt_command.requests import Request
+from rosmc_rqt_command.requests import Answer, Request
 from rosmc_server.core import InvalidRequest, Library, Mission, ParamType, Pose
 from rosmc_server.core.library import ParameterSpec
 from tests.unit.test_command_harness import Gui, open_gui
@@ -77,16 +77,23 @@ def test_numbers_keep_to_their_bounds_and_units(gui: Gui) -> None:
     editor = gui.widget.parameters.editors["speed"]
     assert isinstance(editor, NumberEditor)
     assert editor.spin.suffix() == " m/s"
-    assert (editor.spin.minimum(), editor.spin.maximum()) == (0.1, 2.0)
+    assert editor.spin.toolTip() == "allowed: 0.1 to 2 m/s"
     type_into(editor.spin.lineEdit(), "1.25")
     assert sent(gui).kwargs == {"params": {"speed": 1.25}}
     assert gui.feed.mission.state.skill(skill_id).params["speed"] == 1.25
     assert editor.value() == 1.25  # shown again from the mission
-    type_into(editor.spin.lineEdit(), "7")  # above the maximum: the key is refused
-    assert gui.backend.requests == [] and editor.value() == 1.25
+    type_into(editor.spin.lineEdit(), "7")  # above the maximum: refused with the range
+    message = refused(gui)
+    assert "must be at most 2, got 7 (allowed: 0.1 to 2 m/s)." in message, message
+    assert editor.value() == 7.0 and editor.styleSheet()  # not changed behind one's back
     passes = shown(gui, "alpha", "scan")
     spin = gui.widget.parameters.editors["passes"].spin
-    assert (spin.minimum(), spin.maximum()) == (1, 5)
+    for typed, words in (("-5", "at least 1, got -5"), ("99999", "at most 5, got 99999")):
+        type_into(spin.lineEdit(), typed)
+        message = refused(gui)
+        assert f"{words} (allowed: 1 to 5)." in message, message
+        assert spin.value() == int(typed)
+        gui.widget.messages.log.clear()
     type_into(spin.lineEdit(), "4")
     assert sent(gui).kwargs == {"params": {"passes": 4}}
     assert gui.feed.mission.state.skill(passes).params["passes"] == 4
@@ -195,6 +202,39 @@ def test_label_time_limit_and_retries(gui: Gui) -> None:
     skill = gui.feed.mission.state.skill(skill_id)
     assert skill.label == "rest at the lander" and skill.max_retries == 2
     assert gui.cell("alpha", True, 0, 2, Qt.DisplayRole) == "rest at the lander"
+    # Out of range or empty: refused in a sentence, the field left as typed and tinted.
+    for spin, typed, words in (
+        (panel.retries_spin, "-5", "from 0 to"),
+        (panel.timeout_spin, "-5", "non-negative number, got -5.0 (0 s: no time limit)"),
+    ):
+        gui.widget.messages.log.clear()
+        type_into(spin.lineEdit(), typed)
+        assert words in refused(gui) and spin.value() == -5 and spin.styleSheet()
+    panel.retries_spin.setValue(2)
+    panel.timeout_spin.setValue(0)
+    gui.widget.messages.log.clear()
+    panel.label_edit.selectAll()
+    QTest.keyClick(panel.label_edit, Qt.Key_Backspace)  # the operator empties the label
+    QTest.keyClick(panel.label_edit, Qt.Key_Return)
+    assert "a label cannot be empty (it stays 'rest at the lander')" in refused(gui)
+    assert panel.label_edit.text() == "" and panel.label_edit.styleSheet()
+
+
+def test_a_refused_edit_returns_to_the_servers_value(gui: Gui) -> None:
+    skill_id = shown(gui, "alpha", "move", speed=1.5)
+    panel = gui.widget.parameters
+    speed = panel.editors["speed"].spin
+    type_into(speed.lineEdit(), "0.5")
+    [request] = gui.backend.requests
+    gui.backend.requests.clear()
+    assert speed.value() == 0.5  # a refusal brings no update: only the answer can revert
+    gui.widget.on_answer(Answer(request, error="skill 'x' is RUNNING"))  # the server refuses
+    assert speed.value() == 1.5  # the server's value, even in the focused field
+    said = gui.widget.messages.messages()[0]
+    assert said.endswith("Could not change speed of 'move': skill 'x' is RUNNING."), said
+    speed.editingFinished.emit()  # as when the focus leaves the field: nothing sent again
+    assert gui.backend.requests == []
+    assert gui.feed.mission.state.skill(skill_id).params["speed"] == 1.5
 
 
 @pytest.mark.parametrize(

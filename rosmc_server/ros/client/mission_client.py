@@ -20,6 +20,7 @@ from .results import (
     BarrierAdded,
     ControlCommand,
     ControlSent,
+    EditUndone,
     MarkerAdded,
     MissionSaved,
     Result,
@@ -358,6 +359,19 @@ class MissionClient(ClientBase):
         return Result(
             self._mutate("delete_task_marker", base_revision, retry_on_conflict, name=name).revision
         )
+
+    def undo(
+        self,
+        revision: int = 0,
+        *,
+        base_revision: int | None = None,
+        retry_on_conflict: bool = False,
+    ) -> EditUndone:
+        """Undo the edit that produced ``revision`` (0: the latest edit not undone)."""
+        response = self._mutate(
+            "undo_edit", base_revision, retry_on_conflict, undo_revision=revision
+        )
+        return EditUndone(response.revision, response.summary)
 
     # -- whole missions ----------------------------------------------------------------
     def new_mission(

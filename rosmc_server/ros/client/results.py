@@ -98,6 +98,13 @@ class MarkerAdded(Result):
 
 
 @dataclass(frozen=True)
+class EditUndone(Result):
+    """``undo`` succeeded: ``summary`` says which edit it took back."""
+
+    summary: str
+
+
+@dataclass(frozen=True)
 class MissionSaved(Result):
     """``save_mission``: the YAML document (if asked for), and the server-side path written."""
 

@@ -1,0 +1,119 @@
+"""Undo and redo of this window's own edits (Ctrl+Z, Ctrl+Shift+Z, Edit menu).
+
+The window keeps the revisions its accepted edits produced. Undo asks the server
+to undo the newest (``undo_edit``: the inverse as a new revision); redo undoes that
+undo. The server refuses, in one sentence, an edit whose skills were sent since or
+that someone changed; the message area shows the sentence and the entry is dropped.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from python_qt_binding.QtCore import QObject
+from python_qt_binding.QtWidgets import QWidget
+
+from .actions import CommandActions
+from .mission_view import MissionView
+from .requests import Answer, Request
+
+# The window's requests whose effect undo can take back.
+UNDOABLE = frozenset(
+    {
+        "add_skill",
+        "edit_skill",
+        "delete_skills",
+        "reorder",
+        "add_barrier",
+        "delete_barrier",
+        "add_marker",
+        "move_marker",
+        "rename_marker",
+        "delete_marker",
+    }
+)
+UNDO_OPERATION = "undo"
+
+
+class UndoHistory(QObject):  # type: ignore[misc]
+    """The undo and redo stacks of one command window, and their two actions.
+
+    Args:
+        owner: The command widget (the actions' shortcuts work inside it).
+        view: The mission as shown (for the base revision).
+        send: Hands a request to the backend.
+    """
+
+    def __init__(self, owner: QWidget, view: MissionView, send: Callable[[Request], None]) -> None:
+        super().__init__(owner)
+        self._view = view
+        self._send = send
+        self._undo: list[tuple[int, str]] = []  # (revision an edit produced, what it did)
+        self._redo: list[tuple[int, str]] = []  # (revision an undo produced, what it undid)
+        self._waiting = False  # one undo or redo at a time: the next needs its answer
+        self.read_only = False
+        self.undo_action = CommandActions.make(
+            owner, "&Undo", "Ctrl+Z", "Undo your last edit", "undo"
+        )
+        self.redo_action = CommandActions.make(
+            owner, "&Redo", "Ctrl+Shift+Z|Ctrl+Y", "Redo the edit you undid", "redo"
+        )
+        self.undo_action.triggered.connect(self.undo)
+        self.redo_action.triggered.connect(self.redo)
+        self._update()
+
+    def note(self, answer: Answer) -> str:
+        """Remember an accepted edit of this window; a hint for its message ("" if none)."""
+        operation = answer.request.operation
+        revision = getattr(answer.value, "revision", None)
+        if not answer.ok or operation not in UNDOABLE or revision is None:
+            return ""
+        self._undo.append((int(revision), answer.request.what or operation.replace("_", " ")))
+        self._redo.clear()
+        self._update()
+        return "Ctrl+Z undoes it"
+
+    def undo(self) -> None:
+        """Ask the server to undo this window's newest edit."""
+        if self._undo and not self._waiting and not self.read_only:
+            revision, what = self._undo.pop()
+            self._ask(revision, f"undo {what}", self._redo, self._undo, what)
+
+    def redo(self) -> None:
+        """Ask the server to undo this window's newest undo (the edit comes back)."""
+        if self._redo and not self._waiting and not self.read_only:
+            revision, what = self._redo.pop()
+            self._ask(revision, f"redo {what}", self._undo, self._redo, what)
+
+    def _ask(
+        self,
+        revision: int,
+        words: str,
+        onto: list[tuple[int, str]],
+        back: list[tuple[int, str]],
+        what: str,
+    ) -> None:
+        def answered(answer: Answer) -> None:
+            self._waiting = False
+            if answer.ok:
+                onto.append((int(answer.value.revision), what))
+            elif answer.conflict or answer.unreachable:
+                back.append((revision, what))  # not refused: it can be tried again
+            self._update()
+
+        self._waiting = True
+        self._update()
+        request = Request(UNDO_OPERATION, (revision,), {}, words, self._view.revision, answered)
+        self._send(request)
+
+    def set_read_only(self, read_only: bool) -> None:
+        """A window that follows a replay undoes nothing."""
+        self.read_only = read_only
+        self._update()
+
+    def _update(self) -> None:
+        free = not self._waiting and not self.read_only
+        self.undo_action.setEnabled(free and bool(self._undo))
+        self.redo_action.setEnabled(free and bool(self._redo))
+        self.undo_action.setText(f"&Undo {self._undo[-1][1]}" if self._undo else "&Undo")
+        self.redo_action.setText(f"&Redo {self._redo[-1][1]}" if self._redo else "&Redo")
