@@ -74,6 +74,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.history = UndoHistory(self, self.view, self.send)
         self._select_when_seen: list[str] = []
         self._pending_statuses: dict[str, AgentStatus] = {}
+        self._journal_alerting = False  # the server said its journal has a problem
         self.connected = False
         self._build_layout()
         self._connect()
@@ -239,6 +240,17 @@ class CommandWidget(QWidget):  # type: ignore[misc]
             "shown again as it hears the robots.",
             "warning",
         )
+
+    def on_journal_alert(self, alert: str) -> None:
+        """The server's journal alert changed: a full disk refuses changes, or history lost.
+
+        Said when it begins and when it clears (its byte count may change in between).
+        """
+        alerting, self._journal_alerting = self._journal_alerting, bool(alert)
+        if alert and not alerting:
+            self.messages.say(f"Journal: {alert}.", "error")
+        elif alerting and not alert:
+            self.messages.say("The journal's alert cleared: changes are recorded again.", "info")
 
     def on_answer(self, answer: Answer) -> None:
         """Say how a request ended."""

@@ -80,6 +80,7 @@ class RosBridge(QObject):  # type: ignore[misc]
     answered = Signal(object)  # Answer
     connection_changed = Signal(bool)
     server_restarted = Signal(int)  # the revision a new server process resumed at
+    journal_alert = Signal(str)  # the server's journal alert ("" once it clears)
     selection_received = Signal(list, list)  # skill ids, marker names
     science_received = Signal(object)  # rosmc_server.core.science.Science
     site_received = Signal(object)  # rosmc_server.core.site_source.SiteInForce | None
@@ -93,6 +94,7 @@ class RosBridge(QObject):  # type: ignore[misc]
             timeout=timeout,
             on_connection=self._on_connection,
             on_restart=self.server_restarted.emit,
+            on_journal_alert=self.journal_alert.emit,
         )
         self._have_library = False
         self._queue: deque[ViewUpdate] = deque()

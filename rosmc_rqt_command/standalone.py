@@ -35,6 +35,7 @@ def _wiring(widget: CommandWidget, bridge: RosBridge) -> list[tuple[Any, Any]]:
         (bridge.answered, widget.on_answer),
         (bridge.connection_changed, widget.on_connection),
         (bridge.server_restarted, widget.on_server_restarted),
+        (bridge.journal_alert, widget.on_journal_alert),
         (bridge.selection_received, widget.on_remote_selection),
         (bridge.science_received, widget.science.show_science),
         (bridge.site_received, widget.site.show_site),

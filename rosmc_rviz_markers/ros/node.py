@@ -92,8 +92,13 @@ class MarkerNode:
 
     def __init__(self, config: MarkerNodeConfig) -> None:
         self.config = config
-        self.follower = MissionFollower(prefix=config.ns, on_restart=self._on_server_restart)
+        self.follower = MissionFollower(
+            prefix=config.ns,
+            on_restart=self._on_server_restart,
+            on_journal_alert=self._on_journal_alert,
+        )
         self._server_note = ""  # said in rviz above the origin: the server restarted
+        self._journal_note = ""  # and what its journal alerts (a full disk)
         self._lock = threading.Lock()  # published specs, groups and the server
         self._published: dict[str, MarkerSpec] = {}
         self._groups: dict[str, set[str]] = {}  # task marker -> its interactive markers
@@ -182,6 +187,10 @@ class MarkerNode:
             f"mission server restarted {time.strftime('%H:%M:%S')} from revision {revision}"
         )
         _log.warning("%s", self._server_note)
+        self.mark(Touched(icons={SERVER_ICON}))
+
+    def _on_journal_alert(self, alert: str) -> None:
+        self._journal_note = f"journal: {alert}" if alert else ""
         self.mark(Touched(icons={SERVER_ICON}))
 
     def _on_update(self, update: MirrorUpdate) -> None:
@@ -302,9 +311,10 @@ class MarkerNode:
                 if point is not None:
                     position = point
             out += icon_markers(agent, rows, frame, position, index * 10, level)
-        if self._server_note:
-            note = (IconRow("server", self._server_note, WARN),)
-            for marker in icon_markers(SERVER_ICON, note, MAP_FRAME, SERVER_NOTE_AT, 0):
+        said = (self._server_note, self._journal_note)
+        notes = tuple(IconRow("server", text, WARN) for text in said if text)
+        if notes:
+            for marker in icon_markers(SERVER_ICON, notes, MAP_FRAME, SERVER_NOTE_AT, 0):
                 marker.scale.z = SERVER_NOTE_TEXT
                 out.append(marker)
         return out

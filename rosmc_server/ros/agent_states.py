@@ -69,6 +69,7 @@ class AgentStatePublisher:
         out = wire.AgentStates(stamp=rospy.Time.now())
         with server.locked():
             out.revision = server.mission.revision
+            out.journal_alert = server.journal_alert
             for agent in server.library.dynamic_agents:
                 out.agents.append(self._agent_state(agent))
         return out

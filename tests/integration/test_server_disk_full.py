@@ -23,6 +23,7 @@ from rosmc.msg import ErrorCode
 
 pytest.register_assert_rewrite("tests.integration.server_fixtures")
 
+from rosmc_server.ros.client.follow import MissionFollower  # noqa: E402
 from tests.conftest import wait_until  # noqa: E402
 from tests.integration.server_fixtures import REPO, Client, ServerProcess  # noqa: E402
 
@@ -90,7 +91,11 @@ def test_a_full_disk_refuses_changes_keeps_reads_and_resumes_when_space_returns(
     journal = small_disk / "mission.mcap"
     server = start_server("diskfull", journal=journal)
     filler = small_disk / "filler"
-    with Client() as client:
+    alerts: list[str] = []  # what the GUIs are told, as they follow the server
+    follower = MissionFollower(check_period=0.2, on_journal_alert=alerts.append)
+    follower.start()
+    with contextlib.ExitStack() as cleanup, Client() as client:
+        cleanup.callback(follower.close)
         assert add_marker(client, "Before", 1.0).error_code == ErrorCode.NONE
         before = client.revision()
         fill(filler)
@@ -104,11 +109,13 @@ def test_a_full_disk_refuses_changes_keeps_reads_and_resumes_when_space_returns(
         status = rosmc_status(server).splitlines()[0]
         assert status.startswith("the journal's disk is full: "), status
         assert status.endswith(f"in {small_disk}: changes are refused until space returns")
+        wait_until(lambda: alerts and FULL.match(alerts[-1].split(" in ")[0]), 20.0, "an alert")
         filler.unlink()  # space returns: the next change goes through, nobody restarts anything
         after = add_marker(client, "After", 3.0)
         assert after.error_code == ErrorCode.NONE, after.error
         assert after.revision == before + 1
         assert "disk is full" not in rosmc_status(server)
+        wait_until(lambda: alerts[-1] == "", 20.0, "the alert to clear")
     server.kill9()  # every acknowledged change is in the journal, the refused one is not
     start_server("diskfull", journal=journal, resume=True)
     with Client() as client:

@@ -157,3 +157,20 @@ def _warn_now(gui: Gui) -> None:
         gui.widget._on_warn_timer_timeout()
         if not gui.widget._checker.incomplete:
             return
+
+
+def test_a_journal_alert_is_said_when_it_begins_and_when_it_clears(gui: Gui) -> None:
+    log = gui.widget.messages.log
+
+    def said() -> list[str]:
+        return [log.item(i).text().split("  ", 1)[1] for i in range(log.count())]
+
+    before = len(said())
+    full = "the journal's disk is full: {} bytes free in /data: changes are refused"
+    for free in (1000, 900, 800):  # the count changes every second: said once
+        gui.widget.on_journal_alert(full.format(free))
+    gui.widget.on_journal_alert("")
+    assert said()[: len(said()) - before] == [
+        "The journal's alert cleared: changes are recorded again.",
+        f"Journal: {full.format(1000)}.",
+    ]

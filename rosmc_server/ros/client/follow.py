@@ -56,6 +56,8 @@ class MissionFollower:
         on_connection: Called with True/False when the server appears or goes away.
         on_restart: Called with the revision a new server process is at, once the mirror
             holds its mission (on the worker thread).
+        on_journal_alert: Called with the server's journal alert when it changes ("" once
+            it clears): lost history, or a full disk that refuses changes (ROS thread).
     """
 
     def __init__(
@@ -66,6 +68,7 @@ class MissionFollower:
         check_period: float = 1.0,
         on_connection: ConnectionListener | None = None,
         on_restart: Callable[[int], None] | None = None,
+        on_journal_alert: Callable[[str], None] | None = None,
     ) -> None:
         self.prefix = prefix
         self.mirror = MissionMirror(self._request_snapshot)
@@ -74,6 +77,8 @@ class MissionFollower:
         self._check_period = check_period
         self._on_connection = on_connection
         self._on_restart = on_restart
+        self._on_journal_alert = on_journal_alert
+        self._journal_alert = ""
         self._server_uri: str | None = None  # who answers now (None: nobody)
         self._known_uri: str | None = None  # who answered last
         self._restarted = False
@@ -176,6 +181,11 @@ class MissionFollower:
             return
         self.mirror.on_agent_statuses(statuses)
         self.mirror.on_server_revision(int(msg.revision))
+        alert = str(getattr(msg, "journal_alert", ""))  # absent from older recordings
+        if alert != self._journal_alert:
+            self._journal_alert = alert
+            if self._on_journal_alert is not None:
+                self._on_journal_alert(alert)
 
     def _on_replay_state(self, msg: wire.ReplayState) -> None:
         seeks = int(msg.seeks)
