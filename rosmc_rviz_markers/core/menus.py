@@ -10,6 +10,7 @@
 * Task marker: ``Add skill ▸ <robot> ▸ <skill>`` for skills with a parameter that accepts the
   marker's kind (the new skill is bound to the marker), ``Rename ▸ <suggestion>`` and
   ``Delete`` (only when no skill uses it; rename only while it is not locked).
+* Every one of them ends with ``Undo my last change`` and ``Redo`` (:data:`UNDO_MENU`).
 
 Entries are numbered depth first from 1, as ``visualization_msgs/MenuEntry`` wants.
 """
@@ -55,7 +56,15 @@ class DeleteMarker:
     """Delete the clicked task marker."""
 
 
-MenuAction = AddSkill | RenameMarker | DeleteMarker
+@dataclass(frozen=True)
+class UndoEdit:
+    """Undo the newest edit made in this rviz (``redo``: take back the newest undo)."""
+
+    redo: bool = False
+
+
+EditAction = AddSkill | RenameMarker | DeleteMarker
+MenuAction = EditAction | UndoEdit
 
 
 @dataclass(frozen=True)
@@ -65,6 +74,10 @@ class Menu:
     title: str
     action: MenuAction | None = None
     children: tuple[Menu, ...] = ()
+
+
+UNDO_MENU = (Menu("Undo my last change", UndoEdit()), Menu("Redo", UndoEdit(redo=True)))
+"""Every marker's menu ends with these (see :mod:`.edit_history`)."""
 
 
 @dataclass(frozen=True)

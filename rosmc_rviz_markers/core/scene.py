@@ -31,7 +31,7 @@ from rosmc_server.interface import MAP_FRAME
 
 from . import geometry as geo
 from .labels import Label, layout
-from .menus import flatten, robot_menu, static_agent_menu, task_marker_menu
+from .menus import UNDO_MENU, flatten, robot_menu, static_agent_menu, task_marker_menu
 from .specs import MarkerSpec, agent_spec, describe, task_label, task_specs
 from .styling import is_locked, marker_use
 
@@ -138,9 +138,9 @@ class Scene:
         if self.read_only:
             menu = flatten(())
         elif robot:
-            menu = flatten(robot_menu(self.library, agent))
+            menu = flatten((*robot_menu(self.library, agent), *UNDO_MENU))
         else:
-            menu = flatten(static_agent_menu(self.library, agent))
+            menu = flatten((*static_agent_menu(self.library, agent), *UNDO_MENU))
         highlighted = state is not None and any(
             state.has_skill(s) and state.skill(s).agent == agent for s in self.selection.skill_ids
         )
@@ -183,7 +183,9 @@ class Scene:
         bound = state.bound_to(name)
         locked = is_locked(bound)
         menu = flatten(
-            () if self.read_only else task_marker_menu(self.library, state, marker, bound, locked)
+            ()
+            if self.read_only
+            else (*task_marker_menu(self.library, state, marker, bound, locked), *UNDO_MENU)
         )
         return task_specs(
             marker,

@@ -36,7 +36,8 @@ from rosmc_server.ros.client import AsyncMissionClient, MissionClient, Outcome
 
 from .. import topics
 from ..core import areas
-from ..core.menus import AddSkill, DeleteMarker, MenuAction, RenameMarker
+from ..core.edit_history import EditHistory
+from ..core.menus import AddSkill, DeleteMarker, EditAction, RenameMarker, UndoEdit
 from ..core.requests import SkillPlan, moved_area, moved_pose, new_marker, robot_skill_plan
 from ..core.scene import Selection
 from ..core.specs import Parsed, parse_name
@@ -57,6 +58,7 @@ class Interaction:
         self._node = node
         self._config = config
         self._client = AsyncMissionClient(MissionClient(5.0, config.ns), "rosmc-markers-client")
+        self.history = EditHistory()  # this rviz's own edits, for Undo / Redo
         self._drags: dict[str, tuple[float, float, float]] = {}
         self._timers: dict[str, threading.Timer] = {}
         self._lock = threading.Lock()
@@ -140,6 +142,9 @@ class Interaction:
                 "ignored stale menu entry %d of marker '%s'", fb.menu_entry_id, fb.marker_name
             )
             return
+        if isinstance(action, UndoEdit):
+            self._undo(action.redo)
+            return
         mirror = self._node.mirror
         scene = self._node.scene
         with mirror.lock:
@@ -157,7 +162,7 @@ class Interaction:
             self._submit(call, f"{fb.marker_name}: {self._title(action)}")
 
     @staticmethod
-    def _title(action: MenuAction) -> str:
+    def _title(action: EditAction) -> str:
         if isinstance(action, AddSkill):
             return f"add {action.skill} to {action.agent}"
         if isinstance(action, RenameMarker):
@@ -165,7 +170,7 @@ class Interaction:
         return "delete"
 
     def _menu_call(
-        self, action: MenuAction, parsed: Parsed, library: Any, pose: Pose | None, rev: int | None
+        self, action: EditAction, parsed: Parsed, library: Any, pose: Pose | None, rev: int | None
     ) -> Call | None:
         name = parsed.name
         if isinstance(action, RenameMarker):
@@ -178,6 +183,21 @@ class Interaction:
             bindings = ((action.bind, name),) if action.bind and parsed.kind == "task" else ()
             plan = SkillPlan(action.agent, action.skill, dict(action.values), (), bindings)
         return lambda c: _add_planned(c, plan, self._base(rev))
+
+    def _undo(self, redo: bool) -> None:
+        """Ask the server to undo this rviz's newest edit (``redo``: its newest undo)."""
+        entry = self.history.take_redo() if redo else self.history.take_undo()
+        word = "redo" if redo else "undo"
+        if entry is None:
+            _log.warning("nothing of this rviz's to %s", word)
+            return
+        revision, what = entry
+        keep = self.history.redone if redo else self.history.undone
+        self._submit(
+            lambda c: c.undo(revision),
+            f"{word} {what}",
+            record=lambda result: keep(result.revision, what),
+        )
 
     # -- drags ------------------------------------------------------------------------------------
     def _drag(self, fb: Any, parsed: Parsed) -> None:
@@ -309,6 +329,7 @@ class Interaction:
         """A snapshot came; one older than this node's last result means a new server."""
         if self._own_revision is not None and self._own_revision > revision:
             self._own_revision = None
+            self.history.clear()  # its revisions named another server's edits
 
     def _base(self, seen: int | None) -> int | None:
         """The revision a call is made against: what the operator saw when clicking, or
@@ -319,15 +340,29 @@ class Interaction:
         return max(seen, self._own_revision)
 
     # -- calls ------------------------------------------------------------------------------------
-    def _submit(self, call: Call, what: str, on_error: Callable[[], None] | None = None) -> None:
+    def _submit(
+        self,
+        call: Call,
+        what: str,
+        on_error: Callable[[], None] | None = None,
+        record: Callable[[Any], None] | None = None,
+    ) -> None:
+        """Run ``call`` on the client's thread; an accepted edit goes to the history
+        (``record`` instead: how an undo or redo is kept)."""
+
         def done(outcome: Outcome[Any]) -> None:
             if outcome.error is not None:
                 _log.warning("%s refused: %s", what, outcome.error)
                 if on_error is not None:
                     on_error()
-            else:
-                self._own_revision = getattr(outcome.value, "revision", self._own_revision)
-                _log.info("%s: done", what)
+                return
+            revision = getattr(outcome.value, "revision", None)
+            self._own_revision = revision if revision is not None else self._own_revision
+            if record is not None:
+                record(outcome.value)
+            elif revision is not None:
+                self.history.done(revision, what)
+            _log.info("%s: done", what)
 
         future = self._client.submit(call, done)
         future.add_done_callback(lambda f: f.exception())  # errors reach `done`, not stderr

@@ -26,6 +26,8 @@ pytest_plugins = ["tests.integration.server_fixtures", "tests.integration.marker
 
 SQUARE = (Pose(0.0, 0.0), Pose(6.0, 0.0), Pose(6.0, 6.0), Pose(0.0, 6.0))
 
+UNDO_TITLES = ["Undo my last change", "Redo"]  # every menu ends with them
+
 
 def skills_of(client: MissionClient, agent: str) -> list[Any]:
     return list(current(client).task(agent))
@@ -72,7 +74,7 @@ def test_robot_menu_area_skill_gets_an_area_in_front(mission: Any, rviz: Rviz) -
 
 def test_task_marker_menu_adds_a_skill_bound_to_it(mission: Any, rviz: Rviz) -> None:
     name = add_marker(mission, rviz, TaskMarker("drop", MarkerType.POSE, Pose(5.0, 6.0, yaw=0.5)))
-    assert rviz.titles(f"task/{name}") == ["Add skill", "Rename", "Delete"]
+    assert rviz.titles(f"task/{name}") == ["Add skill", "Rename", "Delete", *UNDO_TITLES]
     rviz.select_menu(f"task/{name}", "Add skill", "manipulator_rover", "place_box")
     (skill,) = wait_for(lambda: skills_of(mission, "manipulator_rover"), "place_box")
     assert skill.skill == "place_box" and skill.bindings == {"target": name}
@@ -98,6 +100,20 @@ def test_rename_and_delete(mission: Any, rviz: Rviz) -> None:
     rviz.select_menu(f"task/{new_name}", "Delete")
     wait_for(lambda: not current(mission).has_marker(new_name), "the delete")
     wait_for(lambda: f"task/{new_name}" not in rviz.markers(), "the marker to go from rviz")
+
+
+def test_undo_and_redo_from_any_menu_take_back_this_rvizs_own_edits(
+    mission: Any, rviz: Rviz
+) -> None:
+    name = add_marker(mission, rviz, TaskMarker("", MarkerType.POSITION, Pose(14.0, -5.0)))
+    renamed = "Position at (14, -5)"
+    rviz.select_menu(f"task/{name}", "Rename", renamed)
+    wait_for(lambda: current(mission).has_marker(renamed), "the rename")
+    rviz.select_menu("robot/drone", "Undo my last change")  # any marker's menu will do
+    wait_for(lambda: current(mission).has_marker(name), "the rename undone")
+    assert not current(mission).has_marker(renamed)
+    rviz.select_menu(f"task/{name}", "Redo")
+    wait_for(lambda: current(mission).has_marker(renamed), "the rename redone")
 
 
 # -- drags --------------------------------------------------------------------------------------
