@@ -11,6 +11,7 @@ from enum import Enum
 from pathlib import Path
 
 from rosmc_server.core import SkillStatus
+from rosmc_server.recording.history import MissionHistory
 from rosmc_server.recording.overlays import timeline_with_overlays
 
 
@@ -63,13 +64,35 @@ def outline_of(path: str | Path) -> RecordingOutline:
     ]
     for interval in timeline.intervals:
         kind = _OUTCOMES.get(interval.outcome) if interval.outcome else None
-        if kind is not None:
+        if kind is not None and interval.outcome is not None:
             verb = "succeeded" if kind is TickKind.SUCCESS else "failed"
             text = f"{interval.agent}: {interval.label} {verb}"
-            ticks.append(ReplayTick(interval.end, kind, text))
+            shown = _shown_at(history, interval.skill_id, interval.outcome, interval.end)
+            ticks.append(ReplayTick(shown, kind, text))
     ticks += [
         ReplayTick(start, TickKind.OUTAGE, f"{agent}: link lost")
         for agent, start, _end in timeline.outages
     ]
     ticks.sort(key=lambda tick: tick.time)
     return RecordingOutline(Path(path), history.duration, tuple(ticks))
+
+
+SHOWN_WITHIN = 10.0  # seconds after a robot's stamp in which the recording shows the outcome
+
+
+def _shown_at(history: MissionHistory, skill_id: str, outcome: SkillStatus, after: float) -> float:
+    """When the recording first shows ``skill_id`` with ``outcome``, from ``after`` on.
+
+    ``after`` is the robot's own stamp of the outcome; the ground learns it a little later
+    (its report travels), and a click on the tick must show it.
+    """
+    for info in history.revisions:
+        seconds = history.seconds(info.log_time)
+        if seconds < after:
+            continue
+        if seconds > after + SHOWN_WITHIN:
+            break
+        state = history.at_revision(info.revision)
+        if state.has_skill(skill_id) and state.skill(skill_id).status is outcome:
+            return seconds
+    return after
