@@ -81,10 +81,11 @@ def test_a_mission_read_from_an_offset_says_where_it_ends(library: Library) -> N
 def test_a_get_mission_answer_reads_into_core_objects(library: Library) -> None:
     content = random_content(library, 300, seed=33)
     packed = SnapshotPacker().pack(content, 17, 1.0)
-    data = serialized(PackedGetMissionResponse(packed, "3 revisions lost at resume (r4..r6)"))
+    alert = "3 revisions lost at resume (r4..r6)"
+    data = serialized(PackedGetMissionResponse(packed, alert, "3f9a01c2"))
     answer = UnpackedGetMissionResponse().deserialize(data)
     assert (answer.content, answer.revision) == (content, 17)
-    assert answer.journal_alert == "3 revisions lost at resume (r4..r6)"
+    assert (answer.journal_alert, answer.epoch) == (alert, "3f9a01c2")
     assert answer.mission == wire.Mission()  # no genpy copy kept beside the core one
 
 
@@ -93,9 +94,10 @@ def test_without_the_definition_it_was_written_for_it_reads_through_genpy(
 ) -> None:
     monkeypatch.setattr(unpacking, "UNPACKED_MISSION_MD5", "0" * 32)
     content = random_content(library, 200, seed=34)
-    data = serialized(srv.GetMissionResponse(mission_to_msg(content, 5, 0.0), "alert"))
+    data = serialized(srv.GetMissionResponse(mission_to_msg(content, 5, 0.0), "alert", "e1"))
     answer = UnpackedGetMissionResponse().deserialize(data)
     assert (answer.content, answer.revision, answer.journal_alert) == (content, 5, "alert")
+    assert answer.epoch == "e1"
 
 
 def one_skill_mission(**fields: object) -> bytes:
