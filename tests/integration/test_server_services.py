@@ -696,7 +696,10 @@ def test_load_mission_rejects(scene: Scene, tmp_path: Path) -> None:
 
 
 def test_save_mission_to_an_unwritable_place_is_refused(scene: Scene, tmp_path: Path) -> None:
-    for path in (str(tmp_path / "no" / "such" / "dir.yaml"), str(tmp_path)):
+    blocker = tmp_path / "a_file"
+    blocker.write_text("not a folder")
+    # A missing folder is made (issue: save to team/plan.yaml); a file in the way is not.
+    for path in (str(blocker / "dir.yaml"), str(tmp_path)):
         response = scene.client.call("save_mission", path=path)
         assert response.error_code == E.INVALID, (response.error_code, response.error)
         assert_one_sentence(response.error)

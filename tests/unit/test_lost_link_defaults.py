@@ -212,3 +212,20 @@ def test_the_default_flag_survives_a_restart(rover: Rover, tmp_path: Path) -> No
                    FakeClock(), Recorder())  # fmt: skip
     load_state(fresh, tmp_path / "state.json")
     assert fresh.lost_link.policy == RETURN and fresh.lost_link.is_default
+
+
+def test_work_started_while_the_robot_returns_runs_once_it_is_back(rover: Rover) -> None:
+    """Contact comes back during the return drive; what waited arrives with a start: the
+    robot goes on with it once back, instead of holding."""
+    rover.set_policy(RETURN)
+    rover.upload(make_skill("a", params={"duration": 1.0}))
+    rover.send(K.START)
+    rover.pose = Pose(25.0, 2.0)
+    rover.run_for(61.5)  # done after 1 s, then idle a minute without a link: it drives back
+    assert rover.engine.state_name() == "contingency"
+    rover.upload(make_skill("home", params={"duration": 1.0}))  # in contact again
+    rover.send(K.START)
+    rover.run_for(2.0)  # the return ends; the start it heard meanwhile stands
+    assert rover.status("home") is SkillStatus.RUNNING or rover.status("home") is (
+        SkillStatus.SUCCESS
+    )

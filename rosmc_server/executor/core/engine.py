@@ -159,6 +159,7 @@ class Engine:
             self.outputs.changed()
         if self.lost_link.step(now):
             self.outputs.changed()
+            self.advance()  # an operator who started the robot meanwhile has it go on
         active = self._active
         if active is None:
             return
