@@ -562,6 +562,24 @@ def journal_reports(path: Path) -> list[wire.RobotReport]:
     return [r.message for r in read_journal(path, [interface.ROBOT_REPORTS_TOPIC]).records]
 
 
+def assert_released_together(path: Path, members: Sequence[str]) -> None:
+    """No barrier member started before the last one arrived (robot clocks, one machine).
+
+    The release skew in milliseconds is a figure for ``bench/bench_executor.py``; a test
+    checks the order: every member's RUNNING ``started`` follows every member's last
+    SYNCWAITING report.
+    """
+    arrived: dict[str, float] = {}
+    for report in journal_reports(path):
+        if report.status.value == S.SYNCWAITING:
+            arrived[report.skill_id] = report.stamp.to_sec()
+    started = running_stamps(path)
+    assert set(members) <= set(arrived), f"a member never waited: {members}, {arrived}"
+    last = max(arrived[m] for m in members)
+    early = {m: started[m] for m in members if started[m] < last}
+    assert not early, f"started before the last member arrived at {last}: {early}"
+
+
 def running_stamps(path: Path) -> dict[str, float]:
     """Each skill's ``started`` stamp from its first RUNNING report (robot clock)."""
     stamps: dict[str, float] = {}

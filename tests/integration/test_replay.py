@@ -155,14 +155,12 @@ def test_replay_republishes_every_event_and_the_final_snapshot(
     node: Any, journal: Path, listen: Callable[[str], Listener]
 ) -> None:
     listener = listen("")
-    started = time.monotonic()
     done = replay(node.env, str(journal), "--rate", "10")
     assert done.returncode == 0, done.stderr
     assert listener.wait(lambda: EVENTS in listener.snapshots)
     assert listener.events == list(range(1, EVENTS + 1))
     assert listener.snapshots[0] == 0 and listener.snapshots[-1] == EVENTS
     assert "replay done at revision 24" in done.stdout
-    assert time.monotonic() - started < 30
     assert publishers(node, "/rosmc/mission") == []  # the replay left the graph
 
 
