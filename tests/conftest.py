@@ -44,8 +44,8 @@ from hypothesis import HealthCheck, settings
 REPO_ROOT = Path(__file__).resolve().parent.parent
 T = TypeVar("T")
 LOOPBACK = "127.0.0.1"
-MASTER_START_TIMEOUT = 20.0
-STOP_TIMEOUT = 10.0
+MASTER_START_TIMEOUT = 60.0
+STOP_TIMEOUT = 30.0
 HYPOTHESIS_PROFILES = {
     "quick": settings(max_examples=100, deadline=None, print_blob=True),
     "thorough": settings(

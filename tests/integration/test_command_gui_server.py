@@ -100,7 +100,7 @@ class Window:
         rect = table.visualRect(table.section.index(row, 2))
         QTest.mouseClick(table.viewport(), Qt.LeftButton, Qt.NoModifier, rect.center())
 
-    def said(self, fragment: str, timeout: float = 10.0) -> str:
+    def said(self, fragment: str, timeout: float = 30.0) -> str:
         return str(
             wait_until(
                 lambda: next((m for m in self.widget.messages.messages() if fragment in m), None),
@@ -224,7 +224,7 @@ def test_a_frozen_server_does_not_freeze_the_window(
     # The calls were waiting, not lost: the thawed server answers both.
     for what in calls:
         message = window.said(what, timeout=60)
-        assert message.startswith("Done:"), message
+        assert "Done: " in message, message
     wait_until(lambda: window.w.view.loaded, 60, "still following")
     added = meanwhile(lambda: add_skill("drone", "land"))
     wait_until(lambda: added in window.ids("drone"), 60, "a later change shown")
@@ -240,7 +240,7 @@ def test_two_windows_stay_consistent_and_a_stale_edit_is_a_conflict(
     shown(second)
     first.add("drone", "take_off")
     first.add("drone", "land")
-    wait_until(lambda: len(second.ids("drone")) == 2, 10, "the second window sees the adds")
+    wait_until(lambda: len(second.ids("drone")) == 2, 30, "the second window sees the adds")
     take_off, land = first.ids("drone")
     assert second.ids("drone") == [take_off, land]
 
@@ -258,8 +258,8 @@ def test_two_windows_stay_consistent_and_a_stale_edit_is_a_conflict(
     QTest.mouseClick(second.w.control.buttons["move_down"], Qt.LeftButton)
     message = second.said("someone else changed the mission first")
     assert "The view was refreshed" in message
-    wait_until(lambda: second.ids("drone") == [land, take_off], 10, "the refreshed view")
-    wait_until(lambda: first.ids("drone") == [land, take_off], 10, "the first window too")
+    wait_until(lambda: second.ids("drone") == [land, take_off], 30, "the refreshed view")
+    wait_until(lambda: first.ids("drone") == [land, take_off], 30, "the first window too")
     no_traceback(second)
 
     # The lost-link policy goes through the client's typed call (the server keeps it for
@@ -310,7 +310,7 @@ def test_a_two_robot_barrier_plan_goes_out_with_one_click_and_one_question(
         window.add(agent, skill)
     wait_until(
         lambda: len(window.ids("drone")) == 2 and len(window.ids("science_rover")) == 2,
-        10,
+        30,
         "the four skills",
     )
     for row in (0, 1):  # barriers: the firsts start together, and so do the seconds
@@ -318,7 +318,7 @@ def test_a_two_robot_barrier_plan_goes_out_with_one_click_and_one_question(
         ctrl_click_row(window, "science_rover", row)
         QTest.mouseClick(window.w.control.buttons["barrier"], Qt.LeftButton)
         window.said("Done: start 'take_off', 'navigate_to' together" if row == 0 else "'land'")
-    wait_until(lambda: len(window.w.view.barriers) == 2, 10, "both barriers shown")
+    wait_until(lambda: len(window.w.view.barriers) == 2, 30, "both barriers shown")
     questions = Questions([QMessageBox.No, QMessageBox.Yes])
     try:
         # The drone up to 'land' but the rover only up to its first skill: one question
@@ -326,7 +326,7 @@ def test_a_two_robot_barrier_plan_goes_out_with_one_click_and_one_question(
         window.click_row("drone", 1)
         ctrl_click_row(window, "science_rover", 0)
         QTest.mouseClick(window.w.control.buttons["synchronize"], Qt.LeftButton)
-        wait_until(lambda: len(questions.asked) == 1, 10, "the question")
+        wait_until(lambda: len(questions.asked) == 1, 30, "the question")
         assert (
             "drone will wait at a barrier for ever unless you also send science_rover's"
             in (questions.asked[0])
@@ -346,7 +346,7 @@ def test_a_two_robot_barrier_plan_goes_out_with_one_click_and_one_question(
         lambda: all(
             window.w.view.view(agent).editable == () for agent in ("drone", "science_rover")
         ),
-        10,
+        30,
         "both plans in transfer",
     )
     no_traceback(window)
@@ -367,7 +367,7 @@ def test_the_science_score_is_in_view_once_published(
             RegionScience("RSS B", 30, -16, 3.5, 0.8, 2, ""),
         )
         publisher.publish(science_to_msg(Science(1.1, 2, regions)))
-        wait_until(lambda: strip.science is not None, 10, "the science state")
+        wait_until(lambda: strip.science is not None, 30, "the science state")
     finally:
         publisher.unregister()
     text = strip.text()
@@ -384,7 +384,7 @@ def test_save_to_a_local_file_and_open_it_again(
     window = windows()
     shown(window)
     window.add("drone", "take_off")
-    wait_until(lambda: window.ids("drone"), 10, "take_off shown")
+    wait_until(lambda: window.ids("drone"), 30, "take_off shown")
     path = tmp_path / "plan.yaml"
 
     # Save as… through the real dialog (Qt's own, so it can be driven offscreen).
@@ -395,14 +395,14 @@ def test_save_to_a_local_file_and_open_it_again(
     assert not window.w.files.dirty
 
     window.add("drone", "land")
-    wait_until(lambda: len(window.ids("drone")) == 2, 10, "land shown")
+    wait_until(lambda: len(window.ids("drone")) == 2, 30, "land shown")
     assert window.w.files.dirty
     window.w.files.ask = lambda doing: "discard"  # the unsaved-changes question
     answer_file_dialog(str(path))
     window.w.actions_.file["open"].trigger()
-    wait_until(lambda: len(window.ids("drone")) == 1, 10, "the saved mission back")
+    wait_until(lambda: len(window.ids("drone")) == 1, 30, "the saved mission back")
     assert [s.skill for s in window.w.view.view("drone").skills] == ["take_off"]
-    wait_until(lambda: not window.w.files.dirty, 5, "the opened file counts as saved")
+    wait_until(lambda: not window.w.files.dirty, 30, "the opened file counts as saved")
     no_traceback(window)
 
 
@@ -456,21 +456,21 @@ def test_a_send_to_a_robot_out_of_contact_is_shown_waiting(
     window = windows()
     shown(window)
     window.add("drone", "take_off")
-    wait_until(lambda: window.ids("drone"), 10, "take_off shown")
+    wait_until(lambda: window.ids("drone"), 30, "take_off shown")
     column = window.w.schedule.columns["drone"]
     send = column.buttons[RobotAction.SYNC_ALL]
-    wait_until(send.isEnabled, 10, "Sync all enabled")
+    wait_until(send.isEnabled, 30, "Sync all enabled")
     QTest.mouseClick(send, Qt.LeftButton)
     window.said("queued for drone: not heard since the server started")
     model = column.blueprint_model
     wait_until(
         lambda: model.data(model.index(0, STATUS)) == "waiting for contact",
-        10,
+        30,
         "the row to say the send waits for contact",
     )
     header = wait_until(
         lambda: (text := column.status_label.text()) and "waiting for contact" in text and text,
-        10,
+        30,
         "the header to say what waits",
     )
     assert "never heard · 1 command waiting for contact" in header, header

@@ -41,10 +41,10 @@ def test_endpoints_find_each_other_through_the_directory(ros_master: RosMaster) 
             lambda: (
                 set(directory.getParam("/t", interface.RADIO_DIRECTORY)[2] or {}) >= set(radios)
             ),
-            10.0,
+            30.0,
             "every endpoint registered",
         )
-        wait_until(lambda: set(radios["r1"].robots()) == {"r2"}, 10.0, "r1 to list r2 only")
+        wait_until(lambda: set(radios["r1"].robots()) == {"r2"}, 30.0, "r1 to list r2 only")
         signal = wire.BarrierSignal(agent="r1", barrier_id="B3", skill_id="s", kind=3)
         signal.stamp = rospy.Time(12, 5)
 
@@ -53,7 +53,7 @@ def test_endpoints_find_each_other_through_the_directory(ros_master: RosMaster) 
             radios["r2"].beacon("ground")
             return bool(heard["r2"].signals) and "r2" in heard["ground"].beacons
 
-        wait_until(exchanged, 10.0, "a signal and a beacon to arrive")
+        wait_until(exchanged, 30.0, "a signal and a beacon to arrive")
         got = heard["r2"].signals[0]
         assert (got.agent, got.barrier_id, got.kind, got.stamp) == ("r1", "B3", 3, signal.stamp)
         assert not heard["ground"].signals  # signals go to robots only
@@ -68,7 +68,7 @@ def test_endpoints_find_each_other_through_the_directory(ros_master: RosMaster) 
         count = len(heard["r2"].signals)
         wait_until(
             lambda: radios["r1"].signal(signal, ["r2"]) or len(heard["r2"].signals) > count,
-            10.0,
+            30.0,
             "r2 to hear on after stray datagrams",
         )
     finally:

@@ -275,7 +275,7 @@ def test_collaborative_identification_scores_the_region_maximum(op: Operator) ->
     op.wait_status(survey + staging + sampling, S.SUCCESS, timeout=60.0)
 
     assert op.science.identified_by("RSS North") == "collaborative"
-    wait_until(lambda: op.science.score() > start_score, 10.0, "the score counts the stone")
+    wait_until(lambda: op.science.score() > start_score, 30.0, "the score counts the stone")
     assert op.science.score() - start_score == pytest.approx(region.max_score)
     assert any("RSS North together" in line for line in op.science.lines)
 
@@ -297,7 +297,7 @@ def test_without_identification_a_stone_scores_the_minimum(op: Operator) -> None
     op.wait_status([explore, *fetch], S.SUCCESS, timeout=60.0)
 
     assert op.science.identified_by("RSS West") == ""
-    wait_until(lambda: op.science.score() > start_score, 10.0, "the score counts the stone")
+    wait_until(lambda: op.science.score() > start_score, 30.0, "the score counts the stone")
     assert op.science.score() - start_score == pytest.approx(0.1)
     assert any("RSS West stone 1 worth 0.10" in line for line in op.science.lines)
 
@@ -311,13 +311,13 @@ def test_a_stopped_skill_runs_again_on_start(op: Operator) -> None:
     drive = c.add_skill(SCIENCE, "navigate_to", target(-6.0, -6.0, speed=0.05)).skill_id
     back = c.add_skill(SCIENCE, "return_to_lander").skill_id
     op.sync_and_start([SCIENCE])
-    op.wait_status([drive], S.RUNNING, timeout=20.0)
+    op.wait_status([drive], S.RUNNING, timeout=60.0)
     c.control(ControlCommand.STOP, SCIENCE)
-    op.wait_status([drive], S.IDLE_SYNCHRONIZED, timeout=20.0)
+    op.wait_status([drive], S.IDLE_SYNCHRONIZED, timeout=60.0)
     c.control(ControlCommand.START, SCIENCE)
     op.wait_mission(
         lambda state: state.skill(drive).status in (S.RUNNING, S.SUCCESS),
-        20.0,
+        60.0,
         f"{drive} runs again",
     )
     op.wait_status([drive, back], S.SUCCESS, timeout=90.0)
@@ -390,7 +390,7 @@ def test_out_of_contact_commands_wait_until_a_lost_link_policy_brings_the_rover_
     c.set_robot_options(SCIENCE, come_back)
     op.wait_mission(
         lambda _m: "run navigate_to" in (op.agent_state(SCIENCE) or AgentStatus("")).policy,
-        20.0,
+        60.0,
         "the return policy in force",
     )
     drive = [
@@ -410,7 +410,7 @@ def test_out_of_contact_commands_wait_until_a_lost_link_policy_brings_the_rover_
     c.set_robot_options(SCIENCE, LostLinkPolicy(LostLinkKind.CONTINUE))
     waiting = wait_until(  # the upload of one skill and the new policy
         lambda: (s := op.agent_state(SCIENCE)) is not None and s.commands_waiting == 2 and s,
-        10.0,
+        30.0,
         "two commands shown waiting",
     )
     assert waiting.link == "down", "the operator was quick enough"
@@ -429,7 +429,7 @@ def test_out_of_contact_commands_wait_until_a_lost_link_policy_brings_the_rover_
         lambda _m: (op.agent_state(SCIENCE) or AgentStatus("")).policy.startswith(
             "on link loss: continue"
         ),
-        20.0,
+        60.0,
         "the new policy in force",
     )
     assert back.skill(extra).is_editable, "the taken-back skill never went"
