@@ -36,6 +36,7 @@ import xmlrpc.client
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from types import MappingProxyType
 from typing import TypeVar
 
 import pytest
@@ -46,15 +47,17 @@ T = TypeVar("T")
 LOOPBACK = "127.0.0.1"
 MASTER_START_TIMEOUT = 60.0
 STOP_TIMEOUT = 30.0
-HYPOTHESIS_PROFILES = {
-    "quick": settings(max_examples=100, deadline=None, print_blob=True),
-    "thorough": settings(
-        max_examples=3000,
-        deadline=None,
-        print_blob=True,
-        suppress_health_check=[HealthCheck.too_slow],
-    ),
-}
+HYPOTHESIS_PROFILES = MappingProxyType(
+    {
+        "quick": settings(max_examples=100, deadline=None, print_blob=True),
+        "thorough": settings(
+            max_examples=3000,
+            deadline=None,
+            print_blob=True,
+            suppress_health_check=[HealthCheck.too_slow],
+        ),
+    }
+)
 
 
 def pytest_configure(config: pytest.Config) -> None:
