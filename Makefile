@@ -5,6 +5,8 @@
 #   make demo    setup, then the demo mission (scripts/rosmc_demo); DEMO_ARGS=... passes options;
 #                GUI=1 also opens rviz and the command GUI on it
 #   make test    setup, lint, then pytest over tests/; PYTEST_ARGS=... passes options
+#   make test-thorough  the same with the thorough hypothesis profile (nightly: many examples)
+#   make test-busy      make test with two CPU-bound processes beside it (tools/beside_busy.py)
 #   make bench   setup, then every bench/ script: bench/results.json, bench/results.md and the
 #                README's figures table; BENCH=server,scale runs only those
 #   make sample  setup, then record bags/samples/demo.mcap anew (after a message change)
@@ -45,7 +47,8 @@ PACKAGES = $(patsubst %/__init__.py,%,$(wildcard rosmc_*/__init__.py))
 # Run a command inside the environment of env.sh.
 IN_ENV := source ./env.sh &&
 
-.PHONY: help setup apt venv requirements msgs demo sample test pytest bench lint format clean
+.PHONY: help setup apt venv requirements msgs demo sample test test-thorough test-busy pytest \
+	bench lint format clean
 
 help:
 	@sed -n '1,/^$$/s/^# \{0,1\}//p' Makefile
@@ -96,6 +99,14 @@ sample: setup
 	$(IN_ENV) python tools/record_sample.py
 
 test: setup lint pytest
+
+# Hypothesis profiles live in tests/conftest.py: `quick` (the default) and `thorough`.
+test-thorough:
+	HYPOTHESIS_PROFILE=thorough $(MAKE) test
+
+# The suite must pass on a loaded machine; the busy processes stop whatever the outcome.
+test-busy: setup
+	$(IN_ENV) python tools/beside_busy.py --busy 2 -- $(MAKE) test
 
 # pytest's own exit codes pass through: 5 (no test collected) fails the target.
 pytest: setup

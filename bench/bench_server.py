@@ -7,7 +7,9 @@ client with persistent service proxies: median and p95 latency of add, edit, del
 reorder, add barrier, marker move, synchronize and get_mission (read into core objects as
 the project's client reads it; ``get_mission_genpy``: decoded by genpy); bytes per event, per
 snapshot and per journaled change; the server's peak RSS after the load and after each
-phase. Before the per-change operations (a load is refused once robots hold synchronized
+phase; after them, how long the latched ``/rosmc/mission`` takes to catch up with a burst
+of 200 back-to-back adds, and how many snapshots the burst caused. Before the per-change
+operations (a load is refused once robots hold synchronized
 skills), the whole-mission paths (``whole``), ``--whole-repeats`` times each, p50 and p95
 (with a few repeats, the max): get_mission right after a change and again at the same
 revision (decoded by genpy, read into core objects, and as raw bytes: the server and
@@ -44,6 +46,7 @@ from typing import Any
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # also when imported as bench.bench_server
 
+from _burst import snapshot_after_burst
 from _missions import agent_name, library_yaml, mission_yaml, skill_id
 from _server_harness import (
     REPO,
@@ -250,6 +253,7 @@ def bench_size(
             result["journal_bytes_per_change"] = round(journaled / changes)
             result["changes"] = changes
             result["server_peak_rss_after_changes_mib"] = server.peak_rss_mib()
+            result["snapshot_after_burst"] = snapshot_after_burst(bench, bench.agents[0])
         if options.cpu_seconds > 0:
             seconds = options.cpu_seconds
             result["snapshot_subscriber"] = subscriber_cpu(bench, server, seconds, bench.edit_label)

@@ -15,7 +15,13 @@ or, after ``source env.sh``, plain ``python -m pytest``.
 :func:`wait_until` is how every tier waits for something to happen: it polls a condition
 instead of sleeping for a fixed time (a test that sleeps is slow on a fast machine and
 flaky on a loaded one). A fixed sleep is left only where a test checks that nothing
-happens for a while, or measures a rate over a time window.
+happens for a while. Tests assert order and outcome, never how long something took: the
+figures are in ``bench/``, and every deadline is one that only something stuck misses.
+
+Hypothesis profiles, chosen with ``HYPOTHESIS_PROFILE`` (default ``quick``):
+``quick`` (what ``make test`` runs: few examples, no deadline) and ``thorough`` (many
+examples, ``make test-thorough``). Property tests that name no example count take it from
+the profile.
 """
 
 from __future__ import annotations
@@ -30,15 +36,39 @@ import xmlrpc.client
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from types import MappingProxyType
 from typing import TypeVar
 
 import pytest
+from hypothesis import HealthCheck, settings
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
 T = TypeVar("T")
 LOOPBACK = "127.0.0.1"
-MASTER_START_TIMEOUT = 20.0
-STOP_TIMEOUT = 10.0
+MASTER_START_TIMEOUT = 60.0
+STOP_TIMEOUT = 30.0
+HYPOTHESIS_PROFILES = MappingProxyType(
+    {
+        "quick": settings(max_examples=100, deadline=None, print_blob=True),
+        "thorough": settings(
+            max_examples=3000,
+            deadline=None,
+            print_blob=True,
+            suppress_health_check=[HealthCheck.too_slow],
+        ),
+    }
+)
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """Load the hypothesis profile that ``HYPOTHESIS_PROFILE`` names (``quick`` by default)."""
+    name = os.environ.get("HYPOTHESIS_PROFILE", "quick")
+    if name not in HYPOTHESIS_PROFILES:
+        known = ", ".join(sorted(HYPOTHESIS_PROFILES))
+        raise pytest.UsageError(f"HYPOTHESIS_PROFILE={name!r} is not one of: {known}")
+    for profile, chosen in HYPOTHESIS_PROFILES.items():
+        settings.register_profile(profile, chosen)
+    settings.load_profile(name)
 
 
 def wait_until(

@@ -45,7 +45,7 @@ from tests.conftest import wait_until
 REPO_ROOT = Path(__file__).resolve().parents[2]
 TEST_LIBRARY = REPO_ROOT / "tests" / "data" / "test_team.yaml"
 S = SkillStatus
-STOP_TIMEOUT = 10.0
+STOP_TIMEOUT = 30.0
 
 
 class OperatorError(RuntimeError):
@@ -201,7 +201,7 @@ class Operator:
         if publisher is None:
             publisher = rospy.Publisher(f"/{agent}/link/blackout", Bool, queue_size=10, latch=True)
             self._blackouts[agent] = publisher
-            wait_until(lambda: publisher.get_num_connections() > 0, 10.0, "the link emulator")
+            wait_until(lambda: publisher.get_num_connections() > 0, 30.0, "the link emulator")
         publisher.publish(Bool(data=on))
 
     # -- waiting --------------------------------------------------------------------
@@ -219,7 +219,7 @@ class Operator:
         return state
 
     def wait_status(
-        self, skill_ids: Sequence[str], status: SkillStatus, timeout: float = 20.0
+        self, skill_ids: Sequence[str], status: SkillStatus, timeout: float = 60.0
     ) -> MissionState:
         """Wait until every skill in ``skill_ids`` has ``status``."""
         names = ", ".join(skill_ids)
@@ -319,7 +319,7 @@ class LinkEnd:
         """Send ``msg`` on topic ``name`` of the link."""
         self._publishers[name].publish(msg)
 
-    def wait_heard(self, name: str, predicate: Callable[[Any], bool], timeout: float = 10.0) -> Any:
+    def wait_heard(self, name: str, predicate: Callable[[Any], bool], timeout: float = 30.0) -> Any:
         """The first message on ``name`` that satisfies ``predicate`` (waits for it)."""
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
@@ -368,7 +368,7 @@ def signal_datagram(msg: wire.BarrierSignal) -> bytes:
 def send_datagrams(name: str, *datagrams: bytes) -> None:
     """Send raw datagrams to ``name``'s radio endpoint, read from the directory."""
     key = f"{interface.RADIO_DIRECTORY}/{name}"
-    endpoint = wait_until(lambda: rospy.get_param(key, ""), 10.0, f"{name}'s radio endpoint")
+    endpoint = wait_until(lambda: rospy.get_param(key, ""), 30.0, f"{name}'s radio endpoint")
     host, port = parse_endpoint(endpoint)
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as udp:
         for datagram in datagrams:
@@ -560,6 +560,24 @@ def journal_timelines(path: Path) -> dict[str, list[Transition]]:
 def journal_reports(path: Path) -> list[wire.RobotReport]:
     """The robot reports the server journaled, in journal order."""
     return [r.message for r in read_journal(path, [interface.ROBOT_REPORTS_TOPIC]).records]
+
+
+def assert_released_together(path: Path, members: Sequence[str]) -> None:
+    """No barrier member started before the last one arrived (robot clocks, one machine).
+
+    The release skew in milliseconds is a figure for ``bench/bench_executor.py``; a test
+    checks the order: every member's RUNNING ``started`` follows every member's last
+    SYNCWAITING report.
+    """
+    arrived: dict[str, float] = {}
+    for report in journal_reports(path):
+        if report.status.value == S.SYNCWAITING:
+            arrived[report.skill_id] = report.stamp.to_sec()
+    started = running_stamps(path)
+    assert set(members) <= set(arrived), f"a member never waited: {members}, {arrived}"
+    last = max(arrived[m] for m in members)
+    early = {m: started[m] for m in members if started[m] < last}
+    assert not early, f"started before the last member arrived at {last}: {early}"
 
 
 def running_stamps(path: Path) -> dict[str, float]:

@@ -44,7 +44,7 @@ from rosmc_server.ros.client import MissionClient
 
 REPO = Path(__file__).resolve().parents[2]
 NODE = REPO / "scripts" / "markers_node"
-TIMEOUT = 15.0
+TIMEOUT = 60.0
 CLIENT_ID = "/rviz_test/InteractiveMarkers"
 T = TypeVar("T")
 

@@ -45,7 +45,7 @@ ROBOTS = ("drone", "science_rover", "manipulator_rover")
 USE_SIM_TIME = "/use_sim_time"
 EMULATOR_NODE = "/rosmc/link_emulator"
 CLOCK_TOPIC = "/clock"
-STOP_TIMEOUT = 10.0
+STOP_TIMEOUT = 30.0
 POLL = 0.05  # wall seconds between looks at something that changes on its own
 S = SkillStatus
 HELD = (S.IDLE_SYNCHRONIZED, S.SYNCWAITING, S.RUNNING, S.PAUSED)  # on a robot, not finished
@@ -417,7 +417,7 @@ class Operator:
     # -- the robots ------------------------------------------------------------------------
     def agent_state(self, agent: str) -> AgentStatus | None:
         """What the server last said about ``agent``'s robot."""
-        states = self.watch.wait_agent_states(timeout=5.0) or {}
+        states = self.watch.wait_agent_states(timeout=30.0) or {}
         return states.get(agent)
 
     def wait_link(self, agent: str, link: str, timeout: float) -> AgentStatus:
@@ -436,7 +436,7 @@ class Operator:
 
     def where(self, robot: str) -> wire.Telemetry:
         """The robot's latest telemetry (pose, battery, coverage), straight from the sim."""
-        return wait_until(lambda: self.telemetry[robot].last, 10.0, f"{robot}'s telemetry")
+        return wait_until(lambda: self.telemetry[robot].last, 30.0, f"{robot}'s telemetry")
 
     def sim_now(self) -> float:
         """A sim time at least as late as the call (one ``/clock`` message heard afresh).

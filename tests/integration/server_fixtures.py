@@ -41,8 +41,8 @@ from rosmc_server import interface
 REPO = Path(__file__).resolve().parents[2]
 SERVER_SCRIPT = REPO / "scripts" / "mission_server"
 READY_LINE = "mission server ready"
-START_TIMEOUT = 30.0
-STOP_TIMEOUT = 8.0
+START_TIMEOUT = 60.0
+STOP_TIMEOUT = 30.0
 # Servers of this process that are running: only one can own the mission server's names.
 _RUNNING: list[ServerProcess] = []
 MUTATING = tuple(
@@ -389,7 +389,7 @@ class Recorder:
             self.times.append(time.monotonic())
             self._cond.notify_all()
 
-    def wait_for(self, predicate: Callable[[list[Any]], bool], timeout: float = 5.0) -> list[Any]:
+    def wait_for(self, predicate: Callable[[list[Any]], bool], timeout: float = 30.0) -> list[Any]:
         """Wait until ``predicate(messages)`` holds; return a copy of the messages."""
         deadline = time.monotonic() + timeout
         with self._cond:
@@ -435,7 +435,7 @@ class FakeRobot:
         self._snapshot = rospy.Publisher(topics.snapshot, wire.ExecutorSnapshot, queue_size=10)
         self._ack = rospy.Publisher(topics.ack, wire.RobotAck, queue_size=10)
         self._report = rospy.Publisher(topics.report, wire.RobotReport, queue_size=10)
-        deadline = time.monotonic() + 10.0
+        deadline = time.monotonic() + 30.0
         for publisher in (self._snapshot, self._ack, self._report):
             while publisher.get_num_connections() == 0:
                 assert time.monotonic() < deadline, f"the server does not listen to {agent}"

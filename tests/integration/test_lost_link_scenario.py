@@ -121,7 +121,7 @@ def test_work_sent_while_out_of_contact_reaches_the_rover_when_its_default_bring
     c.set_robot_options(ARM, LostLinkPolicy())  # a second change replaces the first
     waiting = wait_until(  # one upload and one policy, shown with their age
         lambda: (s := op.agent_state(ARM)) is not None and s.commands_waiting == 2 and s,
-        10.0,
+        30.0,
         "two commands shown waiting",
     )
     assert waiting.link == "down" and "waiting for contact" in waiting.waiting_text

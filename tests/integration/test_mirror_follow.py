@@ -61,15 +61,15 @@ def test_the_mirror_follows_changes_made_through_the_services(
 ) -> None:
     updates: list[MirrorUpdate] = []
     follower.mirror.subscribe(updates.append)
-    with MissionClient(timeout=10.0) as client:
-        wait_until(lambda: follower.mirror.state is not None, 10.0, "the first snapshot")
+    with MissionClient(timeout=30.0) as client:
+        wait_until(lambda: follower.mirror.state is not None, 30.0, "the first snapshot")
         client.add_marker(TaskMarker("rss", MarkerType.POSE, Pose(4.0, 2.0)))
         first = client.add_skill("drone", "take_off", {"altitude": 6.0}).skill_id
         second = client.add_skill("drone", "navigate_to", bindings={"target": "rss"}).skill_id
         client.reorder("drone", [second, first])
         client.move_marker("rss", Pose(7.0, 1.0))
         client.edit_skill(first, {"altitude": 9.0}, label="higher")
-        wait_until(lambda: mirrored(follower, client), 10.0, "the mirror to catch up")
+        wait_until(lambda: mirrored(follower, client), 30.0, "the mirror to catch up")
     assert follower.mirror.snapshots_requested == 1
     assert isinstance(updates[0].changes[0], MissionReset)
     added = [c.skill.id for u in updates for c in u.changes if isinstance(c, SkillAdded)]
@@ -79,22 +79,22 @@ def test_the_mirror_follows_changes_made_through_the_services(
 
 
 def test_a_revision_gap_fetches_one_snapshot(follower: MissionFollower) -> None:
-    with MissionClient(timeout=10.0) as client:
-        wait_until(lambda: follower.mirror.state is not None, 10.0, "the first snapshot")
+    with MissionClient(timeout=30.0) as client:
+        wait_until(lambda: follower.mirror.state is not None, 30.0, "the first snapshot")
         client.add_skill("drone", "land")
-        wait_until(lambda: mirrored(follower, client), 10.0, "the mirror to catch up")
+        wait_until(lambda: mirrored(follower, client), 30.0, "the mirror to catch up")
         # Another publisher on the events topic: an event three revisions ahead.
         forger = rospy.Publisher(interface.EVENTS_TOPIC, wire.MissionEvent, queue_size=1)
         try:
-            wait_until(lambda: forger.get_num_connections() > 0, 10.0, "the follower")
+            wait_until(lambda: forger.get_num_connections() > 0, 30.0, "the follower")
             # An event far ahead: the server never reached it; waiting for it would make
             # the mirror ask for snapshots for ever.
             ahead = client.fetch_mission().revision + 1000
             forger.publish(wire.MissionEvent(revision=ahead, kind=wire.MissionEvent.SKILL_ADDED))
-            wait_until(lambda: follower.mirror.ignored_events == 1, 10.0, "the phantom dropped")
+            wait_until(lambda: follower.mirror.ignored_events == 1, 30.0, "the phantom dropped")
             for _ in range(3):
                 client.add_skill("drone", "take_off")
-            wait_until(lambda: mirrored(follower, client), 10.0, "the mirror to go on")
+            wait_until(lambda: mirrored(follower, client), 30.0, "the mirror to go on")
             assert follower.mirror.snapshots_requested == 2, "one refetch for the gap"
         finally:
             forger.unregister()
@@ -128,18 +128,18 @@ def test_a_restarted_server_is_followed_from_its_new_mission(
     follower = MissionFollower(check_period=0.2, retry_period=0.2, on_connection=connection.append)
     follower.start()
     try:
-        with MissionClient(timeout=10.0) as client:
+        with MissionClient(timeout=30.0) as client:
             for _ in range(4):
                 client.add_skill("drone", "land")
-            wait_until(lambda: mirrored(follower, client), 10.0, "the mirror to catch up")
+            wait_until(lambda: mirrored(follower, client), 30.0, "the mirror to catch up")
             server.stop()
-            wait_until(lambda: connection[-1:] == [False], 10.0, "the server to be missed")
+            wait_until(lambda: connection[-1:] == [False], 30.0, "the server to be missed")
             fresh = start_server("follow-again")  # a new journal: revisions begin again
             assert fresh.alive
             client.close()
             client.get_mission()  # this client's known revision is the old server's
             client.add_skill("science_rover", "explore")
-            wait_until(lambda: mirrored(follower, client), 15.0, "the mirror of the new server")
+            wait_until(lambda: mirrored(follower, client), 45.0, "the mirror of the new server")
         assert follower.mirror.revision == 1
         wait_until(lambda: connection == [True, False, True], 10.0, "the new server seen")
     finally:
@@ -155,7 +155,7 @@ def test_async_calls_answer_by_callback_with_one_sentence(server: ServerProcess)
         if len(outcomes) == 2:
             done.set()
 
-    client = AsyncMissionClient(MissionClient(timeout=10.0))
+    client = AsyncMissionClient(MissionClient(timeout=30.0))
     try:
         added = client.submit(lambda c: c.add_skill("drone", "land"), record)
         client.submit(lambda c: c.edit_skill("no-such-skill", label="x"), record)

@@ -42,10 +42,10 @@ def test_endpoints_find_each_other_through_the_directory(ros_master: RosMaster) 
             lambda: (
                 set(directory.getParam("/t", interface.RADIO_DIRECTORY)[2] or {}) >= set(radios)
             ),
-            10.0,
+            30.0,
             "every endpoint registered",
         )
-        wait_until(lambda: "radio_r2" in radios["radio_r1"].robots(), 10.0, "r1 to list r2")
+        wait_until(lambda: "radio_r2" in radios["radio_r1"].robots(), 30.0, "r1 to list r2")
         robots = radios["radio_r1"].robots()
         assert "ground" not in robots and "radio_r1" not in robots, robots
         signal = wire.BarrierSignal(agent="radio_r1", barrier_id="B3", skill_id="s", kind=3)
@@ -56,7 +56,7 @@ def test_endpoints_find_each_other_through_the_directory(ros_master: RosMaster) 
             radios["radio_r2"].beacon("ground")
             return bool(heard["radio_r2"].signals) and "radio_r2" in heard["ground"].beacons
 
-        wait_until(exchanged, 10.0, "a signal and a beacon to arrive")
+        wait_until(exchanged, 30.0, "a signal and a beacon to arrive")
         got = heard["radio_r2"].signals[0]
         assert (got.agent, got.barrier_id, got.kind) == ("radio_r1", "B3", 3)
         assert got.stamp == signal.stamp
@@ -75,7 +75,7 @@ def test_endpoints_find_each_other_through_the_directory(ros_master: RosMaster) 
                 radios["radio_r1"].signal(signal, ["radio_r2"])
                 or len(heard["radio_r2"].signals) > count
             ),
-            10.0,
+            30.0,
             "r2 to hear on after stray datagrams",
         )
     finally:

@@ -165,7 +165,7 @@ def _session(
     def step(action: Callable[[], object]) -> None:
         before = raw.revision()
         action()
-        wait_until(lambda: raw.revision() > before, 10.0, f"a change after revision {before}")
+        wait_until(lambda: raw.revision() > before, 30.0, f"a change after revision {before}")
         mission = raw.mission()
         assert mission.revision == before + 1, "one change per step"
         recording.truth[before + 1] = mission
@@ -261,7 +261,7 @@ def test_the_replay_publishes_agent_states_tf_site_and_score_as_recorded(
         assert done.returncode == 0, done.stderr
         wait_until(
             lambda: all(len(heard[t]) >= len(recorded[t]) for t in TELEMETRY_TOPICS),
-            10.0,
+            30.0,
             "every recorded message arrived",
         )
     finally:

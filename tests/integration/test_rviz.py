@@ -42,7 +42,7 @@ TOOL = REPO / "tools" / "rviz_screenshot.py"
 CONFIG = REPO / "rviz" / "sim.rviz"
 SCENARIO = REPO / "rosmc_sim" / "scenarios" / "mars_sample_return.yaml"
 GUI_PROGRAMS = ("rviz", "Xvfb", "import", "convert")
-SIM_START_TIMEOUT = 20.0
+SIM_START_TIMEOUT = 60.0
 CALLER = "/test_rviz"
 
 

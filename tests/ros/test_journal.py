@@ -370,7 +370,7 @@ def test_kill_9_loses_no_acknowledged_change(tmp_path: Path) -> None:
         acked = [int(proc.stdout.readline()) for _ in range(kill_after)]
         os.kill(proc.pid, signal.SIGKILL)
         acked += [int(line) for line in proc.stdout.read().split()]
-        proc.wait(timeout=10)
+        proc.wait(timeout=30)
         assert proc.returncode == -signal.SIGKILL
         result = read_journal(path)
         state = latest_state(result)

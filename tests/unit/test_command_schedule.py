@@ -189,7 +189,7 @@ def _selected_rows(gui: Gui, agent: str, blueprint: bool) -> list[int]:
     return sorted(index.row() for index in table.selectionModel().selectedRows())
 
 
-def _wait(condition: Any, timeout: float = 2.0) -> None:
+def _wait(condition: Any, timeout: float = 30.0) -> None:
     deadline = time.monotonic() + timeout
     while not condition():
         assert time.monotonic() < deadline, "timed out"

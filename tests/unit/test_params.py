@@ -14,7 +14,7 @@ import math
 from typing import Any
 
 import pytest
-from hypothesis import given, settings
+from hypothesis import given
 from hypothesis import strategies as st
 
 from rosmc_server.core import InvalidRequest, ParamType, Pose
@@ -56,7 +56,6 @@ def choices_for(draw: Any, ptype: ParamType) -> tuple[Any, ...]:
     return tuple(draw(st.lists(pool, min_size=1, max_size=3)))
 
 
-@settings(max_examples=3000, deadline=None)
 @given(st.sampled_from(list(ParamType)), raw_values, bounds, bounds, st.data())
 def test_the_quick_path_answers_as_the_full_check(
     ptype: ParamType, raw: Any, minimum: Any, maximum: Any, data: Any
@@ -72,7 +71,6 @@ def test_the_quick_path_answers_as_the_full_check(
     assert type(quick) is type(full)
 
 
-@settings(max_examples=3000, deadline=None)
 @given(st.sampled_from(list(ParamType)), raw_values, bounds, bounds, st.data())
 def test_a_specialized_quick_check_answers_as_the_quick_path(
     ptype: ParamType, raw: Any, minimum: Any, maximum: Any, data: Any

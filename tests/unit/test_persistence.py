@@ -5,7 +5,6 @@ from __future__ import annotations
 import copy
 import os
 import stat
-import time
 from pathlib import Path
 from typing import Any
 
@@ -529,8 +528,7 @@ def test_an_alias_bomb_is_refused_at_once(library: Any) -> None:
         "rosmc_mission: 1\nlibrary: unit_team\nrevision: 0\ntasks:\n  alpha:\n"
         "  - id: s\n    skill: wait\n    params:\n      options:\n" + "\n".join(lines) + "\n"
     )
-    started = time.monotonic()
+    # Refused by counting the aliases: expanding them would never end (pytest's timeout).
     with pytest.raises(MissionFileError, match="aliases expand it") as caught:
         parse_mission(text, library, "bomb.yaml")
     assert str(caught.value).startswith("bomb.yaml: ")
-    assert time.monotonic() - started < 2.0
