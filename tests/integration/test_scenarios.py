@@ -424,7 +424,7 @@ def test_a_drone_that_flies_too_long_runs_empty_and_recharges_at_the_lander(op: 
 
 # -- 5. twenty minutes of latency ----------------------------------------------------------------
 LATENCY = 1200.0  # sim seconds, one way: 12 wall seconds at a factor of 100
-SLOW = 0.02  # m/s: 10 m legs take 500 s, long enough to run on after the latency sets in
+SLOW = 0.05  # m/s (the library's least): 10 m legs take 200 s, running on under the latency
 LEGS = ((8.0, -6.0), (8.0, 4.0), (-2.0, 4.0))  # all inside the lander's coverage
 
 
