@@ -61,6 +61,7 @@ from bench_executor import print_figures, summary, team_library  # noqa: E402
 
 from tests.integration.barrier_cuts import (  # noqa: E402
     CutOutcome,
+    cut_while_members_approach,
     every_radio_cut_during_release,
     partner_cut_before_arrival,
 )
@@ -112,26 +113,6 @@ def idle_radio(
         }
         for agent in agents
     }
-
-
-def cut_while_members_approach(
-    op: RemoteOperator, lab: RadioLab, agents: Sequence[str], outage: float
-) -> CutOutcome:
-    """Every radio goes down while all members run towards the barrier."""
-    ahead = [op("add", agent, "wait", {"duration": 1.5}) for agent in agents]
-    members = {agent: op("add", agent, "wait", {"duration": 0.05}) for agent in agents}
-    op("add_barrier", list(members.values()))
-    for agent in agents:
-        op("sync", agent)
-    op("wait_status", ahead, "RUNNING", 30.0)
-    lab.cut(agents)
-    down = time.time()
-    time.sleep(outage)
-    restored = time.time()
-    lab.restore(agents)
-    op("wait_status", list(members.values()), "SUCCESS", 60.0, timeout=70.0)
-    started = op("started")
-    return CutOutcome(down, restored, {a: started[m] for a, m in members.items()})
 
 
 def cut_figures(outcomes: Sequence[CutOutcome], outage: float) -> dict[str, Any]:

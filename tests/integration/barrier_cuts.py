@@ -78,6 +78,26 @@ def _barrier_under_cut(
     op("wait_status", [ahead[last]], "RUNNING", 30.0)
     arrival = op("started")[ahead[last]] + LATE
     time.sleep(max(0.0, arrival - lead - time.time()))
+    return _cut_until_done(op, lab, cut, outage, members)
+
+
+def cut_while_members_approach(
+    op: RemoteOperator, lab: RadioLab, agents: Sequence[str], outage: float
+) -> CutOutcome:
+    """Every radio goes down while all members run towards the barrier."""
+    ahead = [op("add", agent, "wait", {"duration": 1.5}) for agent in agents]
+    members = {agent: op("add", agent, "wait", {"duration": 0.05}) for agent in agents}
+    op("add_barrier", list(members.values()))
+    for agent in agents:
+        op("sync", agent)
+    op("wait_status", ahead, "RUNNING", 30.0)
+    return _cut_until_done(op, lab, list(agents), outage, members)
+
+
+def _cut_until_done(
+    op: RemoteOperator, lab: RadioLab, cut: list[str], outage: float, members: dict[str, str]
+) -> CutOutcome:
+    """Cut the radios of ``cut`` for ``outage`` s, then wait for every member to finish."""
     lab.cut(cut)
     down = time.time()
     time.sleep(outage)
