@@ -13,7 +13,9 @@ around the obstacles), and measures over a window of wall time:
 
 Runs at ``~real_time_factor`` 0 (as fast as possible) and, to check pacing, at the
 targets (20 with 3 robots, 2 with 20), with ``/use_sim_time`` true as in the launch
-files. Run from the repository root::
+files. The ``baseline`` rows run as fast as possible with ``~clock_rate`` 0 (``/clock``
+at every step, the node's behaviour before the rate limit) in the same run.
+Run from the repository root::
 
     source env.sh
     python bench/bench_sim.py [--window 10]
@@ -169,9 +171,14 @@ def long_lived(source: Path, target: Path) -> Path:
 
 
 def measure(
-    env: dict[str, str], robots: int, rtf: float, window: float, tmp: Path
+    env: dict[str, str],
+    robots: int,
+    rtf: float,
+    window: float,
+    tmp: Path,
+    clock_rate: float | None = None,
 ) -> dict[str, Any]:
-    """Run the node on one scenario and measure one window."""
+    """Run the node on one scenario and measure one window (``clock_rate``: the node's own)."""
     path = long_lived(SCENARIOS[robots], tmp / f"bench_{robots}_robots.yaml")
     scenario = load_scenario(path)
     node = subprocess.Popen(
@@ -180,6 +187,7 @@ def measure(
             str(REPO / "scripts" / "sim_node"),
             f"_scenario:={path}",
             f"_real_time_factor:={rtf}",
+            *([] if clock_rate is None else [f"_clock_rate:={clock_rate}"]),
         ],
         env=env,
         stdout=subprocess.DEVNULL,
@@ -204,6 +212,7 @@ def measure(
     return {
         "robots": robots,
         "real_time_factor_param": rtf,
+        "clock_rate_param": "default" if clock_rate is None else clock_rate,
         "rtf": round(sim / wall, 2),
         "cpu_s_per_robot_per_sim_s": round(cpu / robots / sim, 6) if sim > 0 else None,
         "cpu_share": round(cpu / wall, 3),
@@ -221,10 +230,15 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as tmp, private_master(Path(tmp)) as env:
         rospy.init_node("bench_sim", anonymous=True, disable_signals=True)
         rospy.set_param("/use_sim_time", True)  # as the launch files set it
-        results = {"as_fast_as_possible": [], "paced": []}
+        results: dict[str, Any] = {"as_fast_as_possible": [], "paced": [], "baseline": []}
         for robots in (3, 20):
             for key, rtf in (("as_fast_as_possible", 0.0), ("paced", TARGETS[robots])):
                 results[key].append(measure(env, robots, rtf, args.window, Path(tmp)))
+            # Baseline, same run: /clock at every step, as the node did before ~clock_rate.
+            results["baseline"].append(
+                measure(env, robots, 0.0, args.window, Path(tmp), clock_rate=0.0)
+            )
+        results["load_average"] = os.getloadavg()
         rospy.signal_shutdown("done")
     results["targets"] = {f"{n}_robots": TARGETS[n] for n in TARGETS}
     results["cpu_count"] = os.cpu_count()

@@ -73,6 +73,7 @@ class RobotStatePublisher:
             for r in self._robots
         }
         self._pose: dict[str, Pose4] = {r.name: _pose_of(r) for r in self._robots}
+        self._pose_time = 0.0  # the sim time of ``_pose``
         self._velocity: dict[str, Pose4] = {r.name: (0.0, 0.0, 0.0, 0.0) for r in self._robots}
         self._wifi: dict[str, tuple[float, bool]] = {}
         self._coverage_time = float("-inf")
@@ -84,12 +85,12 @@ class RobotStatePublisher:
         """The latest Wi-Fi signal (dBm) and coverage of a robot."""
         return self._wifi.get(robot, (math.nan, False))
 
-    def after_step(self, dt: float, now: float) -> None:
-        """Track velocities, re-check coverage when due, and publish what is due at ``now``."""
-        self._track(dt)
+    def after_step(self, now: float) -> None:
+        """Re-check coverage when due, and publish what is due at wall time ``now``."""
         if self.sim.time - self._coverage_time >= COVERAGE_PERIOD - 1e-9:
             self._update_coverage()
         if self._tf_throttle.due(now):
+            self._track()
             stamp = rospy.Time.from_sec(self.sim.time)
             self._publish_tf(stamp)
             for robot in self._robots:
@@ -102,9 +103,16 @@ class RobotStatePublisher:
             for robot in self._robots:
                 self._blackout[robot.name].publish(Bool(not self.coverage(robot.name)[1]))
 
-    def _track(self, dt: float) -> None:
+    def _track(self) -> None:
+        """The velocities since the last odometry: its twist is their mean over that time.
+
+        Sampled only when odometry goes out, not every step: run fast, the sim steps
+        many times per message, and per-step tracking cost a twentieth of a step.
+        """
+        dt = self.sim.time - self._pose_time
         if dt <= 0:
             return
+        self._pose_time = self.sim.time
         for robot in self._robots:
             x0, y0, z0, yaw0 = self._pose[robot.name]
             pose = _pose_of(robot)

@@ -24,8 +24,10 @@ Topics (names in :mod:`rosmc_sim.ros.topics`; stamps are sim time):
 Private parameters: ``~scenario`` (path, relative ones resolved against the
 ``rosmc_sim`` package; default ``rosmc_sim/scenarios/mars_sample_return.yaml``),
 ``~real_time_factor`` (float, 1.0; 0 runs as fast as possible), ``~step``
-(sim seconds per step, 0.05), ``~gui`` (bool, false: pybullet GUI instead of
-DIRECT), ``~seed`` (int, 0: where the stones lie).
+(sim seconds per step, 0.05), ``~clock_rate`` (Hz of wall time, 1000: how often at most
+``/clock`` is published, as Gazebo's ``pub_clock_frequency``; 0 publishes every step),
+``~gui`` (bool, false: pybullet GUI instead of DIRECT), ``~seed`` (int, 0: where the
+stones lie).
 """
 
 from __future__ import annotations
@@ -58,7 +60,7 @@ from .science import SciencePublisher
 from .site_publisher import SitePublisher
 from .task_channel import TaskChannel
 from .task_desk import TaskDesk
-from .timing import Pacer
+from .timing import Pacer, Throttle
 from .world_markers import WorldPublisher
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
@@ -79,12 +81,13 @@ class SimConfig:
     scenario: Path
     real_time_factor: float = 1.0
     step: float = 0.05
+    clock_rate: float = 1000.0
     gui: bool = False
     seed: int = 0
 
     @classmethod
     def from_params(cls) -> SimConfig:
-        """Read ``~scenario``, ``~real_time_factor``, ``~step``, ``~gui`` and ``~seed`` once."""
+        """Read the private parameters once (see the module docstring)."""
         try:
             config = cls(
                 scenario=resolve_scenario(
@@ -93,6 +96,7 @@ class SimConfig:
                 ),
                 real_time_factor=float(rospy.get_param("~real_time_factor", 1.0)),
                 step=float(rospy.get_param("~step", 0.05)),
+                clock_rate=float(rospy.get_param("~clock_rate", 1000.0)),
                 gui=bool(rospy.get_param("~gui", False)),
                 seed=int(rospy.get_param("~seed", 0)),
             )
@@ -102,6 +106,8 @@ class SimConfig:
             raise ConfigError("~real_time_factor must be 0 (as fast as possible) or positive")
         if not 0 < config.step <= 1.0:
             raise ConfigError("~step must be above 0 and at most 1 s")
+        if config.clock_rate < 0:
+            raise ConfigError("~clock_rate must be 0 (every step) or positive")
         if config.gui and not os.environ.get("DISPLAY"):
             # pybullet would exit the process from C, without a word to rosout.
             raise ConfigError("~gui needs a display, and DISPLAY is not set")
@@ -130,19 +136,28 @@ class ClockSource:
     too; hearing its own clock at every step would cost as much as the simulation.
     So the clock source drops that subscription and sets rospy's time itself (rospy
     has no public API for either; both are guarded).
+
+    Run as fast as possible, the sim steps thousands of times per wall second, more
+    than any subscriber can follow; each publish also hands the GIL to rospy's writer
+    thread. So ``/clock`` goes out at most ``rate`` times per wall second (0: every
+    step), while this process's own time follows every step.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, rate: float = 0.0) -> None:
         self._publisher = rospy.Publisher(CLOCK_TOPIC, Clock, queue_size=10)
+        self._throttle = Throttle(1.0 / rate if rate > 0 else 0.0)
+        self.published = 0
         own = getattr(rospy.impl.simtime, "_clock_sub", None)
         self._set_rostime = getattr(rospy.rostime, "_set_rostime", None) if own else None
         if own is not None and self._set_rostime is not None:
             own.unregister()
 
-    def publish(self, sim_time: float) -> None:
-        """Tell everyone (and rospy here) the sim time."""
+    def publish(self, sim_time: float, now: float) -> None:
+        """Tell rospy here the sim time, and everyone else when due at wall time ``now``."""
         stamp = rospy.Time.from_sec(sim_time)
-        self._publisher.publish(Clock(clock=stamp))
+        if self._throttle.due(now):
+            self._publisher.publish(Clock(clock=stamp))
+            self.published += 1
         if self._set_rostime is not None:
             self._set_rostime(stamp)
 
@@ -160,7 +175,7 @@ class SimNode:
         self.world_markers = WorldPublisher(self.sim)
         self.site = SitePublisher(self.sim)
         self.coverage = CoveragePublisher(self.sim)
-        self._clock = ClockSource()
+        self._clock = ClockSource(config.clock_rate)
         self.steps = 0
 
     def step(self) -> None:
@@ -172,8 +187,8 @@ class SimNode:
             channel.update(now)
         self.sim.step(self.config.step)
         self.steps += 1
-        self._clock.publish(self.sim.time)
-        self.state.after_step(self.config.step, now)
+        self._clock.publish(self.sim.time, now)
+        self.state.after_step(now)
         self.science.after_step(now)
         self.world_markers.after_step(now)
         self.coverage.after_step(now)
@@ -186,9 +201,10 @@ class SimNode:
             self.step()
             pacer.wait(self.sim.time)
         _log.info(
-            "sim: %.1f s of sim time in %d steps, real-time factor %.1f, %.2f CPU s",
+            "sim: %.1f s of sim time in %d steps (%d on /clock), real-time factor %.1f, %.2f CPU s",
             self.sim.time,
             self.steps,
+            self._clock.published,
             pacer.achieved(self.sim.time),
             time.process_time() - cpu0,
         )
@@ -206,7 +222,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     argparse.ArgumentParser(
         prog="sim_node",
         description="The pybullet simulation of the Mars site (_scenario:=FILE "
-        "_real_time_factor:=X _step:=S _gui:=BOOL _seed:=N).",
+        "_real_time_factor:=X _step:=S _clock_rate:=HZ _gui:=BOOL _seed:=N).",
     ).parse_args(args[1:])
     rospy.init_node("sim", disable_signals=True)
     stop = _stop_on_signals()

@@ -318,7 +318,11 @@ def test_a_missing_scenario_exits_with_one_clear_line(ros_master: Any, tmp_path:
 
 
 def test_under_sim_time_the_clock_source_does_not_hear_itself(tmp_path: Path) -> None:
-    """With /use_sim_time true (as launched), rospy would subscribe the node to its own /clock."""
+    """With /use_sim_time true (as launched), rospy would subscribe the node to its own /clock.
+
+    Run as fast as possible, the node also publishes /clock at most ``~clock_rate`` times
+    per wall second, not at every step.
+    """
     with socket.socket() as sock:
         sock.bind(("127.0.0.1", 0))
         port = sock.getsockname()[1]
@@ -339,7 +343,7 @@ def test_under_sim_time_the_clock_source_does_not_hear_itself(tmp_path: Path) ->
         proxy.setParam("/test", "/use_sim_time", True)
         with log_path.open("wb") as log:
             node = subprocess.Popen(
-                node_argv("_real_time_factor:=0"),
+                node_argv("_real_time_factor:=0", "_clock_rate:=20"),
                 env=env,
                 stdout=log,
                 stderr=subprocess.STDOUT,
@@ -357,8 +361,16 @@ def test_under_sim_time_the_clock_source_does_not_hear_itself(tmp_path: Path) ->
         assert "/rosmc/sim" not in clock_nodes()[1]
         stop(node)
         assert node.returncode == 0
-        summary = re.search(r"sim: ([0-9.]+) s of sim time", log_path.read_text())
-        assert summary and float(summary.group(1)) > 10.0, log_path.read_text()[-2000:]
+        summary = re.search(
+            r"sim: ([0-9.]+) s of sim time in (\d+) steps \((\d+) on /clock\), "
+            r"real-time factor ([0-9.]+)",
+            log_path.read_text(),
+        )
+        assert summary, log_path.read_text()[-2000:]
+        sim_time, steps, clocks, factor = (float(g) for g in summary.groups())
+        assert sim_time > 10.0
+        wall = sim_time / max(factor - 0.05, 0.01)  # the factor is printed rounded
+        assert 0 < clocks <= 20 * wall + 2 and clocks < steps
     finally:
         stop(master)
 
