@@ -25,7 +25,8 @@ Private parameters: ``~scenario`` (path, relative ones resolved against the
 ``rosmc_sim`` package; default ``rosmc_sim/scenarios/mars_sample_return.yaml``),
 ``~real_time_factor`` (float, 1.0; 0 runs as fast as possible), ``~step``
 (sim seconds per step, 0.05), ``~gui`` (bool, false: pybullet GUI instead of
-DIRECT), ``~seed`` (int, 0: where the stones lie).
+DIRECT), ``~seed`` (int, 0: where the stones lie), ``~cwd`` (a relative ``~scenario`` is
+also looked for there; launch files pass the directory roslaunch was typed in).
 """
 
 from __future__ import annotations
