@@ -1,7 +1,8 @@
 """The docs' links lead somewhere: every relative link names a file, every #anchor a heading.
 
 Covers README.md, CONTRIBUTING.md and docs/*.md. Anchors are made from headings as GitHub
-makes them (lower case, punctuation dropped, spaces to hyphens).
+makes them (lower case, punctuation dropped, spaces to hyphens). Every repository path the
+docs name in backticks (``rosmc_server/core/mission.py``) exists too.
 """
 
 from __future__ import annotations
@@ -23,6 +24,9 @@ PENDING = {
 LINK = re.compile(r"(?<!!)\[[^\]]*\]\(([^)\s]+)\)")
 IMAGE = re.compile(r"!\[[^\]]*\]\(([^)\s]+)\)")
 FENCE = re.compile(r"^\s*```")
+REPO_PATH = re.compile(
+    r"`((?:rosmc_\w+|tests|test|tools|bench|launch|rviz|scripts|docs|bags)/[\w./-]*)`"
+)
 
 
 def prose(text: str) -> str:
@@ -78,6 +82,16 @@ def test_anchors_are_made_as_github_makes_them() -> None:
 def test_every_link_of_the_docs_leads_somewhere() -> None:
     problems = [problem for path in DOCS for problem in broken_links(path)]
     assert not problems, "\n".join(problems)
+
+
+def test_every_path_the_docs_name_exists() -> None:
+    missing = [
+        f"{path.name}: {name}"
+        for path in DOCS
+        for name in REPO_PATH.findall(path.read_text())
+        if "YYYY" not in name and not (REPO / name).exists()  # a placeholder file name
+    ]
+    assert not missing, "\n".join(missing)
 
 
 def test_a_broken_link_is_found(tmp_path: Path) -> None:
