@@ -8,7 +8,7 @@
 #   make test-thorough  the same with the thorough hypothesis profile (nightly: many examples)
 #   make test-busy      make test with two CPU-bound processes beside it (tools/beside_busy.py)
 #   make bench   setup, then every bench/ script: bench/results.json, bench/results.md and the
-#                README's figures table; BENCH=server,scale runs only those
+#                figures table of docs/performance.md; BENCH=server,scale runs only those
 #   make sample  setup, then record bags/samples/demo.mcap anew (after a message change)
 #   make lint    ruff check, ruff format --check, mypy --strict on every rosmc_* package
 #   make format  ruff format and the safe ruff fixes, in place
@@ -114,7 +114,7 @@ pytest: setup
 
 # Benchmarks print JSON figures; run_all collects them (one after another: they measure time).
 bench: setup
-	$(IN_ENV) python bench/run_all.py --readme $(if $(BENCH),--only $(BENCH))
+	$(IN_ENV) python bench/run_all.py --docs $(if $(BENCH),--only $(BENCH))
 
 lint: setup
 	$(IN_ENV) ruff check .

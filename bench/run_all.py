@@ -6,11 +6,11 @@ its own process group; one that overruns gets SIGTERM, then SIGKILL), then write
 * ``bench/results.json``: the machine it ran on, and per benchmark its wall time, exit code
   and figures;
 * ``bench/results.md``: the headline figures as Markdown tables, the same text that
-  ``--readme`` puts into README.md between the ``bench:begin`` / ``bench:end`` markers.
+  ``--docs`` puts into docs/performance.md between the ``bench:begin`` / ``bench:end`` markers.
 
 Usage::
 
-    python bench/run_all.py [--only server,scale] [--timeout 900] [--readme]
+    python bench/run_all.py [--only server,scale] [--timeout 900] [--docs]
 
 A benchmark that fails or prints no JSON is recorded with its exit code and the tail of its
 output; the run goes on with the next one and exits 1 at the end. One that cannot run here
@@ -35,7 +35,7 @@ from headlines import CURVES, flatten, headline_rows
 
 BENCH_DIR = Path(__file__).resolve().parent
 REPO = BENCH_DIR.parent
-README = REPO / "README.md"
+PERFORMANCE_DOC = REPO / "docs" / "performance.md"
 BEGIN, END = "<!-- bench:begin -->", "<!-- bench:end -->"
 TERM_GRACE = 60.0  # seconds a benchmark stopped for its timeout has to print and clean up
 
@@ -154,34 +154,40 @@ def markdown(results: dict[str, Any]) -> str:
 def update_readme(text: str, table: str) -> str:
     """``text`` with the part between the bench markers replaced by ``table``."""
     if BEGIN not in text or END not in text:
-        raise SystemExit(f"README.md has no {BEGIN} ... {END} markers")
+        raise SystemExit(f"docs/performance.md has no {BEGIN} ... {END} markers")
     head, rest = text.split(BEGIN, 1)
     _, tail = rest.split(END, 1)
     return f"{head}{BEGIN}\n{table}{END}{tail}"
 
 
-def _write_tables(results: dict[str, Any], readme: bool) -> int:
-    """Write results.md (and the README's table) from ``results``; print the tables."""
+def _write_tables(results: dict[str, Any], docs: bool) -> int:
+    """Write results.md (and the table in docs/performance.md) from ``results``; print them."""
     table = markdown(results)
     (BENCH_DIR / "results.md").write_text(table)
-    if readme:
-        README.write_text(update_readme(README.read_text(), table))
+    if docs:
+        PERFORMANCE_DOC.write_text(update_readme(PERFORMANCE_DOC.read_text(), table))
     print(table)
     return 0
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the benchmarks, write results.json and results.md (and README.md with --readme)."""
+    """Run the benchmarks, write results.json and results.md (and the docs' table with --docs)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", default="", help="comma-separated names, e.g. server,scale")
     parser.add_argument("--timeout", type=float, default=900.0, help="seconds per benchmark")
-    parser.add_argument("--readme", action="store_true", help="also update README.md")
+    parser.add_argument(
+        "--docs",
+        "--readme",
+        dest="docs",
+        action="store_true",
+        help="also update the table in docs/performance.md",
+    )
     parser.add_argument(
         "--render", action="store_true", help="run nothing: redo the tables from results.json"
     )
     args = parser.parse_args(argv)
     if args.render:
-        return _write_tables(json.loads((BENCH_DIR / "results.json").read_text()), args.readme)
+        return _write_tables(json.loads((BENCH_DIR / "results.json").read_text()), args.docs)
     wanted = {name.strip() for name in args.only.split(",") if name.strip()}
     scripts = sorted(BENCH_DIR.glob("bench_*.py"))
     if wanted:
@@ -198,7 +204,7 @@ def main(argv: list[str] | None = None) -> int:
         state = "ok" if bench["returncode"] == 0 and bench["figures"] is not None else "FAILED"
         print(f"run_all: {name} {state} in {bench['seconds']:.0f} s", file=sys.stderr, flush=True)
     (BENCH_DIR / "results.json").write_text(json.dumps(results, indent=2) + "\n")
-    _write_tables(results, args.readme)
+    _write_tables(results, args.docs)
     failed = [n for n, b in results["benchmarks"].items() if b["returncode"] or not b["figures"]]
     if failed:
         print(f"run_all: failed: {', '.join(failed)}", file=sys.stderr)

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Take the README's picture of the command GUI: a staged, simulated mission under Xvfb.
+"""Take the docs' picture of the command GUI: a staged, simulated mission under Xvfb.
 
 Starts ``Xvfb`` (``--size``, 1600x1000), a private rosmaster, the mission server and the
 simulated team (``roslaunch rosmc mission_server.launch`` and ``sim.launch``), opens the

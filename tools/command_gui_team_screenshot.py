@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Take the README's picture of the command GUI with the 20-robot team (1600x1000).
+"""Take the docs' picture of the command GUI with the 20-robot team (1600x1000).
 
 Builds the real command widget offscreen, feeds it the staged 20-robot mission of
 ``tests/team_twenty.py`` (the robots of ``tests/data/sim_20_robots.yaml``, each with work

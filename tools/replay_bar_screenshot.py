@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Take the README's picture of a replay in the command GUI (File > Open recording…).
+"""Take the docs' picture of a replay in the command GUI (File > Open recording…).
 
 Starts ``Xvfb`` (``--size``), a private rosmaster and the mission server, opens the real
 command window on the virtual screen, opens ``--recording`` (the committed sample) as an

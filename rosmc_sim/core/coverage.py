@@ -2,8 +2,8 @@
 
 The same model the simulator runs (:meth:`Simulation.signal_at`: range and line of sight
 through the obstacles' bodies), sampled on a grid over each region's disc at a rover's
-antenna height, with the boxes where they are (none deployed at the start). The README's
-site table states these figures and a test compares them.
+antenna height, with the boxes where they are (none deployed at the start). The site table of
+docs/operator-guide.md states these figures and a test compares them.
 """
 
 from __future__ import annotations

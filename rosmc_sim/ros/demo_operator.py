@@ -14,7 +14,9 @@ public operator services only (like the ``rosmc`` CLI would):
 4. print a live progress line per robot, then a summary.
 
 Subscribes ``/rosmc/sim/science`` (rosmc/ScienceState) and ``/rosmc/agent_states``;
-calls the ``/rosmc/*`` operator services. Parameters: ``~timeout`` (wall s, 600).
+calls the ``/rosmc/*`` operator services. Parameters: ``~timeout`` (wall s, 600),
+``~result_file`` (path: where the exit status is written at the end; "" = nowhere),
+``~cwd`` (a relative ``~result_file`` is taken from there; launch files set it).
 """
 
 from __future__ import annotations

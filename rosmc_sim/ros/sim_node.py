@@ -27,7 +27,8 @@ Private parameters: ``~scenario`` (path, relative ones resolved against the
 (sim seconds per step, 0.05), ``~clock_rate`` (Hz of wall time, 1000: how often at most
 ``/clock`` is published, as Gazebo's ``pub_clock_frequency``; 0 publishes every step),
 ``~gui`` (bool, false: pybullet GUI instead of DIRECT), ``~seed`` (int, 0: where the
-stones lie).
+stones lie), ``~cwd`` (a relative ``~scenario`` is also looked for there; launch files
+pass the directory roslaunch was typed in).
 """
 
 from __future__ import annotations

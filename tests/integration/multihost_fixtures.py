@@ -4,7 +4,7 @@
 processes run on the lab's hosts: ``rosmaster``, the mission server, the link emulator and
 the operator on the ground, each robot's executor on its own host, every process with its
 host's ``ROS_IP`` and ``ROS_MASTER_URI`` pointing at the ground. An executor can also be
-started the way the README tells a robot's owner to: ``source env.sh`` with only
+started the way docs/integrator-guide.md tells a robot's owner to: ``source env.sh`` with only
 ``ROS_MASTER_URI`` set, then ``roslaunch rosmc executor.launch robot:=NAME``.
 
 Used by ``tests/integration/test_multihost.py`` and ``bench/bench_multihost.py``. Not a test
@@ -88,7 +88,9 @@ class LabSystem(RosmcSystem):
             raise AssertionError(f"rosmaster did not start on the ground:\n{self.log_tails()}")
 
     def start_launched_executor(self, agent: str, *launch_args: str) -> None:
-        """``agent``'s executor as a robot's owner starts it (README "Robots on other machines").
+        """``agent``'s executor as a robot's owner starts it.
+
+        As docs/integrator-guide.md, "Robots on other machines", tells it.
 
         Only ``ROS_MASTER_URI`` is set: ``env.sh`` must find the robot's own address.
         """

@@ -1,7 +1,7 @@
 """The package builds three ways, and each result finds its messages, scripts and launch files.
 
 Every build goes to a temporary folder and starts from a fresh shell's environment (no env.sh),
-exactly as the README's "Building" section tells a user to do it.
+exactly as docs/integrator-guide.md's "Building" section tells a user to do it.
 """
 
 from __future__ import annotations

@@ -471,7 +471,7 @@ def test_undo_walks_back_and_redoes(server: Server, fresh: MissionClient) -> Non
     skill_id = rosmc(server, "add", "drone", "take_off", "altitude=12").strip()
     fresh.get_mission()
     edited = fresh.edit_skill(skill_id, {"altitude": 20.0}).revision
-    out = rosmc(server, "undo")  # README, "Undo and redo"
+    out = rosmc(server, "undo")  # docs/operator-guide.md, "Undo and redo"
     assert out.startswith(f"revision {edited + 1}: undo of revision {edited} (")
     assert fresh.skill(skill_id).params["altitude"] == 12.0
     rosmc(server, "undo")  # the edit before: the add
@@ -495,7 +495,7 @@ def test_policy_is_checked_and_sent(server: Server) -> None:
             ["policy", "science_rover", "safe_skill", "--skill", "navigate_to", "--param",
              "speed=0.2", "--after", "30"],
             ["--json", "policy", "science_rover", "continue"],
-            # README, "Lost-link policy"
+            # docs/operator-guide.md, "Lost-link policy"
             ["policy", "manipulator_rover", "return_to_link", "--skill", "navigate_to",
              "--when", "idle", "--after", "90"],
         ],

@@ -3,8 +3,8 @@
 Shortcuts fire only in an active window, and offscreen Qt never activates one; so this
 test starts ``Xvfb`` and runs the window in a child process on it (``QT_QPA_PLATFORM``
 xcb). The child is fed by a real :class:`~rosmc_server.core.Mission` through a real
-mirror (the unit harness); it presses each shortcut README lists on the focused table
-and prints, as JSON, which request each key press sent. No ROS master is needed.
+mirror (the unit harness); it presses each shortcut docs/operator-guide.md lists on the
+focused table and prints, as JSON, which request each key press sent. No ROS master is needed.
 """
 
 from __future__ import annotations

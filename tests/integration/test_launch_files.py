@@ -2,7 +2,7 @@
 
 roslaunch reads the XML (a ``--`` inside a comment is not XML and breaks the file), resolves
 ``$(find rosmc)`` and every include and argument, and builds the list of nodes; nothing is
-started. The operator's launch files are also loaded with the arguments the README shows.
+started. The operator's launch files are also loaded with the arguments the docs show.
 """
 
 from __future__ import annotations

@@ -3,10 +3,11 @@
 A ground namespace runs ``rosmaster``, the mission server, the link emulator and the
 operator; each robot's executor runs in a namespace of its own, with its own address, and
 reaches the ground (and the other robots) only over its "radio", a veth pair into a bridge
-on the ground (:mod:`tests.integration.netns`). ``r1`` is started the way the README tells a
-robot's owner to (``source env.sh`` with only ``ROS_MASTER_URI`` set, then ``roslaunch rosmc
-executor.launch``) and talks to the server directly over its radio; ``r2`` and ``r3`` sit
-behind the link emulator, which adds latency and loss (the kernel has no ``netem``).
+on the ground (:mod:`tests.integration.netns`). ``r1`` is started the way
+docs/integrator-guide.md tells a robot's owner to (``source env.sh`` with only
+``ROS_MASTER_URI`` set, then ``roslaunch rosmc executor.launch``) and talks to the server
+directly over its radio; ``r2`` and ``r3`` sit behind the link emulator, which adds latency
+and loss (the kernel has no ``netem``).
 
 The mission has two barriers across all three robots: one released at full speed, one whose
 members arrive while every radio is down. The radios are slowed to a radio's rate with

@@ -7,7 +7,7 @@ the first server was writing (the change acknowledged just before the kill is th
 simulator, radio links, executors and marker node are the same processes, and the mission
 goes on to its end.
 
-Also: the README's manual resume command with a relative journal path, typed from a
+Also: the manual resume command of docs/replay.md with a relative journal path, typed from a
 working directory, reads and writes the journal there (not in ``ROS_HOME``).
 """
 
@@ -203,8 +203,8 @@ def test_a_killed_server_comes_back_on_its_journal_and_the_team_goes_on(
     assert died and all("mission_server" in line for line in died), died  # only the server
 
 
-# As the README shows it (Crash recovery); the first run writes the journal it names.
-README_RESUME = "roslaunch rosmc mission_server.launch journal:=bags/mission_X.mcap resume:=true"
+# As docs/replay.md shows it ("Crash recovery"); the first run writes the journal it names.
+DOC_RESUME = "roslaunch rosmc mission_server.launch journal:=bags/mission_X.mcap resume:=true"
 
 
 def typed_in(directory: Path, command: str) -> list[str]:
@@ -212,12 +212,12 @@ def typed_in(directory: Path, command: str) -> list[str]:
     return ["bash", "-c", f"cd '{directory}' && exec {command}"]
 
 
-def test_the_readme_resume_command_reads_the_journal_where_it_was_typed(
+def test_the_documented_resume_command_reads_the_journal_where_it_was_typed(
     station: Station, launch_process: LaunchProcess, tmp_path: Path
 ) -> None:
     work = tmp_path / "work"
     work.mkdir()
-    first_run = README_RESUME.replace(" resume:=true", "")
+    first_run = DOC_RESUME.replace(" resume:=true", "")
     server = launch_process(typed_in(work, first_run), env=station.env, name="first_run")
 
     def serving() -> bool:
@@ -230,7 +230,7 @@ def test_the_readme_resume_command_reads_the_journal_where_it_was_typed(
     assert (work / "bags" / "mission_X.mcap").is_file()
     assert not list(Path(station.env["ROS_HOME"]).rglob("*.mcap"))
 
-    server = launch_process(typed_in(work, README_RESUME), env=station.env, name="resume")
+    server = launch_process(typed_in(work, DOC_RESUME), env=station.env, name="resume")
     wait_until(serving, START_TIMEOUT, "the server is up again", period=0.5)
     assert [s["skill"] for s in skills(station.status(), "drone")] == ["take_off"]
     assert f"resumed from {work / 'bags' / 'mission_X.mcap'}" in server.log()

@@ -147,7 +147,7 @@ def call_as(env: dict[str, str], name: str) -> str:
 def test_only_nodes_on_the_operator_allow_list_change_the_mission(
     start_server: StartServer, client_node: Any
 ) -> None:
-    # README, "Deployment security": _operators:="[/station/, /trusted_operator]"
+    # docs/integrator-guide.md, "Deployment security": _operators:="[/station/, /trusted_operator]"
     start_server(operators="[/station/, /trusted_operator]")
     env = dict(client_node.env)
     client = MissionClient(timeout=10.0)
@@ -164,7 +164,7 @@ def test_only_nodes_on_the_operator_allow_list_change_the_mission(
     assert client.get_mission().revision == revision  # nothing changed
 
     by_name = call_as(env, "trusted_operator")
-    # README: ROS_NAMESPACE=/station rosmc add drone take_off
+    # docs/integrator-guide.md: ROS_NAMESPACE=/station rosmc add drone take_off
     station = rosmc({**env, "ROS_NAMESPACE": "/station"}, "add", "drone", "take_off")
     assert station.returncode == 0, station.stderr
     mission = client.get_mission()

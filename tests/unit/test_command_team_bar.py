@@ -141,8 +141,8 @@ def row_pixels(picture: Path, status: SkillStatus) -> int:
     )
 
 
-def test_the_readme_screenshot_commands_show_the_team(tmp_path: Path) -> None:
-    """``tools/command_gui_team_screenshot.py`` as the README shows it, then filtered.
+def test_the_documented_screenshot_commands_show_the_team(tmp_path: Path) -> None:
+    """``tools/command_gui_team_screenshot.py`` as docs/operator-guide.md shows it, then filtered.
 
     All robots: the first columns hold the failed drone, the barrier waits are off screen.
     Waiting only: the rovers waiting at their barrier come on screen, the failed drone goes.

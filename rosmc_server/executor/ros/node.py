@@ -27,6 +27,7 @@ Parameters (private):
     ``~tick_rate`` (float, Hz, 50), ``~robot_side`` (bool, false).
     ``~cwd`` (str): a relative ``~state_file`` is taken from there (launch files pass the
     directory roslaunch was typed in).
+
     They are read once at start and deleted, so a later executor of the same name starts
     from its own settings, never from a previous run's.
 """

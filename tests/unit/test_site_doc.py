@@ -1,6 +1,6 @@
-"""The README's site facts are the simulator's: positions, sizes, starts and Wi-Fi coverage.
+"""The site facts of the docs are the simulator's: positions, sizes, starts and Wi-Fi coverage.
 
-Reads the tables of the README's "The simulated site" section and compares them with the
+Reads the tables of docs/operator-guide.md's "The simulated site" section and compares them with the
 scenario file the simulator loads, and the coverage column with the simulator's own radio
 model (range and line of sight through the pybullet bodies of the obstacles).
 """
@@ -25,8 +25,8 @@ POINT = re.compile(rf"\(({NUMBER}), ({NUMBER})\)")
 
 
 def site_section() -> str:
-    """The README's site section, with typographic minus signs made ASCII."""
-    text = (REPO / "README.md").read_text().replace("−", "-")
+    """The operator guide's site section, with typographic minus signs made ASCII."""
+    text = (REPO / "docs" / "operator-guide.md").read_text().replace("−", "-")
     start = text.index("## The simulated site")
     return text[start : text.index("\n## ", start + 1)]
 
