@@ -14,10 +14,10 @@ from typing import TYPE_CHECKING
 from rosmc_server.core import InvalidRequest, LostLinkKind, LostLinkPolicy, SkillInstance
 from rosmc_server.core.commands import CommandKind
 from rosmc_server.core.policy import options_from_argument
+from rosmc_server.core.protocol import Ack, AckResult, Command
 
 from . import queueing
 from .lost_link import pose_parameter
-from .protocol import Ack, AckResult, Command
 
 if TYPE_CHECKING:
     from .engine import Engine
