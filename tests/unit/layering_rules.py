@@ -209,7 +209,7 @@ def module_name(path: Path, root: Path) -> list[str]:
     return parts[:-1] if parts[-1] == "__init__" else parts
 
 
-def _absolute(node: ast.ImportFrom, path: Path, root: Path) -> str:
+def absolute_module(node: ast.ImportFrom, path: Path, root: Path) -> str:
     """The absolute module an ``from ... import`` names (resolving leading dots)."""
     if node.level == 0:
         return node.module or ""
@@ -226,7 +226,7 @@ def _imported(tree: ast.AST, path: Path, root: Path) -> list[tuple[int, str]]:
         if isinstance(node, ast.Import):
             found += [(node.lineno, alias.name) for alias in node.names]
         elif isinstance(node, ast.ImportFrom):
-            module = _absolute(node, path, root)
+            module = absolute_module(node, path, root)
             found.append((node.lineno, module))
             # "from rosmc_server import ros" imports the ros layer too.
             found += [(node.lineno, f"{module}.{alias.name}") for alias in node.names]
@@ -240,7 +240,7 @@ def _imported(tree: ast.AST, path: Path, root: Path) -> list[tuple[int, str]]:
     return found
 
 
-def _module_path(module: str, root: Path) -> str:
+def module_path(module: str, root: Path) -> str:
     """The path of the file an imported ``rosmc_*`` name lives in (its longest module part)."""
     parts = module.split(".")
     for end in range(len(parts), 0, -1):
@@ -272,7 +272,7 @@ def _outside_rule(relative: str, top: str) -> bool:
 def _inside_rule(relative: str, module: str, root: Path) -> str | None:
     """Why ``relative`` may not import the rosmc_* name ``module`` (None: it may)."""
     layer = layer_of(relative)
-    target = _module_path(module, root)
+    target = module_path(module, root)
     target_layer = layer_of(target)
     if layer is None or target_layer is None:
         return None  # reported by the test that every module has a layer
