@@ -17,8 +17,7 @@ from rosmc_server.core import (
 )
 from rosmc_server.core.vocabulary import STATUS_COLOURS as STATUS_COLOURS
 from rosmc_server.core.vocabulary import STATUS_WORDS as STATUS_WORDS
-from rosmc_server.core.vocabulary import dbm, percent
-from rosmc_server.core.vocabulary import number as number
+from rosmc_server.core.vocabulary import dbm, number, percent
 
 TRANSFER_COLOUR = "#dae6fa"  # uploading or removing: on its way, not settled (italic too)
 SETTLED_FAILURE_COLOUR = "#f9bbb0"  # a failure the operator retried or skipped
