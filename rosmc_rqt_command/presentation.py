@@ -6,8 +6,6 @@ status looks the same everywhere. Words are for a geologist, not a roboticist.
 
 from __future__ import annotations
 
-import math
-
 from rosmc_server.core import (
     AgentStatus,
     Pose,
@@ -17,19 +15,10 @@ from rosmc_server.core import (
     Transfer,
     Value,
 )
+from rosmc_server.core.vocabulary import STATUS_COLOURS as STATUS_COLOURS
+from rosmc_server.core.vocabulary import STATUS_WORDS as STATUS_WORDS
+from rosmc_server.core.vocabulary import dbm, number, percent
 
-# Row background per status. Planned work is plain white, work on the robot blue, work
-# in progress green (amber while it waits for a partner), finished work fades to a warm
-# grey, and a failure is a strong red with white text: it must catch the eye.
-STATUS_COLOURS: dict[SkillStatus, str] = {
-    SkillStatus.IDLE: "#ffffff",
-    SkillStatus.IDLE_SYNCHRONIZED: "#b4cff5",
-    SkillStatus.SYNCWAITING: "#ffc94d",
-    SkillStatus.RUNNING: "#6fcf7f",
-    SkillStatus.PAUSED: "#b9a6d9",
-    SkillStatus.SUCCESS: "#d9d6c6",
-    SkillStatus.FAILURE: "#d7382b",
-}
 TRANSFER_COLOUR = "#dae6fa"  # uploading or removing: on its way, not settled (italic too)
 SETTLED_FAILURE_COLOUR = "#f9bbb0"  # a failure the operator retried or skipped
 TEXT_COLOUR = "#1d1d1d"
@@ -46,16 +35,6 @@ BARRIER_COLOURS = (
     "#5d4037",
     "#c2185b",
 )
-
-STATUS_WORDS: dict[SkillStatus, str] = {
-    SkillStatus.IDLE: "planned",
-    SkillStatus.IDLE_SYNCHRONIZED: "on robot",
-    SkillStatus.SYNCWAITING: "waiting",
-    SkillStatus.RUNNING: "running",
-    SkillStatus.PAUSED: "paused",
-    SkillStatus.SUCCESS: "done",
-    SkillStatus.FAILURE: "failed",
-}
 
 
 def row_colour(skill: SkillInstance) -> str:
@@ -108,14 +87,6 @@ def status_text(
     return word
 
 
-def number(value: float) -> str:
-    """A number for display: at most two decimals, no trailing zeros."""
-    if not math.isfinite(value):
-        return str(value)
-    text = f"{value:.2f}".rstrip("0").rstrip(".")
-    return "0" if text == "-0" else text
-
-
 def value_summary(value: Value) -> str:
     """A parameter value in a few characters."""
     if isinstance(value, bool):
@@ -152,10 +123,10 @@ def link_summary(status: AgentStatus | None) -> str:
     if status.commands_waiting:
         parts.append(status.waiting_text)
     if status.battery is not None:
-        parts.append(f"battery {status.battery * 100:.0f}%")
+        parts.append(f"battery {percent(status.battery)}")
     if status.wifi_signal is not None:
         coverage = "" if status.in_coverage else " (out of range)"
-        parts.append(f"Wi-Fi {status.wifi_signal:.0f} dBm{coverage}")
+        parts.append(f"Wi-Fi {dbm(status.wifi_signal)}{coverage}")
     if status.executor_state:
         parts.append(status.executor_state)
     if status.policy:

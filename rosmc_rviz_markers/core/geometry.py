@@ -18,6 +18,7 @@ from dataclasses import dataclass, replace
 
 from rosmc_server.core.frames import IDENTITY, Quaternion
 from rosmc_server.core.frames import quaternion_from_rpy as quaternion
+from rosmc_server.core.vocabulary import PALETTE
 
 Point = tuple[float, float, float]
 
@@ -105,16 +106,17 @@ def body_kind(model: str) -> BodyKind:
     return BodyKind.GENERIC
 
 
-# Body colours per kind (the simulator's palette, so rviz and pybullet agree).
-BODY_COLORS = {
-    BodyKind.DRONE: Color(0.20, 0.55, 0.95),
-    BodyKind.SCIENCE_ROVER: Color(0.95, 0.75, 0.20),
-    BodyKind.MANIPULATOR_ROVER: Color(0.30, 0.80, 0.40),
-    BodyKind.ROVER: Color(0.85, 0.55, 0.25),
-    BodyKind.LANDER: Color(0.85, 0.85, 0.88),
-    BodyKind.PAYLOAD_BOX: Color(0.80, 0.80, 0.80),
-    BodyKind.GENERIC: Color(0.7, 0.7, 0.7),
+# Body colours per kind: the palette the simulator paints its bodies with.
+_PALETTE_NAME = {
+    BodyKind.DRONE: "drone",
+    BodyKind.SCIENCE_ROVER: "science_rover",
+    BodyKind.MANIPULATOR_ROVER: "manipulator_rover",
+    BodyKind.ROVER: "rover",
+    BodyKind.LANDER: "lander",
+    BodyKind.PAYLOAD_BOX: "boxes",
+    BodyKind.GENERIC: "robot",
 }
+BODY_COLORS = {kind: Color(*PALETTE[name]) for kind, name in _PALETTE_NAME.items()}
 DARK = Color(0.12, 0.12, 0.14)
 METAL = Color(0.55, 0.57, 0.60)
 WHEEL_ROLL = quaternion(roll=math.pi / 2)

@@ -4,7 +4,8 @@ A robot's block is two short camera-facing lines, so that it stays above its own
 without covering the others:
 
 * the robot's name, its current skill and that skill's status
-  (``science_rover: navigate_to > running``), coloured by the status;
+  (``science_rover: navigate_to >> running``), in the status's colour (the words, marks and
+  colours of :mod:`rosmc_server.core.vocabulary`, as in the command GUI and ``rosmc``);
 * its health: battery, Wi-Fi and ground link
   (``BAT 97% | WiFi -54 dBm | link up``), coloured by the worst of the three (green,
   yellow, red; the part past its threshold is written in capitals). Commands waiting
@@ -23,6 +24,14 @@ from dataclasses import dataclass
 
 from rosmc_server.core.agent_status import AgentStatus
 from rosmc_server.core.model import SkillStatus
+from rosmc_server.core.vocabulary import (
+    STATUS_COLOURS,
+    STATUS_MARKS,
+    STATUS_WORDS,
+    dbm,
+    percent,
+    rgb,
+)
 from rosmc_server.core.waiting import duration_text
 
 from .geometry import Color, Point
@@ -70,16 +79,16 @@ def battery_row(level: float | None) -> IconRow:
     level = min(max(level, 0.0), 1.0)
     color = BAD if level < BATTERY_LOW else WARN if level < BATTERY_MID else GOOD
     word = "BAT LOW" if color == BAD else "BAT"
-    return IconRow("battery", f"{word} {level * 100:.0f}%", color)
+    return IconRow("battery", f"{word} {percent(level)}", color)
 
 
-def wifi_row(dbm: float | None) -> IconRow:
+def wifi_row(signal: float | None) -> IconRow:
     """Wi-Fi: the signal in dBm, red below -68 dBm, yellow below -60 dBm."""
-    if dbm is None:
+    if signal is None:
         return IconRow("wifi", "WiFi ?", DIM)
-    color = BAD if dbm < WIFI_WEAK else WARN if dbm < WIFI_FAIR else GOOD
+    color = BAD if signal < WIFI_WEAK else WARN if signal < WIFI_FAIR else GOOD
     word = "WIFI WEAK" if color == BAD else "WiFi"
-    return IconRow("wifi", f"{word} {dbm:.0f} dBm", color)
+    return IconRow("wifi", f"{word} {dbm(signal)}", color)
 
 
 def link_row(link: str, last_heard: float, waiting: int = 0, waiting_for: float = -1.0) -> IconRow:
@@ -102,24 +111,21 @@ def _link_only(link: str, last_heard: float) -> IconRow:
     return IconRow("link", f"LINK DOWN {last_heard:.0f} s", BAD)
 
 
-_STATUS_WORDS = {
-    SkillStatus.RUNNING: ("> running", GOOD),
-    SkillStatus.SYNCWAITING: ("|| waiting at barrier", WARN),
-    SkillStatus.PAUSED: ("|| paused", DIM),
-    SkillStatus.FAILURE: ("X FAILED", BAD),
-    SkillStatus.SUCCESS: ("done", Color(0.2, 0.9, 1.0)),
-    SkillStatus.IDLE_SYNCHRONIZED: ("uploaded, not started", NEUTRAL),
-}
+def status_color(status: SkillStatus) -> Color:
+    """The colour of a skill status, as in the command GUI (:data:`STATUS_COLOURS`)."""
+    return Color(*rgb(STATUS_COLOURS[status]))
 
 
 def skill_row(skill: str, status: SkillStatus | None, waiting_on: str = "") -> IconRow:
-    """The robot's current skill and its status (waiting: on whom)."""
+    """The robot's current skill and its status (waiting: on whom); a failure in capitals."""
     if not skill or status is None or status is SkillStatus.IDLE:
         return IconRow("skill", "idle", NEUTRAL)
-    words, color = _STATUS_WORDS[status]
+    word = STATUS_WORDS[status]
     if status is SkillStatus.SYNCWAITING and waiting_on:
-        words = f"|| waits for {waiting_on}"
-    return IconRow("skill", f"{skill} {words}", color)
+        word = f"{word} on {waiting_on}"
+    if status is SkillStatus.FAILURE:
+        word = word.upper()
+    return IconRow("skill", f"{skill} {STATUS_MARKS[status]} {word}", status_color(status))
 
 
 def status_parts(status: AgentStatus | None, skill_label: str = "") -> tuple[IconRow, ...]:

@@ -24,7 +24,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         # Imported late: rospy and the generated messages load slowly, and --help needs neither.
         from ..core import RosmcError
-        from ..ros.client import MissionClient, ServerUnavailable, identify
+        from ..core.errors import ServerUnavailable
+        from ..ros.client import MissionClient, identify
         from . import edits
         from .context import Context, UsageError
     except ImportError as error:

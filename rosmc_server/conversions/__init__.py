@@ -19,8 +19,8 @@ Modules:
 * :mod:`.agents`: agent states (``rosmc/AgentStates``) as core ``AgentStatus``;
 * :mod:`.policy`: the lost-link policy <-> ``rosmc/SetRobotOptions`` request fields;
 * :mod:`.site`: the site map (``rosmc/SiteMap``) the server checks skill targets against;
-* :mod:`.robot_link`: the executor's protocol (commands, acks, reports, barrier
-  signals, snapshots); import it from the module (it needs the executor core).
+* :mod:`.robot_link`: the robot link's protocol (commands, acks, reports, barrier
+  signals, snapshots); import it from the module.
 
 ``x_to_msg`` builds a message from a core object and ``x_from_msg`` the object
 back; malformed input raises :class:`~rosmc_server.core.InvalidRequest` (or

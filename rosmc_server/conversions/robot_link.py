@@ -1,8 +1,8 @@
-"""The executor's protocol objects <-> robot-link and barrier messages.
+"""The robot link's protocol objects <-> robot-link and barrier messages.
 
 Part of :mod:`rosmc_server.conversions`, the one boundary between the ``rosmc``
-messages and the core (here the executor core's protocol, which the on-robot
-executor speaks).
+messages and the core (here :mod:`rosmc_server.core.protocol`, which the ground and
+the on-robot executor both speak).
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from __future__ import annotations
 import rosmc.msg as wire
 
 from ..core.commands import CommandKind
-from ..executor.core import Ack, BarrierInfo, Command, Report, Signal, SignalKind, Snapshot
+from ..core.protocol import Ack, BarrierInfo, Command, Report, Signal, SignalKind, Snapshot
 from .mission import skill_from_msg, skill_to_msg
 from .values import time_to_msg
 

@@ -68,6 +68,10 @@ class StorageFull(Unavailable):
         self.free_bytes = free_bytes
 
 
+class ServerUnavailable(RosmcError):
+    """The mission server (or the ROS master) did not answer in time: a client's error."""
+
+
 class NotPermitted(RosmcError):
     """The calling node is not on the mission server's operator allow-list."""
 

@@ -25,18 +25,9 @@ from .state import MissionContent, MissionState
 from .undo import UndoHistory
 from .updates import apply_event
 from .validation import check_skill_count
+from .vocabulary import ROBOT_EVENTS
 
 IdFactory = Callable[[str], str]
-
-# Changes the robots make (answers and reports); every other event is an operator's.
-ROBOT_EVENTS = frozenset(
-    {
-        EventKind.SYNC_CONFIRMED,
-        EventKind.SYNC_DECLINED,
-        EventKind.UNSYNC_CONFIRMED,
-        EventKind.STATUS_CHANGED,
-    }
-)
 
 
 def random_ids(prefix: str) -> str:

@@ -11,22 +11,13 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..core import EventKind
+from ..core.vocabulary import ROBOT_EVENTS as _ROBOT_EVENTS  # drawn in the lanes: not marks
 from ..interface import SCIENCE_TOPIC
 from .history import MissionHistory
 from .reader import read_journal
 from .summary import link_outages
 from .timeline import OperatorMark, Timeline
 
-# The robots' side of the exchange (confirmations, status reports) is drawn in the lanes;
-# every other event is something the operator did.
-_ROBOT_EVENTS = frozenset(
-    {
-        EventKind.SYNC_CONFIRMED,
-        EventKind.SYNC_DECLINED,
-        EventKind.UNSYNC_CONFIRMED,
-        EventKind.STATUS_CHANGED,
-    }
-)
 _MARK_KIND = {EventKind.SYNC_REQUESTED: "sync", EventKind.UNSYNC_REQUESTED: "unsync"}
 
 

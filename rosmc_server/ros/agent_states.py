@@ -10,7 +10,6 @@ from __future__ import annotations
 import math
 import threading
 from collections.abc import Callable
-from typing import TYPE_CHECKING
 
 import rosmc.msg as wire
 import rospy
@@ -19,9 +18,7 @@ from .. import interface
 from ..core import SkillStatus
 from ..core.advice import waiting_on_unsynced
 from .coverage_watch import CoverageWatch
-
-if TYPE_CHECKING:
-    from .server_node import MissionServer
+from .server_host import ServerHost
 
 
 class AgentStatePublisher:
@@ -29,7 +26,7 @@ class AgentStatePublisher:
 
     def __init__(
         self,
-        server: MissionServer,
+        server: ServerHost,
         rate: float,
         on_published: Callable[[wire.AgentStates], None] | None = None,
     ) -> None:

@@ -15,7 +15,7 @@ from __future__ import annotations
 import logging
 import re
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import rosmc.srv as srv
 import rospy
@@ -50,11 +50,9 @@ from ..core.link import LinkStatus
 from ..core.policy import options_argument
 from ..core.waiting import queued_notes, refusal
 from .caller_id import caller_id
+from .server_host import ServerHost
 from .team_sync import synchronize_team
 from .whole_mission import WholeMissionServices
-
-if TYPE_CHECKING:
-    from .server_node import MissionServer
 
 _log = logging.getLogger(__name__)
 
@@ -112,7 +110,7 @@ def _text(value: str, what: str) -> str:
 class OperatorServices:
     """Request handlers of every operator service."""
 
-    def __init__(self, server: MissionServer) -> None:
+    def __init__(self, server: ServerHost) -> None:
         self._server = server
         self._library_msg = library_to_msg(server.library)
         self._whole = WholeMissionServices(server)

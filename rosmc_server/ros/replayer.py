@@ -53,8 +53,8 @@ from ..core import EventKind, InvalidRequest, MissionEvent, NotFound, RosmcError
 from ..recording import JournalRecord
 from ..recording.history import MissionHistory
 from ..recording.playback import PlaybackClock, PlaybackStatus, Playlist
-from .client import init_node
-from .client.graph_names import taken_names
+from .graph_names import taken_names
+from .node_setup import init_node
 from .replay_control import ReplayControl
 from .replay_output import TYPES, ReplayOutput, first_telemetry
 

@@ -61,8 +61,6 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 from contextlib import AbstractContextManager
-from dataclasses import dataclass, field
-from pathlib import Path
 
 import rosmc.msg as wire
 import rospy
@@ -86,7 +84,6 @@ from ..core import (
 )
 from ..core.changes import EventKind
 from ..core.commands import commands_for_event, default_policy_commands
-from ..core.operators import OperatorAllowList
 from ..recording import JournalOptions, JournalWriter, default_journal_path, latest_state
 from ..recording.high_water import RevisionMark, first_mark, read_mark, resumed_mark
 from ..recording.recovery import ResumeReport
@@ -98,63 +95,10 @@ from .logging_bridge import bridge_logging_to_rosout
 from .operator_services import OperatorServices
 from .publishing import SnapshotPublisher
 from .recorder import TelemetryRecorder
+from .server_config import ServerConfig
 from .site_listener import SiteListener
 
 _log = logging.getLogger(__name__)
-
-PACKAGE_ROOT = Path(__file__).resolve().parents[2]
-DEFAULT_LIBRARY = PACKAGE_ROOT / "rosmc_server" / "config" / "mars_team.yaml"
-DEFAULT_JOURNAL_DIR = PACKAGE_ROOT / "bags"
-DEFAULT_MISSION_DIR = PACKAGE_ROOT / "missions"
-
-
-@dataclass(frozen=True)
-class ServerConfig:
-    """The server's settings, read once at start."""
-
-    library: Path = DEFAULT_LIBRARY
-    journal: Path | None = None
-    journal_dir: Path = DEFAULT_JOURNAL_DIR
-    resume: bool = False
-    link_timeout: float = 3.0
-    agent_state_rate: float = 2.0
-    fsync: bool = True
-    mission_dir: Path = DEFAULT_MISSION_DIR
-    snapshot_every: int = JournalOptions.snapshot_every
-    operators: OperatorAllowList = field(default_factory=OperatorAllowList)
-
-    @classmethod
-    def from_params(cls) -> ServerConfig:
-        """Read the private parameters (``~name``).
-
-        ``~journal`` and ``~resume`` are deleted once read: left on the parameter
-        server (as ``rosrun ... _resume:=true`` leaves them), they would make a
-        later, plain start resume an old journal.
-        """
-        journal = str(rospy.get_param("~journal", ""))
-        resume = bool(rospy.get_param("~resume", False))
-        for once in ("~journal", "~resume"):
-            if rospy.has_param(once):
-                rospy.delete_param(once)
-        previous = station.previous_journal()
-        if previous is not None:  # restarted by roslaunch: go on where the last server was
-            journal, resume = str(previous), True
-        return cls(
-            library=station.launch_path(str(rospy.get_param("~library", str(DEFAULT_LIBRARY)))),
-            journal=station.launch_path(journal) if journal else None,
-            journal_dir=station.launch_path(
-                str(rospy.get_param("~journal_dir", str(DEFAULT_JOURNAL_DIR)))
-            ),
-            resume=resume,
-            link_timeout=float(rospy.get_param("~link_timeout", 3.0)),
-            agent_state_rate=float(rospy.get_param("~agent_state_rate", 2.0)),
-            fsync=bool(rospy.get_param("~fsync", True)),
-            mission_dir=station.launch_path(
-                str(rospy.get_param("~mission_dir", str(DEFAULT_MISSION_DIR)))
-            ),
-            snapshot_every=max(1, int(rospy.get_param("~snapshot_every", cls.snapshot_every))),
-            operators=OperatorAllowList.of(rospy.get_param("~operators", [])),
-        )
 
 
 class MissionServer:

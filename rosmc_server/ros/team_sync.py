@@ -9,17 +9,15 @@ its own upload (with the barriers it now shares with the others).
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ..core import InvalidRequest, MissionEvent
 from ..core.advice import unsynced_partners
 from ..core.team import robots_with_blueprints
-
-if TYPE_CHECKING:
-    from .server_node import MissionServer
+from .server_host import ServerHost
 
 
-def uploads_from_request(server: MissionServer, req: Any) -> dict[str, str | None]:
+def uploads_from_request(server: ServerHost, req: Any) -> dict[str, str | None]:
     """Robot -> last skill to send (None: all), from the request's lists; InvalidRequest if bad."""
     agents, uptos = list(req.agents), list(req.upto_ids)
     if uptos and len(uptos) != len(agents):
@@ -37,7 +35,7 @@ def uploads_from_request(server: MissionServer, req: Any) -> dict[str, str | Non
 
 
 def synchronize_team(
-    server: MissionServer,
+    server: ServerHost,
     require_link: Callable[[str], None],
     queued_note: Callable[[list[str]], str],
     req: Any,

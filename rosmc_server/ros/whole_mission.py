@@ -20,7 +20,7 @@ import logging
 import time
 from collections.abc import Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import rosmc.srv as srv
 
@@ -28,9 +28,7 @@ from ..conversions.packing import PackedGetMissionResponse
 from ..core import InvalidRequest, MissionEvent, MissionFileError, load_mission, parse_mission
 from ..core.persistence import MissionDumper, write_document
 from ..core.validation import check_file_path
-
-if TYPE_CHECKING:
-    from .server_node import MissionServer
+from .server_host import ServerHost
 
 _log = logging.getLogger(__name__)
 
@@ -65,7 +63,7 @@ def make_folder(folder: Path) -> None:
 class WholeMissionServices:
     """Handlers of GetMission, SaveMission and LoadMission."""
 
-    def __init__(self, server: MissionServer) -> None:
+    def __init__(self, server: ServerHost) -> None:
         self._server = server
         self._dumper = MissionDumper()
 

@@ -16,7 +16,6 @@ from .data import (
     skill_to_json,
 )
 from .plain import (
-    STATUS_MARK,
     format_agent_status,
     format_event,
     format_library,
@@ -27,7 +26,6 @@ from .plain import (
 )
 
 __all__ = [
-    "STATUS_MARK",
     "agent_status_to_json",
     "event_to_json",
     "format_agent_status",

@@ -19,22 +19,13 @@ from ..core import (
     Pose,
     SkillInstance,
     SkillSpec,
-    SkillStatus,
     TaskMarker,
     Transfer,
     Value,
 )
 from ..core.agent_status import AgentStatus
+from ..core.vocabulary import STATUS_MARKS, dbm, number, percent
 
-STATUS_MARK = {
-    SkillStatus.IDLE: "  ",
-    SkillStatus.IDLE_SYNCHRONIZED: "==",
-    SkillStatus.SYNCWAITING: "..",
-    SkillStatus.RUNNING: ">>",
-    SkillStatus.PAUSED: "||",
-    SkillStatus.SUCCESS: "ok",
-    SkillStatus.FAILURE: "!!",
-}
 _RULE = "    " + "-" * 56
 
 
@@ -84,7 +75,7 @@ def _skill_line(state: MissionState, skill: SkillInstance) -> str:
         tags.append(skill.resolution.name.lower())
     if skill.status_text:
         tags.append(skill.status_text)
-    mark = STATUS_MARK[skill.status]
+    mark = STATUS_MARKS[skill.status]
     return f"    {mark} {skill.id:<24} {skill.label:<20} {', '.join(tags)}"
 
 
@@ -108,12 +99,12 @@ def format_agent_status(status: AgentStatus | None) -> str:
     if status.commands_waiting:
         parts.append(status.waiting_text)
     if status.battery is not None:
-        parts.append(f"battery {status.battery * 100:.0f}%")
+        parts.append(f"battery {percent(status.battery)}")
     if status.wifi_signal is not None:
-        parts.append(f"Wi-Fi {status.wifi_signal:.0f} dBm")
+        parts.append(f"Wi-Fi {dbm(status.wifi_signal)}")
     if status.pose is not None:
         pose = status.pose
-        parts.append(f"at ({_short(pose.x)}, {_short(pose.y)}, {_short(pose.z)})")
+        parts.append(f"at ({number(pose.x, 3)}, {number(pose.y, 3)}, {number(pose.z, 3)})")
         parts.append("in coverage" if status.in_coverage else "out of coverage")
     if status.executor_state:
         parts.append(f"executor {status.executor_state}")
@@ -147,15 +138,11 @@ def format_params(skill: SkillInstance) -> str:
     )
 
 
-def _num(number: float) -> str:
-    if math.isfinite(number) and number == int(number) and abs(number) < 1e15:
-        return str(int(number))
-    return repr(float(number))
-
-
-def _short(number: float) -> str:
-    """A coordinate for display: at most three decimals."""
-    return _num(round(number, 3)) if math.isfinite(number) else str(number)
+def _num(value: float) -> str:
+    """A number exactly, as ``rosmc add`` reads it back (:func:`number` rounds for people)."""
+    if math.isfinite(value) and value == int(value) and abs(value) < 1e15:
+        return str(int(value))
+    return repr(float(value))
 
 
 def format_markers(markers: Iterable[TaskMarker]) -> str:
@@ -163,11 +150,11 @@ def format_markers(markers: Iterable[TaskMarker]) -> str:
     lines = []
     for marker in markers:
         pose = marker.pose
-        where = f"({_short(pose.x)}, {_short(pose.y)}, {_short(pose.z)})"
+        where = f"({number(pose.x, 3)}, {number(pose.y, 3)}, {number(pose.z, 3)})"
         if marker.vertices:
             where = f"{len(marker.vertices)} vertices around {where}"
         elif pose.yaw:
-            where += f" yaw {_short(pose.yaw)}"
+            where += f" yaw {number(pose.yaw, 3)}"
         lines.append(f"{marker.name:<24} {marker.type.name.lower():<9} {where}")
     return "\n".join(lines) if lines else "(no task markers)"
 

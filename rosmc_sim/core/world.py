@@ -12,24 +12,10 @@ from dataclasses import dataclass
 
 import pybullet as pb
 
+from rosmc_server.core.vocabulary import PALETTE
+
 from .scenario import Scenario
 
-# One palette for the pybullet bodies and the rviz world markers (RGBA, 0..1).
-COLORS = {
-    "ground": (0.76, 0.45, 0.30, 1.0),
-    "obstacles": (0.45, 0.30, 0.25, 1.0),
-    "slopes": (0.60, 0.35, 0.20, 0.35),
-    "lander": (0.85, 0.85, 0.88, 1.0),
-    "drone": (0.20, 0.55, 0.95, 1.0),
-    "science_rover": (0.95, 0.75, 0.20, 1.0),
-    "manipulator_rover": (0.30, 0.80, 0.40, 1.0),
-    "boxes": (0.80, 0.80, 0.80, 1.0),
-    "stones": (0.30, 0.30, 0.32, 1.0),
-    "regions": (0.95, 0.85, 0.20, 0.35),
-    "region_labels": (1.0, 1.0, 1.0, 1.0),
-    "score": (1.0, 0.45, 0.85, 1.0),  # the science score over the lander: a colour of its own
-    "wifi": (0.20, 0.60, 1.00, 0.8),
-}
 ROBOT_SIZE = {
     "drone": (0.7, 0.7, 0.15),
     "science_rover": (1.3, 0.9, 0.6),
@@ -129,7 +115,7 @@ class World:
                 shape, halfExtents=size, physicsClientId=self.client
             )
             visual = pb.createVisualShape(
-                shape, halfExtents=size, rgbaColor=COLORS[kind], physicsClientId=self.client
+                shape, halfExtents=size, rgbaColor=PALETTE[kind], physicsClientId=self.client
             )
         elif shape == pb.GEOM_CYLINDER:
             collision = pb.createCollisionShape(
@@ -139,13 +125,13 @@ class World:
                 shape,
                 radius=size[0],
                 length=size[1],
-                rgbaColor=COLORS[kind],
+                rgbaColor=PALETTE[kind],
                 physicsClientId=self.client,
             )
         else:
             collision = pb.createCollisionShape(shape, radius=size[0], physicsClientId=self.client)
             visual = pb.createVisualShape(
-                shape, radius=size[0], rgbaColor=COLORS[kind], physicsClientId=self.client
+                shape, radius=size[0], rgbaColor=PALETTE[kind], physicsClientId=self.client
             )
         body: int = pb.createMultiBody(
             0,

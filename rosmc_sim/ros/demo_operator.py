@@ -34,6 +34,7 @@ import rospy
 
 from rosmc_server.core import MarkerType, Pose, RosmcError, SkillStatus, TaskMarker
 from rosmc_server.core.changes import EventKind
+from rosmc_server.core.vocabulary import OPERATOR_EVENTS
 from rosmc_server.ros.client import ControlCommand, MissionClient, MissionWatch
 from rosmc_server.ros.station import launch_path
 
@@ -44,22 +45,6 @@ T = TypeVar("T")
 SURVEY = ((9.0, 3.0), (23.0, 3.0), (23.0, 15.0), (9.0, 15.0))
 WIFI_SPOT_PLANNED = Pose(19.0, -8.0)  # at the foot of the ridge, in its radio shadow
 WIFI_SPOT_ADAPTED = Pose(15.0, -13.0, 0.0, 0.0, 0.0, -0.6)
-OPERATOR_KINDS = {
-    EventKind.SKILL_ADDED,
-    EventKind.SKILL_EDITED,
-    EventKind.SKILL_DELETED,
-    EventKind.SKILLS_REORDERED,
-    EventKind.SYNC_REQUESTED,
-    EventKind.UNSYNC_REQUESTED,
-    EventKind.SKILL_RETRIED,
-    EventKind.SKILL_SKIPPED,
-    EventKind.BARRIER_ADDED,
-    EventKind.BARRIER_DELETED,
-    EventKind.MARKER_ADDED,
-    EventKind.MARKER_MOVED,
-    EventKind.MARKER_RENAMED,
-    EventKind.MARKER_DELETED,
-}
 
 
 class DemoOperator:
@@ -228,7 +213,7 @@ class DemoOperator:
         for agent in mission.agents:
             done = [s.skill for s in mission.task(agent) if s.status is SkillStatus.SUCCESS]
             lines.append(f"{agent}: {len(done)} skill(s) executed: {', '.join(done)}")
-        changes = sum(n for kind, n in self.events.items() if kind in OPERATOR_KINDS)
+        changes = sum(n for kind, n in self.events.items() if kind in OPERATOR_EVENTS)
         lines.append(f"operator changes: {changes}; mission revision {mission.revision}")
         return "\n".join(lines)
 

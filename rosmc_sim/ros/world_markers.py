@@ -26,10 +26,11 @@ from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
 from rosmc_rviz_markers.core.labels import CHAR_WIDTH
+from rosmc_server.core.vocabulary import PALETTE
 from rosmc_server.interface import MAP_FRAME
 
 from ..core.sim import LEVEL_COLLABORATIVE, LEVEL_SCIENCE, Simulation
-from ..core.world import BOX_SIZE, COLORS, STONE_RADIUS
+from ..core.world import BOX_SIZE, STONE_RADIUS
 from .robot_state import yaw_quaternion
 from .timing import Throttle
 from .topics import WORLD_TOPIC
@@ -81,7 +82,7 @@ def _marker(ns: str, ident: int, kind: int, x: float, y: float, z: float) -> Mar
     marker.header.stamp = rospy.Time(0)
     marker.pose.position = Point(x, y, z)
     marker.pose.orientation = yaw_quaternion(0.0)
-    marker.color = ColorRGBA(*COLORS[ns])
+    marker.color = ColorRGBA(*PALETTE[ns])
     return marker
 
 
@@ -118,7 +119,7 @@ def _pick_ground(sim: Simulation) -> Marker:
     x_min, x_max, y_min, y_max = sim.scenario.bounds
     slab = _marker("ground", 0, Marker.CUBE, (x_min + x_max) / 2, (y_min + y_max) / 2, -0.01)
     slab.ns = "pick_ground"  # its own namespace: shown even where the ground is hidden
-    slab.color = ColorRGBA(*COLORS["ground"][:3], PICK_GROUND_ALPHA)
+    slab.color = ColorRGBA(*PALETTE["ground"][:3], PICK_GROUND_ALPHA)
     return _sized(slab, x_max - x_min, y_max - y_min, 0.02)
 
 
@@ -132,7 +133,7 @@ def _box_markers(sim: Simulation) -> list[Marker]:
     out = []
     for i, box in enumerate(sim.boxes.values()):
         m = _sized(_marker("boxes", i, Marker.CUBE, box.x, box.y, box.z), *(BOX_SIZE,) * 3)
-        m.color = ColorRGBA(*_BOX_COLORS.get(box.spec.kind, COLORS["boxes"]))
+        m.color = ColorRGBA(*_BOX_COLORS.get(box.spec.kind, PALETTE["boxes"]))
         out.append(m)
     sources = [(0.0, 0.0, sim.scenario.lander_wifi_radius)]
     sources += [

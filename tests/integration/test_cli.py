@@ -37,15 +37,11 @@ from rosmc_server.core import (
     TaskMarker,
     load_library,
 )
+from rosmc_server.core.errors import ServerUnavailable
 from rosmc_server.core.science import RegionScience, Science
 from rosmc_server.interface import SCIENCE_TOPIC
-from rosmc_server.ros.client import (
-    MissionClient,
-    RevisionConflict,
-    ServerUnavailable,
-    init_node,
-    library_from_msg,
-)
+from rosmc_server.ros.client import MissionClient, RevisionConflict, library_from_msg
+from rosmc_server.ros.node_setup import init_node
 from rosmc_server.text import mission_to_json
 from tests.conftest import wait_until
 

@@ -37,7 +37,7 @@ from rosmc_server.interface import (
     base_link,
 )
 from rosmc_server.recording import JournalWriter
-from rosmc_server.ros.client.graph_names import taken_names
+from rosmc_server.ros.graph_names import taken_names
 from tests.conftest import free_port
 
 REPO = Path(__file__).resolve().parents[2]

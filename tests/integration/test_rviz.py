@@ -31,8 +31,8 @@ import numpy as np
 import pytest
 import yaml
 
+from rosmc_server.core.vocabulary import PALETTE
 from rosmc_sim.core.scenario import load_scenario
-from rosmc_sim.core.world import COLORS
 from rosmc_sim.ros.robot_state import MAP_FRAME, base_link
 from rosmc_sim.ros.topics import WORLD_TOPIC, odom_topic
 from tests.conftest import LaunchProcess, RosMaster
@@ -178,8 +178,8 @@ def _leftovers(master_uri: str) -> list[str]:
 @pytest.mark.usefixtures("gui_programs", "sim")
 def test_rviz_draws_the_site_under_xvfb(ros_master: RosMaster, tmp_path: Path) -> None:
     config = load_config()
-    wifi = blended(COLORS["wifi"], background(config))
-    score = blended(COLORS["score"], background(config))  # the score text over the lander
+    wifi = blended(PALETTE["wifi"], background(config))
+    score = blended(PALETTE["score"], background(config))  # the score text over the lander
     output, log = tmp_path / "sim.png", tmp_path / "rviz.log"
     started = time.monotonic()
     result = subprocess.run(

@@ -34,10 +34,11 @@ from rosmc_server.core import (
     Transfer,
 )
 from rosmc_server.core.changes import EventKind
+from rosmc_server.core.vocabulary import OPERATOR_EVENTS
 from rosmc_server.interface import AGENT_STATES_TOPIC, EVENTS_TOPIC
 from rosmc_server.recording import read_journal
 from rosmc_server.ros.client import ControlCommand
-from rosmc_sim.ros.demo_operator import OPERATOR_KINDS, WIFI_SPOT_ADAPTED
+from rosmc_sim.ros.demo_operator import WIFI_SPOT_ADAPTED
 from tests.conftest import wait_until
 from tests.integration.scenario_fixtures import Operator, Team, TeamSettings
 
@@ -111,7 +112,7 @@ def test_the_demo_mission_completes_with_a_score_and_a_full_recording(tmp_path: 
     assert [e.revision for e in events] == list(range(1, len(events) + 1)), "revision gap"
     assert events[-1].revision == int(changes.group(2))
     kinds = Counter(EventKind(e.kind) for e in events)
-    made = {kind: n for kind, n in kinds.items() if kind in OPERATOR_KINDS}
+    made = {kind: n for kind, n in kinds.items() if kind in OPERATOR_EVENTS}
     assert sum(made.values()) == int(changes.group(1)), made
     expected = {
         EventKind.MARKER_ADDED,

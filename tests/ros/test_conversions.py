@@ -79,11 +79,11 @@ from rosmc_server.core import (
 )
 from rosmc_server.core.changes import SkillMove
 from rosmc_server.core.commands import CommandKind
+from rosmc_server.core.protocol import Signal, SignalKind
 from rosmc_server.core.radio_map import GridSpec, Prediction, Reading
 from rosmc_server.core.science import RegionScience, Science
 from rosmc_server.core.site import Footprint, GroundRobot, Shape, SiteCheck, SiteModel
 from rosmc_server.core.site_source import SiteInForce
-from rosmc_server.executor.core import Signal, SignalKind
 
 
 def over_the_wire(msg: Any) -> Any:

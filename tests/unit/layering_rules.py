@@ -9,16 +9,18 @@ order of layers, and a module imports only from its own layer or below::
     core < conversions < recording < ros < client < app
     (0)(1)(2)(3)(4)(5)
 
-* **core**: every ``core/`` package (``rosmc_server/core``, ``rosmc_server/executor/core``,
-  ``rosmc_sim/core``, ``rosmc_rviz_markers/core``), ``rosmc_server/interface.py`` (graph
-  names) and the executor's plain skills. Pure Python.
+* **core**: every ``core/`` package of every component, whatever its depth (a folder named
+  ``core`` is the core layer without a table entry: ``rosmc_server/core``,
+  ``rosmc_server/executor/core``, ``rosmc_sim/core``, ``rosmc_rviz_markers/core``, and a
+  command-GUI ``core/`` once there is one), ``rosmc_server/interface.py`` (graph names),
+  ``rosmc_server/text`` (plain-text rendering of core objects) and the executor's plain
+  skills. Pure Python.
 * **conversions**: ``rosmc_server/conversions`` (the only msg <-> core boundary; generated
-  messages and genpy, no rospy) and ``rosmc_server/text`` (plain-text rendering).
+  messages and genpy, no rospy).
 * **recording**: ``rosmc_server/recording`` (the MCAP journal, history, timelines).
-* **ros**: the ROS adapters of the server, the executor and the simulator
+* **ros**: the ROS adapters of the server, the replayer, the executor and the simulator
   (``rosmc_server/ros``, ``rosmc_server/executor/ros``, ``rosmc_sim/ros``).
-* **client**: ``rosmc_server/ros/client`` and ``rosmc_server/ros/replayer.py`` (it plays a
-  recording for clients, driven by ``rosmc replay``).
+* **client**: ``rosmc_server/ros/client``.
 * **app**: the CLI (``rosmc_server/cli``), the GUIs (everything of ``rosmc_rviz_markers``
   and ``rosmc_rqt_command`` outside their ``core/``), the demos and the scripted demo
   operator (``rosmc_sim/ros/demo_operator.py``).
@@ -37,6 +39,9 @@ Besides the order, by what a module imports from outside:
   text rendering, the CLI or a GUI model/widget (they get core objects from the client).
 * **Qt** only in the GUI packages outside their ``core/``.
 * **pybullet** only in ``rosmc_sim/core``.
+* **The executor is the robot's**: the ground (``rosmc_server`` outside its ``executor/``)
+  imports nothing of it; what both ends speak (the robot link's protocol) is in
+  ``rosmc_server/core``. A robot may run without the ground's code and the other way round.
 * **The server's insides**: apps reach the graph through the client. They import nothing
   of ``rosmc_server.ros`` but the client, the replayer and the logging bridge; a GUI
   model or widget (neither a ROS adapter nor an entry module) imports nothing of
@@ -58,35 +63,32 @@ PACKAGES = ("rosmc_server", "rosmc_sim", "rosmc_rviz_markers", "rosmc_rqt_comman
 LAYERS = ("core", "conversions", "recording", "ros", "client", "app")
 RANK = {name: rank for rank, name in enumerate(LAYERS)}
 
-# Path (a folder ending in "/" or one file) -> layer; the longest matching entry wins. A new
-# folder or top-level module needs an entry (test_every_module_has_a_layer says so).
+# Path (a folder ending in "/" or one file) -> layer; the longest matching entry wins, and a
+# folder named "core" counts as an entry "<its path>/" of the core layer. A new folder or
+# top-level module needs an entry (test_every_module_has_a_layer says so); every entry names
+# a file or folder that exists (test_the_table_names_real_paths).
 LAYER_OF_PATH = {
     "rosmc_server/__init__.py": "core",
-    "rosmc_server/core/": "core",
     "rosmc_server/interface.py": "core",
     "rosmc_server/venv.py": "core",  # sys.path only: entry scripts call it before anything
+    "rosmc_server/text/": "core",
     "rosmc_server/executor/__init__.py": "core",
-    "rosmc_server/executor/core/": "core",
     "rosmc_server/executor/basic_skills.py": "core",
     "rosmc_server/conversions/": "conversions",
-    "rosmc_server/text/": "conversions",
     "rosmc_server/recording/": "recording",
     "rosmc_server/ros/": "ros",
     "rosmc_server/executor/ros/": "ros",
     "rosmc_server/ros/client/": "client",
-    "rosmc_server/ros/replayer.py": "client",
     "rosmc_server/cli/": "app",
     "rosmc_server/demo.py": "app",
     "rosmc_sim/__init__.py": "core",
-    "rosmc_sim/core/": "core",
     "rosmc_sim/ros/": "ros",
     "rosmc_sim/ros/demo_operator.py": "app",
     "rosmc_sim/demo.py": "app",
     "rosmc_rviz_markers/": "app",
-    "rosmc_rviz_markers/core/": "core",
     "rosmc_rqt_command/": "app",
-    "rosmc_rqt_command/core/": "core",
 }
+CORE_FOLDER = "core"
 
 ROS_RUNTIME = {
     "rospy",
@@ -133,7 +135,7 @@ WHY = {
     **dict.fromkeys(PYBULLET, "pybullet: only rosmc_sim/core"),
 }
 GUI_PACKAGES = ("rosmc_rviz_markers/", "rosmc_rqt_command/")
-TEXT = "rosmc_server/text/"  # with the conversions in the order, but speaks no messages
+EXECUTOR = "rosmc_server/executor/"
 PYBULLET_ALLOWED = ("rosmc_sim/core/",)
 # What the apps may use of rosmc_server.ros: the client and what serves clients.
 FOR_APPS = (
@@ -179,12 +181,14 @@ def core_modules(root: Path = REPO) -> list[Path]:
 
 def layer_of(relative: str) -> str | None:
     """The layer of a module given by its path below the repository (None: no entry)."""
+    table = dict(LAYER_OF_PATH)
+    folders = relative.split("/")[:-1]
+    if CORE_FOLDER in folders[1:]:
+        table["/".join(folders[: folders.index(CORE_FOLDER, 1) + 1]) + "/"] = "core"
     matches = [
-        key
-        for key in LAYER_OF_PATH
-        if key == relative or (key.endswith("/") and relative.startswith(key))
+        key for key in table if key == relative or (key.endswith("/") and relative.startswith(key))
     ]
-    return LAYER_OF_PATH[max(matches, key=len)] if matches else None
+    return table[max(matches, key=len)] if matches else None
 
 
 def is_gui_entry(relative: str) -> bool:
@@ -205,7 +209,7 @@ def module_name(path: Path, root: Path) -> list[str]:
     return parts[:-1] if parts[-1] == "__init__" else parts
 
 
-def _absolute(node: ast.ImportFrom, path: Path, root: Path) -> str:
+def absolute_module(node: ast.ImportFrom, path: Path, root: Path) -> str:
     """The absolute module an ``from ... import`` names (resolving leading dots)."""
     if node.level == 0:
         return node.module or ""
@@ -222,7 +226,7 @@ def _imported(tree: ast.AST, path: Path, root: Path) -> list[tuple[int, str]]:
         if isinstance(node, ast.Import):
             found += [(node.lineno, alias.name) for alias in node.names]
         elif isinstance(node, ast.ImportFrom):
-            module = _absolute(node, path, root)
+            module = absolute_module(node, path, root)
             found.append((node.lineno, module))
             # "from rosmc_server import ros" imports the ros layer too.
             found += [(node.lineno, f"{module}.{alias.name}") for alias in node.names]
@@ -236,7 +240,7 @@ def _imported(tree: ast.AST, path: Path, root: Path) -> list[tuple[int, str]]:
     return found
 
 
-def _module_path(module: str, root: Path) -> str:
+def module_path(module: str, root: Path) -> str:
     """The path of the file an imported ``rosmc_*`` name lives in (its longest module part)."""
     parts = module.split(".")
     for end in range(len(parts), 0, -1):
@@ -257,7 +261,7 @@ def _outside_rule(relative: str, top: str) -> bool:
     if top in MESSAGES:
         if is_ros_adapter(relative):
             return True
-        return layer in ("conversions", "recording") and not relative.startswith(TEXT)
+        return layer in ("conversions", "recording")
     if top in QT:
         return gui and layer != "core"
     if top in PYBULLET:
@@ -268,12 +272,15 @@ def _outside_rule(relative: str, top: str) -> bool:
 def _inside_rule(relative: str, module: str, root: Path) -> str | None:
     """Why ``relative`` may not import the rosmc_* name ``module`` (None: it may)."""
     layer = layer_of(relative)
-    target = _module_path(module, root)
+    target = module_path(module, root)
     target_layer = layer_of(target)
     if layer is None or target_layer is None:
         return None  # reported by the test that every module has a layer
     if RANK[target_layer] > RANK[layer]:
         return f"the {target_layer} layer, above this {layer} module"
+    ground = relative.startswith("rosmc_server/") and not relative.startswith(EXECUTOR)
+    if ground and target.startswith(EXECUTOR):
+        return "the executor runs on the robot: the ground shares only rosmc_server.core with it"
     if layer == "app" and module.startswith(CONVERSIONS) and not is_ros_adapter(relative):
         return "message conversions: apps get core objects from the client"
     if layer == "app" and module.startswith("rosmc_server.ros"):

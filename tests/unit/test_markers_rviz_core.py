@@ -22,6 +22,7 @@ from rosmc_rviz_markers.core.icons import (
     WARN,
     block_centre,
     icon_levels,
+    status_color,
     status_parts,
     status_rows,
 )
@@ -186,7 +187,8 @@ def test_icon_thresholds() -> None:
     assert parts["battery"].color == BAD and "20%" in parts["battery"].text
     assert parts["wifi"].color == BAD and "-72 dBm" in parts["wifi"].text
     assert parts["link"].color == GOOD
-    assert parts["skill"].text == "fly over A || waits for science_rover"
+    assert parts["skill"].text == "fly over A .. waiting on science_rover"
+    assert parts["skill"].color == status_color(SkillStatus.SYNCWAITING)
     status = replace(status, battery=0.4, wifi_signal=-63.0, link="down", last_heard=12.0)
     parts = {r.key: r for r in status_parts(status)}
     assert parts["battery"].color == WARN and parts["wifi"].color == WARN
@@ -200,7 +202,8 @@ def test_icon_thresholds() -> None:
     status = replace(status, battery=0.9, wifi_signal=-50.0, current_status=SkillStatus.FAILURE)
     parts = {r.key: r for r in status_parts(status)}
     assert parts["battery"].color == GOOD and parts["wifi"].color == GOOD
-    assert "FAILED" in parts["skill"].text and parts["skill"].color == BAD
+    assert "!! FAILED" in parts["skill"].text
+    assert parts["skill"].color == status_color(SkillStatus.FAILURE)
 
 
 def test_icon_block_is_two_short_lines_in_the_worst_colour() -> None:
@@ -214,7 +217,8 @@ def test_icon_block_is_two_short_lines_in_the_worst_colour() -> None:
         current_status=SkillStatus.RUNNING,
     )
     head, health = status_rows(status, "navigate_to", "science_rover")
-    assert head.text == "science_rover: navigate_to > running" and head.color == GOOD
+    assert head.text == "science_rover: navigate_to >> running"
+    assert head.color == status_color(SkillStatus.RUNNING)
     assert health.text == "BAT 97% | WiFi -54 dBm | link up" and health.color == GOOD
     assert max(len(head.text), len(health.text)) <= 40
     _, health = status_rows(replace(status, wifi_signal=-64.0))

@@ -1,7 +1,17 @@
 """Executor logic in pure Python: queue, barriers, skills, store-and-forward reports."""
 
+from rosmc_server.core.protocol import (
+    Ack,
+    AckResult,
+    BarrierInfo,
+    Command,
+    Report,
+    Signal,
+    SignalKind,
+    Snapshot,
+)
+
 from .engine import Engine, EngineOutputs
-from .protocol import Ack, AckResult, BarrierInfo, Command, Report, Signal, SignalKind, Snapshot
 from .skills import Outcome, SkillBehavior, SkillContext, SkillType, ThreadedSkill
 
 __all__ = [

@@ -10,8 +10,9 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from rosmc_server.core.protocol import BarrierInfo, Signal, SignalKind
+
 from .barriers import BarrierBoard
-from .protocol import BarrierInfo, Signal, SignalKind
 
 ANNOUNCE_PERIOD = 0.5  # seconds between re-announcements (READY or CONFIRMED) while waiting
 

@@ -1,31 +1,74 @@
 """What the executor does with each ground command, and its answers.
 
 Every handler takes the engine and one command, changes the robot's queue or
-execution through the engine's public surface, and returns the :class:`Ack` the
-ground receives.
+execution through the engine's public surface (:class:`CommandTarget`, which the
+:class:`~.engine.Engine` is), and returns the :class:`Ack` the ground receives.
 """
 
 from __future__ import annotations
 
 import functools
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from rosmc_server.core import InvalidRequest, LostLinkKind, LostLinkPolicy, SkillInstance
 from rosmc_server.core.commands import CommandKind
 from rosmc_server.core.policy import options_from_argument
+from rosmc_server.core.protocol import Ack, AckResult, BarrierInfo, Command
 
 from . import queueing
-from .lost_link import pose_parameter
-from .protocol import Ack, AckResult, Command
-
-if TYPE_CHECKING:
-    from .engine import Engine
+from .barriers import BarrierBoard
+from .lost_link import LostLinkGuard, pose_parameter
+from .skills import SkillType
 
 
-def execute(engine: Engine, cmd: Command) -> Ack:
+class CommandTarget(Protocol):
+    """What the ground's commands change on a robot: the engine's public surface."""
+
+    queue: list[SkillInstance]
+
+    @property
+    def agent(self) -> str:
+        """The robot's name."""
+
+    @property
+    def skill_types(self) -> Mapping[str, SkillType]:
+        """The skills this robot implements, by name."""
+
+    @property
+    def board(self) -> BarrierBoard:
+        """The barriers the robot knows."""
+
+    @property
+    def lost_link(self) -> LostLinkGuard:
+        """What the robot does on its own when out of contact."""
+
+    @property
+    def active_skill_id(self) -> str:
+        """The skill running (or paused, or waiting at its barrier); "" if none."""
+
+    def queue_hash(self) -> str:
+        """The digest of the queue the ground compares with its own."""
+
+    def advance(self) -> None:
+        """Start the next skill if the robot is running and none is active."""
+
+    def start(self) -> None:
+        """Start (or resume) executing the queue."""
+
+    def pause(self, why: str) -> None:
+        """Pause the active skill."""
+
+    def stop(self, why: str) -> None:
+        """Stop executing; the active skill goes back to the queue."""
+
+    def set_barriers(self, barriers: tuple[BarrierInfo, ...]) -> None:
+        """Replace the barriers the robot knows."""
+
+
+def execute(engine: CommandTarget, cmd: Command) -> Ack:
     """Run one ground command on the engine and give the robot's answer."""
-    handlers: Mapping[CommandKind, Callable[[Engine, Command], Ack]] = {
+    handlers: Mapping[CommandKind, Callable[[CommandTarget, Command], Ack]] = {
         CommandKind.UPLOAD: _upload,
         CommandKind.UNSYNC: _unsync,
         CommandKind.START: _start,
@@ -41,7 +84,7 @@ def execute(engine: Engine, cmd: Command) -> Ack:
     return handlers[cmd.kind](engine, cmd)
 
 
-def ack(engine: Engine, seq: int, **fields: object) -> Ack:
+def ack(engine: CommandTarget, seq: int, **fields: object) -> Ack:
     """The answer to command ``seq``: accepted, partly or wholly rejected per ``fields``."""
     rejected = fields.get("rejected_ids", ())
     accepted = fields.get("accepted_ids", ())
@@ -51,7 +94,7 @@ def ack(engine: Engine, seq: int, **fields: object) -> Ack:
     return Ack(seq, result, queue_hash=engine.queue_hash(), **fields)  # type: ignore[arg-type]
 
 
-def _upload(engine: Engine, cmd: Command) -> Ack:
+def _upload(engine: CommandTarget, cmd: Command) -> Ack:
     answer = queueing.upload(engine.queue, cmd.skills, functools.partial(why_not, engine))
     engine.queue = answer.queue
     engine.board.replace(cmd.barriers)
@@ -59,7 +102,7 @@ def _upload(engine: Engine, cmd: Command) -> Ack:
     return _answer(engine, cmd.seq, answer, error=next(iter(answer.reasons), ""))
 
 
-def _answer(engine: Engine, seq: int, answer: queueing.Answer, error: str = "") -> Ack:
+def _answer(engine: CommandTarget, seq: int, answer: queueing.Answer, error: str = "") -> Ack:
     return ack(
         engine,
         seq,
@@ -70,7 +113,7 @@ def _answer(engine: Engine, seq: int, answer: queueing.Answer, error: str = "") 
     )
 
 
-def why_not(engine: Engine, skill: SkillInstance) -> str:
+def why_not(engine: CommandTarget, skill: SkillInstance) -> str:
     """Why the robot cannot take ``skill`` ("" if it can)."""
     if skill.agent != engine.agent:
         return f"skill '{skill.id}' is for {skill.agent}, not {engine.agent}"
@@ -80,30 +123,30 @@ def why_not(engine: Engine, skill: SkillInstance) -> str:
     return kind.check(skill.params)
 
 
-def _unsync(engine: Engine, cmd: Command) -> Ack:
+def _unsync(engine: CommandTarget, cmd: Command) -> Ack:
     answer = queueing.unsync(engine.queue, cmd.skill_ids, engine.active_skill_id)
     engine.queue = answer.queue
     return _answer(engine, cmd.seq, answer)
 
 
-def _start(engine: Engine, cmd: Command) -> Ack:
+def _start(engine: CommandTarget, cmd: Command) -> Ack:
     engine.start()
     holding = queueing.holding(engine.queue)
     note = f"holding after the failure of '{holding.id}': retry or skip it" if holding else ""
     return ack(engine, cmd.seq, error=note)
 
 
-def _pause_command(engine: Engine, cmd: Command) -> Ack:
+def _pause_command(engine: CommandTarget, cmd: Command) -> Ack:
     engine.pause("paused by the operator")
     return ack(engine, cmd.seq)
 
 
-def _stop(engine: Engine, cmd: Command) -> Ack:
+def _stop(engine: CommandTarget, cmd: Command) -> Ack:
     engine.stop("stopped by the operator")
     return ack(engine, cmd.seq)
 
 
-def _retry(engine: Engine, cmd: Command) -> Ack:
+def _retry(engine: CommandTarget, cmd: Command) -> Ack:
     if not cmd.skill_ids or not cmd.skills:
         return ack(engine, cmd.seq, error="a retry names the failed skill and its new instance")
     answer = queueing.retry(engine.queue, cmd.skill_ids[0], cmd.skills[0])
@@ -112,24 +155,24 @@ def _retry(engine: Engine, cmd: Command) -> Ack:
     return _queue_changed(engine, cmd.seq, answer)
 
 
-def _skip(engine: Engine, cmd: Command) -> Ack:
+def _skip(engine: CommandTarget, cmd: Command) -> Ack:
     if not cmd.skill_ids:
         return ack(engine, cmd.seq, error="a skip names the failed skill")
     return _queue_changed(engine, cmd.seq, queueing.skip(engine.queue, cmd.skill_ids[0]))
 
 
-def _queue_changed(engine: Engine, seq: int, answer: queueing.Answer) -> Ack:
+def _queue_changed(engine: CommandTarget, seq: int, answer: queueing.Answer) -> Ack:
     engine.queue = answer.queue
     engine.advance()
     return _answer(engine, seq, answer, error=next(iter(answer.reasons), ""))
 
 
-def _set_barriers(engine: Engine, cmd: Command) -> Ack:
+def _set_barriers(engine: CommandTarget, cmd: Command) -> Ack:
     engine.set_barriers(cmd.barriers)
     return ack(engine, cmd.seq)
 
 
-def _set_options(engine: Engine, cmd: Command) -> Ack:
+def _set_options(engine: CommandTarget, cmd: Command) -> Ack:
     try:
         policy, default = options_from_argument(cmd.argument)
         check_policy_skill(engine, policy)
@@ -139,7 +182,7 @@ def _set_options(engine: Engine, cmd: Command) -> Ack:
     return ack(engine, cmd.seq)
 
 
-def check_policy_skill(engine: Engine, policy: LostLinkPolicy) -> None:
+def check_policy_skill(engine: CommandTarget, policy: LostLinkPolicy) -> None:
     """InvalidRequest unless the robot implements the skill ``policy`` runs, if any."""
     if not policy.kind.runs_skill:
         return
@@ -152,7 +195,7 @@ def check_policy_skill(engine: Engine, policy: LostLinkPolicy) -> None:
         )
 
 
-def _sync_state(engine: Engine, cmd: Command) -> Ack:
+def _sync_state(engine: CommandTarget, cmd: Command) -> Ack:
     """Make the queue the ground's list, keeping whatever has started here."""
     engine.board.replace(cmd.barriers)
     return _queue_changed(

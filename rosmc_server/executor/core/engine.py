@@ -20,12 +20,21 @@ from typing import Protocol
 
 from rosmc_server.core import SkillInstance, SkillStatus
 from rosmc_server.core.link import queue_hash, status_digest
+from rosmc_server.core.protocol import (
+    Ack,
+    BarrierInfo,
+    Command,
+    Mode,
+    Report,
+    Signal,
+    SignalKind,
+    Snapshot,
+)
 
 from . import commanding, queueing
 from .barrier_wait import ANNOUNCE_PERIOD, Announcements, BarrierWaits
 from .barriers import BarrierBoard
 from .lost_link import LostLinkGuard, PoseSource, no_pose
-from .protocol import Ack, BarrierInfo, Command, Mode, Report, Signal, SignalKind, Snapshot
 from .skills import Outcome, SkillBehavior, SkillContext, SkillType
 
 _log = logging.getLogger(__name__)

@@ -22,9 +22,9 @@ from rosmc_server.core import (
     SkillStatus,
     Transfer,
 )
+from rosmc_server.core.protocol import Ack, AckResult, BarrierInfo, Mode, Report
 
 from .engine import Engine
-from .protocol import Ack, AckResult, BarrierInfo, Mode, Report
 
 STATE_VERSION = 1
 

@@ -8,6 +8,8 @@ the events, agent states and snapshots; :class:`MissionWatch` queues the raw eve
 """
 
 from ...conversions import agent_status_from_msg, agent_statuses_from_msg, library_from_msg
+from ...core.errors import ServerUnavailable
+from ..node_setup import init_node
 from .follow import MissionFollower
 from .mission_client import MissionClient
 from .results import (
@@ -18,7 +20,6 @@ from .results import (
     MissionSaved,
     Result,
     RevisionConflict,
-    ServerUnavailable,
     SkillAdded,
     SkillRetried,
     TeamTransferred,
@@ -26,7 +27,7 @@ from .results import (
 )
 from .science import ScienceWatch
 from .site import SiteWatch
-from .watch import MissionWatch, identify, init_node
+from .watch import MissionWatch, identify
 from .worker import AsyncMissionClient, Outcome
 
 __all__ = [

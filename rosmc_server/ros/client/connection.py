@@ -32,7 +32,8 @@ from ...core import (
     RuleViolation,
     Unavailable,
 )
-from .results import RevisionConflict, ServerUnavailable
+from ...core.errors import ServerUnavailable
+from .results import RevisionConflict
 
 _log = logging.getLogger(__name__)
 

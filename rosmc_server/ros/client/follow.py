@@ -44,7 +44,8 @@ ConnectionListener = Callable[[bool], None]
 class MissionFollower:
     """Feeds a mission mirror from the mission server (or a replay); call :meth:`start`.
 
-    The process must be a ROS node (:func:`~.watch.init_node` or ``rospy.init_node``).
+    The process must be a ROS node (:func:`~rosmc_server.ros.node_setup.init_node` or
+    ``rospy.init_node``).
     Everything that waits on the network runs on worker threads; the mirror's listeners
     are called on rospy's or the worker's threads (see :class:`MissionMirror`).
 

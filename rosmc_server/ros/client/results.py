@@ -1,8 +1,9 @@
 """What the operator services answer, as core-level values, and the client's own errors.
 
 Every refusal the client raises is a core :class:`~rosmc_server.core.RosmcError`
-subclass (one error family for callers); :class:`ServerUnavailable` means the
-mission server did not answer at all.
+subclass (one error family for callers);
+:class:`~rosmc_server.core.errors.ServerUnavailable` means the mission server did not
+answer at all.
 """
 
 from __future__ import annotations
@@ -11,10 +12,6 @@ import enum
 from dataclasses import dataclass
 
 from ...core import RosmcError, StaleRevision
-
-
-class ServerUnavailable(RosmcError):
-    """The mission server (or the ROS master) did not answer in time."""
 
 
 class RevisionConflict(StaleRevision):

@@ -8,7 +8,6 @@ Subscribes:
 from __future__ import annotations
 
 import logging
-import os
 import queue
 import threading
 import time
@@ -20,25 +19,9 @@ import rospy
 from ... import interface
 from ...conversions import agent_statuses_from_msg, event_from_msg
 from ...core import AgentStatus, MissionEvent
+from ..node_setup import init_node
 
 _log = logging.getLogger(__name__)
-
-
-def init_node(name: str | None = None) -> str:
-    """Make this process a ROS node (subscriptions need one); return its name.
-
-    The default name is ``rosmc_cli_<pid>``. Signals stay with the caller (Ctrl-C
-    raises KeyboardInterrupt as usual) and nothing is logged to ``/rosout``.
-    Does nothing if the process is a node already.
-    """
-    if not rospy.core.is_initialized():
-        rospy.init_node(
-            name or f"rosmc_cli_{os.getpid()}",
-            anonymous=False,
-            disable_signals=True,
-            disable_rosout=True,
-        )
-    return str(rospy.get_name())
 
 
 def identify() -> None:

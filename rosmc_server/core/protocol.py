@@ -1,7 +1,9 @@
-"""The executor's view of the robot link: commands in; acks, reports, signals, snapshots out.
+"""The robot link's protocol: commands to a robot; acks, reports, signals, snapshots back.
 
-These mirror ``rosmc/RobotCommand``, ``RobotAck``, ``RobotReport``,
-``BarrierSignal`` and ``ExecutorSnapshot``; the ROS adapter converts.
+Both ends speak it: the ground (:mod:`rosmc_server.ros.ground_link`) and the on-robot
+executor (:mod:`rosmc_server.executor`). These mirror ``rosmc/RobotCommand``,
+``RobotAck``, ``RobotReport``, ``BarrierSignal`` and ``ExecutorSnapshot``;
+:mod:`rosmc_server.conversions.robot_link` converts.
 """
 
 from __future__ import annotations
@@ -9,8 +11,8 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass
 
-from rosmc_server.core import SkillInstance, SkillStatus
-from rosmc_server.core.commands import CommandKind
+from .commands import CommandKind
+from .model import SkillInstance, SkillStatus
 
 
 @dataclass(frozen=True)

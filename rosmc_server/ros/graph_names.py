@@ -15,7 +15,7 @@ from collections.abc import Sequence
 
 import rosgraph
 
-from .results import ServerUnavailable
+from ..core.errors import ServerUnavailable
 
 PING_TIMEOUT = 2.0
 """Seconds a listed node has to answer before its registration counts as stale."""
