@@ -18,12 +18,12 @@ REPO_ROOT = Path(__file__).resolve().parent.parent
 STATION = "rosmc_server/ros/station.py"
 
 # (node name, its module, more modules it reads parameters through: path -> the names it
-# reads there). The node module's docstring describes every parameter.
-NODES: tuple[tuple[str, str, dict[str, tuple[str, ...]]], ...] = (
+# reads there, None for all). The node module's docstring describes every parameter.
+NODES: tuple[tuple[str, str, dict[str, tuple[str, ...] | None]], ...] = (
     (
         "/rosmc/mission_server",
         "rosmc_server/ros/server_node.py",
-        {STATION: ("~cwd", "~station_journal")},
+        {"rosmc_server/ros/server_config.py": None, STATION: ("~cwd", "~station_journal")},
     ),
     ("/<robot>/mission_executor", "rosmc_server/executor/ros/node.py", {STATION: ("~cwd",)}),
     ("/rosmc/sim", "rosmc_sim/ros/sim_node.py", {STATION: ("~cwd",)}),
@@ -137,7 +137,8 @@ def node_parameters(root: Path = REPO_ROOT) -> list[tuple[str, str, list[Paramet
         path = root / module
         params = read_params(path)
         for other, wanted in more.items():
-            params.update({k: v for k, v in read_params(root / other).items() if k in wanted})
+            found = read_params(root / other)
+            params.update({k: v for k, v in found.items() if wanted is None or k in wanted})
         docstring = ast.get_docstring(ast.parse(path.read_text())) or ""
         rows = [
             Parameter(name, default, describe(docstring, name, set(params)))
