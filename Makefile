@@ -26,7 +26,7 @@ BUILD := build
 
 # ROS 1 from Debian, message generation, Qt bindings; rviz, a virtual screen and imagemagick
 # for the GUIs and their screenshots; xdotool drives them with a real mouse in tests;
-# rostest's CMake module (add_rostest), rosdep and catkin_lint for the package checks.
+# rostest's CMake module (add_rostest), rosdep, catkin_lint and catkin_tools (`catkin build`).
 APT_PACKAGES := \
 	python3-rospy python3-rosmaster python3-interactive-markers python3-visualization-msgs \
 	python3-geometry-msgs python3-std-msgs python3-std-srvs python3-rosbag python3-rostest \
@@ -36,7 +36,7 @@ APT_PACKAGES := \
 	ros-geometry-msgs ros-std-msgs ros-visualization-msgs ros-std-srvs rosbash \
 	python3-venv cmake make \
 	xvfb rviz python3-rviz imagemagick xdotool \
-	librostest-dev python3-rosdep2 catkin-lint
+	librostest-dev python3-rosdep2 catkin-lint catkin-tools
 
 # Everything the standalone message build reads. A new script, package or data folder at the
 # top also counts: catkin makes devel-space relays for scripts and top-level packages.

@@ -1,4 +1,4 @@
-"""The package builds three ways, and each result finds its messages, scripts and launch files.
+"""The package builds four ways, and each result finds its messages, scripts and launch files.
 
 Every build goes to a temporary folder and starts from a fresh shell's environment (no env.sh),
 exactly as docs/workspace.md tells a user to do it. The catkin and colcon workspaces are built
@@ -18,10 +18,11 @@ import pytest
 
 from rosmc_server.interface import service_name
 from tests.conftest import LaunchProcess, free_port, log_tail, wait_until
-from tests.integration.conftest import run_in_workspace
+from tests.integration.conftest import Run, run_in_workspace
 from tests.integration.test_launch_files import REQUIRED_ARGS
 from tests.integration.workspaces import (
     JOBS,
+    PYTHON_MESSAGES_ONLY,
     SYSTEM_PYTHON,
     CatkinWorkspace,
     Workspace,
@@ -165,6 +166,29 @@ def test_install_space_without_a_venv_says_what_to_install(catkin_ws: CatkinWork
     assert lines[0].startswith("rosmc: the Python module 'mcap'"), lines
     assert "rosdep install --from-paths src --ignore-src -y" in lines[0]
     assert "ROSMC_VENV" in lines[0]
+
+
+def test_catkin_build(tmp_path: Path, clean_env: dict[str, str], run: Run) -> None:
+    # catkin_tools' `catkin build`, with its default linked devel space.
+    clean_env.update(PYTHON_MESSAGES_ONLY)
+    (tmp_path / "ws" / "src").mkdir(parents=True)
+    source = tmp_path / "ws" / "src" / "rosmc"
+    source.symlink_to(REPO_ROOT, target_is_directory=True)
+    workspace = tmp_path / "ws"
+    run(["catkin", "init"], clean_env, cwd=workspace)
+    cmake_args = ["--cmake-args", f"-DPYTHON_EXECUTABLE={SYSTEM_PYTHON}"]
+    run(["catkin", "build", "--no-status", *cmake_args], clean_env, cwd=workspace)
+
+    devel = workspace / "devel"
+    lines = run_in_workspace(devel / "setup.bash", PRINT_LOOKUPS, clean_env)
+    check_lookups(
+        lines,
+        share=source,
+        script=devel / "lib" / "rosmc" / "rosmc_demo",
+        launch=source / "launch",
+        python=devel / "lib" / "python3" / "dist-packages",
+    )
+    check_pypi_packages(devel / "setup.bash", clean_env, REPO_ROOT / ".venv")
 
 
 def check_install_space(lines: list[str], prefix: Path, share: Path, bin_dir: Path) -> None:
