@@ -13,6 +13,7 @@ import os
 import shlex
 import xmlrpc.client
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -226,6 +227,13 @@ def install_space(request: pytest.FixtureRequest, space: str) -> Workspace:
     return colcon
 
 
+def probe_launch(workspace: Workspace, launch: str, args: list[str], cwd: Path) -> Any:
+    """What launch_probe.py says of ``roslaunch rosmc LAUNCH ARGS`` in ``workspace``."""
+    argv = [SYSTEM_PYTHON, LAUNCH_PROBE, "rosmc", launch, *args]
+    command = shlex.join(str(arg) for arg in argv)
+    return json.loads(run_in_workspace(workspace.setup, command, workspace.env, cwd=cwd)[-1])
+
+
 def strings(value: object) -> list[str]:
     """Every string inside a parameter value (lists and dicts included), split at spaces."""
     if isinstance(value, str):
@@ -243,9 +251,7 @@ def test_launch_file_works_from_an_install_space(
     space: str, launch: str, request: pytest.FixtureRequest, tmp_path: Path
 ) -> None:
     workspace = install_space(request, space)
-    argv = [SYSTEM_PYTHON, LAUNCH_PROBE, "rosmc", launch, *REQUIRED_ARGS.get(launch, [])]
-    command = shlex.join(str(arg) for arg in argv)
-    found = json.loads(run_in_workspace(workspace.setup, command, workspace.env, cwd=tmp_path)[-1])
+    found = probe_launch(workspace, launch, REQUIRED_ARGS.get(launch, []), tmp_path)
 
     root = workspace.setup.parent
     for name in found["files"]:  # roslaunch reads roscore.xml from Debian's /etc/ros first
@@ -262,24 +268,18 @@ def test_launch_file_works_from_an_install_space(
 
 
 def test_install_space_runs_the_simulated_team(
-    catkin_ws: CatkinWorkspace, launch_process: LaunchProcess
+    catkin_ws: CatkinWorkspace, launch_process: LaunchProcess, tmp_path: Path
 ) -> None:
     install = catkin_ws.install
+    args = ["sim:=true", "rviz:=false", "command_gui:=false"]
+    nodes = set(probe_launch(install, "operator.launch", args, tmp_path)["nodes"])
+    assert {"/rosmc/mission_server", "/rosmc/sim", "/drone/mission_executor"} <= nodes
     port = free_port()
     uri = f"http://127.0.0.1:{port}/"
     env = {**install.env, "ROSMC_VENV": str(REPO_ROOT / ".venv"), "ROS_IP": "127.0.0.1"}
-    launch = "roslaunch rosmc operator.launch sim:=true rviz:=false command_gui:=false"
-    script = f"source {install.setup} && export ROS_MASTER_URI={uri} && exec {launch} -p {port}"
-    process = launch_process(["bash", "-c", script], env=env, name="operator", cwd=install.prefix)
-    nodes = {
-        "/rosmc/mission_server",
-        "/rosmc/sim",
-        "/rosmc/link_emulator",
-        "/rosmc/markers",
-        "/drone/mission_executor",
-        "/science_rover/mission_executor",
-        "/manipulator_rover/mission_executor",
-    }
+    launch = shlex.join(["roslaunch", "rosmc", "operator.launch", *args, "-p", str(port)])
+    script = f"source {install.setup} && export ROS_MASTER_URI={uri} && exec {launch}"
+    process = launch_process(["bash", "-c", script], env=env, name="operator", cwd=tmp_path)
 
     def team_is_up() -> bool:
         assert process.poll() is None, f"roslaunch ended:\n{log_tail(process.log_path)}"
