@@ -10,7 +10,8 @@
 #   make bench   setup, then every bench/ script: bench/results.json, bench/results.md and the
 #                figures table of docs/performance.md; BENCH=server,scale runs only those
 #   make sample  setup, then record bags/samples/demo.mcap anew (after a message change)
-#   make lint    ruff check, ruff format --check, mypy --strict on every rosmc_* package
+#   make lint    ruff check, ruff format --check, mypy --strict on every rosmc_* package,
+#                catkin_lint on the package (its rosdep keys checked offline: tools/rosdep_offline.sh)
 #   make format  ruff format and the safe ruff fixes, in place
 #   make clean   remove build/ and the tool caches (keeps .venv)
 
@@ -24,7 +25,8 @@ VENV := .venv
 BUILD := build
 
 # ROS 1 from Debian, message generation, Qt bindings; rviz, a virtual screen and imagemagick
-# for the GUIs and their screenshots; xdotool drives them with a real mouse in tests.
+# for the GUIs and their screenshots; xdotool drives them with a real mouse in tests;
+# rostest's CMake module (add_rostest), rosdep, catkin_lint and catkin_tools (`catkin build`).
 APT_PACKAGES := \
 	python3-rospy python3-rosmaster python3-interactive-markers python3-visualization-msgs \
 	python3-geometry-msgs python3-std-msgs python3-std-srvs python3-rosbag python3-rostest \
@@ -33,7 +35,8 @@ APT_PACKAGES := \
 	ros-message-generation ros-message-runtime python3-tf2-ros python3-python-qt-binding \
 	ros-geometry-msgs ros-std-msgs ros-visualization-msgs ros-std-srvs rosbash \
 	python3-venv cmake make \
-	xvfb rviz python3-rviz imagemagick xdotool
+	xvfb rviz python3-rviz imagemagick xdotool \
+	librostest-dev python3-rosdep2 catkin-lint catkin-tools
 
 # Everything the standalone message build reads. A new script, package or data folder at the
 # top also counts: catkin makes devel-space relays for scripts and top-level packages.
@@ -121,6 +124,7 @@ lint: setup
 	$(IN_ENV) ruff format --check .
 	@echo "mypy --strict $(PACKAGES)"
 	@$(IN_ENV) mypy --strict $(PACKAGES)
+	tools/rosdep_offline.sh $(BUILD)/rosdep catkin_lint --strict --rosdistro debian .
 
 format: setup
 	$(IN_ENV) ruff check --fix .

@@ -11,17 +11,24 @@ of Debian's ``dist-packages`` (where the venv's own interpreter has it), when it
 2. ``.venv`` in the source checkout this package is imported from (devel spaces and
    ``source env.sh``).
 
-Nothing changes when the interpreter already runs inside a venv or none is found; a module
-that is still missing then fails with its usual ``ImportError``.
+Nothing changes when the interpreter already runs inside a venv or none is found. An entry
+script started through :func:`run_entry_point` then ends with one sentence that names the
+missing package and the two ways to install it, instead of a traceback.
 """
 
 from __future__ import annotations
 
+import importlib
 import os
 import sys
+from collections.abc import Callable
 from pathlib import Path
+from typing import cast
 
 VENV_VARIABLE = "ROSMC_VENV"
+OWN_PACKAGE_PREFIX = "rosmc"
+# Import names whose PyPI name differs (requirements.txt has the PyPI names).
+PYPI_NAMES = {"mcap_ros1": "mcap-ros1-support", "yaml": "PyYAML"}
 
 
 def site_packages(venv: Path) -> Path:
@@ -66,3 +73,32 @@ def _package_path() -> list[str]:
     import rosmc_server
 
     return list(getattr(rosmc_server, "__path__", []))
+
+
+def run_entry_point(module: str) -> int:
+    """Run ``module.main()`` with the project's venv; a missing dependency ends in one sentence.
+
+    What a ``scripts/`` entry script calls. A module of this project that is missing is a
+    broken install and raises as usual.
+    """
+    use_project_venv()
+    try:
+        main = cast(Callable[[], int], importlib.import_module(module).main)
+        return main()
+    except ModuleNotFoundError as error:
+        top = (error.name or "").partition(".")[0]
+        if not top or top.startswith(OWN_PACKAGE_PREFIX):
+            raise
+        print(missing_dependency_message(top, Path(sys.argv[0]).name), file=sys.stderr)
+        return 1
+
+
+def missing_dependency_message(name: str, program: str) -> str:
+    """One sentence: which module is missing and how to install it (rosdep or a venv)."""
+    pypi = PYPI_NAMES.get(name, name)
+    return (
+        f"{program}: the Python module '{name}' (PyPI package {pypi}) is missing; install "
+        "ROSMC's dependencies with `rosdep install --from-paths src --ignore-src -y` in the "
+        f"workspace, or set {VENV_VARIABLE} to a venv made from requirements.txt "
+        "(`make setup` makes .venv in the checkout)."
+    )

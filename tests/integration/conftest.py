@@ -7,8 +7,12 @@ import shlex
 import subprocess
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
+
+if TYPE_CHECKING:
+    from tests.integration.workspaces import CatkinWorkspace
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 HERE = Path(__file__).resolve().parent
@@ -45,24 +49,40 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
             item.add_marker(pytest.mark.integration)
 
 
-def _outside_checkout(entry: str) -> bool:
-    path = Path(entry).resolve() if entry else Path()
-    return not entry or REPO_ROOT not in (path, *path.parents)
+def _in_a_fresh_shell(entry: str) -> bool:
+    """Whether a PATH entry stays in a ROS user's fresh shell on Debian.
+
+    Entries in the checkout (scripts/, build/, .venv/bin, even through a symlink) go, and so
+    does any other folder with a ``python3`` (a venv, pyenv): on Debian ``python3`` is
+    /usr/bin/python3, which installed entry scripts (``#!/usr/bin/env python3``) run with.
+    """
+    if not entry:
+        return False
+    path = Path(entry)
+    for place in (path.absolute(), path.resolve()):
+        if REPO_ROOT in (place, *place.parents):
+            return False
+    return entry in ("/usr/bin", "/bin") or not (path / "python3").exists()
+
+
+def fresh_shell_env(home: Path) -> dict[str, str]:
+    """The environment of a fresh shell: none of env.sh's or a workspace's settings.
+
+    PATH keeps what :func:`_in_a_fresh_shell` keeps; ROS_HOME and COLCON_HOME are in ``home``.
+    """
+    env = {key: value for key, value in os.environ.items() if key not in WORKSPACE_VARIABLES}
+    env["PATH"] = ":".join(
+        entry for entry in os.environ.get("PATH", "").split(":") if _in_a_fresh_shell(entry)
+    )
+    env["ROS_HOME"] = str(home / "ros_home")
+    env["COLCON_HOME"] = str(home / "colcon_home")
+    return env
 
 
 @pytest.fixture
 def clean_env(tmp_path: Path) -> dict[str, str]:
-    """The environment of a fresh shell: none of env.sh's or a workspace's settings.
-
-    PATH loses the venv, scripts/ and build/ entries; ROS_HOME is private to the test.
-    """
-    env = {key: value for key, value in os.environ.items() if key not in WORKSPACE_VARIABLES}
-    env["PATH"] = ":".join(
-        entry for entry in os.environ.get("PATH", "").split(":") if _outside_checkout(entry)
-    )
-    env["ROS_HOME"] = str(tmp_path / "ros_home")
-    env["COLCON_HOME"] = str(tmp_path / "colcon_home")
-    return env
+    """:func:`fresh_shell_env` with its homes in the test's ``tmp_path``."""
+    return fresh_shell_env(tmp_path)
 
 
 Run = Callable[..., subprocess.CompletedProcess[str]]
@@ -105,16 +125,33 @@ def run() -> Run:
     return _run
 
 
-@pytest.fixture
-def in_workspace() -> Callable[[Path, str, Mapping[str, str]], list[str]]:
-    """``in_workspace(setup_bash, commands, env)``: run bash commands after sourcing a setup file.
+def run_in_workspace(
+    setup: Path, commands: str, env: Mapping[str, str], cwd: Path | None = None
+) -> list[str]:
+    """Run bash ``commands`` after sourcing ``setup``; fail the test if they fail.
 
     Returns the output lines. Commands run with ``set -euo pipefail``.
     """
+    script = f"set -eo pipefail\nsource {shlex.quote(str(setup))}\nset -u\n{commands}"
+    result = _run(["bash", "-c", script], env=env, cwd=cwd, timeout=120.0)
+    return result.stdout.splitlines()
 
-    def source_and_run(setup: Path, commands: str, env: Mapping[str, str]) -> list[str]:
-        script = f"set -eo pipefail\nsource {shlex.quote(str(setup))}\nset -u\n{commands}"
-        result = _run(["bash", "-c", script], env=env, timeout=120.0)
-        return result.stdout.splitlines()
 
-    return source_and_run
+@pytest.fixture
+def in_workspace() -> Callable[[Path, str, Mapping[str, str]], list[str]]:
+    """``in_workspace(setup_bash, commands, env)``: :func:`run_in_workspace` as a fixture."""
+    return run_in_workspace
+
+
+run_command = _run  # for module-scoped fixtures, which cannot use the ``run`` fixture
+
+
+@pytest.fixture(scope="session")
+def catkin_ws(tmp_path_factory: pytest.TempPathFactory) -> CatkinWorkspace:
+    """The checkout built by ``catkin_make`` and ``catkin_make install``, once per session.
+
+    Shared by the build, install-space and rostest tests (see workspaces.py).
+    """
+    from tests.integration.workspaces import build_catkin_workspace  # it imports this module
+
+    return build_catkin_workspace(tmp_path_factory.mktemp("catkin_ws"))

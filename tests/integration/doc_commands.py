@@ -163,8 +163,19 @@ CLI = "tests/integration/test_cli.py"
 BUILD = "tests/integration/test_build.py"
 DOCS = "tests/integration/test_docs_commands.py"
 MULTIHOST = "tests/integration/test_multihost.py::test_a_mission_across_hosts_survives_a_slow_radio_and_an_outage"  # noqa: E501
-ROSTEST = ("tests/integration/test_rostest.py::test_rostest_file_passes", ('"rostest"', '"rosmc"'))
-CATKIN = f"{BUILD}::test_catkin_make_devel_and_install"
+ROSTEST = (
+    "tests/integration/test_rostest.py::test_rostest_runs_a_file_as_the_docs_show",
+    ('"rostest"', '"rosmc"'),
+)
+# catkin_make run_tests runs `rostest rosmc <file>` for each file add_rostest names.
+RUN_TESTS = (
+    "tests/integration/test_rostest.py::test_run_tests_runs_the_rostest_file",
+    ("TEST_FILES",),
+)
+CATKIN = f"{BUILD}::test_catkin_make_devel_space"
+CATKIN_INSTALL = f"{BUILD}::test_catkin_make_install_space"
+CATKIN_TOOLS = f"{BUILD}::test_catkin_build"
+ROSDEP = "tests/integration/test_rosdep.py::test_rosdep_install_accepts_the_workspace"
 COLCON = f"{BUILD}::test_colcon_build"
 REVIEW = f"{DOCS}::test_the_review_commands_run_on_the_sample"
 REPLAY = f"{DOCS}::test_the_replay_commands_run_against_a_master"
@@ -269,24 +280,42 @@ DOC_COMMANDS: dict[str, Evidence] = {
         f"{BUILD}::test_standalone_cmake_build", ('in_workspace(devel / "setup.bash"',)
     ),
     'mkdir -p ~/rosmc_ws/src && ln -s "$PWD" ~/rosmc_ws/src/rosmc': Evidence(
-        CATKIN, ('(workspace / "src").mkdir(', "source.symlink_to(REPO_ROOT")
+        CATKIN, ('(root / "src").mkdir()', '(root / "src" / "rosmc").symlink_to(REPO_ROOT')
     ),
-    "cd ~/rosmc_ws": Evidence(CATKIN, ("cwd=workspace",)),
+    "cd ~/rosmc_ws": Evidence(CATKIN, ("cwd=root",)),
     "catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3": Evidence(
         CATKIN, ('["catkin_make", f"-DPYTHON_EXECUTABLE={SYSTEM_PYTHON}"',)
     ),
-    "source devel/setup.bash": Evidence(CATKIN, ('in_workspace(devel / "setup.bash"',)),
-    "catkin_make install": Evidence(CATKIN, ('["catkin_make", "install"',)),
-    "source install/setup.bash": Evidence(CATKIN, ('in_workspace(install / "setup.bash"',)),
+    "source devel/setup.bash": Evidence(CATKIN, ('run_in_workspace(devel / "setup.bash"',)),
+    "catkin_make install": Evidence(CATKIN_INSTALL, ('["catkin_make", "install"',)),
+    "source install/setup.bash": Evidence(CATKIN_INSTALL, ("run_in_workspace(install.setup",)),
+    # docs/workspace.md: rosdep (rosdep_offline.sh lists rosdep/sources.sh's sources, then
+    # runs rosdep update, against local files: rosdistro is not reachable from CI)
+    "src/rosmc/rosdep/sources.sh | sudo tee /etc/ros/rosdep/sources.list.d/30-rosmc.list": (
+        Evidence(ROSDEP, ('"rosdep_offline.sh"',))
+    ),
+    "rosdep update": Evidence(ROSDEP, ('"rosdep_offline.sh"',)),
+    "rosdep install --from-paths src --ignore-src -y": Evidence(
+        ROSDEP, ('"rosdep", "install"', '["--from-paths", "src", "--ignore-src", "-y"]')
+    ),
+    "catkin init": Evidence(CATKIN_TOOLS, ('["catkin", "init"]',)),
+    "catkin build --cmake-args -DPYTHON_EXECUTABLE=/usr/bin/python3": Evidence(
+        CATKIN_TOOLS,
+        ('["catkin", "build"', '["--cmake-args", f"-DPYTHON_EXECUTABLE={SYSTEM_PYTHON}"]'),
+    ),
+    "catkin_make run_tests && catkin_test_results build/test_results": Evidence(
+        "tests/integration/test_rostest.py::test_results",
+        ('["catkin_make", "run_tests"', '["catkin_test_results"'),
+    ),
     "source .venv/bin/activate": Evidence(COLCON, ("colcon = Path(sys.executable).parent",)),
-    "mkdir -p ~/rosmc_colcon && cd ~/rosmc_colcon": Evidence(COLCON, ("cwd=tmp_path",)),
+    "mkdir -p ~/rosmc_colcon && cd ~/rosmc_colcon": Evidence(COLCON, ("cwd=root",)),
     "colcon build --base-paths /path/to/rosmc --cmake-args -DPYTHON_EXECUTABLE=/usr/bin/python3": (
         Evidence(COLCON, ('"--base-paths",', '"--cmake-args",'))
     ),
     "rostest rosmc server.test": Evidence(*ROSTEST),
-    "rostest rosmc executor.test": Evidence(*ROSTEST),
-    "rostest rosmc sim.test": Evidence(*ROSTEST),
-    "rostest rosmc markers.test": Evidence(*ROSTEST),
+    "rostest rosmc executor.test": Evidence(*RUN_TESTS),
+    "rostest rosmc sim.test": Evidence(*RUN_TESTS),
+    "rostest rosmc markers.test": Evidence(*RUN_TESTS),
 }
 
 

@@ -1,25 +1,37 @@
-"""The package builds three ways, and each result finds its messages, scripts and launch files.
+"""The package builds four ways, and each result finds its messages, scripts and launch files.
 
 Every build goes to a temporary folder and starts from a fresh shell's environment (no env.sh),
-exactly as docs/integrator-guide.md's "Building" section tells a user to do it.
+exactly as docs/workspace.md tells a user to do it. The catkin and colcon workspaces are built
+once per module and shared: every launch file is then loaded from both install spaces (what
+roslaunch would start, with every file it names), and the simulated team is started from one.
 """
 
 from __future__ import annotations
 
+import json
 import os
-import sys
+import shlex
+import xmlrpc.client
 from pathlib import Path
+from typing import Any
 
 import pytest
 
-REPO_ROOT = Path(__file__).resolve().parents[2]
-SYSTEM_PYTHON = "/usr/bin/python3"
-JOBS = f"-j{os.cpu_count() or 1}"
-DATA_SUFFIXES = {".yaml", ".yml", ".json", ".xml", ".rviz", ".ui", ".png", ".svg", ".urdf"}
+from rosmc_server.interface import service_name
+from tests.conftest import LaunchProcess, free_port, log_tail, wait_until
+from tests.integration.conftest import Run, run_in_workspace
+from tests.integration.test_launch_files import REQUIRED_ARGS
+from tests.integration.workspaces import (
+    JOBS,
+    PYTHON_MESSAGES_ONLY,
+    SYSTEM_PYTHON,
+    CatkinWorkspace,
+    Workspace,
+    build_colcon_workspace,
+)
 
-# The workspace builds skip the C++ and Lisp messages, which nothing here uses: the full
-# generation is built by `make setup` and by test_standalone_cmake_build. Saves ~40 %.
-PYTHON_MESSAGES_ONLY = {"ROS_LANG_DISABLE": "gencpp:genlisp:geneus:gennodejs"}
+REPO_ROOT = Path(__file__).resolve().parents[2]
+DATA_SUFFIXES = {".yaml", ".yml", ".json", ".xml", ".rviz", ".ui", ".png", ".svg", ".urdf"}
 
 pytestmark = pytest.mark.slow
 
@@ -89,9 +101,9 @@ def check_lookups(lines: list[str], share: Path, script: Path, launch: Path, pyt
     assert lines[5:7] == ["float64 x", "uint64 base_revision"], lines[5:]
 
 
-def check_pypi_packages(setup: Path, env: dict[str, str], in_workspace, venv: Path) -> None:
+def check_pypi_packages(setup: Path, env: dict[str, str], venv: Path) -> None:
     """Outside env.sh an entry script finds the PyPI packages in ``venv``."""
-    lines = in_workspace(setup, PYPI_IMPORTS, env)
+    lines = run_in_workspace(setup, PYPI_IMPORTS, env)
     assert lines[0] == str(venv), lines
     assert Path(lines[1]).is_relative_to(venv), lines
 
@@ -110,23 +122,66 @@ def test_standalone_cmake_build(tmp_path: Path, clean_env, run, in_workspace) ->
         launch=REPO_ROOT / "launch",
         python=devel / "lib" / "python3" / "dist-packages",
     )
-    check_pypi_packages(devel / "setup.bash", clean_env, in_workspace, REPO_ROOT / ".venv")
+    check_pypi_packages(devel / "setup.bash", clean_env, REPO_ROOT / ".venv")
     if (REPO_ROOT / "rosmc_server" / "demo.py").exists():
         # The relay runs the script in scripts/ with Debian's python.
         lines = in_workspace(devel / "setup.bash", "rosrun rosmc rosmc_demo --help", clean_env)
         assert lines[0].startswith("usage: rosmc_demo")
 
 
-def test_catkin_make_devel_and_install(tmp_path: Path, clean_env, run, in_workspace) -> None:
-    clean_env.update(PYTHON_MESSAGES_ONLY)
-    workspace = tmp_path / "ws"
-    (workspace / "src").mkdir(parents=True)
-    source = workspace / "src" / "rosmc"
-    source.symlink_to(REPO_ROOT, target_is_directory=True)
+@pytest.fixture(scope="module")
+def colcon_ws(tmp_path_factory: pytest.TempPathFactory) -> Workspace:
+    """The checkout built with ``colcon build``, once for the module."""
+    return build_colcon_workspace(tmp_path_factory.mktemp("colcon_ws"))
 
-    run(["catkin_make", f"-DPYTHON_EXECUTABLE={SYSTEM_PYTHON}", JOBS], clean_env, cwd=workspace)
+
+def test_catkin_make_devel_space(catkin_ws: CatkinWorkspace) -> None:
+    devel = catkin_ws.devel
+    lines = run_in_workspace(devel / "setup.bash", PRINT_LOOKUPS, catkin_ws.env)
+    check_lookups(
+        lines,
+        share=catkin_ws.source,
+        script=devel / "lib" / "rosmc" / "rosmc_demo",
+        launch=catkin_ws.source / "launch",
+        python=devel / "lib" / "python3" / "dist-packages",
+    )
+    check_pypi_packages(devel / "setup.bash", catkin_ws.env, REPO_ROOT / ".venv")
+
+
+def test_catkin_make_install_space(catkin_ws: CatkinWorkspace) -> None:
+    install = catkin_ws.install
+    lines = run_in_workspace(install.setup, PRINT_LOOKUPS, install.env)
+    check_install_space(lines, install.prefix, install.share, install.prefix / "lib" / "rosmc")
+    # An install space has no checkout beside it: ROSMC_VENV names the venv.
+    venv_env = {**install.env, "ROSMC_VENV": str(REPO_ROOT / ".venv")}
+    check_pypi_packages(install.setup, venv_env, REPO_ROOT / ".venv")
+
+
+def test_install_space_without_a_venv_says_what_to_install(catkin_ws: CatkinWorkspace) -> None:
+    # This machine's Debian python has no mcap (requirements.txt puts it in .venv only).
+    install = catkin_ws.install
+    command = "rosrun rosmc rosmc --help 2>&1 && echo 'exit 0' || echo \"exit $?\""
+    lines = run_in_workspace(install.setup, command, install.env)
+    assert lines[-1] == "exit 1", lines
+    assert len(lines) == 2, "one sentence, no traceback"
+    assert lines[0].startswith("rosmc: the Python module 'mcap'"), lines
+    assert "rosdep install --from-paths src --ignore-src -y" in lines[0]
+    assert "ROSMC_VENV" in lines[0]
+
+
+def test_catkin_build(tmp_path: Path, clean_env: dict[str, str], run: Run) -> None:
+    # catkin_tools' `catkin build`, with its default linked devel space.
+    clean_env.update(PYTHON_MESSAGES_ONLY)
+    (tmp_path / "ws" / "src").mkdir(parents=True)
+    source = tmp_path / "ws" / "src" / "rosmc"
+    source.symlink_to(REPO_ROOT, target_is_directory=True)
+    workspace = tmp_path / "ws"
+    run(["catkin", "init"], clean_env, cwd=workspace)
+    cmake_args = ["--cmake-args", f"-DPYTHON_EXECUTABLE={SYSTEM_PYTHON}"]
+    run(["catkin", "build", "--no-status", *cmake_args], clean_env, cwd=workspace)
+
     devel = workspace / "devel"
-    lines = in_workspace(devel / "setup.bash", PRINT_LOOKUPS, clean_env)
+    lines = run_in_workspace(devel / "setup.bash", PRINT_LOOKUPS, clean_env)
     check_lookups(
         lines,
         share=source,
@@ -134,16 +189,7 @@ def test_catkin_make_devel_and_install(tmp_path: Path, clean_env, run, in_worksp
         launch=source / "launch",
         python=devel / "lib" / "python3" / "dist-packages",
     )
-    check_pypi_packages(devel / "setup.bash", clean_env, in_workspace, REPO_ROOT / ".venv")
-
-    run(["catkin_make", "install", JOBS], clean_env, cwd=workspace)
-    install = workspace / "install"
-    share = install / "share" / "rosmc"
-    lines = in_workspace(install / "setup.bash", PRINT_LOOKUPS, clean_env)
-    check_install_space(lines, install, share, install / "lib" / "rosmc")
-    # An install space has no checkout beside it: ROSMC_VENV names the venv.
-    venv_env = {**clean_env, "ROSMC_VENV": str(REPO_ROOT / ".venv")}
-    check_pypi_packages(install / "setup.bash", venv_env, in_workspace, REPO_ROOT / ".venv")
+    check_pypi_packages(devel / "setup.bash", clean_env, REPO_ROOT / ".venv")
 
 
 def check_install_space(lines: list[str], prefix: Path, share: Path, bin_dir: Path) -> None:
@@ -162,29 +208,93 @@ def check_install_space(lines: list[str], prefix: Path, share: Path, bin_dir: Pa
         assert (share / "rosmc_server" / "config").is_dir()
 
 
-def test_colcon_build(tmp_path: Path, clean_env, run, in_workspace) -> None:
-    clean_env.update(PYTHON_MESSAGES_ONLY)
-    colcon = Path(sys.executable).parent / "colcon"
-    assert colcon.is_file(), "colcon is installed into the venv from requirements.txt"
-    install = tmp_path / "install"
-    run(
-        [
-            colcon,
-            "--log-base",
-            tmp_path / "log",
-            "build",
-            "--base-paths",
-            REPO_ROOT,
-            "--build-base",
-            tmp_path / "build",
-            "--install-base",
-            install,
-            "--cmake-args",
-            f"-DPYTHON_EXECUTABLE={SYSTEM_PYTHON}",
-        ],
-        clean_env,
-        cwd=tmp_path,
-    )
-    prefix = install / "rosmc"  # colcon's default isolated layout
-    lines = in_workspace(install / "setup.bash", PRINT_LOOKUPS, clean_env)
-    check_install_space(lines, prefix, prefix / "share" / "rosmc", prefix / "lib" / "rosmc")
+def test_colcon_build(colcon_ws: Workspace) -> None:
+    lines = run_in_workspace(colcon_ws.setup, PRINT_LOOKUPS, colcon_ws.env)
+    prefix = colcon_ws.prefix
+    check_install_space(lines, prefix, colcon_ws.share, prefix / "lib" / "rosmc")
+
+
+LAUNCH_PROBE = Path(__file__).resolve().parent / "launch_probe.py"
+INSTALL_SPACES = ["catkin_make install", "colcon build"]
+
+
+def install_space(request: pytest.FixtureRequest, space: str) -> Workspace:
+    """The install space named in INSTALL_SPACES (its module fixture is built on first use)."""
+    if space == "catkin_make install":
+        workspace: CatkinWorkspace = request.getfixturevalue("catkin_ws")
+        return workspace.install
+    colcon: Workspace = request.getfixturevalue("colcon_ws")
+    return colcon
+
+
+def probe_launch(workspace: Workspace, launch: str, args: list[str], cwd: Path) -> Any:
+    """What launch_probe.py says of ``roslaunch rosmc LAUNCH ARGS`` in ``workspace``."""
+    argv = [SYSTEM_PYTHON, LAUNCH_PROBE, "rosmc", launch, *args]
+    command = shlex.join(str(arg) for arg in argv)
+    return json.loads(run_in_workspace(workspace.setup, command, workspace.env, cwd=cwd)[-1])
+
+
+def strings(value: object) -> list[str]:
+    """Every string inside a parameter value (lists and dicts included), split at spaces."""
+    if isinstance(value, str):
+        return value.split()
+    if isinstance(value, dict):
+        return [s for item in value.values() for s in strings(item)]
+    if isinstance(value, list):
+        return [s for item in value for s in strings(item)]
+    return []
+
+
+@pytest.mark.parametrize("launch", launch_files())
+@pytest.mark.parametrize("space", INSTALL_SPACES)
+def test_launch_file_works_from_an_install_space(
+    space: str, launch: str, request: pytest.FixtureRequest, tmp_path: Path
+) -> None:
+    workspace = install_space(request, space)
+    found = probe_launch(workspace, launch, REQUIRED_ARGS.get(launch, []), tmp_path)
+
+    root = workspace.setup.parent
+    for name in found["files"]:  # roslaunch reads roscore.xml from Debian's /etc/ros first
+        roscore = name.endswith("/etc/ros/roscore.xml")
+        assert roscore or Path(name).parent == workspace.share / "launch", name
+    for node, node_argv in found["nodes"].items():
+        if not node_argv[0].startswith("/usr/"):  # rviz comes from Debian
+            assert Path(node_argv[0]).parent == workspace.prefix / "lib" / "rosmc", node
+    named = [s for value in found["params"].values() for s in strings(value)]
+    named += [s for node_argv in found["nodes"].values() for s in node_argv]
+    for path in (s for s in named if s.startswith(str(root))):
+        assert Path(path).exists(), f"{launch} names {path}, which is not installed"
+    assert not [s for s in named if str(REPO_ROOT) in s], "nothing reaches into the checkout"
+
+
+def test_install_space_runs_the_simulated_team(
+    catkin_ws: CatkinWorkspace, launch_process: LaunchProcess, tmp_path: Path
+) -> None:
+    install = catkin_ws.install
+    args = ["sim:=true", "rviz:=false", "command_gui:=false"]
+    nodes = set(probe_launch(install, "operator.launch", args, tmp_path)["nodes"])
+    assert {"/rosmc/mission_server", "/rosmc/sim", "/drone/mission_executor"} <= nodes
+    port = free_port()
+    uri = f"http://127.0.0.1:{port}/"
+    env = {**install.env, "ROSMC_VENV": str(REPO_ROOT / ".venv"), "ROS_IP": "127.0.0.1"}
+    launch = shlex.join(["roslaunch", "rosmc", "operator.launch", *args, "-p", str(port)])
+    script = f"source {install.setup} && export ROS_MASTER_URI={uri} && exec {launch}"
+    process = launch_process(["bash", "-c", script], env=env, name="operator", cwd=tmp_path)
+
+    def team_is_up() -> bool:
+        assert process.poll() is None, f"roslaunch ended:\n{log_tail(process.log_path)}"
+        try:
+            _, _, (publishers, _, services) = xmlrpc.client.ServerProxy(uri).getSystemState("/t")
+        except OSError:
+            return False  # the master is not up yet
+        running = {node for _, names in publishers + services for node in names}
+        clock = [names for topic, names in publishers if topic == "/clock"]
+        offered = {name for name, _ in services}
+        return (
+            nodes <= running
+            and clock == [["/rosmc/sim"]]
+            and (service_name("get_mission") in offered)
+        )
+
+    wait_until(team_is_up, timeout=180, what="the team from the install space is up", period=0.5)
+    assert process.poll() is None, log_tail(process.log_path)

@@ -71,3 +71,14 @@ def test_relative_paths_are_taken_from_where_roslaunch_was_typed(
     # the launch's server notes its journal there, so that a respawned one resumes it
     assert team.params["/rosmc/mission_server/station_journal"].value == ""
     assert "station_journal" not in str(loaded("mission_server.launch", []).params)
+
+
+@pytest.mark.parametrize(
+    ("args", "expected"),
+    [([], None), (["use_sim_time:=true"], True), (["use_sim_time:=false"], False)],
+)
+def test_rviz_sets_use_sim_time_only_when_asked(args: list[str], expected: bool | None) -> None:
+    # rviz opened beside a running simulation must not switch the simulation's clock off.
+    params = loaded("rviz.launch", args).params
+    value = params["/use_sim_time"].value if "/use_sim_time" in params else None
+    assert value is expected

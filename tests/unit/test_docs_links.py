@@ -17,7 +17,6 @@ PENDING = {
     "docs/architecture-gui.md",
     "docs/writing-skills.md",
     "docs/export.md",
-    "docs/workspace.md",
     "docs/performance-notes.md",
 }
 LINK = re.compile(r"(?<!!)\[[^\]]*\]\(([^)\s]+)\)")

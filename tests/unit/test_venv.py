@@ -45,3 +45,41 @@ def test_nothing_changes_inside_a_venv_or_without_one(
     monkeypatch.setattr(venv, "_package_path", lambda: [str(tmp_path / "nowhere" / "pkg")])
     assert venv.use_project_venv({}) is None
     assert path == ["/usr/lib/python3/dist-packages"]
+
+
+def _entry_module(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, name: str, body: str) -> str:
+    """A module ``name`` in ``tmp_path`` (on sys.path) whose text is ``body``."""
+    (tmp_path / f"{name}.py").write_text(body)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    return name
+
+
+def test_an_entry_point_runs_main_and_returns_its_status(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    module = _entry_module(tmp_path, monkeypatch, "entry_ok", "def main():\n    return 3\n")
+    assert venv.run_entry_point(module) == 3
+
+
+def test_a_missing_dependency_ends_in_one_sentence_naming_both_routes(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    body = "import mcap_ros1.decoder\n\ndef main():\n    return 0\n"
+    monkeypatch.setitem(sys.modules, "mcap_ros1", None)  # as if it were not installed
+    monkeypatch.setattr(sys, "argv", ["/opt/ws/install/lib/rosmc/rosmc", "--help"])
+    module = _entry_module(tmp_path, monkeypatch, "entry_needs_mcap", body)
+
+    assert venv.run_entry_point(module) == 1
+    error = capsys.readouterr().err
+    assert error.startswith("rosmc: the Python module 'mcap_ros1' (PyPI package mcap-ros1-support)")
+    assert "rosdep install --from-paths src --ignore-src -y" in error
+    assert "ROSMC_VENV" in error
+    assert error.count(". ") == 0 and error.count("\n") == 1, "one sentence, one line"
+
+
+def test_a_missing_module_of_the_project_itself_is_not_hidden(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    module = _entry_module(tmp_path, monkeypatch, "entry_broken", "import rosmc_not_here\n")
+    with pytest.raises(ModuleNotFoundError, match="rosmc_not_here"):
+        venv.run_entry_point(module)
