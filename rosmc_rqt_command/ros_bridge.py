@@ -44,8 +44,8 @@ from rosmc_server.ros.client import (
     SiteWatch,
 )
 
-from .requests import MUTATING, Answer, Request
-from .view_state import ViewUpdate, view_update
+from .core.requests import MUTATING, Answer, Request
+from .core.view_state import ViewUpdate, view_update
 
 _log = logging.getLogger(__name__)
 

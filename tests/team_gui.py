@@ -11,9 +11,9 @@ from python_qt_binding.QtCore import QPoint, QRect, Qt
 from python_qt_binding.QtTest import QTest
 from python_qt_binding.QtWidgets import QApplication
 
-from rosmc_rqt_command.agent_column import AgentColumn
-from rosmc_rqt_command.command_widget import CommandWidget
-from rosmc_rqt_command.team_bar import TeamBar
+from rosmc_rqt_command.qt.agent_column import AgentColumn
+from rosmc_rqt_command.qt.command_widget import CommandWidget
+from rosmc_rqt_command.qt.team_bar import TeamBar
 from tests import conftest
 
 

@@ -22,7 +22,7 @@ import logging
 import math
 import threading
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import rosmc.msg as wire
 import rospy
@@ -42,10 +42,8 @@ from ..core.requests import SkillPlan, moved_area, moved_pose, new_marker, robot
 from ..core.scene import Selection
 from ..core.specs import Parsed, parse_name
 from ..core.styling import is_locked
+from .config import MarkerHost, MarkerNodeConfig
 from .convert import pose_numbers
-
-if TYPE_CHECKING:
-    from .node import MarkerNode, MarkerNodeConfig
 
 _log = logging.getLogger(__name__)
 Call = Callable[[MissionClient], Any]
@@ -54,7 +52,7 @@ Call = Callable[[MissionClient], Any]
 class Interaction:
     """Feedback, stock tools and selection of one marker node."""
 
-    def __init__(self, node: MarkerNode, config: MarkerNodeConfig) -> None:
+    def __init__(self, node: MarkerHost, config: MarkerNodeConfig) -> None:
         self._node = node
         self._config = config
         self._client = AsyncMissionClient(MissionClient(5.0, config.ns), "rosmc-markers-client")

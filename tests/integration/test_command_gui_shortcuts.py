@@ -86,8 +86,8 @@ def drive() -> None:
     from python_qt_binding.QtGui import QKeySequence
     from python_qt_binding.QtTest import QTest
 
-    from rosmc_rqt_command.legality import RobotAction
-    from rosmc_rqt_command.requests import Answer, Request
+    from rosmc_rqt_command.core.legality import RobotAction
+    from rosmc_rqt_command.core.requests import Answer, Request
     from rosmc_server.core import AgentStatus, SkillStatus
     from rosmc_server.core.library import library_from_dict
     from tests.unit.conftest import TEST_LIBRARY, make_mission

@@ -9,7 +9,7 @@ import pytest
 from python_qt_binding.QtCore import Qt
 from python_qt_binding.QtTest import QTest
 
-from rosmc_rqt_command.policy_dialog import PolicyDialog
+from rosmc_rqt_command.qt.policy_dialog import PolicyDialog
 from rosmc_server.core import (
     AgentStatus,
     Library,

@@ -12,8 +12,8 @@ import pytest
 from python_qt_binding.QtCore import Qt
 from python_qt_binding.QtTest import QTest
 
-from rosmc_rqt_command.legality import RobotAction, RobotLegality, legal_robot_actions
-from rosmc_rqt_command.policy_dialog import PolicyDialog
+from rosmc_rqt_command.core.legality import RobotAction, RobotLegality, legal_robot_actions
+from rosmc_rqt_command.qt.policy_dialog import PolicyDialog
 from rosmc_server.core import (
     AgentStatus,
     InvalidRequest,

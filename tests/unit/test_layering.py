@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 
 from tests.unit.layering_rules import (
+    LAYER_OF_PATH,
     MESSAGES,
     PYBULLET,
     PYBULLET_ALLOWED,
@@ -57,6 +58,10 @@ def test_there_are_core_modules_to_scan() -> None:
         )
     }
     assert expected <= modules
+
+
+def test_the_layer_table_names_real_paths() -> None:
+    assert [key for key in LAYER_OF_PATH if not (REPO / key).exists()] == []
 
 
 def test_every_module_has_a_layer() -> None:

@@ -18,8 +18,8 @@ from python_qt_binding.QtGui import QBrush, QColor, QFont
 
 from rosmc_server.core import SkillInstance
 
-from . import presentation
-from .mission_view import MissionView
+from ..core import presentation
+from ..core.mission_view import MissionView
 
 MIME_TYPE = "application/x-rosmc-skill-ids"
 SKILL_ID_ROLE = Qt.UserRole + 1

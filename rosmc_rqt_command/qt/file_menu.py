@@ -15,10 +15,10 @@ from python_qt_binding.QtWidgets import QFileDialog, QInputDialog, QMessageBox, 
 
 from rosmc_server.core import Barrier, SkillInstance, TaskMarker
 
+from ..core.mission_view import MissionView
+from ..core.requests import Answer, Request
 from .actions import CommandActions
 from .message_area import MessageArea
-from .mission_view import MissionView
-from .requests import Answer, Request
 
 FILTER = "Mission files (*.yaml *.yml);;All files (*)"
 Send = Callable[[Request], None]

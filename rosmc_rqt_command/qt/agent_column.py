@@ -29,14 +29,14 @@ from python_qt_binding.QtWidgets import (
 
 from rosmc_server.core import AgentStatus, LostLinkPolicy
 
-from . import presentation
+from ..core import presentation
+from ..core.legality import RobotAction
+from ..core.mission_view import MissionView
+from ..core.view_state import AgentView
 from .coverage_warning import coverage_warning_label, show_coverage_warning
-from .legality import RobotAction
-from .mission_view import MissionView
 from .policy_dialog import ask_policy
 from .row_delegate import RowDelegate
 from .schedule_model import NUMBER, PARAMS, SKILL, STATUS, TAG, SectionModel
-from .view_state import AgentView
 
 ROW_HEIGHT = 22
 # A column is at least this wide (more robots than fit: the schedule scrolls sideways)

@@ -16,9 +16,9 @@ from python_qt_binding.QtWidgets import QApplication, QHBoxLayout, QScrollArea, 
 
 from rosmc_server.core import AgentStatus, Library
 
+from ..core.mission_view import MissionView
+from ..core.view_state import ViewUpdate
 from .agent_column import AgentColumn, SectionTable
-from .mission_view import MissionView
-from .view_state import ViewUpdate
 
 
 class ScheduleWidget(QScrollArea):  # type: ignore[misc]

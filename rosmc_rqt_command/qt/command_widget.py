@@ -26,25 +26,25 @@ from python_qt_binding.QtWidgets import (
 
 from rosmc_server.core import AgentStatus, Library, LostLinkPolicy
 
-from . import alerts
+from ..core import alerts
+from ..core.dispatch import Dispatcher
+from ..core.legality import Action, RobotAction, RobotLegality, legal_actions
+from ..core.mission_view import MissionView
+from ..core.requests import Answer, Backend, Request
+from ..core.view_state import ViewUpdate
 from .actions import CommandActions
 from .agent_column import SectionTable
 from .control_panel import ControlPanel
-from .dispatch import Dispatcher
 from .file_menu import FileController
-from .legality import Action, RobotAction, RobotLegality, legal_actions
 from .legend import StatusLegend
 from .message_area import MessageArea
-from .mission_view import MissionView
 from .parameter_panel import ParameterPanel
-from .requests import Answer, Backend, Request
 from .schedule_widget import ScheduleWidget
 from .science_strip import ScienceStrip
 from .site_strip import SiteStrip
 from .team_bar import TeamBar
 from .team_dialog import ask_team_send
 from .undo_history import UndoHistory
-from .view_state import ViewUpdate
 
 # Robot headers and robot buttons follow live reports at most this often (ms): robots
 # report at up to 10 Hz each, and nobody reads a battery figure faster than that.

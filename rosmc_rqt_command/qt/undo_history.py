@@ -13,9 +13,9 @@ from collections.abc import Callable
 from python_qt_binding.QtCore import QObject
 from python_qt_binding.QtWidgets import QWidget
 
+from ..core.mission_view import MissionView
+from ..core.requests import Answer, Request
 from .actions import CommandActions
-from .mission_view import MissionView
-from .requests import Answer, Request
 
 # The window's requests whose effect undo can take back.
 UNDOABLE = frozenset(
