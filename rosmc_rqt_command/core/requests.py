@@ -1,57 +1,87 @@
 """What the widgets ask the mission server to do, and how it answered, as plain values.
 
-Widgets build a :class:`Request` naming a :class:`~rosmc_server.ros.client.MissionClient`
-method and its arguments; the ROS bridge runs it off the GUI thread and hands back an
-:class:`Answer`. Keeping this as data keeps rospy out of the widgets.
+A :class:`Request` is one typed call of a
+:class:`~rosmc_server.ros.client.MissionClient` method: ``pick`` chooses the method
+(``lambda c: c.delete_skills``) and :func:`ask` checks the arguments against its
+signature, so mypy refuses a wrong call where the widget makes it. The ROS bridge runs
+it on the client's worker against the revision the operator saw (``seen``): the client
+fills in the base revision of every mutating call, and a change made by someone else
+since is refused as a conflict. Nothing here imports the client or rospy at run time.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, ParamSpec, Protocol
 
-# Client methods that take a base revision (the rest do not change the plan).
-MUTATING = frozenset(
-    {
-        "add_skill",
-        "edit_skill",
-        "delete_skills",
-        "reorder",
-        "synchronize",
-        "synchronize_team",
-        "unsynchronize",
-        "retry",
-        "skip",
-        "add_barrier",
-        "delete_barrier",
-        "rename_marker",
-        "new_mission",
-        "load_mission",
-        "undo",
-    }
-)
+if TYPE_CHECKING:  # for the type checker only: the widgets never load the client
+    from rosmc_server.ros.client import MissionClient
+
+P = ParamSpec("P")
+Pick = Callable[["MissionClient"], Callable[..., Any]]
 
 
 @dataclass(frozen=True)
 class Request:
-    """One call of a client method.
+    """One call of a client method, made against the revision the operator saw.
+
+    Build it with :func:`ask` (which checks the arguments).
 
     Attributes:
-        operation: The :class:`MissionClient` method, e.g. ``"add_skill"``.
+        pick: Chooses the client method, e.g. ``lambda c: c.add_skill``.
         args: Positional arguments.
         kwargs: Keyword arguments.
         what: What the operator asked for, as words ("add take_off to drone").
-        base_revision: The revision the operator saw (for mutating calls).
+        seen: The revision the operator saw (None: the client's own).
         on_answer: Called on the GUI thread with the answer (besides the message area).
     """
 
-    operation: str
+    pick: Pick = field(compare=False)
     args: tuple[Any, ...] = ()
     kwargs: Mapping[str, Any] = field(default_factory=dict)
     what: str = ""
-    base_revision: int | None = None
+    seen: int | None = None
     on_answer: Callable[[Answer], None] | None = field(default=None, compare=False)
+    operation: str = field(init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "operation", _method_name(self.pick))
+
+    def __call__(self, client: MissionClient) -> Any:
+        """Make the call (on the client's worker thread)."""
+        return self.pick(client)(*self.args, **self.kwargs)
+
+
+def ask(
+    pick: Callable[[MissionClient], Callable[P, object]],
+    what: str = "",
+    seen: int | None = None,
+    on_answer: Callable[[Answer], None] | None = None,
+) -> Callable[P, Request]:
+    """A request maker taking exactly the arguments of the method ``pick`` chooses.
+
+    ``ask(lambda c: c.delete_skills, "delete 'go'", revision)(["s1"])``.
+    """
+
+    def make(*args: P.args, **kwargs: P.kwargs) -> Request:
+        return Request(pick, args, kwargs, what, seen, on_answer)
+
+    return make
+
+
+class _Name:
+    """Stands in for the client to learn which method a pick chooses (its attribute name)."""
+
+    def __getattr__(self, name: str) -> str:
+        return name
+
+
+def _method_name(pick: Pick) -> str:
+    name: object = pick(_Name())  # type: ignore[arg-type]
+    if not isinstance(name, str):
+        raise TypeError("a request's pick must choose a client method, as lambda c: c.method")
+    return name
 
 
 @dataclass(frozen=True)

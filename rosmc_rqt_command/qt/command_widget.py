@@ -30,7 +30,7 @@ from ..core import alerts
 from ..core.dispatch import Dispatcher
 from ..core.legality import Action, RobotAction, RobotLegality, legal_actions
 from ..core.mission_view import MissionView
-from ..core.requests import Answer, Backend, Request
+from ..core.requests import Answer, Backend, Request, ask
 from ..core.view_state import ViewUpdate
 from .actions import CommandActions
 from .agent_column import SectionTable
@@ -369,24 +369,15 @@ class CommandWidget(QWidget):  # type: ignore[misc]
                     self.schedule.select_ids(self._select_when_seen)
                     self._select_when_seen = []
 
-        self.send(
-            Request(
-                "add_skill",
-                (agent, skill),
-                {},
-                f"add {skill} to {agent}",
-                self.view.revision,
-                select_new,
-            )
-        )
+        what = f"add {skill} to {agent}"
+        self.send(ask(lambda c: c.add_skill, what, self.view.revision, select_new)(agent, skill))
 
     def _on_schedule_policy_chosen(self, agent: str, policy: LostLinkPolicy) -> None:
-        self.dispatcher.request(
-            "set_robot_options", agent, policy, what=f"set {agent}'s policy ({policy.describe()})"
-        )
+        what = f"set {agent}'s policy ({policy.describe()})"
+        self.dispatcher.call(lambda c: c.set_robot_options, what)(agent, policy)
 
     def _on_schedule_reorder_requested(self, agent: str, order: list[str]) -> None:
-        self.dispatcher.request("reorder", agent, order, what=f"reorder {agent}'s plan")
+        self.dispatcher.call(lambda c: c.reorder, f"reorder {agent}'s plan")(agent, order)
 
     def _on_parameters_edit_requested(self, skill_id: str, fields: dict[str, Any]) -> None:
         skill = self.view.skill(skill_id)
@@ -394,10 +385,10 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         changed = ", ".join(fields.get("params", {}) or fields.get("bindings", {}) or fields)
         revert = self.parameters.reverter(skill_id)  # a refused value leaves the field
         what = f"change {changed} of {name}"
-        self.send(Request("edit_skill", (skill_id,), fields, what, self.view.revision, revert))
+        self.send(ask(lambda c: c.edit_skill, what, self.view.revision, revert)(skill_id, **fields))
 
     def _on_parameters_rename_requested(self, old: str, new: str) -> None:
-        self.dispatcher.request("rename_marker", old, new, what=f"rename marker {old} to {new}")
+        self.dispatcher.call(lambda c: c.rename_marker, f"rename marker {old} to {new}")(old, new)
 
     def _on_refresh_triggered(self) -> None:
         self.backend.refresh()

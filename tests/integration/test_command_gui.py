@@ -22,7 +22,7 @@ from python_qt_binding.QtGui import QContextMenuEvent
 from python_qt_binding.QtTest import QTest
 from python_qt_binding.QtWidgets import QApplication, QMessageBox
 
-from rosmc_rqt_command import presentation
+from rosmc_rqt_command.core import presentation
 from rosmc_rqt_command.qt.agent_column import SectionTable
 from rosmc_rqt_command.qt.command_widget import CommandWidget
 from rosmc_rqt_command.qt.schedule_model import SKILL, STATUS, TAG

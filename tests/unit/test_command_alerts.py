@@ -9,7 +9,7 @@ from typing import Any
 
 import pytest
 
-from rosmc_rqt_command import alerts
+from rosmc_rqt_command.core import alerts
 from rosmc_rqt_command.core.legality import Action
 from rosmc_server.core import AgentStatus, Library, Mission, SkillStatus
 from rosmc_server.core.library import library_from_dict

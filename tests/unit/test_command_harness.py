@@ -195,4 +195,4 @@ def test_requests_are_recorded_not_sent(gui: Gui) -> None:
     gui.widget.do(Action.DELETE)
     assert gui.backend.operations() == ["delete_skills"]
     assert gui.backend.requests[0].args == ([skill],)
-    assert gui.backend.requests[0].base_revision == gui.feed.mission.revision
+    assert gui.backend.requests[0].seen == gui.feed.mission.revision

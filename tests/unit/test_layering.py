@@ -167,6 +167,7 @@ def fake_repo(tmp_path: Path) -> Path:
         "rosmc_server/recording",
         "rosmc_server/cli",
         "rosmc_rqt_command",
+        "rosmc_rqt_command/core",
         "rosmc_rviz_markers/core",
         "rosmc_rviz_markers/ros",
     ):
@@ -306,6 +307,11 @@ def _scan_source(root: Path, relative: str, source: str) -> list[str]:
         ("rosmc_rviz_markers/core/geometry.py", "from visualization_msgs.msg import Marker"),
         ("rosmc_rviz_markers/core/geometry.py", "from python_qt_binding import QtCore"),
         ("rosmc_rviz_markers/core/geometry.py", "from rosmc_server.ros.client import X"),
+        ("rosmc_rqt_command/core/x.py", "from rosmc_server.ros.client import MissionClient"),
+        # under TYPE_CHECKING only the client's types, and only in a GUI
+        ("rosmc_rqt_command/core/x.py", "if TYPE_CHECKING:\n    import rospy"),
+        ("rosmc_rqt_command/core/x.py", "if TYPE_CHECKING:\n    from rosmc_server.ros import x"),
+        ("rosmc_server/core/x.py", "if TYPE_CHECKING:\n    from ..ros.client import X"),
         # GUI adapters use the client, not the server's insides
         ("rosmc_rqt_command/ros_bridge.py", "from rosmc_server.ros.operator_services import X"),
         ("rosmc_rviz_markers/ros/markers.py", "from rosmc_server.ros import ground_link"),
@@ -340,6 +346,10 @@ def test_scanner_catches_a_layer_break(fake_repo: Path, relative: str, source: s
         ("rosmc_rqt_command/standalone.py", "import rospy\nfrom rosmc_server.ros.client import X"),
         ("rosmc_rqt_command/schedule_model.py", "from python_qt_binding import QtCore"),
         ("rosmc_rqt_command/schedule_model.py", "from rosmc_server.core import MissionState"),
+        (
+            "rosmc_rqt_command/core/x.py",
+            "if TYPE_CHECKING:\n    from rosmc_server.ros.client import MissionClient",
+        ),
         ("rosmc_rviz_markers/ros/node.py", "import rospy\nfrom interactive_markers import x"),
         ("rosmc_rviz_markers/ros/node.py", "from visualization_msgs.msg import Marker"),
         ("rosmc_rviz_markers/ros/node.py", "from rosmc_server.ros.client import MissionFollower"),

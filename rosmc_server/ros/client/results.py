@@ -7,10 +7,10 @@ mission server did not answer at all.
 
 from __future__ import annotations
 
-import enum
 from dataclasses import dataclass
 
 from ...core import RosmcError, StaleRevision
+from ...core.control import ControlCommand as ControlCommand  # callers import it from here
 
 
 class ServerUnavailable(RosmcError):
@@ -28,15 +28,6 @@ class RevisionConflict(StaleRevision):
         RosmcError.__init__(self, message)
         self.base_revision = base_revision
         self.current_revision = current_revision
-
-
-class ControlCommand(enum.IntEnum):
-    """Execution control of a robot (numbers match ``rosmc/Control``)."""
-
-    START = 0
-    PAUSE = 1
-    RESUME = 2
-    STOP = 3
 
 
 @dataclass(frozen=True)
