@@ -13,7 +13,8 @@ import time
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
-from rosmc_server.core import AgentStatus, Barrier, MissionState, SkillInstance, TaskMarker
+from rosmc_server.core import AgentStatus, Barrier, MissionState, TaskMarker
+from rosmc_server.core.legality import TaskView
 from rosmc_server.core.updates import (
     AgentStatusChanged,
     BarrierPut,
@@ -28,40 +29,7 @@ from rosmc_server.core.updates import (
     SkillsMoved,
 )
 
-
-@dataclass(frozen=True)
-class AgentView:
-    """One robot's task at one revision, split as the mission state splits it.
-
-    ``skills[:synced_end]`` is the synchronized section, ``skills[synced_end:]`` the
-    blueprint, of which ``skills[synced_end:editable_start]`` is being uploaded.
-    """
-
-    agent: str
-    skills: tuple[SkillInstance, ...] = ()
-    synced_end: int = 0
-    editable_start: int = 0
-
-    @property
-    def synced(self) -> tuple[SkillInstance, ...]:
-        """The synchronized section (on the robot, or being removed from it)."""
-        return self.skills[: self.synced_end]
-
-    @property
-    def blueprint(self) -> tuple[SkillInstance, ...]:
-        """The blueprint: skills not on the robot (the first may be uploading)."""
-        return self.skills[self.synced_end :]
-
-    @property
-    def editable(self) -> tuple[SkillInstance, ...]:
-        """The part of the blueprint that can be edited and reordered."""
-        return self.skills[self.editable_start :]
-
-    @classmethod
-    def of(cls, state: MissionState, agent: str) -> AgentView:
-        """``agent``'s task in ``state`` (call with the mirror's lock held)."""
-        sections = state.sections(agent)
-        return cls(agent, tuple(state.task(agent)), sections.synced_end, sections.editable_start)
+AgentView = TaskView  # one robot's task as the panels show it (the rules read the same)
 
 
 @dataclass(frozen=True)

@@ -8,7 +8,7 @@ was last saved or loaded, the operator is asked whether to save it first.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from python_qt_binding.QtWidgets import QFileDialog, QInputDialog, QMessageBox, QWidget
@@ -26,7 +26,7 @@ Send = Callable[[Request], None]
 
 Plan = tuple[
     str,
-    tuple[tuple[str, tuple[SkillInstance, ...]], ...],
+    tuple[tuple[str, Sequence[SkillInstance]], ...],
     tuple[Barrier, ...],
     tuple[TaskMarker, ...],
 ]
