@@ -1,10 +1,12 @@
 """What the GUI shows of the mission, as immutable values taken from the mirror.
 
 The mirror calls its listeners on ROS threads with its lock held; :func:`view_update` runs
-there and copies only what an update touched (the tasks of the agents it changed, the
-barriers or markers if they changed, the robot statuses that changed) into a
-:class:`ViewUpdate`. That value then crosses to the GUI thread, where models apply it row
-by row. No Qt and no rospy here, so it is tested without either.
+there and forwards what the mirror said changed (its skill deltas, with indexes as the
+mirror applied them), the section bounds of the robots they touched, the barriers or
+markers if they changed and the robot statuses that changed, as a :class:`ViewUpdate`.
+Only a reset copies whole tasks. The value then crosses to the GUI thread, where the
+view applies the deltas in order and models change only the rows they name. No Qt and no
+rospy here, so it is tested without either.
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ import time
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
-from rosmc_server.core import AgentStatus, Barrier, MissionState, TaskMarker
+from rosmc_server.core import AgentStatus, Barrier, MissionState, SkillInstance, TaskMarker
 from rosmc_server.core.legality import TaskView
 from rosmc_server.core.updates import (
     AgentStatusChanged,
@@ -30,29 +32,58 @@ from rosmc_server.core.updates import (
 )
 
 AgentView = TaskView  # one robot's task as the panels show it (the rules read the same)
+SkillDelta = SkillAdded | SkillChanged | SkillRemoved | SkillsMoved
+
+
+@dataclass(frozen=True)
+class TaskBounds:
+    """Where a robot's task splits after an update (see :class:`TaskView`)."""
+
+    agent: str
+    synced_end: int
+    editable_start: int
+    uploading: bool = False
+    removing: bool = False
+
+    @classmethod
+    def of(cls, state: MissionState, agent: str) -> TaskBounds:
+        """``agent``'s bounds in ``state`` (call with the mirror's lock held)."""
+        live = TaskView.live(state, agent)
+        return cls(agent, live.synced_end, live.editable_start, live.uploading, live.removing)
 
 
 @dataclass(frozen=True)
 class ViewUpdate:
     """What one mirror update changed, ready for the GUI thread.
 
-    ``reset``: the whole mission was replaced; ``agents`` then holds every robot in order.
-    Otherwise ``agents`` holds the robots whose task changed. ``barriers`` / ``markers``
-    are every barrier / marker, or None if none changed. ``statuses`` are robot statuses
-    that changed. ``changed_ids`` are the skills this update added, changed or moved.
-    ``received`` is when the update reached this process (monotonic seconds).
+    ``reset``: the whole mission was replaced; ``agents`` then holds every robot's task in
+    order. Otherwise ``deltas`` are the skill changes in the order the mirror made them (a
+    view that applies them one after the other ends equal to the mission) and ``bounds``
+    the sections of each robot they touched. ``barriers`` / ``markers`` are every barrier /
+    marker, or None if none changed. ``statuses`` are robot statuses that changed.
+    ``changed_ids`` are the skills this update added, changed or moved. ``received`` is
+    when the update reached this process (monotonic seconds).
     """
 
     revision: int
     reset: bool = False
     library: str = ""
     agents: tuple[AgentView, ...] = ()
+    deltas: tuple[SkillDelta, ...] = ()
+    bounds: tuple[TaskBounds, ...] = ()
     barriers: tuple[Barrier, ...] | None = None
     markers: tuple[TaskMarker, ...] | None = None
     statuses: tuple[AgentStatus, ...] = ()
     changed_ids: frozenset[str] = frozenset()
     summary: str = ""
     received: float = field(default_factory=time.monotonic)
+
+    @property
+    def touched(self) -> tuple[str, ...]:
+        """The robots whose task this update changed (every robot on a reset)."""
+        if self.reset:
+            return tuple(view.agent for view in self.agents)
+        return tuple(bounds.agent for bounds in self.bounds)
 
 
 def view_update(update: MirrorUpdate, state: MissionState | None) -> ViewUpdate:
@@ -72,32 +103,52 @@ def view_update(update: MirrorUpdate, state: MissionState | None) -> ViewUpdate:
             statuses=statuses,
             summary=summary,
         )
+    deltas = tuple(c for c in update.changes if isinstance(c, SkillDelta))
     agents: list[str] = []
     changed: set[str] = set()
-    barriers = markers = False
-    for change in update.changes:
-        if isinstance(change, (SkillAdded, SkillRemoved)):
-            _add_once(agents, change.skill.agent)
-            changed.add(change.skill.id)
-        elif isinstance(change, SkillChanged):
-            _add_once(agents, change.new.agent)
-            changed.add(change.new.id)
-        elif isinstance(change, SkillsMoved):
-            _add_once(agents, change.agent)
-            changed.update(move.skill_id for move in change.moves)
-        elif isinstance(change, (BarrierPut, BarrierRemoved)):
-            barriers = True
-        elif isinstance(change, (MarkerPut, MarkerRemoved)):
-            markers = True
+    for delta in deltas:
+        _add_once(agents, delta_agent(delta))
+        changed.update(delta_ids(delta))
+    barriers = any(isinstance(c, (BarrierPut, BarrierRemoved)) for c in update.changes)
+    markers = any(isinstance(c, (MarkerPut, MarkerRemoved)) for c in update.changes)
     return ViewUpdate(
         update.revision,
-        agents=tuple(AgentView.of(state, agent) for agent in agents if agent in state.agents),
+        deltas=deltas,
+        bounds=tuple(TaskBounds.of(state, agent) for agent in agents if agent in state.agents),
         barriers=tuple(state.barriers) if barriers else None,
         markers=tuple(state.markers) if markers else None,
         statuses=statuses,
         changed_ids=frozenset(changed),
         summary=summary,
     )
+
+
+def delta_agent(delta: SkillDelta) -> str:
+    """The robot whose task ``delta`` changed."""
+    if isinstance(delta, SkillsMoved):
+        return delta.agent
+    return delta.new.agent if isinstance(delta, SkillChanged) else delta.skill.agent
+
+
+def delta_ids(delta: SkillDelta) -> tuple[str, ...]:
+    """The skills ``delta`` added, changed, removed or moved."""
+    if isinstance(delta, SkillsMoved):
+        return tuple(move.skill_id for move in delta.moves)
+    return (delta.new.id,) if isinstance(delta, SkillChanged) else (delta.skill.id,)
+
+
+def apply_delta(task: list[SkillInstance], delta: SkillDelta) -> None:
+    """Apply one delta to a robot's task list, as the mirror applied it."""
+    if isinstance(delta, SkillAdded):
+        task.insert(delta.index, delta.skill)
+    elif isinstance(delta, SkillChanged):
+        task[delta.index] = delta.new
+    elif isinstance(delta, SkillRemoved):
+        del task[delta.index]
+    else:
+        for move in delta.moves:
+            at = next(i for i, skill in enumerate(task) if skill.id == move.skill_id)
+            task.insert(move.index, task.pop(at))
 
 
 def _add_once(items: list[str], item: str) -> None:

@@ -183,10 +183,10 @@ class CommandWidget(QWidget):  # type: ignore[misc]
             reset = reset or update.reset
             self.view.apply(update)
             self.schedule.apply(update)
-            agents.update(view.agent for view in update.agents)
+            agents.update(update.touched)
             changed |= update.changed_ids
             refresh_parameters = refresh_parameters or bool(
-                update.agents or update.markers is not None or update.barriers is not None
+                update.touched or update.markers is not None or update.barriers is not None
             )
             for status in update.statuses:
                 self._pending_statuses[status.agent] = status

@@ -33,8 +33,8 @@ Plan = tuple[
 
 
 def plan_of(view: MissionView) -> Plan:
-    """The plan as it is now, by reference (cheap: the view holds immutable values)."""
-    tasks = tuple((agent, task.skills) for agent, task in view.agents.items())
+    """The plan as it is now (skills are immutable values; only the task lists are copied)."""
+    tasks = tuple((agent, tuple(task.skills)) for agent, task in view.agents.items())
     return (view.library_name, tasks, view.barriers, tuple(view.markers.values()))
 
 

@@ -26,6 +26,7 @@ from rosmc_server.core import (
     AgentStatus,
     Library,
     Mission,
+    MissionEvent,
     MissionState,
     RosmcError,
     SkillInstance,
@@ -61,11 +62,12 @@ def random_mission(library: Library, seed: int) -> Mission:
     mission = Mission(library, new_id=ids(), clock=lambda: 1.0)
     for _ in range(60):
         with contextlib.suppress(RosmcError):  # refused: the mission is unchanged
-            _random_step(mission, rng)
+            random_step(mission, rng)
     return mission
 
 
-def _random_step(mission: Mission, rng: random.Random) -> None:
+def random_step(mission: Mission, rng: random.Random) -> MissionEvent | None:
+    """One random operator request or robot answer (RosmcError if the mission refuses it)."""
     library = mission.library
     agent = rng.choice(list(library.dynamic_agents))
     task = list(mission.state.task(agent))
@@ -73,34 +75,33 @@ def _random_step(mission: Mission, rng: random.Random) -> None:
     skills = [s.id for s in mission.state.skills()]
     step = rng.choice([0, 0, 1, 2, 2, 3, 4, 5, 5, 5, 5, 6, 6, 7, 8])
     if step == 0 or not skills:
-        mission.add_skill(agent, rng.choice(sorted(library.skills_of(agent))))
-    elif step == 1:
-        mission.synchronize(agent, some)
-    elif step == 2:
-        mission.confirm_synchronized(agent, _transferring(task))
-    elif step == 3:
-        mission.unsynchronize(agent, some)
-    elif step == 4:
-        mission.confirm_unsynchronized(agent, _transferring(task))
-    elif step == 5:
-        _report(mission, task, rng)
-    elif step == 6:
-        mission.add_barrier(rng.sample(skills, min(2, len(skills))))
-    elif step == 7:
-        mission.retry(rng.choice(skills))
-    else:
-        mission.stop(agent)
+        return mission.add_skill(agent, rng.choice(sorted(library.skills_of(agent))))
+    if step == 1:
+        return mission.synchronize(agent, some)
+    if step == 2:
+        return mission.confirm_synchronized(agent, _transferring(task))
+    if step == 3:
+        return mission.unsynchronize(agent, some)
+    if step == 4:
+        return mission.confirm_unsynchronized(agent, _transferring(task))
+    if step == 5:
+        return _report(mission, task, rng)
+    if step == 6:
+        return mission.add_barrier(rng.sample(skills, min(2, len(skills))))
+    if step == 7:
+        return mission.retry(rng.choice(skills))
+    return mission.stop(agent)
 
 
 def _transferring(task: list[SkillInstance]) -> list[str]:
     return [s.id for s in task if s.transfer.name != "NONE"]
 
 
-def _report(mission: Mission, task: list[SkillInstance], rng: random.Random) -> None:
+def _report(mission: Mission, task: list[SkillInstance], rng: random.Random) -> MissionEvent | None:
     """The robot reports its next synchronized skill one step further, as robots do."""
     pending = [s for s in task if s.status in (S.IDLE_SYNCHRONIZED, S.RUNNING, S.PAUSED)]
     if not pending:
-        return
+        return None
     skill = pending[0]
     if skill.status is S.RUNNING:
         status = rng.choice([S.SUCCESS, S.SUCCESS, S.FAILURE, S.PAUSED])
@@ -110,7 +111,7 @@ def _report(mission: Mission, task: list[SkillInstance], rng: random.Random) -> 
             if skill.status is S.IDLE_SYNCHRONIZED
             else S.RUNNING
         )
-    mission.report_status(skill.id, status)
+    return mission.report_status(skill.id, status)
 
 
 def accepted(mission: Mission, operation: Callable[[Mission], Any]) -> bool:
