@@ -19,7 +19,7 @@ from tests import conftest
 
 def settle(widget: CommandWidget) -> None:
     """Let Qt lay the columns out (and show the robots' reports)."""
-    timer = widget._status_timer
+    timer = widget.repaints.status_timer
     conftest.wait_until(lambda: not timer.isActive(), 10, "reports shown", pause=conftest.qt_pause)
     for _ in range(3):
         QApplication.processEvents()

@@ -144,7 +144,7 @@ def test_robot_buttons_follow_the_robot(gui: Gui) -> None:
     column = gui.widget.schedule.columns["alpha"]
 
     def enabled() -> set[RobotAction]:
-        gui.widget._on_status_timer_timeout()  # the 5 Hz header repaint, now
+        gui.widget.repaints.show_statuses_now()  # the 5 Hz header repaint, now
         return {action for action, button in column.buttons.items() if button.isEnabled()}
 
     assert enabled() == set()
