@@ -73,40 +73,60 @@ class Dispatcher:
 
     def skill_action(self, kind: Action, selected: Sequence[SkillInstance]) -> None:
         """Run ``kind`` on the selected skills (nothing if it is not legal for them)."""
-        view = self._view
-        if not selected or kind not in legal_actions(view, selected):
+        if not selected or kind not in legal_actions(self._view, selected):
             return
-        first = selected[0]
         names = ", ".join(f"'{s.label or s.skill}'" for s in selected)
-        if kind is Action.DELETE:
-            self.call(lambda c: c.delete_skills, f"delete {names}")([s.id for s in selected])
-        elif kind in (Action.MOVE_UP, Action.MOVE_DOWN):
-            order = moved([s.id for s in view.view(first.agent).editable], selected, kind)
-            self.call(lambda c: c.reorder, f"move {names}")(first.agent, order)
-        elif kind is Action.SYNC and selection_agent(selected) is None:
+        handlers = {
+            Action.DELETE: self._delete,
+            Action.MOVE_UP: self._move,
+            Action.MOVE_DOWN: self._move,
+            Action.SYNC: self._sync,
+            Action.UNSYNC: self._unsync,
+            Action.RETRY: self._resolve,
+            Action.SKIP: self._resolve,
+            Action.BARRIER: self._barrier,
+            Action.DELETE_BARRIER: self._delete_barrier,
+        }
+        handlers[kind](kind, selected, names)
+
+    def _delete(self, _: Action, selected: Sequence[SkillInstance], names: str) -> None:
+        self.call(lambda c: c.delete_skills, f"delete {names}")([s.id for s in selected])
+
+    def _move(self, kind: Action, selected: Sequence[SkillInstance], names: str) -> None:
+        agent = selected[0].agent
+        order = moved([s.id for s in self._view.view(agent).editable], selected, kind)
+        self.call(lambda c: c.reorder, f"move {names}")(agent, order)
+
+    def _sync(self, _: Action, selected: Sequence[SkillInstance], names: str) -> None:
+        view = self._view
+        if selection_agent(selected) is None:
             self.send_team(up_to_selection(view, list(selected)))
-        elif kind is Action.SYNC:
-            editable = view.view(first.agent).editable
-            last = max(view.position(s) for s in selected)
-            sending = [s for s in editable if view.position(s) <= last]
-            if self._barriers_ok(sending):
-                self.call(lambda c: c.synchronize, f"send {first.agent}'s plan up to {names}")(
-                    first.agent, sending[-1].id
-                )
-        elif kind is Action.UNSYNC:
-            start = min(selected, key=view.position)
-            what = f"take back {first.agent}'s skills from '{start.label or start.skill}'"
-            self.call(lambda c: c.unsynchronize, what)(first.agent, start.id)
-        elif kind is Action.RETRY:
-            self.call(lambda c: c.retry, f"retry {names}")(first.id)
-        elif kind is Action.SKIP:
-            self.call(lambda c: c.skip, f"skip {names}")(first.id)
-        elif kind is Action.BARRIER:
-            self.call(lambda c: c.add_barrier, f"start {names} together")([s.id for s in selected])
-        elif kind is Action.DELETE_BARRIER:
-            barriers = {b.id for s in selected if (b := view.barrier_of(s.id)) is not None}
-            for barrier_id in sorted(barriers):
-                self.call(lambda c: c.delete_barrier, f"remove barrier of {names}")(barrier_id)
+            return
+        agent = selected[0].agent
+        last = max(view.position(s) for s in selected)
+        sending = [s for s in view.view(agent).editable if view.position(s) <= last]
+        if self._barriers_ok(sending):
+            what = f"send {agent}'s plan up to {names}"
+            self.call(lambda c: c.synchronize, what)(agent, sending[-1].id)
+
+    def _unsync(self, _: Action, selected: Sequence[SkillInstance], names: str) -> None:
+        start = min(selected, key=self._view.position)
+        what = f"take back {start.agent}'s skills from '{start.label or start.skill}'"
+        self.call(lambda c: c.unsynchronize, what)(start.agent, start.id)
+
+    def _resolve(self, kind: Action, selected: Sequence[SkillInstance], names: str) -> None:
+        if kind is Action.RETRY:
+            self.call(lambda c: c.retry, f"retry {names}")(selected[0].id)
+        else:
+            self.call(lambda c: c.skip, f"skip {names}")(selected[0].id)
+
+    def _barrier(self, _: Action, selected: Sequence[SkillInstance], names: str) -> None:
+        self.call(lambda c: c.add_barrier, f"start {names} together")([s.id for s in selected])
+
+    def _delete_barrier(self, _: Action, selected: Sequence[SkillInstance], names: str) -> None:
+        barriers = {b.id for s in selected if (b := self._view.barrier_of(s.id)) is not None}
+        for barrier_id in sorted(barriers):
+            self.call(lambda c: c.delete_barrier, f"remove barrier of {names}")(barrier_id)
 
     def robot_action(self, agent: str | None, kind: RobotAction) -> None:
         """Run ``kind`` on ``agent`` (None: every robot), if it is legal now."""
