@@ -64,19 +64,19 @@ class TaskView:
     removing: bool = False
 
     @property
-    def synced(self) -> Sequence[SkillInstance]:
+    def synced(self) -> tuple[SkillInstance, ...]:
         """The synchronized section (on the robot, or being removed from it)."""
-        return self.skills[: self.synced_end]
+        return tuple(self.skills[: self.synced_end])
 
     @property
-    def blueprint(self) -> Sequence[SkillInstance]:
+    def blueprint(self) -> tuple[SkillInstance, ...]:
         """The blueprint: skills not on the robot (the first may be uploading)."""
-        return self.skills[self.synced_end :]
+        return tuple(self.skills[self.synced_end :])
 
     @property
-    def editable(self) -> Sequence[SkillInstance]:
+    def editable(self) -> tuple[SkillInstance, ...]:
         """The part of the blueprint that can be edited and reordered."""
-        return self.skills[self.editable_start :]
+        return tuple(self.skills[self.editable_start :])
 
     @classmethod
     def of(cls, state: MissionState, agent: str) -> TaskView:
