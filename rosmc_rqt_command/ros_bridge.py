@@ -147,6 +147,9 @@ class RosBridge(QObject):  # type: ignore[misc]
     # -- callbacks (ROS and worker threads: only emit) ---------------------------------------------
     def _on_mirror_update(self, update: MirrorUpdate) -> None:
         converted = view_update(update, self._follower.mirror.state)
+        if converted.reset:  # a new server may count from a lower revision: forget ours
+            revision = converted.revision
+            self._client.submit(lambda client: client.forget_newer_than(revision))
         with self._queue_lock:
             wake = not self._queue
             self._queue.append(converted)

@@ -151,3 +151,29 @@ def test_the_marker_nodes_worker_fills_the_base_revision_too(
     refused, accepted = outcomes
     assert refused.error is not None and "revision" in str(refused.error), refused
     assert accepted.ok, accepted
+
+
+def test_after_a_fresh_server_requests_are_made_against_its_revisions(
+    client_node: Any, start_server: StartServer
+) -> None:
+    """A new server process with a new mission counts from 0 again: the window's client
+    forgets the old server's revisions once the new snapshot arrives."""
+    server = start_server()
+    app = QApplication.instance() or QApplication([])
+    bridge = RosBridge(timeout=5.0)
+    bridge.start()
+    try:
+        for _ in range(3):
+            seen = bridge.mirror_revision
+            assert answer_of(bridge, ask(lambda c: c.add_marker, "new", seen)(POINT)).ok
+        server.stop()
+        start_server("second")  # an empty mission at revision 0
+        conftest.wait_until(
+            lambda: bridge.mirror_revision == 0, 60, "the new mission", pause=conftest.qt_pause
+        )
+        answer = answer_of(bridge, ask(lambda c: c.add_marker, "new", 0)(POINT))
+        assert answer.ok, answer
+        assert mission_now()[0] == 1
+    finally:
+        bridge.close()
+        app.processEvents()
