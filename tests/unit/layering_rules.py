@@ -288,6 +288,12 @@ def _inside_rule(relative: str, module: str, root: Path) -> str | None:
     return None
 
 
+def imported_modules(path: Path, root: Path = REPO) -> set[str]:
+    """The absolute names a module imports (each ``from x import y`` also as ``x.y``)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    return {module for _, module in _imported(tree, path, root)}
+
+
 def _type_only_lines(tree: ast.AST) -> set[int]:
     """Lines of imports inside ``if TYPE_CHECKING:`` (seen by the type checker only)."""
     lines: set[int] = set()

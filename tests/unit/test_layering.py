@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 
 from tests.unit.layering_rules import (
+    GUI_PACKAGES,
     LAYER_OF_PATH,
     MESSAGES,
     PYBULLET,
@@ -25,6 +26,7 @@ from tests.unit.layering_rules import (
     REPO,
     ROS_RUNTIME,
     core_modules,
+    imported_modules,
     is_gui_entry,
     is_ros_adapter,
     layer_of,
@@ -99,6 +101,35 @@ def test_layer_table(relative: str, layer: str) -> None:
 def test_no_module_breaks_the_layers() -> None:
     violations = [str(v) for path in package_modules() for v in scan(path)]
     assert violations == []
+
+
+@pytest.mark.parametrize("package", GUI_PACKAGES)
+def test_no_gui_module_imports_itself_in_a_circle(package: str) -> None:
+    """Even under TYPE_CHECKING: a circle means two modules cannot be read apart."""
+    names = {".".join(module_name(path, REPO)): path for path in (REPO / package).glob("**/*.py")}
+    edges = {name: imported_modules(path) & set(names) for name, path in names.items()}
+    edges = {name: targets - {name} for name, targets in edges.items()}
+    assert _circles(edges) == []
+
+
+def _circles(edges: dict[str, set[str]]) -> list[list[str]]:
+    """One path per circle found by a depth-first search (empty: none)."""
+    found: list[list[str]] = []
+    done: set[str] = set()
+
+    def visit(node: str, path: list[str]) -> None:
+        if node in path:
+            found.append([*path[path.index(node) :], node])
+            return
+        if node in done:
+            return
+        for target in sorted(edges[node]):
+            visit(target, [*path, node])
+        done.add(node)
+
+    for start in sorted(edges):
+        visit(start, [])
+    return found
 
 
 def test_core_packages_import_with_the_forbidden_modules_blocked() -> None:
