@@ -41,8 +41,8 @@ from python_qt_binding.QtTest import QTest  # noqa: E402
 from python_qt_binding.QtWidgets import QApplication  # noqa: E402
 
 from bench.bench_server import Server, agent_name, library_yaml, mission_yaml, ros_master  # noqa: E402
+from rosmc_rqt_command.core.view_state import ViewUpdate  # noqa: E402
 from rosmc_rqt_command.standalone import build  # noqa: E402
-from rosmc_rqt_command.view_state import ViewUpdate  # noqa: E402
 from rosmc_server import interface  # noqa: E402
 from rosmc_server.ros.client import MissionClient, init_node  # noqa: E402
 

@@ -1,1 +1,2 @@
-"""ROSMC command GUI: Qt models and widgets, mission client, rqt plugin and standalone window."""
+"""ROSMC command GUI: a Qt-free ``core/``, Qt widgets in ``qt/``, the ROS bridge, rqt plugin
+and standalone window."""

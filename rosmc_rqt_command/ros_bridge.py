@@ -34,7 +34,6 @@ from rosmc_server.core import Library, RosmcError
 from rosmc_server.core.updates import MirrorUpdate
 from rosmc_server.ros.client import (
     AsyncMissionClient,
-    ControlCommand,
     MissionClient,
     MissionFollower,
     Outcome,
@@ -44,23 +43,10 @@ from rosmc_server.ros.client import (
     SiteWatch,
 )
 
-from .requests import MUTATING, Answer, Request
-from .view_state import ViewUpdate, view_update
+from .core.requests import Answer, Request
+from .core.view_state import ViewUpdate, view_update
 
 _log = logging.getLogger(__name__)
-
-
-def run_request(client: MissionClient, request: Request) -> Any:
-    """Call the client method ``request`` names (on the worker thread)."""
-    kwargs = dict(request.kwargs)
-    if request.operation in MUTATING:
-        known = [r for r in (request.base_revision, client.revision) if r is not None and r >= 0]
-        if known:
-            kwargs["base_revision"] = max(known)
-    if request.operation == "control":
-        command, agent = request.args
-        return client.control(ControlCommand[command], agent)
-    return getattr(client, request.operation)(*request.args, **kwargs)
 
 
 class RosBridge(QObject):  # type: ignore[misc]
@@ -138,8 +124,7 @@ class RosBridge(QObject):  # type: ignore[misc]
     def request(self, request: Request) -> None:
         """Run ``request`` on the worker; :attr:`answered` carries the outcome."""
         self._client.submit(
-            lambda client: run_request(client, request),
-            lambda outcome: self._on_outcome(request, outcome),
+            request, lambda outcome: self._on_outcome(request, outcome), seen=request.seen
         )
 
     def refresh(self) -> None:
@@ -162,6 +147,9 @@ class RosBridge(QObject):  # type: ignore[misc]
     # -- callbacks (ROS and worker threads: only emit) ---------------------------------------------
     def _on_mirror_update(self, update: MirrorUpdate) -> None:
         converted = view_update(update, self._follower.mirror.state)
+        if converted.reset:  # a new server may count from a lower revision: forget ours
+            revision = converted.revision
+            self._client.submit(lambda client: client.forget_newer_than(revision))
         with self._queue_lock:
             wake = not self._queue
             self._queue.append(converted)

@@ -20,7 +20,7 @@ from python_qt_binding.QtCore import QObject, Signal
 from rosmc_server import interface
 from rosmc_server.recording.playback import PlaybackStatus
 
-from .replay_bar import ShownStatus
+from .qt.replay_bar import ShownStatus
 
 _log = logging.getLogger(__name__)
 Request = wire_srv.ReplayControlRequest

@@ -20,11 +20,11 @@ from python_qt_binding.QtWidgets import QApplication, QMainWindow, QWidget
 
 from rosmc_server.ros.client import init_node
 
-from .command_widget import CommandWidget
-from .replay_mode import ReplayHooks, ReplayMode
+from .core.view_state import ViewUpdate
+from .qt.command_widget import CommandWidget
+from .qt.replay_mode import ReplayHooks, ReplayMode
 from .ros_bridge import RosBridge
 from .ros_replay import ReplayLink
-from .view_state import ViewUpdate
 
 
 def _wiring(widget: CommandWidget, bridge: RosBridge) -> list[tuple[Any, Any]]:

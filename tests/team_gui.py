@@ -11,15 +11,15 @@ from python_qt_binding.QtCore import QPoint, QRect, Qt
 from python_qt_binding.QtTest import QTest
 from python_qt_binding.QtWidgets import QApplication
 
-from rosmc_rqt_command.agent_column import AgentColumn
-from rosmc_rqt_command.command_widget import CommandWidget
-from rosmc_rqt_command.team_bar import TeamBar
+from rosmc_rqt_command.qt.agent_column import AgentColumn
+from rosmc_rqt_command.qt.command_widget import CommandWidget
+from rosmc_rqt_command.qt.team_bar import TeamBar
 from tests import conftest
 
 
 def settle(widget: CommandWidget) -> None:
     """Let Qt lay the columns out (and show the robots' reports)."""
-    timer = widget._status_timer
+    timer = widget.repaints.status_timer
     conftest.wait_until(lambda: not timer.isActive(), 10, "reports shown", pause=conftest.qt_pause)
     for _ in range(3):
         QApplication.processEvents()

@@ -101,7 +101,7 @@ def run(
     from python_qt_binding.QtTest import QTest
     from python_qt_binding.QtWidgets import QApplication
 
-    from rosmc_rqt_command.legality import RobotAction
+    from rosmc_rqt_command.core.legality import RobotAction
     from rosmc_rqt_command.standalone import CommandWindow, build
     from rosmc_server.core import SkillStatus
     from rosmc_server.ros.client import MissionClient, init_node

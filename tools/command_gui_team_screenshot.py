@@ -27,7 +27,7 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
 from python_qt_binding.QtTest import QTest  # noqa: E402
 
-from rosmc_rqt_command.team_filter import StatusFilter  # noqa: E402
+from rosmc_rqt_command.core.team_filter import StatusFilter  # noqa: E402
 from tests.team_twenty import stage, twenty_robot_library  # noqa: E402
 from tests.unit.conftest import make_mission  # noqa: E402
 from tests.unit.test_command_harness import Gui  # noqa: E402

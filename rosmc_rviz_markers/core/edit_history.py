@@ -49,6 +49,12 @@ class EditHistory:
         with self._lock:
             self._undo.append((revision, what))
 
+    def newest_above(self, revision: int) -> bool:
+        """Some entry names a revision above ``revision`` (a snapshot older than this rviz's
+        own edits: a new server, whose revisions are another history)."""
+        with self._lock:
+            return any(entry[0] > revision for entry in (*self._undo, *self._redo))
+
     def clear(self) -> None:
         """Forget everything (a new mission, or a new server)."""
         with self._lock:

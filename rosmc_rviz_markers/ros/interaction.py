@@ -11,8 +11,9 @@ Feedback arrives as rviz sends it (``visualization_msgs/InteractiveMarkerFeedbac
 * ``MOUSE_DOWN`` / ``BUTTON_CLICK``: select (publish ``rosmc/Selection``).
 
 The stock tools' topics create task markers. Every call goes through the
-:class:`~rosmc_server.ros.client.AsyncMissionClient` worker with the mirror's revision as
-``base_revision``; nothing here blocks a ROS callback.
+:class:`~rosmc_server.ros.client.AsyncMissionClient` worker, made against the mirror's
+revision when the operator acted (the client fills in each call's base revision, as for
+the command GUI); nothing here blocks a ROS callback.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ import logging
 import math
 import threading
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import rosmc.msg as wire
 import rospy
@@ -42,10 +43,8 @@ from ..core.requests import SkillPlan, moved_area, moved_pose, new_marker, robot
 from ..core.scene import Selection
 from ..core.specs import Parsed, parse_name
 from ..core.styling import is_locked
+from .config import MarkerHost, MarkerNodeConfig
 from .convert import pose_numbers
-
-if TYPE_CHECKING:
-    from .node import MarkerNode, MarkerNodeConfig
 
 _log = logging.getLogger(__name__)
 Call = Callable[[MissionClient], Any]
@@ -54,7 +53,7 @@ Call = Callable[[MissionClient], Any]
 class Interaction:
     """Feedback, stock tools and selection of one marker node."""
 
-    def __init__(self, node: MarkerNode, config: MarkerNodeConfig) -> None:
+    def __init__(self, node: MarkerHost, config: MarkerNodeConfig) -> None:
         self._node = node
         self._config = config
         self._client = AsyncMissionClient(MissionClient(5.0, config.ns), "rosmc-markers-client")
@@ -63,7 +62,6 @@ class Interaction:
         self._timers: dict[str, threading.Timer] = {}
         self._lock = threading.Lock()
         self._selected = Selection()
-        self._own_revision: int | None = None  # revision after this node's last call
         selection_topic = interface.prefixed(interface.SELECTION_TOPIC, config.ns)
         self._selection_pub = rospy.Publisher(
             selection_topic, wire.Selection, queue_size=1, latch=True
@@ -157,9 +155,8 @@ class Interaction:
                 return
             status = mirror.agent_status(parsed.name) if parsed.kind == "robot" else None
             pose = status.pose if status is not None else None
-        call = self._menu_call(action, parsed, scene.library, pose, revision)
-        if call is not None:
-            self._submit(call, f"{fb.marker_name}: {self._title(action)}")
+        call = self._menu_call(action, parsed, scene.library, pose)
+        self._submit(call, f"{fb.marker_name}: {self._title(action)}", revision)
 
     @staticmethod
     def _title(action: EditAction) -> str:
@@ -169,20 +166,19 @@ class Interaction:
             return f"rename to '{action.new_name}'"
         return "delete"
 
-    def _menu_call(
-        self, action: EditAction, parsed: Parsed, library: Any, pose: Pose | None, rev: int | None
-    ) -> Call | None:
+    @staticmethod
+    def _menu_call(action: EditAction, parsed: Parsed, library: Any, pose: Pose | None) -> Call:
         name = parsed.name
         if isinstance(action, RenameMarker):
-            return lambda c: c.rename_marker(name, action.new_name, base_revision=self._base(rev))
+            return lambda c: c.rename_marker(name, action.new_name)
         if isinstance(action, DeleteMarker):
-            return lambda c: c.delete_marker(name, base_revision=self._base(rev))
+            return lambda c: c.delete_marker(name)
         if action.from_robot:
             plan = robot_skill_plan(library, action.agent, action.skill, pose)
         else:
             bindings = ((action.bind, name),) if action.bind and parsed.kind == "task" else ()
             plan = SkillPlan(action.agent, action.skill, dict(action.values), (), bindings)
-        return lambda c: _add_planned(c, plan, self._base(rev))
+        return lambda c: _add_planned(c, plan)
 
     def _undo(self, redo: bool) -> None:
         """Ask the server to undo this rviz's newest edit (``redo``: its newest undo)."""
@@ -253,10 +249,9 @@ class Interaction:
         if pose == marker.pose and tuple(vertices) == marker.vertices:
             return
         self._submit(
-            lambda c: c.move_marker(
-                parsed.name, pose, vertices, base_revision=self._base(revision)
-            ),
+            lambda c: c.move_marker(parsed.name, pose, vertices),
             f"move '{parsed.name}'",
+            revision,
             on_error=lambda: self._node.snap_back(name),
         )
 
@@ -321,34 +316,26 @@ class Interaction:
             _log.warning("ignored a new %s marker: %s", what, error)
             return
         revision = self._node.mirror.revision
-        self._submit(
-            lambda c: c.add_marker(marker, base_revision=self._base(revision)), f"new {what} marker"
-        )
+        self._submit(lambda c: c.add_marker(marker), f"new {what} marker", revision)
 
     def on_reset(self, revision: int) -> None:
         """A snapshot came; one older than this node's last result means a new server."""
-        if self._own_revision is not None and self._own_revision > revision:
-            self._own_revision = None
+        if self.history.newest_above(revision):
             self.history.clear()  # its revisions named another server's edits
-
-    def _base(self, seen: int | None) -> int | None:
-        """The revision a call is made against: what the operator saw when clicking, or
-        the result of this node's own previous call if that is newer (calls run in order,
-        so a quick second click is not refused because of the first)."""
-        if self._own_revision is None or seen is None:
-            return seen
-        return max(seen, self._own_revision)
+        self._client.submit(lambda c: c.forget_newer_than(revision))
 
     # -- calls ------------------------------------------------------------------------------------
     def _submit(
         self,
         call: Call,
         what: str,
+        seen: int | None = None,
         on_error: Callable[[], None] | None = None,
         record: Callable[[Any], None] | None = None,
     ) -> None:
-        """Run ``call`` on the client's thread; an accepted edit goes to the history
-        (``record`` instead: how an undo or redo is kept)."""
+        """Run ``call`` on the client's thread against ``seen``, the revision the operator
+        saw; an accepted edit goes to the history (``record`` instead: how an undo or redo
+        is kept)."""
 
         def done(outcome: Outcome[Any]) -> None:
             if outcome.error is not None:
@@ -357,31 +344,30 @@ class Interaction:
                     on_error()
                 return
             revision = getattr(outcome.value, "revision", None)
-            self._own_revision = revision if revision is not None else self._own_revision
             if record is not None:
                 record(outcome.value)
             elif revision is not None:
                 self.history.done(revision, what)
             _log.info("%s: done", what)
 
-        future = self._client.submit(call, done)
+        future = self._client.submit(call, done, seen)
         future.add_done_callback(lambda f: f.exception())  # errors reach `done`, not stderr
 
 
-def _add_planned(client: MissionClient, plan: SkillPlan, revision: int | None) -> Any:
-    """Create the plan's new markers, then the skill bound to them; undo markers on failure."""
+def _add_planned(client: MissionClient, plan: SkillPlan) -> Any:
+    """Create the plan's new markers, then the skill bound to them; undo markers on failure.
+
+    Each call is made against the one before (the client's own last result)."""
     created: list[tuple[str, str]] = []
     try:
         for param, marker in plan.new_markers:
-            added = client.add_marker(marker, base_revision=revision)
-            revision = added.revision
+            added = client.add_marker(marker)
             created.append((param, added.name))
         return client.add_skill(
             plan.agent,
             plan.skill,
             {k: value_to_data(v) for k, v in plan.params.items()},
             bindings={**dict(plan.bindings), **dict(created)},
-            base_revision=revision,
         )
     except RosmcError:
         for _, name in created:

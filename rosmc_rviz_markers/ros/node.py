@@ -32,7 +32,6 @@ import sys
 import threading
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 
 import rospy
 from visualization_msgs.msg import Marker, MarkerArray
@@ -51,6 +50,7 @@ from ..core.labels import Label
 from ..core.scene import Scene, Touched
 from ..core.specs import MarkerSpec
 from .adapter import MarkerServer
+from .config import MarkerNodeConfig
 from .convert import icon_markers, interactive_marker_msg, pose_msg
 from .coverage_layer import CoverageLayer
 from .interaction import Interaction
@@ -62,29 +62,6 @@ SERVER_NOTE_TEXT = 0.8  # letter height (m): as large as the site's region label
 DEFAULT_LIBRARY = os.path.join(
     os.path.dirname(__file__), "..", "..", "rosmc_server", "config", "mars_team.yaml"
 )
-
-
-@dataclass(frozen=True)
-class MarkerNodeConfig:
-    """The node's settings (private parameters, read once)."""
-
-    ns: str = ""
-    read_only: bool = False
-    follow_tf: bool = True
-    library: str = ""
-    commit_delay: float = 0.5
-
-    @classmethod
-    def from_params(cls) -> MarkerNodeConfig:
-        """Read ``~ns``, ``~read_only``, ``~follow_tf``, ``~library``, ``~commit_delay``."""
-        ns = str(rospy.get_param("~" + topics.PARAM_NS, "")).strip()
-        return cls(
-            ns=ns,
-            read_only=bool(rospy.get_param("~" + topics.PARAM_READ_ONLY, bool(ns))),
-            follow_tf=bool(rospy.get_param("~" + topics.PARAM_FOLLOW_TF, not ns)),
-            library=str(rospy.get_param("~" + topics.PARAM_LIBRARY, "")),
-            commit_delay=float(rospy.get_param("~" + topics.PARAM_COMMIT_DELAY, 0.5)),
-        )
 
 
 class MarkerNode:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from .control import ExecutorState
 from .model import SkillStatus
 from .params import Pose
 from .waiting import waiting_text
@@ -48,6 +49,11 @@ class AgentStatus:
     commands_waiting: int = 0
     waiting_for: float = -1.0
     coverage_warning: str = ""
+
+    @property
+    def executor(self) -> ExecutorState:
+        """``executor_state`` as a state (UNKNOWN if not reported)."""
+        return ExecutorState.of(self.executor_state)
 
     @property
     def waiting_text(self) -> str:

@@ -8,81 +8,16 @@ A:[x1, y1], B:[y2, x2] with barriers {x1, x2} and {y1, y2}.
 
 from __future__ import annotations
 
-import itertools
-from collections.abc import Iterable, Iterator, Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Iterable, Iterator, Sequence
 
 from .changes import Change, EventKind, Proposal, SkillMove
+from .deadlock import OrderEdge as OrderEdge  # callers import the deadlock search from here
+from .deadlock import describe_cycle as describe_cycle
+from .deadlock import find_deadlock as find_deadlock
 from .errors import InvalidRequest, RuleViolation
-from .model import Barrier, SkillInstance, SkillStatus, Transfer
+from .legality import member_refusal, staying_refusal
+from .model import Barrier, SkillInstance, SkillStatus
 from .state import MissionState
-
-
-@dataclass(frozen=True)
-class OrderEdge:
-    """``before`` runs before ``after`` on ``agent``."""
-
-    agent: str
-    before: str
-    after: str
-
-
-def find_deadlock(
-    tasks: Mapping[str, Sequence[str]], groups: Iterable[Sequence[str]]
-) -> list[OrderEdge] | None:
-    """Return the task-order edges of a cycle through the barrier groups, or None.
-
-    ``tasks`` maps each agent to its skill ids in order; ``groups`` are the
-    barriers' member ids. A skill in no barrier only passes "runs before" on
-    along its task, so each task shrinks to its barrier members in order and
-    the graph has one node per barrier: small, whatever the mission's size.
-    """
-    point: dict[str, str] = {}
-    for number, members in enumerate(groups):
-        for skill_id in members:
-            point[skill_id] = f"barrier#{number}"
-    graph: dict[str, list[tuple[str, OrderEdge]]] = {}
-    for agent, ids in tasks.items():
-        members = [skill_id for skill_id in ids if skill_id in point]
-        for before, after in itertools.pairwise(members):
-            edge = OrderEdge(agent, before, after)
-            graph.setdefault(point[before], []).append((point[after], edge))
-    return _find_cycle(graph)
-
-
-def _find_cycle(
-    graph: Mapping[str, list[tuple[str, OrderEdge]]],
-) -> list[OrderEdge] | None:
-    done: set[str] = set()
-    for root in graph:
-        if root in done:
-            continue
-        on_path: dict[str, int] = {root: 0}
-        path_edges: list[OrderEdge] = []
-        stack = [(root, iter(graph.get(root, ())))]
-        while stack:
-            node, edges = stack[-1]
-            step = next(edges, None)
-            if step is None:
-                stack.pop()
-                on_path.pop(node)
-                done.add(node)
-                if path_edges:
-                    path_edges.pop()
-                continue
-            target, edge = step
-            if target in on_path:
-                return [*path_edges[on_path[target] :], edge]
-            if target not in done:
-                on_path[target] = len(path_edges) + 1
-                path_edges.append(edge)
-                stack.append((target, iter(graph.get(target, ()))))
-    return None
-
-
-def describe_cycle(cycle: Sequence[OrderEdge]) -> str:
-    """Name a deadlock cycle in words, e.g. ``A runs x1 before y1, B runs y2 before x2``."""
-    return ", ".join(f"{e.agent} runs '{e.before}' before '{e.after}'" for e in cycle)
 
 
 def check_no_deadlock(
@@ -246,17 +181,9 @@ def plan_delete_barrier(state: MissionState, barrier_id: str) -> Proposal:
 
 
 def _check_member_changeable(state: MissionState, skill: SkillInstance, action: str) -> None:
-    if skill.status not in (SkillStatus.IDLE, SkillStatus.IDLE_SYNCHRONIZED):
-        raise RuleViolation(f"skill '{skill.id}' is {skill.status.name} and can no longer {action}")
-    if skill.transfer is not Transfer.NONE:
-        raise RuleViolation(
-            f"skill '{skill.id}' is being {_transfer_word(skill.transfer)}; "
-            f"it can {action} once the robot has answered"
-        )
-
-
-def _transfer_word(transfer: Transfer) -> str:
-    return "uploaded" if transfer is Transfer.UPLOADING else "removed from the robot"
+    refusal = member_refusal(skill, action)
+    if refusal is not None:
+        raise RuleViolation(refusal)
 
 
 def barrier_without(state: MissionState, removed: set[str]) -> Change:
@@ -271,9 +198,9 @@ def barrier_without(state: MissionState, removed: set[str]) -> Change:
         if not removed.intersection(barrier.skill_ids):
             continue
         remaining = tuple(s for s in barrier.skill_ids if s not in removed)
-        for skill_id in remaining:
-            # The robots hold this barrier too; once a member has started it is fixed.
-            _check_member_changeable(state, state.skill(skill_id), "have its barrier changed")
+        refusal = staying_refusal(state.skill(skill_id) for skill_id in remaining)
+        if refusal is not None:
+            raise RuleViolation(refusal)
         if len(remaining) >= 2:
             put.append(Barrier(barrier.id, remaining))
         else:

@@ -15,6 +15,13 @@ from dataclasses import replace
 from .barriers import after_retry, after_skip
 from .changes import Change, EventKind, PlacedSkill, Proposal
 from .errors import InvalidRequest, RuleViolation
+from .legality import (
+    TaskView,
+    failure_refusal,
+    sync_refusal,
+    unsync_refusal,
+    unsync_start,
+)
 from .model import Resolution, SkillInstance, SkillStatus, Transfer
 from .state import MissionState
 from .validation import clip_status_text, excerpt
@@ -35,12 +42,9 @@ def plan_synchronize(state: MissionState, agent: str, upto_id: str | None) -> Pr
     """Mark ``agent``'s editable blueprint up to ``upto_id`` (all if None) as uploading."""
     task = state.task(agent)
     sections = state.sections(agent)
-    if state.pending(agent, Transfer.REMOVING):
-        raise RuleViolation(
-            f"an unsynchronize on {agent} awaits the robot's answer; synchronize after it"
-        )
-    if sections.editable_start == len(task):
-        raise RuleViolation(f"{agent} has no blueprint skills to synchronize")
+    refusal = sync_refusal(TaskView.live(state, agent))
+    if refusal is not None:
+        raise RuleViolation(refusal)
     end = len(task)
     if upto_id:
         owner, index = state.locate(upto_id)  # NotFound for an unknown id
@@ -122,31 +126,18 @@ def plan_cancel_uploads(state: MissionState, agent: str, from_id: str | None = N
 
 def plan_request_unsync(state: MissionState, agent: str, from_id: str | None) -> Proposal:
     """Ask the robot to give back ``from_id`` and every later synchronized skill."""
-    task = state.task(agent)
-    sections = state.sections(agent)
-    if state.pending(agent, Transfer.UPLOADING):
-        raise RuleViolation(
-            f"an upload to {agent} awaits the robot's answer; unsynchronize after it"
-        )
-    if state.pending(agent, Transfer.REMOVING):
-        raise RuleViolation(f"an unsynchronize on {agent} already awaits the robot's answer")
-    synced = task[: sections.synced_end]
-    start = len(synced)
-    while start > 0 and synced[start - 1].status is S.IDLE_SYNCHRONIZED:
-        start -= 1
+    view = TaskView.live(state, agent)
+    synced = view.synced
+    index = None
     if from_id:
         agent_of, index = state.locate(from_id)
         if agent_of != agent or index >= len(synced):
             raise RuleViolation(f"skill '{from_id}' is not in {agent}'s synchronized section")
-        if index < start:
-            raise RuleViolation(
-                f"skill '{from_id}' or a later one has started; only skills after the last "
-                "started one can be unsynchronized"
-            )
-        start = index
+    refusal = unsync_refusal(view, index)
+    if refusal is not None:
+        raise RuleViolation(refusal)
+    start = unsync_start(view) if index is None else index
     pulled = synced[start:]
-    if not pulled:
-        raise RuleViolation(f"{agent} has no synchronized skills that have not started")
     puts = tuple(
         PlacedSkill(start + offset, replace(skill, transfer=Transfer.REMOVING))
         for offset, skill in enumerate(pulled)
@@ -320,14 +311,9 @@ def plan_skip(state: MissionState, skill_id: str) -> Proposal:
 
 def _unresolved_failure(state: MissionState, skill_id: str, verb: str) -> SkillInstance:
     skill = state.skill(skill_id)
-    if skill.status is not S.FAILURE:
-        raise RuleViolation(
-            f"skill '{skill_id}' is {skill.status.name}; only a FAILURE can be {verb}"
-        )
-    if skill.resolution is not Resolution.NONE:
-        raise RuleViolation(
-            f"failed skill '{skill_id}' was already {skill.resolution.name.lower()}"
-        )
+    refusal = failure_refusal(skill, verb)
+    if refusal is not None:
+        raise RuleViolation(refusal)
     return skill
 
 

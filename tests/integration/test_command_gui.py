@@ -22,11 +22,11 @@ from python_qt_binding.QtGui import QContextMenuEvent
 from python_qt_binding.QtTest import QTest
 from python_qt_binding.QtWidgets import QApplication, QMessageBox
 
-from rosmc_rqt_command import presentation
-from rosmc_rqt_command.agent_column import SectionTable
-from rosmc_rqt_command.command_widget import CommandWidget
+from rosmc_rqt_command.core import presentation
+from rosmc_rqt_command.qt.agent_column import SectionTable
+from rosmc_rqt_command.qt.command_widget import CommandWidget
+from rosmc_rqt_command.qt.schedule_model import SKILL, STATUS, TAG
 from rosmc_rqt_command.ros_bridge import RosBridge
-from rosmc_rqt_command.schedule_model import SKILL, STATUS, TAG
 from rosmc_rqt_command.standalone import build
 from rosmc_server.core import MarkerType, Pose, SkillStatus, TaskMarker
 from rosmc_server.ros.client import MissionClient
@@ -394,12 +394,12 @@ def test_operator_builds_edits_runs_and_adapts_a_two_robot_mission(team: Any) ->
 
 
 def _action(name: str) -> Any:
-    from rosmc_rqt_command.legality import Action
+    from rosmc_rqt_command.core.legality import Action
 
     return Action[name]
 
 
 def _robot(name: str) -> Any:
-    from rosmc_rqt_command.legality import RobotAction
+    from rosmc_rqt_command.core.legality import RobotAction
 
     return RobotAction[name]

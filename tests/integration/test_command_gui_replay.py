@@ -24,7 +24,7 @@ from python_qt_binding.QtCore import QPoint, Qt
 from python_qt_binding.QtTest import QTest
 from python_qt_binding.QtWidgets import QApplication
 
-from rosmc_rqt_command.legality import RobotAction
+from rosmc_rqt_command.core.legality import RobotAction
 from rosmc_rqt_command.replay_ticks import TickKind
 from rosmc_server.recording import read_journal
 from rosmc_server.recording.history import MissionHistory

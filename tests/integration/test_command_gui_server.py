@@ -34,11 +34,11 @@ from python_qt_binding.QtWidgets import (
     QMessageBox,
 )
 
-from rosmc_rqt_command.command_widget import CommandWidget
-from rosmc_rqt_command.legality import Action, RobotAction
-from rosmc_rqt_command.schedule_model import STATUS
-from rosmc_rqt_command.science_strip import NO_SCORE
-from rosmc_rqt_command.site_strip import NO_SITE
+from rosmc_rqt_command.core.legality import Action, RobotAction
+from rosmc_rqt_command.qt.command_widget import CommandWidget
+from rosmc_rqt_command.qt.schedule_model import STATUS
+from rosmc_rqt_command.qt.science_strip import NO_SCORE
+from rosmc_rqt_command.qt.site_strip import NO_SITE
 from rosmc_rqt_command.standalone import build
 from rosmc_server.conversions.science import science_to_msg
 from rosmc_server.conversions.site import site_to_msg

@@ -86,8 +86,8 @@ def drive() -> None:
     from python_qt_binding.QtGui import QKeySequence
     from python_qt_binding.QtTest import QTest
 
-    from rosmc_rqt_command.legality import RobotAction
-    from rosmc_rqt_command.requests import Answer, Request
+    from rosmc_rqt_command.core.legality import RobotAction
+    from rosmc_rqt_command.core.requests import Answer, ask
     from rosmc_server.core import AgentStatus, SkillStatus
     from rosmc_server.core.library import library_from_dict
     from tests.unit.conftest import TEST_LIBRARY, make_mission
@@ -111,7 +111,7 @@ def drive() -> None:
         target = gui.app.focusWidget() or widget
         QTest.keyClick(target, key, modifiers)
         gui.app.processEvents()
-        sent = [[r.operation, list(r.args)] for r in backend.requests]
+        sent = [[r.operation, [getattr(a, "name", a) for a in r.args]] for r in backend.requests]
         report[keys] = sent
         return sent
 
@@ -201,7 +201,7 @@ def drive() -> None:
     # answer to its undo (revision 42), which redo undoes in turn.
     for request in backend.requests:
         widget.on_answer(Answer(request, error="not served here"))
-    deleted = Request("delete_skills", ([alpha[1]],), what="delete")
+    deleted = ask(lambda c: c.delete_skills, "delete")([alpha[1]])
     widget.on_answer(Answer(deleted, value=SimpleNamespace(revision=41)))
     widget.activateWindow()
     QTest.qWaitForWindowActive(widget, 5000)

@@ -22,7 +22,7 @@ from python_qt_binding.QtCore import Qt
 from python_qt_binding.QtTest import QTest
 from python_qt_binding.QtWidgets import QApplication
 
-from rosmc_rqt_command.command_widget import CommandWidget
+from rosmc_rqt_command.qt.command_widget import CommandWidget
 from rosmc_rqt_command.standalone import build
 from rosmc_sim.core.scenario import load_scenario
 from tests import conftest

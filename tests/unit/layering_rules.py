@@ -48,7 +48,9 @@ Besides the order, by what a module imports from outside:
   ``rosmc_server.ros`` at all: the bridge hands it core objects.
 
 The scanner reads every module with :mod:`ast`, so a forbidden import is found even where
-it would never run (inside a function, an ``if`` or ``TYPE_CHECKING``).
+it would never run (inside a function, an ``if`` or ``TYPE_CHECKING``). One exception: a GUI
+module may name the client's types under ``if TYPE_CHECKING:`` (nothing loads the client;
+mypy then checks each request a widget makes against the client method's signature).
 """
 
 from __future__ import annotations
@@ -145,6 +147,7 @@ FOR_APPS = (
     "rosmc_server.ros.station",  # where a launched node's relative paths point
 )
 CONVERSIONS = "rosmc_server.conversions"
+CLIENT = "rosmc_server.ros.client"  # a GUI module may name its types for the type checker
 # Dynamic imports with a literal module name are checked too.
 IMPORT_FUNCTIONS = {"import_module", "__import__"}
 
@@ -292,14 +295,46 @@ def _inside_rule(relative: str, module: str, root: Path) -> str | None:
     return None
 
 
+def imported_modules(path: Path, root: Path = REPO) -> set[str]:
+    """The absolute names a module imports (each ``from x import y`` also as ``x.y``)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    return {module for _, module in _imported(tree, path, root)}
+
+
+def _type_only_lines(tree: ast.AST) -> set[int]:
+    """Lines of imports inside ``if TYPE_CHECKING:`` (seen by the type checker only)."""
+    lines: set[int] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.If):
+            test = node.test
+            name = test.attr if isinstance(test, ast.Attribute) else getattr(test, "id", "")
+            if name == "TYPE_CHECKING":
+                lines |= {
+                    inner.lineno
+                    for statement in node.body
+                    for inner in ast.walk(statement)
+                    if isinstance(inner, (ast.Import, ast.ImportFrom))
+                }
+    return lines
+
+
+def _names_client_types(relative: str, module: str, line: int, type_only: set[int]) -> bool:
+    """A GUI module naming the client's types for the type checker only."""
+    client = module == CLIENT or module.startswith(CLIENT + ".")
+    return client and line in type_only and relative.startswith(GUI_PACKAGES)
+
+
 def scan(path: Path, root: Path = REPO) -> list[Violation]:
     """The forbidden imports of one module of the rosmc_* packages."""
     relative = path.relative_to(root).as_posix()
     tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    type_only = _type_only_lines(tree)
     violations = []
     for line, module in _imported(tree, path, root):
         top = module.split(".")[0]
-        if top.startswith("rosmc_"):
+        if _names_client_types(relative, module, line, type_only):
+            why = None
+        elif top.startswith("rosmc_"):
             why = _inside_rule(relative, module, root)
         else:
             why = None if _outside_rule(relative, top) else WHY[top]

@@ -9,8 +9,8 @@ from typing import Any
 
 import pytest
 
-from rosmc_rqt_command import alerts
-from rosmc_rqt_command.legality import Action
+from rosmc_rqt_command.core import alerts
+from rosmc_rqt_command.core.legality import Action
 from rosmc_server.core import AgentStatus, Library, Mission, SkillStatus
 from rosmc_server.core.library import library_from_dict
 from tests.unit.test_command_harness import Gui, open_gui
@@ -86,7 +86,7 @@ def test_a_robot_leaving_coverage_with_planned_work(
         AgentStatus("alpha", link="up", wifi_signal=signal, in_coverage=in_coverage, battery=0.5)
     )
     warnings = alerts.coverage_warnings(gui.widget.view)
-    gui.widget._on_status_timer_timeout()
+    gui.widget.repaints.show_statuses_now()
     _warn_now(gui)
     if expected is None:
         assert warnings == []
@@ -154,8 +154,8 @@ def test_parameter_checks_are_sliced_and_cover_only_changes(
 def _warn_now(gui: Gui) -> None:
     """Run the warnings pass now (the widget runs it 300 ms after changes)."""
     for _ in range(100):
-        gui.widget._on_warn_timer_timeout()
-        if not gui.widget._checker.incomplete:
+        gui.widget.repaints.warn_now()
+        if not gui.widget.repaints.checker.incomplete:
             return
 
 

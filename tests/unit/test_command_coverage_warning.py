@@ -9,7 +9,7 @@ import pytest
 from python_qt_binding.QtCore import Qt
 from python_qt_binding.QtTest import QTest
 
-from rosmc_rqt_command.policy_dialog import PolicyDialog
+from rosmc_rqt_command.qt.policy_dialog import PolicyDialog
 from rosmc_server.core import (
     AgentStatus,
     Library,
@@ -40,21 +40,21 @@ def test_the_column_warns_while_the_server_does(gui: Gui) -> None:
     assert not column.warning_label.isVisibleTo(gui.widget)
     gui.feed.statuses(AgentStatus("alpha", link="up", policy="on link loss: continue",
                                   coverage_warning=WARNING))  # fmt: skip
-    gui.widget._on_status_timer_timeout()  # the header refreshes on its timer
+    gui.widget.repaints.show_statuses_now()  # the header refreshes on its timer
     assert column.warning_label.isVisibleTo(gui.widget)
     assert column.warning_label.text() == "⚠ T" + WARNING[1:]
     assert "Link loss" in column.warning_label.toolTip()
     other = gui.widget.schedule.columns["bravo"]
     assert not other.warning_label.isVisibleTo(gui.widget)
     gui.feed.statuses(AgentStatus("alpha", link="up", policy=DEFAULT))  # the operator fixed it
-    gui.widget._on_status_timer_timeout()
+    gui.widget.repaints.show_statuses_now()
     assert not column.warning_label.isVisibleTo(gui.widget)
 
 
 def test_the_dialog_shows_the_policy_in_force_and_offers_the_return(gui: Gui) -> None:
     column = gui.widget.schedule.columns["alpha"]
     gui.feed.statuses(AgentStatus("alpha", link="up", policy=DEFAULT))
-    gui.widget._on_status_timer_timeout()
+    gui.widget.repaints.show_statuses_now()
     shown: list[str] = []
 
     def ask(agent: str, skills: Sequence[str], parent: object, in_force: str) -> LostLinkPolicy:

@@ -16,7 +16,8 @@ import pytest
 from python_qt_binding.QtCore import Qt
 from python_qt_binding.QtTest import QTest
 
-from rosmc_rqt_command.param_editors import (
+from rosmc_rqt_command.core.requests import Answer, Request
+from rosmc_rqt_command.qt.param_editors import (
     BoolEditor,
     ChoiceEditor,
     NumberEditor,
@@ -25,7 +26,6 @@ from rosmc_rqt_command.param_editors import (
     VertexEditor,
     make_editor,
 )
-from rosmc_rqt_command.requests import Answer, Request
 from rosmc_server.core import InvalidRequest, Library, Mission, ParamType, Pose
 from rosmc_server.core.library import ParameterSpec
 from tests.unit.test_command_harness import Gui, open_gui

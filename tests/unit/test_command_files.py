@@ -12,7 +12,7 @@ from types import SimpleNamespace
 
 import pytest
 
-from rosmc_rqt_command.requests import Answer, Request
+from rosmc_rqt_command.core.requests import Answer, Request
 from rosmc_server.core import Library, Mission, SkillStatus
 from rosmc_server.core.persistence import dump_mission, parse_mission
 from tests.unit.test_command_harness import Gui, open_gui

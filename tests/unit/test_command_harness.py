@@ -2,7 +2,7 @@
 
 A real :class:`~rosmc_server.core.Mission` makes the changes; its events go through a
 real :class:`~rosmc_server.core.mirror.MissionMirror` and
-:func:`~rosmc_rqt_command.view_state.view_update` (the code the ROS bridge runs) into the
+:func:`~rosmc_rqt_command.core.view_state.view_update` (the code the ROS bridge runs) into the
 widget, so the widget sees exactly the updates it would see live. Only the ROS side is
 absent: requests the widget sends are recorded by :class:`RecordingBackend` (tests may
 apply them to the mission, as the server would).
@@ -24,12 +24,12 @@ from python_qt_binding.QtCore import Qt
 from python_qt_binding.QtTest import QTest
 from python_qt_binding.QtWidgets import QApplication
 
-from rosmc_rqt_command.agent_column import SectionTable
-from rosmc_rqt_command.command_widget import CommandWidget
-from rosmc_rqt_command.legality import Action
-from rosmc_rqt_command.requests import Request
-from rosmc_rqt_command.schedule_model import SKILL, STATUS
-from rosmc_rqt_command.view_state import ViewUpdate, view_update
+from rosmc_rqt_command.core.legality import Action
+from rosmc_rqt_command.core.requests import Request
+from rosmc_rqt_command.core.view_state import ViewUpdate, view_update
+from rosmc_rqt_command.qt.agent_column import SectionTable
+from rosmc_rqt_command.qt.command_widget import CommandWidget
+from rosmc_rqt_command.qt.schedule_model import SKILL, STATUS
 from rosmc_server.core import AgentStatus, Library, Mission, MissionEvent, MissionState
 from rosmc_server.core.mirror import MissionMirror
 from rosmc_server.core.updates import MirrorUpdate
@@ -42,7 +42,7 @@ def qt_app() -> QApplication:
 
 
 class RecordingBackend:
-    """The widget's :class:`~rosmc_rqt_command.requests.Backend` without ROS: keeps requests."""
+    """The widget's :class:`~rosmc_rqt_command.core.requests.Backend`, recording requests."""
 
     def __init__(self, read_only: bool = False) -> None:
         self.read_only = read_only
@@ -195,4 +195,4 @@ def test_requests_are_recorded_not_sent(gui: Gui) -> None:
     gui.widget.do(Action.DELETE)
     assert gui.backend.operations() == ["delete_skills"]
     assert gui.backend.requests[0].args == ([skill],)
-    assert gui.backend.requests[0].base_revision == gui.feed.mission.revision
+    assert gui.backend.requests[0].seen == gui.feed.mission.revision

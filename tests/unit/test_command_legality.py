@@ -12,8 +12,8 @@ import pytest
 from python_qt_binding.QtCore import Qt
 from python_qt_binding.QtTest import QTest
 
-from rosmc_rqt_command.legality import RobotAction, RobotLegality, legal_robot_actions
-from rosmc_rqt_command.policy_dialog import PolicyDialog
+from rosmc_rqt_command.core.legality import RobotAction, RobotLegality, legal_robot_actions
+from rosmc_rqt_command.qt.policy_dialog import PolicyDialog
 from rosmc_server.core import (
     AgentStatus,
     InvalidRequest,
@@ -144,7 +144,7 @@ def test_robot_buttons_follow_the_robot(gui: Gui) -> None:
     column = gui.widget.schedule.columns["alpha"]
 
     def enabled() -> set[RobotAction]:
-        gui.widget._on_status_timer_timeout()  # the 5 Hz header repaint, now
+        gui.widget.repaints.show_statuses_now()  # the 5 Hz header repaint, now
         return {action for action, button in column.buttons.items() if button.isEnabled()}
 
     assert enabled() == set()

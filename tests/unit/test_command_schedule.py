@@ -14,7 +14,7 @@ import pytest
 from python_qt_binding.QtCore import Qt
 from python_qt_binding.QtTest import QTest
 
-from rosmc_rqt_command.schedule_model import STATUS, SectionModel
+from rosmc_rqt_command.qt.schedule_model import STATUS, SectionModel
 from rosmc_server.core import AgentStatus, Library, Mission, SkillStatus
 from tests.unit.test_command_harness import Gui, open_gui
 

@@ -18,8 +18,8 @@ from python_qt_binding.QtCore import Qt
 from python_qt_binding.QtGui import QColor, QImage
 from python_qt_binding.QtTest import QTest
 
-from rosmc_rqt_command.agent_column import COLUMN_WIDTH, COMPACT_WIDTH
-from rosmc_rqt_command.presentation import STATUS_COLOURS
+from rosmc_rqt_command.core.presentation import STATUS_COLOURS
+from rosmc_rqt_command.qt.agent_column import COLUMN_WIDTH, COMPACT_WIDTH
 from rosmc_server.core import SkillStatus
 from tests.team_gui import click, columns, on_screen, settle, step_right, team, tick
 from tests.team_twenty import WAITING, Staged, stage, twenty_robot_library

@@ -9,8 +9,13 @@ from __future__ import annotations
 
 import pytest
 
-from rosmc_rqt_command.mission_view import MissionView
-from rosmc_rqt_command.team_filter import StatusFilter, TeamFilter, robot_states, visible_agents
+from rosmc_rqt_command.core.mission_view import MissionView
+from rosmc_rqt_command.core.team_filter import (
+    StatusFilter,
+    TeamFilter,
+    robot_states,
+    visible_agents,
+)
 from rosmc_server.core import AgentStatus, SkillStatus
 from tests.team_twenty import WAITING, Staged, stage, twenty_robot_library
 from tests.unit.conftest import make_mission

@@ -20,8 +20,6 @@ BEING_REMOVED = {
     ),
     # "replay": the private MCAP layer
     frozenset(f"rosmc_server/recording/_{name}.py" for name in ("records", "scan", "section")),
-    # "gui": the marker node and its request wiring
-    frozenset(f"rosmc_rviz_markers/ros/{name}.py" for name in ("interaction", "node")),
 }
 
 

@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 
 from tests.unit.layering_rules import (
+    GUI_PACKAGES,
     LAYER_OF_PATH,
     MESSAGES,
     PYBULLET,
@@ -25,6 +26,7 @@ from tests.unit.layering_rules import (
     REPO,
     ROS_RUNTIME,
     core_modules,
+    imported_modules,
     is_gui_entry,
     is_ros_adapter,
     layer_of,
@@ -58,6 +60,10 @@ def test_there_are_core_modules_to_scan() -> None:
         )
     }
     assert expected <= modules
+
+
+def test_the_layer_table_names_real_paths() -> None:
+    assert [key for key in LAYER_OF_PATH if not (REPO / key).exists()] == []
 
 
 def test_every_module_has_a_layer() -> None:
@@ -104,6 +110,35 @@ def test_the_table_names_real_paths() -> None:
 def test_no_module_breaks_the_layers() -> None:
     violations = [str(v) for path in package_modules() for v in scan(path)]
     assert violations == []
+
+
+@pytest.mark.parametrize("package", GUI_PACKAGES)
+def test_no_gui_module_imports_itself_in_a_circle(package: str) -> None:
+    """Even under TYPE_CHECKING: a circle means two modules cannot be read apart."""
+    names = {".".join(module_name(path, REPO)): path for path in (REPO / package).glob("**/*.py")}
+    edges = {name: imported_modules(path) & set(names) for name, path in names.items()}
+    edges = {name: targets - {name} for name, targets in edges.items()}
+    assert _circles(edges) == []
+
+
+def _circles(edges: dict[str, set[str]]) -> list[list[str]]:
+    """One path per circle found by a depth-first search (empty: none)."""
+    found: list[list[str]] = []
+    done: set[str] = set()
+
+    def visit(node: str, path: list[str]) -> None:
+        if node in path:
+            found.append([*path[path.index(node) :], node])
+            return
+        if node in done:
+            return
+        for target in sorted(edges[node]):
+            visit(target, [*path, node])
+        done.add(node)
+
+    for start in sorted(edges):
+        visit(start, [])
+    return found
 
 
 def test_core_packages_import_with_the_forbidden_modules_blocked() -> None:
@@ -172,6 +207,7 @@ def fake_repo(tmp_path: Path) -> Path:
         "rosmc_server/recording",
         "rosmc_server/cli",
         "rosmc_rqt_command",
+        "rosmc_rqt_command/core",
         "rosmc_rviz_markers/core",
         "rosmc_rviz_markers/ros",
     ):
@@ -321,6 +357,11 @@ def _scan_source(root: Path, relative: str, source: str) -> list[str]:
         ("rosmc_rviz_markers/core/geometry.py", "from visualization_msgs.msg import Marker"),
         ("rosmc_rviz_markers/core/geometry.py", "from python_qt_binding import QtCore"),
         ("rosmc_rviz_markers/core/geometry.py", "from rosmc_server.ros.client import X"),
+        ("rosmc_rqt_command/core/x.py", "from rosmc_server.ros.client import MissionClient"),
+        # under TYPE_CHECKING only the client's types, and only in a GUI
+        ("rosmc_rqt_command/core/x.py", "if TYPE_CHECKING:\n    import rospy"),
+        ("rosmc_rqt_command/core/x.py", "if TYPE_CHECKING:\n    from rosmc_server.ros import x"),
+        ("rosmc_server/core/x.py", "if TYPE_CHECKING:\n    from ..ros.client import X"),
         # GUI adapters use the client, not the server's insides
         ("rosmc_rqt_command/ros_bridge.py", "from rosmc_server.ros.operator_services import X"),
         ("rosmc_rviz_markers/ros/markers.py", "from rosmc_server.ros import ground_link"),
@@ -359,6 +400,10 @@ def test_scanner_catches_a_layer_break(fake_repo: Path, relative: str, source: s
         ("rosmc_rqt_command/standalone.py", "import rospy\nfrom rosmc_server.ros.client import X"),
         ("rosmc_rqt_command/schedule_model.py", "from python_qt_binding import QtCore"),
         ("rosmc_rqt_command/schedule_model.py", "from rosmc_server.core import MissionState"),
+        (
+            "rosmc_rqt_command/core/x.py",
+            "if TYPE_CHECKING:\n    from rosmc_server.ros.client import MissionClient",
+        ),
         ("rosmc_rviz_markers/ros/node.py", "import rospy\nfrom interactive_markers import x"),
         ("rosmc_rviz_markers/ros/node.py", "from visualization_msgs.msg import Marker"),
         ("rosmc_rviz_markers/ros/node.py", "from rosmc_server.ros.client import MissionFollower"),

@@ -11,7 +11,7 @@ from typing import Any
 
 import pytest
 
-from rosmc_rqt_command import presentation
+from rosmc_rqt_command.core import presentation
 from rosmc_rviz_markers.core import geometry, icons
 from rosmc_server.core import EventKind, Mission, SkillInstance, SkillStatus
 from rosmc_server.core.agent_status import AgentStatus

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field, replace
 from typing import Protocol
 
 from rosmc_server.core import SkillInstance, SkillStatus
+from rosmc_server.core.control import ExecutorState
 from rosmc_server.core.link import queue_hash, status_digest
 from rosmc_server.core.protocol import (
     Ack,
@@ -450,17 +451,21 @@ class Engine:
         return queue_hash(s.id for s in self.queue)
 
     def state_name(self) -> str:
-        """A one-word state for operators."""
+        """A one-word state for operators (an :class:`ExecutorState`'s word)."""
+        return self.state().value
+
+    def state(self) -> ExecutorState:
+        """What the executor is doing now."""
         if self.lost_link.contingency is not None:
-            return "contingency"
+            return ExecutorState.CONTINGENCY
         if self.mode is not Mode.STARTED:
-            return str(self.mode.value)
+            return ExecutorState(self.mode.value)
         if queueing.holding(self.queue):
-            return "holding"
+            return ExecutorState.HOLDING
         active = self._active
         if active is None:
-            return "idle"
-        return "waiting" if active.behavior is None else "running"
+            return ExecutorState.IDLE
+        return ExecutorState.WAITING if active.behavior is None else ExecutorState.RUNNING
 
     def snapshot(self, full: bool = True) -> Snapshot:
         """The state for the periodic snapshot: the queue only if ``full``, its digest always."""

@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import threading
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from typing import Any, Self
 
 from rosmc.msg import ErrorCode
@@ -34,6 +35,7 @@ class ClientBase:
         history)."""
         self._library: Library | None = None
         self._kinds: dict[str, tuple[str, str]] = {}
+        self._seen: int | None = None  # the revision a GUI's operator saw (see against())
         self._lock = threading.RLock()
 
     @property
@@ -55,6 +57,30 @@ class ClientBase:
 
     def __exit__(self, *exc_info: object) -> None:
         self.close()
+
+    @contextmanager
+    def against(self, seen: int | None) -> Iterator[None]:
+        """Make the block's mutating calls against ``seen``, the revision an operator saw.
+
+        Each call without its own ``base_revision`` is then made against ``seen``, or
+        against the client's own last result if that is newer (calls run in order, so a
+        quick second click is not refused because of the first). ``seen`` None or negative
+        (nothing shown yet): the client's known revision, as outside the block. Holds the
+        client's lock for the block.
+        """
+        with self._lock:
+            before, self._seen = self._seen, seen if seen is not None and seen >= 0 else None
+            try:
+                yield
+            finally:
+                self._seen = before
+
+    def forget_newer_than(self, revision: int) -> None:
+        """A mission snapshot at ``revision`` arrived: a known revision above it was another
+        server's (a new mission server process), so later calls are made against the new one."""
+        with self._lock:
+            if self.revision is not None and self.revision > revision:
+                self.revision = None
 
     # -- queries -------------------------------------------------------------------
     def library(self) -> Library:
@@ -124,6 +150,8 @@ class ClientBase:
     def _base(self, base_revision: int | None) -> int:
         if base_revision is not None:
             return base_revision
+        if self._seen is not None:
+            return max(self._seen, self.revision if self.revision is not None else -1)
         if self.revision is None:
             return self.get_mission().revision
         return self.revision

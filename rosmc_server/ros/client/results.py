@@ -8,10 +8,10 @@ answer at all.
 
 from __future__ import annotations
 
-import enum
 from dataclasses import dataclass
 
 from ...core import RosmcError, StaleRevision
+from ...core.control import ControlCommand as ControlCommand  # callers import it from here
 
 
 class RevisionConflict(StaleRevision):
@@ -25,15 +25,6 @@ class RevisionConflict(StaleRevision):
         RosmcError.__init__(self, message)
         self.base_revision = base_revision
         self.current_revision = current_revision
-
-
-class ControlCommand(enum.IntEnum):
-    """Execution control of a robot (numbers match ``rosmc/Control``)."""
-
-    START = 0
-    PAUSE = 1
-    RESUME = 2
-    STOP = 3
 
 
 @dataclass(frozen=True)

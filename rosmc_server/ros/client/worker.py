@@ -70,11 +70,16 @@ class AsyncMissionClient:
         self,
         call: Callable[[MissionClient], T],
         on_done: Callable[[Outcome[T]], None] | None = None,
+        seen: int | None = None,
     ) -> Future[T]:
-        """Run ``call(client)`` on the worker; its result or error reaches ``on_done``."""
+        """Run ``call(client)`` on the worker; its result or error reaches ``on_done``.
+
+        ``seen``: the mission revision the operator saw when asking; the client makes the
+        call's mutating requests against it (see :meth:`MissionClient.against`).
+        """
         with self._lock:
             self._pending += 1
-        return self._executor.submit(self._run, call, on_done)
+        return self._executor.submit(self._run, call, on_done, seen)
 
     def close(self, wait: bool = False) -> None:
         """Stop taking calls; calls not started are dropped. Closes the connections."""
@@ -82,10 +87,14 @@ class AsyncMissionClient:
         self.client.close()
 
     def _run(
-        self, call: Callable[[MissionClient], T], on_done: Callable[[Outcome[T]], None] | None
+        self,
+        call: Callable[[MissionClient], T],
+        on_done: Callable[[Outcome[T]], None] | None,
+        seen: int | None,
     ) -> T:
         try:
-            value = call(self.client)
+            with self.client.against(seen):
+                value = call(self.client)
         except RosmcError as error:
             self._finish(on_done, Outcome(error=error))
             raise

@@ -27,16 +27,17 @@ from python_qt_binding.QtWidgets import (
     QWidget,
 )
 
-from rosmc_server.core import AgentStatus, LostLinkPolicy
+from rosmc_server.core import AgentStatus, LostLinkPolicy, SkillStatus
+from rosmc_server.core.updates import SkillAdded, SkillChanged, SkillRemoved
 
-from . import presentation
+from ..core import presentation
+from ..core.legality import RobotAction
+from ..core.mission_view import MissionView
+from ..core.view_state import AgentView, SkillDelta
 from .coverage_warning import coverage_warning_label, show_coverage_warning
-from .legality import RobotAction
-from .mission_view import MissionView
 from .policy_dialog import ask_policy
 from .row_delegate import RowDelegate
 from .schedule_model import NUMBER, PARAMS, SKILL, STATUS, TAG, SectionModel
-from .view_state import AgentView
 
 ROW_HEIGHT = 22
 # A column is at least this wide (more robots than fit: the schedule scrolls sideways)
@@ -255,6 +256,16 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         self.synced_model.set_rows(task.synced, 0)
         self.blueprint_model.set_rows(task.blueprint, task.synced_end)
 
+    def apply(self, task: AgentView, deltas: Sequence[SkillDelta]) -> None:
+        """Show ``task`` after ``deltas``: row by row where the sections keep their bounds
+        (a status report, a blueprint edit), else by comparing rows (:meth:`show_task`)."""
+        synced_end = len(self.synced_model.rows)
+        if synced_end != task.synced_end or not all(
+            _row_edit(delta, synced_end, self.synced_model, self.blueprint_model)
+            for delta in deltas
+        ):
+            self.show_task(task)
+
     def show_status(self, status: AgentStatus | None) -> None:
         """Show the robot's link and telemetry in the header."""
         text = presentation.link_summary(status)
@@ -290,3 +301,22 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         policy = self.ask_policy(self.agent, self.skill_names, self, self.policy_in_force)
         if policy is not None:
             self.policy_chosen.emit(self.agent, policy)
+
+
+def _row_edit(
+    delta: SkillDelta, synced_end: int, synced: SectionModel, blueprint: SectionModel
+) -> bool:
+    """Make ``delta`` as a row edit if it keeps the sections' bounds; False if it cannot."""
+    if isinstance(delta, SkillChanged):
+        if (delta.old.status is SkillStatus.IDLE) != (delta.new.status is SkillStatus.IDLE):
+            return False  # the skill changes section
+        if delta.index < synced_end:
+            return synced.replace_row(delta.index, delta.new)
+        return blueprint.replace_row(delta.index - synced_end, delta.new)
+    if isinstance(delta, (SkillAdded, SkillRemoved)):
+        if delta.index < synced_end or delta.skill.status is not SkillStatus.IDLE:
+            return False
+        if isinstance(delta, SkillAdded):
+            return blueprint.insert_row(delta.index - synced_end, delta.skill)
+        return blueprint.remove_row(delta.index - synced_end, delta.skill.id)
+    return False  # moves: compare rows

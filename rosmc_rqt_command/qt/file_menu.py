@@ -8,17 +8,17 @@ was last saved or loaded, the operator is asked whether to save it first.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from python_qt_binding.QtWidgets import QFileDialog, QInputDialog, QMessageBox, QWidget
 
 from rosmc_server.core import Barrier, SkillInstance, TaskMarker
 
+from ..core.mission_view import MissionView
+from ..core.requests import Answer, Request, ask
 from .actions import CommandActions
 from .message_area import MessageArea
-from .mission_view import MissionView
-from .requests import Answer, Request
 
 FILTER = "Mission files (*.yaml *.yml);;All files (*)"
 Send = Callable[[Request], None]
@@ -26,15 +26,15 @@ Send = Callable[[Request], None]
 
 Plan = tuple[
     str,
-    tuple[tuple[str, tuple[SkillInstance, ...]], ...],
+    tuple[tuple[str, Sequence[SkillInstance]], ...],
     tuple[Barrier, ...],
     tuple[TaskMarker, ...],
 ]
 
 
 def plan_of(view: MissionView) -> Plan:
-    """The plan as it is now, by reference (cheap: the view holds immutable values)."""
-    tasks = tuple((agent, task.skills) for agent, task in view.agents.items())
+    """The plan as it is now (skills are immutable values; only the task lists are copied)."""
+    tasks = tuple((agent, tuple(task.skills)) for agent, task in view.agents.items())
     return (view.library_name, tasks, view.barriers, tuple(view.markers.values()))
 
 
@@ -137,12 +137,12 @@ class FileController:
         """Start an empty mission (after asking about unsaved changes)."""
         if self.confirm_discard("starting a new mission"):
             self._send(
-                Request(
-                    "new_mission",
-                    what="start a new mission",
-                    base_revision=self._view.revision,
-                    on_answer=self._on_replaced,
-                )
+                ask(
+                    lambda c: c.new_mission,
+                    "start a new mission",
+                    self._view.revision,
+                    self._on_replaced,
+                )()
             )
 
     def open_local(self, path: str) -> None:
@@ -153,25 +153,23 @@ class FileController:
             self._messages.say(f"Cannot read {path}: {error}.", "error")
             return
         self._send(
-            Request(
-                "load_mission",
-                kwargs={"document": document},
-                what=f"open {path}",
-                base_revision=self._view.revision,
-                on_answer=lambda a: self._on_loaded(a, ("local", path)),
-            )
+            ask(
+                lambda c: c.load_mission,
+                f"open {path}",
+                self._view.revision,
+                lambda a: self._on_loaded(a, ("local", path)),
+            )(document=document)
         )
 
     def open_server(self, path: str) -> None:
         """Load a mission file from the server's computer."""
         self._send(
-            Request(
-                "load_mission",
-                kwargs={"path": path},
-                what=f"open {path} on the server",
-                base_revision=self._view.revision,
-                on_answer=lambda a: self._on_loaded(a, ("server", path)),
-            )
+            ask(
+                lambda c: c.load_mission,
+                f"open {path} on the server",
+                self._view.revision,
+                lambda a: self._on_loaded(a, ("server", path)),
+            )(path=path)
         )
 
     def save(self) -> bool:
@@ -188,23 +186,22 @@ class FileController:
         """Save the mission to a file on this computer."""
         fingerprint = plan_of(self._view)
         self._send(
-            Request(
-                "save_mission",
-                what=f"save to {path}",
+            ask(
+                lambda c: c.save_mission,
+                f"save to {path}",
                 on_answer=lambda a: self._on_saved_document(a, path, fingerprint),
-            )
+            )()
         )
 
     def save_server(self, path: str) -> None:
         """Save the mission to a file on the server's computer."""
         fingerprint = plan_of(self._view)
         self._send(
-            Request(
-                "save_mission",
-                (path,),
-                what=f"save to {path} on the server",
+            ask(
+                lambda c: c.save_mission,
+                f"save to {path} on the server",
                 on_answer=lambda a: self._on_saved(a, ("server", path), fingerprint),
-            )
+            )(path)
         )
 
     # -- answers ----------------------------------------------------------------------------

@@ -21,9 +21,9 @@ from python_qt_binding.QtWidgets import QAction, QFileDialog
 
 from rosmc_server.core import RosmcError
 
+from ..replay_process import ReplayProcess
+from ..replay_ticks import outline_of
 from .replay_bar import ReplayBar, ShownStatus
-from .replay_process import ReplayProcess
-from .replay_ticks import outline_of
 
 if TYPE_CHECKING:
     from .command_widget import CommandWidget

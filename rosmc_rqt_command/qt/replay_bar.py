@@ -24,7 +24,7 @@ from python_qt_binding.QtWidgets import (
 
 from rosmc_server.recording.playback import MAX_RATE, MIN_RATE, PlaybackStatus
 
-from .replay_ticks import RecordingOutline, ReplayTick, TickKind
+from ..replay_ticks import RecordingOutline, ReplayTick, TickKind
 
 TICK_COLOURS = {
     TickKind.OPERATOR: QColor("#1f5fbf"),

@@ -16,9 +16,9 @@ from python_qt_binding.QtWidgets import QApplication, QHBoxLayout, QScrollArea, 
 
 from rosmc_server.core import AgentStatus, Library
 
+from ..core.mission_view import MissionView
+from ..core.view_state import ViewUpdate, delta_agent
 from .agent_column import AgentColumn, SectionTable
-from .mission_view import MissionView
-from .view_state import ViewUpdate
 
 
 class ScheduleWidget(QScrollArea):  # type: ignore[misc]
@@ -70,11 +70,16 @@ class ScheduleWidget(QScrollArea):  # type: ignore[misc]
         if update.reset:
             self._ensure_columns([view.agent for view in update.agents])
         touched: list[AgentColumn] = []
-        for task in update.agents:
-            column = self.columns.get(task.agent)
-            if column is not None:
+        for agent in update.touched:
+            column = self.columns.get(agent)
+            if column is None:
+                continue
+            task = self._view.view(agent)
+            if update.reset:
                 column.show_task(task)
-                touched.append(column)
+            else:
+                column.apply(task, [d for d in update.deltas if delta_agent(d) == agent])
+            touched.append(column)
         if update.barriers is not None or update.reset:
             touched = list(self.columns.values())
             for column in touched:

@@ -1,13 +1,15 @@
 """The GUI thread's picture of the mission: the latest :class:`AgentView` of every robot.
 
-:class:`MissionView` takes :class:`~.view_state.ViewUpdate` values in order and answers the
-read-only questions panels ask (which skill has this id, which barrier holds it, what a
-robot reports). It holds immutable values only, so nothing here needs a lock.
+:class:`MissionView` takes :class:`~.view_state.ViewUpdate` values in order (applying each
+update's skill deltas to its own task lists) and answers the read-only questions panels
+ask (which skill has this id, which barrier holds it, what a robot reports). It lives on
+the GUI thread only, so nothing here needs a lock.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import replace
 
 from rosmc_server.core import (
     AgentStatus,
@@ -17,9 +19,10 @@ from rosmc_server.core import (
     SkillStatus,
     TaskMarker,
 )
+from rosmc_server.core.updates import SkillAdded, SkillChanged, SkillRemoved
 
 from . import presentation
-from .view_state import AgentView, ViewUpdate, barrier_tags
+from .view_state import AgentView, ViewUpdate, apply_delta, barrier_tags, delta_agent
 
 
 class MissionView:
@@ -29,7 +32,8 @@ class MissionView:
         self.revision = -1
         self.library: Library | None = None
         self.library_name = ""
-        self.agents: dict[str, AgentView] = {}
+        self.agents: dict[str, AgentView] = {}  # each over its task list in _tasks
+        self._tasks: dict[str, list[SkillInstance]] = {}
         self.barriers: tuple[Barrier, ...] = ()
         self.markers: dict[str, TaskMarker] = {}
         self.statuses: dict[str, AgentStatus] = {}
@@ -42,18 +46,16 @@ class MissionView:
         return self.revision >= 0
 
     def apply(self, update: ViewUpdate) -> None:
-        """Take one update (in revision order)."""
+        """Take one update (in revision order): a reset's tasks, or the skill deltas."""
         if update.reset:
-            self.agents = {}
-            self._skills = {}
+            self._tasks = {view.agent: list(view.skills) for view in update.agents}
+            self._skills = {skill.id: skill for view in update.agents for skill in view.skills}
+            self.agents = {
+                view.agent: replace(view, skills=self._tasks[view.agent]) for view in update.agents
+            }
             self.library_name = update.library
-        for view in update.agents:
-            old = self.agents.get(view.agent)
-            if old is not None:
-                for skill in old.skills:
-                    self._skills.pop(skill.id, None)
-            self.agents[view.agent] = view
-            self._skills.update((skill.id, skill) for skill in view.skills)
+        elif self.loaded:  # before the first snapshot there is nothing to change
+            self._apply_deltas(update)
         if update.barriers is not None:
             self.barriers = update.barriers
             self._tags = barrier_tags(update.barriers)
@@ -65,6 +67,26 @@ class MissionView:
             self.revision = update.revision
         elif self.loaded:
             self.revision = max(self.revision, update.revision)
+
+    def _apply_deltas(self, update: ViewUpdate) -> None:
+        for delta in update.deltas:
+            apply_delta(self._tasks.setdefault(delta_agent(delta), []), delta)
+            if isinstance(delta, SkillRemoved):
+                self._skills.pop(delta.skill.id, None)
+            elif isinstance(delta, SkillChanged):
+                self._skills[delta.new.id] = delta.new
+            elif isinstance(delta, SkillAdded):
+                self._skills[delta.skill.id] = delta.skill
+        for bounds in update.bounds:
+            agent = bounds.agent
+            self.agents[agent] = AgentView(
+                agent,
+                self._tasks.setdefault(agent, []),
+                bounds.synced_end,
+                bounds.editable_start,
+                bounds.uploading,
+                bounds.removing,
+            )
 
     # -- queries ---------------------------------------------------------------------------
     def skill(self, skill_id: str) -> SkillInstance | None:

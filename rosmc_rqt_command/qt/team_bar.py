@@ -21,9 +21,9 @@ from python_qt_binding.QtWidgets import (
     QWidget,
 )
 
-from .mission_view import MissionView
+from ..core.mission_view import MissionView
+from ..core.team_filter import StatusFilter, TeamFilter, visible_agents
 from .schedule_widget import ScheduleWidget
-from .team_filter import StatusFilter, TeamFilter, visible_agents
 
 
 class StayOpenMenu(QMenu):  # type: ignore[misc]

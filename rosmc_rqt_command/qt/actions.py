@@ -11,7 +11,7 @@ from python_qt_binding.QtCore import QObject, Qt
 from python_qt_binding.QtGui import QKeySequence
 from python_qt_binding.QtWidgets import QAction, QWidget
 
-from .legality import Action, RobotAction
+from ..core.legality import Action, RobotAction
 
 # (text, shortcuts, tooltip) of each skill action ("A|B": either key sequence).
 SKILL_ACTIONS: dict[Action, tuple[str, str, str]] = {

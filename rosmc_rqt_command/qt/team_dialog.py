@@ -1,4 +1,4 @@
-"""The one question before a team send: what each robot gets, and every warning at once."""
+"""The questions before a send: a team send, or a barrier member whose partners stay behind."""
 
 from __future__ import annotations
 
@@ -17,3 +17,15 @@ def ask_team_send(parent: QWidget, text: str, warnings: list[str]) -> bool:
     box.setStandardButtons(QMessageBox.Yes | QMessageBox.No)
     box.setDefaultButton(QMessageBox.No if warnings else QMessageBox.Yes)
     return bool(box.exec_() == QMessageBox.Yes)
+
+
+def ask_send_anyway(parent: QWidget, warnings: list[str]) -> bool:
+    """Ask whether to send although a robot would wait for ever (No is the default)."""
+    answer = QMessageBox.warning(
+        parent,
+        "A robot would wait for ever",
+        "\n".join(warnings) + "\n\nSend anyway?",
+        QMessageBox.Yes | QMessageBox.No,
+        QMessageBox.No,
+    )
+    return bool(answer == QMessageBox.Yes)

@@ -29,9 +29,9 @@ from rosmc_server.core import InvalidRequest, RosmcError, SkillInstance, SkillSp
 from rosmc_server.core.editing import check_retries, check_timeout
 from rosmc_server.core.validation import MAX_RETRIES
 
-from .mission_view import MissionView
+from ..core.mission_view import MissionView
+from ..core.requests import Answer
 from .param_editors import INVALID_STYLE, Editor, MarkerPicker, make_editor, wide_range
-from .requests import Answer
 
 
 class ParameterPanel(QScrollArea):  # type: ignore[misc]

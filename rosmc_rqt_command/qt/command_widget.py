@@ -10,141 +10,82 @@ shown as a sentence.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from typing import Any
 
-from python_qt_binding.QtCore import QPoint, Qt, QTimer
-from python_qt_binding.QtWidgets import (
-    QLabel,
-    QMenu,
-    QMenuBar,
-    QMessageBox,
-    QSplitter,
-    QVBoxLayout,
-    QWidget,
-)
+from python_qt_binding.QtCore import QPoint
+from python_qt_binding.QtWidgets import QMenu, QWidget
 
 from rosmc_server.core import AgentStatus, Library, LostLinkPolicy
 
-from . import alerts
+from ..core.dispatch import Dispatcher
+from ..core.legality import Action, RobotAction
+from ..core.mission_view import MissionView
+from ..core.phrasing import answer_message
+from ..core.requests import Answer, Backend, Request, ask
+from ..core.view_state import ViewUpdate
 from .actions import CommandActions
 from .agent_column import SectionTable
 from .control_panel import ControlPanel
-from .dispatch import Dispatcher
+from .enabling import Enabling
 from .file_menu import FileController
-from .legality import Action, RobotAction, RobotLegality, legal_actions
-from .legend import StatusLegend
 from .message_area import MessageArea
-from .mission_view import MissionView
 from .parameter_panel import ParameterPanel
-from .requests import Answer, Backend, Request
+from .repaints import Repaints
 from .schedule_widget import ScheduleWidget
-from .science_strip import ScienceStrip
-from .site_strip import SiteStrip
 from .team_bar import TeamBar
-from .team_dialog import ask_team_send
+from .team_dialog import ask_send_anyway, ask_team_send
 from .undo_history import UndoHistory
-from .view_state import ViewUpdate
-
-# Robot headers and robot buttons follow live reports at most this often (ms): robots
-# report at up to 10 Hz each, and nobody reads a battery figure faster than that.
-STATUS_REPAINT_MS = 200
+from .window_layout import Panels, lay_out
 
 
 class CommandWidget(QWidget):  # type: ignore[misc]
-    """The operator's command window content."""
+    """The operator's command window: a composition of small parts.
+
+    The panels (schedule, team bar, parameters, control, messages), the file menu's
+    controller, the undo history, the :class:`~..core.dispatch.Dispatcher` (actions to
+    requests), :class:`~.enabling.Enabling` (what is enabled) and
+    :class:`~.repaints.Repaints` (timed repaints and warnings); :func:`~.window_layout.lay_out`
+    places them. The widget itself only wires them and takes what the backend reports.
+    """
 
     def __init__(self, backend: Backend, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("rosmc_command")
         self.setWindowTitle("ROSMC command")
         self.backend = backend
-        self.view = MissionView()
+        self.view = view = MissionView()
         self.actions_ = CommandActions(self)
-        self.schedule = ScheduleWidget(self.view)
-        self.parameters = ParameterPanel(self.view)
+        self.schedule = ScheduleWidget(view)
+        self.parameters = ParameterPanel(view)
         self.control = ControlPanel(self.actions_)
         self.messages = MessageArea()
-        self.files = FileController(self, self.actions_, self.view, self.messages, self.send)
-        self._checker = alerts.ParameterChecker()
-        self._robot_legal = RobotLegality()
+        self.files = FileController(self, self.actions_, view, self.messages, self.send)
+        self.history = UndoHistory(self, view, self.send)
+        self.team = TeamBar(self.schedule, view)
+        self.enabling = Enabling(view, self.actions_, self.schedule, self.history)
+        self.repaints = Repaints(view, self.messages, self._show_statuses)
         self.dispatcher = Dispatcher(
-            self.view, self.send, self._confirm, self._robot_legal.any, self._confirm_team
+            view, self.send, self._confirm, self.enabling.legal_for_all, self._confirm_team
         )
-        self.history = UndoHistory(self, self.view, self.send)
+        panels = Panels(
+            self.actions_,
+            self.history,
+            self.schedule,
+            self.team,
+            self.parameters,
+            self.control,
+            self.messages,
+        )
+        layout = lay_out(self, panels)
+        self.menu_bar, self.banner, self.splitter = layout.menu_bar, layout.banner, layout.splitter
+        self.science, self.site, self.legend = layout.science, layout.site, layout.legend
         self._select_when_seen: list[str] = []
-        self._pending_statuses: dict[str, AgentStatus] = {}
         self._journal_alerting = False  # the server said its journal has a problem
         self.connected = False
-        self._build_layout()
         self._connect()
-        self._warn_timer = QTimer(self)
-        self._warn_timer.setSingleShot(True)
-        self._warn_timer.setInterval(300)
-        self._warn_timer.timeout.connect(self._on_warn_timer_timeout)
-        self._status_timer = QTimer(self)
-        self._status_timer.setSingleShot(True)
-        self._status_timer.setInterval(STATUS_REPAINT_MS)
-        self._status_timer.timeout.connect(self._on_status_timer_timeout)
         self.banner.setText("Waiting for the mission server…")
         self.set_backend(backend)
-
-    # -- layout ---------------------------------------------------------------------------
-    def _build_layout(self) -> None:
-        self.menu_bar = QMenuBar(self)
-        file_menu = self.menu_bar.addMenu("&File")
-        for name in ("new", "open", "open_server", None, "save", "save_as", "save_server"):
-            if name is None:
-                file_menu.addSeparator()
-            else:
-                file_menu.addAction(self.actions_.file[name])
-        self.menu_bar.addMenu("&Edit").addActions(
-            [self.history.undo_action, self.history.redo_action]
-        )
-        mission_menu = self.menu_bar.addMenu("&Mission")
-        for action in self.actions_.skill.values():
-            mission_menu.addAction(action)
-        mission_menu.addSeparator()
-        for action in self.actions_.all_robots.values():
-            mission_menu.addAction(action)
-        mission_menu.addSeparator()
-        mission_menu.addAction(self.actions_.refresh)
-        mission_menu.addAction(self.actions_.clear_selection)
-        self.banner = QLabel()
-        self.banner.setObjectName("banner")
-        self.banner.setWordWrap(True)
-        self.banner.setStyleSheet("QLabel { background:#fde2e1; color:#8a0010; padding:4px; }")
-        right = QSplitter(Qt.Vertical)
-        right.addWidget(self.parameters)
-        right.addWidget(self.control)
-        right.addWidget(self.messages)
-        right.setStretchFactor(0, 3)
-        right.setStretchFactor(2, 1)
-        self.legend = StatusLegend()
-        left = QWidget()
-        left_layout = QVBoxLayout(left)
-        left_layout.setContentsMargins(0, 0, 0, 0)
-        left_layout.setSpacing(2)
-        self.science = ScienceStrip()
-        left_layout.addWidget(self.science)
-        self.site = SiteStrip()
-        left_layout.addWidget(self.site)
-        self.team = TeamBar(self.schedule, self.view)
-        left_layout.addWidget(self.team)
-        left_layout.addWidget(self.schedule, 1)
-        left_layout.addWidget(self.legend)
-        self.splitter = QSplitter(Qt.Horizontal)
-        self.splitter.addWidget(left)
-        self.splitter.addWidget(right)
-        self.splitter.setStretchFactor(0, 1)
-        self.splitter.setStretchFactor(1, 0)
-        self.splitter.setSizes([1230, 370])
-        right.setMaximumWidth(370)
-        layout = QVBoxLayout(self)
-        layout.setContentsMargins(2, 2, 2, 2)
-        layout.setMenuBar(self.menu_bar)
-        layout.addWidget(self.banner)
-        layout.addWidget(self.splitter, 1)
 
     def _connect(self) -> None:
         self.schedule.selection_changed.connect(self._on_schedule_selection_changed)
@@ -173,7 +114,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
 
         Rows change update by update (only those an update touched); what depends on the
         whole picture (buttons, parameter panel, warnings) is worked out once per batch.
-        Robot reports are only collected here and shown by a timer (STATUS_REPAINT_MS).
+        Robot reports are only collected here and shown by a timer (see :mod:`.repaints`).
         """
         agents: set[str] = set()
         changed: set[str] = set()
@@ -183,20 +124,19 @@ class CommandWidget(QWidget):  # type: ignore[misc]
             reset = reset or update.reset
             self.view.apply(update)
             self.schedule.apply(update)
-            agents.update(view.agent for view in update.agents)
+            agents.update(update.touched)
             changed |= update.changed_ids
             refresh_parameters = refresh_parameters or bool(
-                update.agents or update.markers is not None or update.barriers is not None
+                update.touched or update.markers is not None or update.barriers is not None
             )
-            for status in update.statuses:
-                self._pending_statuses[status.agent] = status
+            self.repaints.note_statuses(update.statuses)
         if refresh_parameters:
             self.parameters.refresh(force=reset or any(u.markers is not None for u in updates))
         if self._select_when_seen and all(self.view.skill(i) for i in self._select_when_seen):
             self.schedule.select_ids(self._select_when_seen)
             self._select_when_seen = []
-        self._checker.note(None if reset else changed)
-        self._update_legal(None if reset else agents)
+        self.repaints.checker.note(None if reset else changed)
+        self.enabling.update(None if reset else agents)
         self.files.on_mission_shown()
         if first:
             self.files.mark_saved()
@@ -204,20 +144,17 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         if reset:
             self.banner.hide()
         self.team.refresh()
-        if self._pending_statuses and not self._status_timer.isActive():
-            self._status_timer.start()
-        if (agents or reset) and not self._warn_timer.isActive():
-            self._warn_timer.start(300)
+        if agents or reset:
+            self.repaints.warn_soon()
 
     def on_library(self, library: Library) -> None:
         """The skill library arrived: offer each robot's skills."""
         self.view.library = library
         self.schedule.set_library(library)
         self.parameters.refresh(force=True)
-        self._checker.note(None)
-        self._update_legal()
-        if not self._warn_timer.isActive():
-            self._warn_timer.start(300)
+        self.repaints.checker.note(None)
+        self.enabling.update()
+        self.repaints.warn_soon()
 
     def on_connection(self, connected: bool) -> None:
         """The mission server appeared or went away."""
@@ -254,29 +191,8 @@ class CommandWidget(QWidget):  # type: ignore[misc]
 
     def on_answer(self, answer: Answer) -> None:
         """Say how a request ended."""
-        what = answer.request.what or answer.request.operation.replace("_", " ")
-        if answer.ok:
-            revision = getattr(answer.value, "revision", None)
-            hint = self.history.note(answer)  # "Ctrl+Z undoes it" after this window's edits
-            extra = f"; {hint}" if hint else ""
-            suffix = f" (revision {revision}{extra})" if revision is not None else ""
-            note = getattr(answer.value, "note", "")
-            if note:  # accepted, but the operator should know (queued, a barrier partner)
-                self.messages.say(f"Done: {what}{suffix}; {note}.", "warning")
-            else:
-                self.messages.say(f"Done: {what}{suffix}.", "ok")
-        elif answer.conflict:
-            self.messages.say(
-                f"Could not {what}: someone else changed the mission first ({answer.error}). "
-                "The view was refreshed; check it and try again.",
-                "error",
-            )
-        elif answer.unreachable:
-            self.messages.say(
-                f"Could not {what}: the mission server did not answer ({answer.error}).", "error"
-            )
-        else:
-            self.messages.say(f"Could not {what}: {answer.error}.", "error")
+        hint = self.history.note(answer) if answer.ok else ""  # "Ctrl+Z undoes it"
+        self.messages.say(*answer_message(answer, hint))
         if answer.request.on_answer is not None:
             answer.request.on_answer(answer)
 
@@ -296,7 +212,8 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.backend = backend
         self.view.statuses = {}  # the robots as the new backend reports them
         self.parameters.set_read_only(backend.read_only)
-        self._update_legal()
+        self.enabling.read_only = backend.read_only
+        self.enabling.update()
 
     # -- sending ------------------------------------------------------------------------------
     def send(self, request: Request) -> None:
@@ -321,14 +238,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
     def _confirm(self, warnings: list[str]) -> bool:
         for warning in warnings:
             self.messages.say(warning, "warning")
-        answer = QMessageBox.warning(
-            self,
-            "A robot would wait for ever",
-            "\n".join(warnings) + "\n\nSend anyway?",
-            QMessageBox.Yes | QMessageBox.No,
-            QMessageBox.No,
-        )
-        return bool(answer == QMessageBox.Yes)
+        return ask_send_anyway(self, warnings)
 
     def _confirm_team(self, text: str, warnings: list[str]) -> bool:
         return ask_team_send(self, text, warnings)
@@ -336,7 +246,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
     # -- slots ----------------------------------------------------------------------------------
     def _on_schedule_selection_changed(self, ids: list[str]) -> None:
         self.parameters.show_selection(ids)
-        self._update_legal()
+        self.enabling.update()
         selected = self.view.skills(ids)
         self.backend.publish_selection(ids, self.view.bound_markers(selected))
 
@@ -369,24 +279,15 @@ class CommandWidget(QWidget):  # type: ignore[misc]
                     self.schedule.select_ids(self._select_when_seen)
                     self._select_when_seen = []
 
-        self.send(
-            Request(
-                "add_skill",
-                (agent, skill),
-                {},
-                f"add {skill} to {agent}",
-                self.view.revision,
-                select_new,
-            )
-        )
+        what = f"add {skill} to {agent}"
+        self.send(ask(lambda c: c.add_skill, what, self.view.revision, select_new)(agent, skill))
 
     def _on_schedule_policy_chosen(self, agent: str, policy: LostLinkPolicy) -> None:
-        self.dispatcher.request(
-            "set_robot_options", agent, policy, what=f"set {agent}'s policy ({policy.describe()})"
-        )
+        what = f"set {agent}'s policy ({policy.describe()})"
+        self.dispatcher.call(lambda c: c.set_robot_options, what)(agent, policy)
 
     def _on_schedule_reorder_requested(self, agent: str, order: list[str]) -> None:
-        self.dispatcher.request("reorder", agent, order, what=f"reorder {agent}'s plan")
+        self.dispatcher.call(lambda c: c.reorder, f"reorder {agent}'s plan")(agent, order)
 
     def _on_parameters_edit_requested(self, skill_id: str, fields: dict[str, Any]) -> None:
         skill = self.view.skill(skill_id)
@@ -394,50 +295,17 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         changed = ", ".join(fields.get("params", {}) or fields.get("bindings", {}) or fields)
         revert = self.parameters.reverter(skill_id)  # a refused value leaves the field
         what = f"change {changed} of {name}"
-        self.send(Request("edit_skill", (skill_id,), fields, what, self.view.revision, revert))
+        self.send(ask(lambda c: c.edit_skill, what, self.view.revision, revert)(skill_id, **fields))
 
     def _on_parameters_rename_requested(self, old: str, new: str) -> None:
-        self.dispatcher.request("rename_marker", old, new, what=f"rename marker {old} to {new}")
+        self.dispatcher.call(lambda c: c.rename_marker, f"rename marker {old} to {new}")(old, new)
 
     def _on_refresh_triggered(self) -> None:
         self.backend.refresh()
         self.messages.say("Fetching the mission again.", "info")
 
-    def _on_warn_timer_timeout(self) -> None:
-        warnings = [
-            *alerts.barrier_warnings(self.view),
-            *alerts.coverage_warnings(self.view),
-            *self._checker.warnings(self.view),
-        ]
-        self.messages.show_warnings(warnings)
-        if self._checker.incomplete:
-            self._warn_timer.start(50)  # the rest of a big mission in a moment
-
-    def _on_status_timer_timeout(self) -> None:
-        statuses, self._pending_statuses = self._pending_statuses, {}
-        self.schedule.show_statuses(statuses.values())
+    def _show_statuses(self, statuses: list[AgentStatus]) -> None:
+        """The robots' latest reports, collected by the status timer: headers and buttons."""
+        self.schedule.show_statuses(statuses)
         self.team.refresh()
-        self._update_legal(statuses)
-        if not self._warn_timer.isActive():
-            self._warn_timer.start(300)
-
-    # -- enabling -------------------------------------------------------------------------------
-    def _update_legal(self, agents: Iterable[str] | None = None) -> None:
-        """Enable what is legal now; only ``agents``' robot actions are recomputed."""
-        read_only = self.backend.read_only
-        self.history.set_read_only(read_only)
-        agents = None if agents is None else list(agents)
-        self._robot_legal.update(self.view, agents)
-        selected = self.view.skills(self.schedule.selected_ids)
-        legal = set() if read_only else legal_actions(self.view, selected)
-        for kind, action in self.actions_.skill.items():
-            action.setEnabled(kind in legal)
-        everyone = set() if read_only else self._robot_legal.any()
-        for robot_action, action in self.actions_.all_robots.items():
-            action.setEnabled(robot_action in everyone)
-        for name, action in self.actions_.file.items():
-            action.setEnabled(not read_only or name in ("save_as",))
-        for agent in self.schedule.columns if agents is None else agents:
-            column = self.schedule.columns.get(agent)
-            if column is not None:
-                column.set_legal(self._robot_legal.of(agent), read_only)
+        self.enabling.update(status.agent for status in statuses)

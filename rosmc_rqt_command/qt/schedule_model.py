@@ -18,8 +18,8 @@ from python_qt_binding.QtGui import QBrush, QColor, QFont
 
 from rosmc_server.core import SkillInstance
 
-from . import presentation
-from .mission_view import MissionView
+from ..core import presentation
+from ..core.mission_view import MissionView
 
 MIME_TYPE = "application/x-rosmc-skill-ids"
 SKILL_ID_ROLE = Qt.UserRole + 1
@@ -98,6 +98,32 @@ class SectionModel(QAbstractTableModel):  # type: ignore[misc]
             before = old[row if row < start else row + shift]
             if renumber or (before is not new[row] and before != new[row]):
                 self._changed(row, row)
+
+    def replace_row(self, row: int, skill: SkillInstance) -> bool:
+        """Show ``skill`` in place of the same skill at ``row``; False if it is not there."""
+        if not (0 <= row < len(self._rows)) or self._rows[row].id != skill.id:
+            return False
+        self._rows[row] = skill
+        self._changed(row, row)
+        return True
+
+    def insert_row(self, row: int, skill: SkillInstance) -> bool:
+        """Show ``skill`` as a new row ``row``; False if there is no such place."""
+        if not 0 <= row <= len(self._rows):
+            return False
+        self.beginInsertRows(QModelIndex(), row, row)
+        self._rows.insert(row, skill)
+        self.endInsertRows()  # rows below move down: the view repaints them with their number
+        return True
+
+    def remove_row(self, row: int, skill_id: str) -> bool:
+        """Stop showing ``skill_id``, at ``row``; False if it is not there."""
+        if not (0 <= row < len(self._rows)) or self._rows[row].id != skill_id:
+            return False
+        self.beginRemoveRows(QModelIndex(), row, row)
+        del self._rows[row]
+        self.endRemoveRows()
+        return True
 
     def refresh(self) -> None:
         """Repaint every row (barriers or robot statuses changed)."""

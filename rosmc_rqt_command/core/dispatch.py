@@ -9,21 +9,26 @@ disabled) and asks before sending a barrier member whose partners stay behind.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, ParamSpec
 
 from rosmc_server.core import SkillInstance
+from rosmc_server.core.control import ControlCommand
 
 from . import alerts
 from .legality import Action, RobotAction, legal_actions, legal_robot_actions, selection_agent
 from .mission_view import MissionView
-from .requests import Request
+from .requests import Request, ask
 from .team_send import plan_team_send, team_question, up_to_selection, whole_team
 
-CONTROL_WORDS = {
-    RobotAction.START: "START",
-    RobotAction.PAUSE: "PAUSE",
-    RobotAction.RESUME: "RESUME",
-    RobotAction.STOP: "STOP",
+if TYPE_CHECKING:  # for the type checker only
+    from rosmc_server.ros.client import MissionClient
+
+P = ParamSpec("P")
+CONTROLS = {
+    RobotAction.START: ControlCommand.START,
+    RobotAction.PAUSE: ControlCommand.PAUSE,
+    RobotAction.RESUME: ControlCommand.RESUME,
+    RobotAction.STOP: ControlCommand.STOP,
 }
 Confirm = Callable[[list[str]], bool]  # warnings -> send anyway?
 ConfirmTeam = Callable[[str, list[str]], bool]  # what goes, warnings -> send?
@@ -54,53 +59,74 @@ class Dispatcher:
         self.confirm_team = confirm_team
         self._legal_for_all = legal_for_all
 
-    def request(self, operation: str, *args: Any, what: str, **kwargs: Any) -> None:
-        """Send one client call made against the revision shown."""
-        self._send(Request(operation, args, kwargs, what, self._view.revision))
+    def call(
+        self, pick: Callable[[MissionClient], Callable[P, object]], what: str
+    ) -> Callable[P, None]:
+        """A sender of one call of the client method ``pick`` chooses, against the revision
+        shown: ``call(lambda c: c.retry, "retry 'go'")(skill_id)``."""
+        make = ask(pick, what, self._view.revision)
+
+        def send(*args: P.args, **kwargs: P.kwargs) -> None:
+            self._send(make(*args, **kwargs))
+
+        return send
 
     def skill_action(self, kind: Action, selected: Sequence[SkillInstance]) -> None:
         """Run ``kind`` on the selected skills (nothing if it is not legal for them)."""
-        view = self._view
-        if not selected or kind not in legal_actions(view, selected):
+        if not selected or kind not in legal_actions(self._view, selected):
             return
-        first = selected[0]
         names = ", ".join(f"'{s.label or s.skill}'" for s in selected)
-        if kind is Action.DELETE:
-            self.request("delete_skills", [s.id for s in selected], what=f"delete {names}")
-        elif kind in (Action.MOVE_UP, Action.MOVE_DOWN):
-            order = moved([s.id for s in view.view(first.agent).editable], selected, kind)
-            self.request("reorder", first.agent, order, what=f"move {names}")
-        elif kind is Action.SYNC and selection_agent(selected) is None:
+        handlers = {
+            Action.DELETE: self._delete,
+            Action.MOVE_UP: self._move,
+            Action.MOVE_DOWN: self._move,
+            Action.SYNC: self._sync,
+            Action.UNSYNC: self._unsync,
+            Action.RETRY: self._resolve,
+            Action.SKIP: self._resolve,
+            Action.BARRIER: self._barrier,
+            Action.DELETE_BARRIER: self._delete_barrier,
+        }
+        handlers[kind](kind, selected, names)
+
+    def _delete(self, _: Action, selected: Sequence[SkillInstance], names: str) -> None:
+        self.call(lambda c: c.delete_skills, f"delete {names}")([s.id for s in selected])
+
+    def _move(self, kind: Action, selected: Sequence[SkillInstance], names: str) -> None:
+        agent = selected[0].agent
+        order = moved([s.id for s in self._view.view(agent).editable], selected, kind)
+        self.call(lambda c: c.reorder, f"move {names}")(agent, order)
+
+    def _sync(self, _: Action, selected: Sequence[SkillInstance], names: str) -> None:
+        view = self._view
+        if selection_agent(selected) is None:
             self.send_team(up_to_selection(view, list(selected)))
-        elif kind is Action.SYNC:
-            editable = view.view(first.agent).editable
-            last = max(view.position(s) for s in selected)
-            sending = [s for s in editable if view.position(s) <= last]
-            if self._barriers_ok(sending):
-                self.request(
-                    "synchronize",
-                    first.agent,
-                    sending[-1].id,
-                    what=f"send {first.agent}'s plan up to {names}",
-                )
-        elif kind is Action.UNSYNC:
-            start = min(selected, key=view.position)
-            self.request(
-                "unsynchronize",
-                first.agent,
-                start.id,
-                what=f"take back {first.agent}'s skills from '{start.label or start.skill}'",
-            )
-        elif kind is Action.RETRY:
-            self.request("retry", first.id, what=f"retry {names}")
-        elif kind is Action.SKIP:
-            self.request("skip", first.id, what=f"skip {names}")
-        elif kind is Action.BARRIER:
-            self.request("add_barrier", [s.id for s in selected], what=f"start {names} together")
-        elif kind is Action.DELETE_BARRIER:
-            barriers = {b.id for s in selected if (b := view.barrier_of(s.id)) is not None}
-            for barrier_id in sorted(barriers):
-                self.request("delete_barrier", barrier_id, what=f"remove barrier of {names}")
+            return
+        agent = selected[0].agent
+        last = max(view.position(s) for s in selected)
+        sending = [s for s in view.view(agent).editable if view.position(s) <= last]
+        if self._barriers_ok(sending):
+            what = f"send {agent}'s plan up to {names}"
+            self.call(lambda c: c.synchronize, what)(agent, sending[-1].id)
+
+    def _unsync(self, _: Action, selected: Sequence[SkillInstance], names: str) -> None:
+        start = min(selected, key=self._view.position)
+        what = f"take back {start.agent}'s skills from '{start.label or start.skill}'"
+        self.call(lambda c: c.unsynchronize, what)(start.agent, start.id)
+
+    def _resolve(self, kind: Action, selected: Sequence[SkillInstance], names: str) -> None:
+        if kind is Action.RETRY:
+            self.call(lambda c: c.retry, f"retry {names}")(selected[0].id)
+        else:
+            self.call(lambda c: c.skip, f"skip {names}")(selected[0].id)
+
+    def _barrier(self, _: Action, selected: Sequence[SkillInstance], names: str) -> None:
+        self.call(lambda c: c.add_barrier, f"start {names} together")([s.id for s in selected])
+
+    def _delete_barrier(self, _: Action, selected: Sequence[SkillInstance], names: str) -> None:
+        barriers = {b.id for s in selected if (b := self._view.barrier_of(s.id)) is not None}
+        for barrier_id in sorted(barriers):
+            self.call(lambda c: c.delete_barrier, f"remove barrier of {names}")(barrier_id)
 
     def robot_action(self, agent: str | None, kind: RobotAction) -> None:
         """Run ``kind`` on ``agent`` (None: every robot), if it is legal now."""
@@ -112,11 +138,11 @@ class Dispatcher:
             self.send_team(whole_team(self._view))
         elif kind is RobotAction.SYNC_ALL and agent is not None:
             if self._barriers_ok(self._view.view(agent).editable):
-                self.request("synchronize", agent, None, what=f"send {agent}'s whole plan")
+                self.call(lambda c: c.synchronize, f"send {agent}'s whole plan")(agent, None)
         elif kind is RobotAction.UNSYNC_ALL and agent is not None:
-            self.request("unsynchronize", agent, None, what=f"take back {agent}'s plan")
-        elif kind in CONTROL_WORDS:
-            self.request("control", CONTROL_WORDS[kind], agent, what=f"{kind.value} {who}")
+            self.call(lambda c: c.unsynchronize, f"take back {agent}'s plan")(agent, None)
+        elif kind in CONTROLS:
+            self.call(lambda c: c.control, f"{kind.value} {who}")(CONTROLS[kind], agent)
 
     def send_team(self, uploads: dict[str, str | None]) -> None:
         """Send several robots' plans in one change, after one question listing every warning."""
@@ -126,7 +152,8 @@ class Dispatcher:
         text, warnings = team_question(self._view, send)
         if self.confirm_team(text, warnings):
             robots = ", ".join(send.sending)
-            self.request("synchronize_team", dict(send.uploads), what=f"send the plans of {robots}")
+            what = f"send the plans of {robots}"
+            self.call(lambda c: c.synchronize_team, what)(dict(send.uploads))
 
     def _barriers_ok(self, sending: Sequence[SkillInstance]) -> bool:
         warnings = alerts.barrier_warnings(self._view, sending)

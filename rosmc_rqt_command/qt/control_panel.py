@@ -18,8 +18,8 @@ from python_qt_binding.QtWidgets import (
     QWidget,
 )
 
+from ..core.legality import Action, RobotAction
 from .actions import CommandActions
-from .legality import Action, RobotAction
 
 # Three to a row, so the panel stays narrow and the schedule gets the width.
 SKILL_ROWS = (

@@ -13,9 +13,9 @@ from collections.abc import Callable
 from python_qt_binding.QtCore import QObject
 from python_qt_binding.QtWidgets import QWidget
 
+from ..core.mission_view import MissionView
+from ..core.requests import Answer, Request, ask
 from .actions import CommandActions
-from .mission_view import MissionView
-from .requests import Answer, Request
 
 # The window's requests whose effect undo can take back.
 UNDOABLE = frozenset(
@@ -24,6 +24,7 @@ UNDOABLE = frozenset(
         "edit_skill",
         "delete_skills",
         "reorder",
+        "move_skills",
         "add_barrier",
         "delete_barrier",
         "add_marker",
@@ -32,7 +33,6 @@ UNDOABLE = frozenset(
         "delete_marker",
     }
 )
-UNDO_OPERATION = "undo"
 
 
 class UndoHistory(QObject):  # type: ignore[misc]
@@ -103,8 +103,7 @@ class UndoHistory(QObject):  # type: ignore[misc]
 
         self._waiting = True
         self._update()
-        request = Request(UNDO_OPERATION, (revision,), {}, words, self._view.revision, answered)
-        self._send(request)
+        self._send(ask(lambda c: c.undo, words, self._view.revision, answered)(revision))
 
     def set_read_only(self, read_only: bool) -> None:
         """A window that follows a replay undoes nothing."""

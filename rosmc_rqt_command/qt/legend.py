@@ -9,7 +9,7 @@ from python_qt_binding.QtWidgets import QHBoxLayout, QLabel, QWidget
 
 from rosmc_server.core import SkillStatus
 
-from . import presentation
+from ..core import presentation
 
 # (words, background, text colour) in the order a skill lives through them.
 ENTRIES = (

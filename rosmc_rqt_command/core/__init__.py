@@ -1,0 +1,1 @@
+"""The command GUI without Qt or ROS: view state, legality views, requests, phrasing."""

@@ -1,0 +1,1 @@
+"""The command GUI's Qt models and widgets (no rospy: the ROS bridge feeds them)."""

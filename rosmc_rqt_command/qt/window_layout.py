@@ -1,0 +1,102 @@
+"""Where the command window's parts sit: menus, banner, schedule on the left, panels right."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from python_qt_binding.QtCore import Qt
+from python_qt_binding.QtWidgets import QLabel, QMenuBar, QSplitter, QVBoxLayout, QWidget
+
+from .actions import CommandActions
+from .control_panel import ControlPanel
+from .legend import StatusLegend
+from .message_area import MessageArea
+from .parameter_panel import ParameterPanel
+from .schedule_widget import ScheduleWidget
+from .science_strip import ScienceStrip
+from .site_strip import SiteStrip
+from .team_bar import TeamBar
+from .undo_history import UndoHistory
+
+FILE_ITEMS = ("new", "open", "open_server", None, "save", "save_as", "save_server")
+BANNER_STYLE = "QLabel { background:#fde2e1; color:#8a0010; padding:4px; }"
+
+
+@dataclass(frozen=True)
+class Panels:
+    """The window's parts that the layout places (made by the window)."""
+
+    actions: CommandActions
+    history: UndoHistory
+    schedule: ScheduleWidget
+    team: TeamBar
+    parameters: ParameterPanel
+    control: ControlPanel
+    messages: MessageArea
+
+
+@dataclass(frozen=True)
+class Layout:
+    """What the layout made around the panels."""
+
+    menu_bar: QMenuBar
+    banner: QLabel
+    science: ScienceStrip
+    site: SiteStrip
+    legend: StatusLegend
+    splitter: QSplitter
+
+
+def lay_out(window: QWidget, panels: Panels) -> Layout:
+    """Place ``panels`` in ``window`` under a menu bar and a banner."""
+    menu_bar = _menus(window, panels)
+    banner = QLabel()
+    banner.setObjectName("banner")
+    banner.setWordWrap(True)
+    banner.setStyleSheet(BANNER_STYLE)
+    right = QSplitter(Qt.Vertical)
+    for panel in (panels.parameters, panels.control, panels.messages):
+        right.addWidget(panel)
+    right.setStretchFactor(0, 3)
+    right.setStretchFactor(2, 1)
+    right.setMaximumWidth(370)
+    science, site, legend = ScienceStrip(), SiteStrip(), StatusLegend()
+    left = QWidget()
+    left_layout = QVBoxLayout(left)
+    left_layout.setContentsMargins(0, 0, 0, 0)
+    left_layout.setSpacing(2)
+    for widget, stretch in ((science, 0), (site, 0), (panels.team, 0), (panels.schedule, 1)):
+        left_layout.addWidget(widget, stretch)
+    left_layout.addWidget(legend)
+    splitter = QSplitter(Qt.Horizontal)
+    splitter.addWidget(left)
+    splitter.addWidget(right)
+    splitter.setStretchFactor(0, 1)
+    splitter.setStretchFactor(1, 0)
+    splitter.setSizes([1230, 370])
+    layout = QVBoxLayout(window)
+    layout.setContentsMargins(2, 2, 2, 2)
+    layout.setMenuBar(menu_bar)
+    layout.addWidget(banner)
+    layout.addWidget(splitter, 1)
+    return Layout(menu_bar, banner, science, site, legend, splitter)
+
+
+def _menus(window: QWidget, panels: Panels) -> QMenuBar:
+    actions = panels.actions
+    menu_bar = QMenuBar(window)
+    file_menu = menu_bar.addMenu("&File")
+    for name in FILE_ITEMS:
+        if name is None:
+            file_menu.addSeparator()
+        else:
+            file_menu.addAction(actions.file[name])
+    menu_bar.addMenu("&Edit").addActions([panels.history.undo_action, panels.history.redo_action])
+    mission_menu = menu_bar.addMenu("&Mission")
+    mission_menu.addActions(list(actions.skill.values()))
+    mission_menu.addSeparator()
+    mission_menu.addActions(list(actions.all_robots.values()))
+    mission_menu.addSeparator()
+    mission_menu.addAction(actions.refresh)
+    mission_menu.addAction(actions.clear_selection)
+    return menu_bar
