@@ -15,11 +15,11 @@ from rosmc_server.interface import (
     ROBOT_COMMANDS_TOPIC,
     ROBOT_REPORTS_TOPIC,
 )
-from rosmc_server.recording import _format as fmt
-from rosmc_server.recording._codec import RosMessage, serialize
-from rosmc_server.recording._files import journal_parts, part_path
-from rosmc_server.recording._part import PartFile
-from rosmc_server.recording._resume import reopen
+from rosmc_server.recording._mcap import records as fmt
+from rosmc_server.recording._mcap.codec import RosMessage, serialize
+from rosmc_server.recording._mcap.files import journal_parts, part_path
+from rosmc_server.recording._mcap.reopen import reopen
+from rosmc_server.recording._mcap.write import PartFile
 from rosmc_server.recording.channels import JOURNAL_TOPICS, TELEMETRY_TOPICS
 from rosmc_server.recording.errors import JournalError
 from rosmc_server.recording.reader import JournalResult
@@ -68,7 +68,7 @@ class JournalWriter:
     complete, indexed MCAP file. Telemetry is skipped, and robot reports refused, near a
     full disk (:mod:`.space`); ask :meth:`require_space` before applying a change. A
     journal that grows past ``part_bytes`` goes on in part files beside the first (see
-    :mod:`._files`). Open one with :meth:`create` or :meth:`resume`. Thread-safe:
+    :mod:`._mcap.files`). Open one with :meth:`create` or :meth:`resume`. Thread-safe:
     appends from several threads are written one after the other. An advisory file
     lock keeps a second writer (in any process) off the same file.
     """
@@ -132,7 +132,7 @@ class JournalWriter:
     ) -> "JournalWriter":
         """Recover a journal and continue it.
 
-        Reads the journal's last file (and the one before if needed, see :mod:`._resume`),
+        Reads the journal's last file (and the one before if needed, see :mod:`._mcap.reopen`),
         keeps every intact record and continues after the last one; a torn tail is cut off
         (and saved beside the file as ``<name>.dropped-<offset>``), as is the summary of a
         closed file. A last file with damage is left untouched and the journal goes on in
