@@ -31,7 +31,8 @@ steer it through the service <prefix>/rosmc/replay/control
 
 AT_HELP = """\
 WHEN is seconds since the recording started (12.5) or a revision (r42).
-The mission shown is the one the mission server held then."""
+The mission shown is the one the mission server held then; a time past
+the recording's end is refused, like a revision it does not hold."""
 
 
 def add_commands(command: _Command) -> None:
@@ -111,22 +112,20 @@ def replay(ctx: Context) -> int:
 
 def at(ctx: Context) -> int:
     """Print the mission at a time (seconds since the start) or a revision (rN)."""
+    from ..recording.diff import resolve_when
     from ..recording.history import MissionHistory
     from ..text import format_markers, format_schedule, mission_to_json
     from .context import UsageError
 
     history = _history(MissionHistory.from_journal(ctx.args.file))
     when = ctx.args.when.strip()
-    match = re.fullmatch(r"[rR](\d+)", when)
-    if match:
-        state = history.at_revision(int(match.group(1)))
-    else:
+    if not re.fullmatch(r"[rR]\d+", when):
         try:
-            seconds = float(when)
+            float(when)
         except ValueError:
             raise UsageError(f"WHEN must be seconds or rN, got {when!r}") from None
-        state = history.at_time(seconds)
-        when = f"{seconds:g} s"
+    moment = resolve_when(history, when)  # refuses a revision or time it does not hold
+    state, when = moment.state, moment.label
     info = next(r for r in history.revisions if r.revision == state.revision)
     changed = history.seconds(info.log_time)
     last = f"{info.kind.name}: {info.summary}" if info.kind else "the recorded snapshot"
