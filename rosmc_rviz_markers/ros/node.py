@@ -20,14 +20,13 @@ ROS interface (every name behind ``~ns``):
     and, through the follower, ``/rosmc/mission_events`` and ``/rosmc/agent_states``.
     Calls the operator services ``/rosmc/*`` (``get_library``, ``get_mission``, mutations).
     Parameters: ``~ns`` (""; ``/replay`` follows a replay), ``~read_only`` (default: ns set),
-    ``~follow_tf`` (default: ns empty), ``~library`` (library file when the followed
-    server serves none, as a replay), ``~commit_delay`` (0.5 s).
+    ``~follow_tf`` (default: ns empty), ``~library`` (a library file to use instead of
+    the one the followed server or replay serves), ``~commit_delay`` (0.5 s).
 """
 
 from __future__ import annotations
 
 import logging
-import os
 import sys
 import threading
 import time
@@ -59,9 +58,6 @@ _log = logging.getLogger(__name__)
 SERVER_ICON = "mission_server"  # the status text of the server itself (icons/mission_server)
 SERVER_NOTE_AT = (0.0, 0.0, 3.0)  # just above the lander (the map origin), below its score
 SERVER_NOTE_TEXT = 0.8  # letter height (m): as large as the site's region labels
-DEFAULT_LIBRARY = os.path.join(
-    os.path.dirname(__file__), "..", "..", "rosmc_server", "config", "mars_team.yaml"
-)
 
 
 @dataclass(frozen=True)
@@ -153,9 +149,9 @@ class MarkerNode:
         """Fetch the library, follow the mission and start publishing."""
         self._worker.start()
         self.follower.start()
-        if self.config.library or self.config.read_only:
-            self._take_library(load_library(self.config.library or DEFAULT_LIBRARY))
-        else:
+        if self.config.library:
+            self._take_library(load_library(self.config.library))
+        else:  # the server's, or a replay's: the library the recording ran with
             self.follower.library(self._on_library)
 
     def close(self) -> None:
