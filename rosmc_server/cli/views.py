@@ -103,9 +103,7 @@ def watch(ctx: Context) -> int:
     return 0
 
 
-def _watch_loop(
-    ctx: Context, watcher: MissionWatch, interval: float | None, revision: int
-) -> None:
+def _watch_loop(ctx: Context, watcher: MissionWatch, interval: float | None, revision: int) -> None:
     """Print the events after ``revision`` (those heard before the fetch are in it)."""
     remaining = ctx.args.count
     last_states = -float("inf")
