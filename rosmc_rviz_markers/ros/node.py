@@ -53,6 +53,7 @@ from .adapter import MarkerServer
 from .convert import icon_markers, interactive_marker_msg, pose_msg
 from .coverage_layer import CoverageLayer
 from .interaction import Interaction
+from .tf_presence import TfPresence
 
 _log = logging.getLogger(__name__)
 SERVER_ICON = "mission_server"  # the status text of the server itself (icons/mission_server)
@@ -109,6 +110,7 @@ class MarkerNode:
         )
         self.interaction = Interaction(self, config)
         self.coverage = CoverageLayer(config.ns)  # radio coverage and last-link marks
+        self._tf: TfPresence | None = None  # which agents have TF (follow_tf only)
         self._worker = threading.Thread(target=self._run, name="rosmc-markers", daemon=True)
 
     # -- what the interaction layer reads ---------------------------------------------------------
@@ -161,6 +163,8 @@ class MarkerNode:
             self._wake.notify()
         self.interaction.close()
         self.follower.close()
+        if self._tf is not None:
+            self._tf.close()
 
     def _on_library(self, outcome: Outcome[Library]) -> None:
         if outcome.value is None:
@@ -176,7 +180,18 @@ class MarkerNode:
             library, read_only=self.config.read_only, follow_tf=self.config.follow_tf
         )
         self._unsubscribe.append(self.mirror.subscribe(self._on_update))
+        if self.config.follow_tf and self._tf is None:
+            self._tf = TfPresence(self._agents, self._on_tf_missing)
         _log.info("markers for library '%s' (%d agents)", library.name, len(library.agents))
+
+    def _agents(self) -> list[str]:
+        scene = self._scene
+        return scene.agents() if scene is not None else []
+
+    def _on_tf_missing(self, agents: frozenset[str]) -> None:
+        scene = self._scene
+        if scene is not None:
+            self.mark(scene.set_tf_missing(agents))
 
     def _on_server_restart(self, revision: int) -> None:
         self._server_note = (
@@ -302,10 +317,9 @@ class MarkerNode:
         out: list[Marker] = []
         for index, (agent, rows, point, level) in enumerate(self._blocks(scene, statuses, state)):
             frame, position = base_link(agent), (0.0, 0.0, 0.0)
-            if not self.config.follow_tf:
+            if not self.config.follow_tf or agent in scene.tf_missing:
                 frame = MAP_FRAME
-                if point is not None:
-                    position = point
+                position = point or scene.agent_spec(agent, state, statuses.get(agent)).position
             out += icon_markers(agent, rows, frame, position, index * 10, level)
         said = (self._server_note, self._journal_note)
         notes = tuple(IconRow("server", text, WARN) for text in said if text)
