@@ -176,13 +176,29 @@ class MarkerNode:
         self._take_library(outcome.value)
 
     def _take_library(self, library: Library) -> None:
-        self._scene = Scene(
-            library, read_only=self.config.read_only, follow_tf=self.config.follow_tf
-        )
-        self._unsubscribe.append(self.mirror.subscribe(self._on_update))
+        old = self._scene
+        if old is not None and old.library == library:
+            return  # a restarted server with the same library
+        scene = Scene(library, read_only=self.config.read_only, follow_tf=self.config.follow_tf)
+        if self._tf is not None:
+            scene.set_tf_missing(self._tf.last)
+        self._scene = scene
+        if old is None:
+            self._unsubscribe.append(self.mirror.subscribe(self._on_update))
+        else:  # another library: the old agents' markers go, everything is drawn anew
+            self._forget_published()
+            self.mark(Touched(everything=True))
         if self.config.follow_tf and self._tf is None:
             self._tf = TfPresence(self._agents, self._on_tf_missing)
         _log.info("markers for library '%s' (%d agents)", library.name, len(library.agents))
+
+    def _forget_published(self) -> None:
+        with self._lock:
+            for name in self._published:
+                self.server.erase(name)
+            self._published.clear()
+            self._groups.clear()
+            self.server.apply()
 
     def _agents(self) -> list[str]:
         scene = self._scene
@@ -199,6 +215,9 @@ class MarkerNode:
         )
         _log.warning("%s", self._server_note)
         self.mark(Touched(icons={SERVER_ICON}))
+        if not self.config.library:  # it may run with another library: follow it
+            self.interaction.forget_library()
+            self.follower.library(self._on_library, fresh=True)
 
     def _on_journal_alert(self, alert: str) -> None:
         self._journal_note = f"journal: {alert}" if alert else ""

@@ -53,8 +53,13 @@ class TfPresence:
         self._thread = threading.Thread(target=self._run, name="rosmc-tf-presence", daemon=True)
         self._thread.start()
 
-    def missing(self) -> frozenset[str]:
+    @property
+    def last(self) -> frozenset[str]:
         """The agents whose frame was missing at the last look."""
+        return self._missing
+
+    def missing(self) -> frozenset[str]:
+        """The agents whose frame is missing now."""
         frames = {agent: base_link(agent) for agent in self._agents()}
         latest = rospy.Time(0)
         return frozenset(

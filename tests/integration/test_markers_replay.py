@@ -35,7 +35,12 @@ from rosmc_rviz_markers import topics
 from rosmc_server.core import MarkerType, TaskMarker
 from rosmc_server.core import Pose as MissionPose
 from rosmc_server.ros.client import MissionClient
-from tests.integration.markers_fixtures import MarkerNodeProcess, label_of, wait_for
+from tests.integration.markers_fixtures import (
+    MarkerNodeProcess,
+    label_of,
+    scout_library,
+    wait_for,
+)
 
 pytest_plugins = ["tests.integration.server_fixtures"]
 
@@ -48,10 +53,7 @@ READ_ONLY_MODES = (InteractiveMarkerControl.NONE, InteractiveMarkerControl.BUTTO
 @pytest.fixture
 def journal(start_server: Any, tmp_path: Path) -> Path:
     """The journal of a short planning session on a real server with a custom library."""
-    shipped = (REPO / "rosmc_server" / "config" / "mars_team.yaml").read_text()
-    library = tmp_path / "scouts.yaml"
-    library.write_text(shipped.replace("\n  drone: {", "\n  scout: {"))
-    server = start_server(library=str(library))
+    server = start_server(library=str(scout_library(tmp_path)))
     client = MissionClient(10.0)
     try:
         client.get_mission()
