@@ -24,6 +24,8 @@ AGENT_STATES_TOPIC = f"{NAMESPACE}/agent_states"  # rosmc/AgentStates, steady ra
 ROBOT_REPORTS_TOPIC = f"{NAMESPACE}/robot_reports"  # rosmc/RobotReport
 # Journaled only: each command for a robot, when asked and when delivered (or cancelled).
 ROBOT_COMMANDS_TOPIC = f"{NAMESPACE}/robot_commands"  # rosmc/CommandRecord
+# Journaled only: the skill library the server ran with (a replay serves it as get_library).
+LIBRARY_TOPIC = f"{NAMESPACE}/library"  # rosmc/Library
 # Published by robots (or the simulator), one topic per agent.
 TELEMETRY_TOPIC = "/{agent}/telemetry"  # rosmc/Telemetry
 # Published by the robots or the simulator, and journaled by the server (low rate) so that a

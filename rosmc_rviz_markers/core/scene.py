@@ -11,7 +11,7 @@ the markers whose label moved are republished.
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from rosmc_server.core.agent_status import AgentStatus
 from rosmc_server.core.library import AgentKind, Library
@@ -36,6 +36,8 @@ from .specs import MarkerSpec, agent_spec, describe, task_label, task_specs
 from .styling import is_locked, marker_use
 
 LABEL_STEP = 0.25  # task labels move south by whole steps (m)
+UNHEARD_AT = (-5.0, 3.0)  # where agents without TF or a reported pose wait (m, map frame),
+UNHEARD_STEP = 3.0  # side by side southwards, beside the lander at the origin
 
 
 @dataclass(frozen=True)
@@ -66,7 +68,10 @@ class Scene:
         library: The mission's skill library.
         read_only: A replay view: no menus, nothing draggable.
         follow_tf: Agents follow their TF frames (live); otherwise they are placed in the
-            map frame at the pose their status reports (a replay has no TF).
+            map frame at the pose their status reports (a replay has no TF). An agent
+            whose frame is missing (:meth:`set_tf_missing`: not started, powered off) is
+            placed so too, labelled "not heard": rviz holds back every marker of an update
+            until it can transform each one, so one missing frame would hide them all.
     """
 
     def __init__(self, library: Library, *, read_only: bool = False, follow_tf: bool = True):
@@ -75,6 +80,12 @@ class Scene:
         self.follow_tf = follow_tf
         self.selection = Selection()
         self.label_south: dict[str, float] = {}  # task marker -> its label moved south (m)
+        self.tf_missing: frozenset[str] = frozenset()  # agents whose TF frame is not there
+
+    def set_tf_missing(self, agents: Iterable[str]) -> Touched:
+        """Take the agents whose TF frame is missing; returns those whose body changes."""
+        old, self.tf_missing = self.tf_missing, frozenset(agents)
+        return Touched(agents=set(old ^ self.tf_missing), icons=set(old ^ self.tf_missing))
 
     # -- which markers an update touches -------------------------------------------------------
     def touched(self, update: MirrorUpdate) -> Touched:
@@ -105,7 +116,7 @@ class Scene:
                 out.markers.add(change.marker.name)
             elif isinstance(change, AgentStatusChanged):
                 out.icons.add(change.new.agent)
-                if not self.follow_tf:
+                if not self.follow_tf or change.new.agent in self.tf_missing:
                     out.agents.add(change.new.agent)
         return out
 
@@ -144,13 +155,17 @@ class Scene:
         highlighted = state is not None and any(
             state.has_skill(s) and state.skill(s).agent == agent for s in self.selection.skill_ids
         )
+        unheard = self.follow_tf and agent in self.tf_missing
         frame, position, yaw = None, (0.0, 0.0, 0.0), 0.0
-        if not self.follow_tf:
+        if not self.follow_tf or unheard:
             frame = MAP_FRAME
             if status is not None and status.pose is not None:
                 position = (status.pose.x, status.pose.y, status.pose.z)
                 yaw = status.pose.yaw
-        return agent_spec(
+            elif unheard:
+                index = [a for a in self.agents() if a in self.tf_missing].index(agent)
+                position = (UNHEARD_AT[0], UNHEARD_AT[1] - UNHEARD_STEP * index, 0.0)
+        made = agent_spec(
             agent,
             geo.body_kind(spec.model),
             menu,
@@ -160,6 +175,7 @@ class Scene:
             position=position,
             yaw=yaw,
         )
+        return replace(made, description=f"{agent}: not heard") if unheard else made
 
     def relayout(self, state: MissionState, blocks: Sequence[Label] = ()) -> set[str]:
         """Lay the task markers' labels out clear of each other and of the robots' status

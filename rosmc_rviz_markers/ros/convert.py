@@ -5,7 +5,6 @@ from __future__ import annotations
 import rospy
 from geometry_msgs.msg import Point as PointMsg
 from geometry_msgs.msg import Pose, Quaternion
-from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import (
     InteractiveMarker,
     InteractiveMarkerControl,
@@ -14,6 +13,7 @@ from visualization_msgs.msg import (
     MenuEntry,
 )
 
+from rosmc_server.conversions.primitives import color_msg, primitive_msg
 from rosmc_server.core.frames import quaternion_from_rpy, yaw_of
 
 from ..core import geometry as geo
@@ -22,26 +22,6 @@ from ..core.menus import FlatMenu
 from ..core.specs import ControlSpec, MarkerSpec
 
 ICONS_NS = "icons"
-
-
-def color_msg(color: geo.Color) -> ColorRGBA:
-    """A colour as ``std_msgs/ColorRGBA``."""
-    return ColorRGBA(color.r, color.g, color.b, color.a)
-
-
-def primitive_msg(primitive: geo.Primitive, ident: int) -> Marker:
-    """One primitive as a ``visualization_msgs/Marker`` (frame and stamp left to rviz)."""
-    marker = Marker()
-    marker.id = ident
-    marker.type = int(primitive.shape)
-    marker.action = Marker.ADD
-    marker.pose.position = PointMsg(*primitive.position)
-    marker.pose.orientation = Quaternion(*primitive.orientation)
-    marker.scale.x, marker.scale.y, marker.scale.z = primitive.scale
-    marker.color = color_msg(primitive.color)
-    marker.points = [PointMsg(*p) for p in primitive.points]
-    marker.text = primitive.text
-    return marker
 
 
 def pose_msg(position: geo.Point, yaw: float) -> Pose:

@@ -78,6 +78,10 @@ class Interaction:
                     rospy.Subscriber(topics.topic(name, config.ns), kind, self._guard(callback))
                 )
 
+    def forget_library(self) -> None:
+        """Check requests against the library fetched anew (the server restarted)."""
+        self._client.submit(lambda client: client.forget_library())
+
     def close(self) -> None:
         """Stop the worker, the timers and the subscribers."""
         for subscriber in self._subscribers:

@@ -20,14 +20,13 @@ ROS interface (every name behind ``~ns``):
     and, through the follower, ``/rosmc/mission_events`` and ``/rosmc/agent_states``.
     Calls the operator services ``/rosmc/*`` (``get_library``, ``get_mission``, mutations).
     Parameters: ``~ns`` (""; ``/replay`` follows a replay), ``~read_only`` (default: ns set),
-    ``~follow_tf`` (default: ns empty), ``~library`` (library file when the followed
-    server serves none, as a replay), ``~commit_delay`` (0.5 s).
+    ``~follow_tf`` (default: ns empty), ``~library`` (a library file to use instead of
+    the one the followed server or replay serves), ``~commit_delay`` (0.5 s).
 """
 
 from __future__ import annotations
 
 import logging
-import os
 import sys
 import threading
 import time
@@ -54,14 +53,12 @@ from .config import MarkerNodeConfig
 from .convert import icon_markers, interactive_marker_msg, pose_msg
 from .coverage_layer import CoverageLayer
 from .interaction import Interaction
+from .tf_presence import TfPresence
 
 _log = logging.getLogger(__name__)
 SERVER_ICON = "mission_server"  # the status text of the server itself (icons/mission_server)
 SERVER_NOTE_AT = (0.0, 0.0, 3.0)  # just above the lander (the map origin), below its score
 SERVER_NOTE_TEXT = 0.8  # letter height (m): as large as the site's region labels
-DEFAULT_LIBRARY = os.path.join(
-    os.path.dirname(__file__), "..", "..", "rosmc_server", "config", "mars_team.yaml"
-)
 
 
 class MarkerNode:
@@ -90,6 +87,7 @@ class MarkerNode:
         )
         self.interaction = Interaction(self, config)
         self.coverage = CoverageLayer(config.ns)  # radio coverage and last-link marks
+        self._tf: TfPresence | None = None  # which agents have TF (follow_tf only)
         self._worker = threading.Thread(target=self._run, name="rosmc-markers", daemon=True)
 
     # -- what the interaction layer reads ---------------------------------------------------------
@@ -130,9 +128,9 @@ class MarkerNode:
         """Fetch the library, follow the mission and start publishing."""
         self._worker.start()
         self.follower.start()
-        if self.config.library or self.config.read_only:
-            self._take_library(load_library(self.config.library or DEFAULT_LIBRARY))
-        else:
+        if self.config.library:
+            self._take_library(load_library(self.config.library))
+        else:  # the server's, or a replay's: the library the recording ran with
             self.follower.library(self._on_library)
 
     def close(self) -> None:
@@ -142,6 +140,8 @@ class MarkerNode:
             self._wake.notify()
         self.interaction.close()
         self.follower.close()
+        if self._tf is not None:
+            self._tf.close()
 
     def _on_library(self, outcome: Outcome[Library]) -> None:
         if outcome.value is None:
@@ -153,11 +153,38 @@ class MarkerNode:
         self._take_library(outcome.value)
 
     def _take_library(self, library: Library) -> None:
-        self._scene = Scene(
-            library, read_only=self.config.read_only, follow_tf=self.config.follow_tf
-        )
-        self._unsubscribe.append(self.mirror.subscribe(self._on_update))
+        old = self._scene
+        if old is not None and old.library == library:
+            return  # a restarted server with the same library
+        scene = Scene(library, read_only=self.config.read_only, follow_tf=self.config.follow_tf)
+        if self._tf is not None:
+            scene.set_tf_missing(self._tf.last)
+        self._scene = scene
+        if old is None:
+            self._unsubscribe.append(self.mirror.subscribe(self._on_update))
+        else:  # another library: the old agents' markers go, everything is drawn anew
+            self._forget_published()
+            self.mark(Touched(everything=True))
+        if self.config.follow_tf and self._tf is None:
+            self._tf = TfPresence(self._agents, self._on_tf_missing)
         _log.info("markers for library '%s' (%d agents)", library.name, len(library.agents))
+
+    def _forget_published(self) -> None:
+        with self._lock:
+            for name in self._published:
+                self.server.erase(name)
+            self._published.clear()
+            self._groups.clear()
+            self.server.apply()
+
+    def _agents(self) -> list[str]:
+        scene = self._scene
+        return scene.agents() if scene is not None else []
+
+    def _on_tf_missing(self, agents: frozenset[str]) -> None:
+        scene = self._scene
+        if scene is not None:
+            self.mark(scene.set_tf_missing(agents))
 
     def _on_server_restart(self, revision: int) -> None:
         self._server_note = (
@@ -165,6 +192,9 @@ class MarkerNode:
         )
         _log.warning("%s", self._server_note)
         self.mark(Touched(icons={SERVER_ICON}))
+        if not self.config.library:  # it may run with another library: follow it
+            self.interaction.forget_library()
+            self.follower.library(self._on_library, fresh=True)
 
     def _on_journal_alert(self, alert: str) -> None:
         self._journal_note = f"journal: {alert}" if alert else ""
@@ -283,10 +313,9 @@ class MarkerNode:
         out: list[Marker] = []
         for index, (agent, rows, point, level) in enumerate(self._blocks(scene, statuses, state)):
             frame, position = base_link(agent), (0.0, 0.0, 0.0)
-            if not self.config.follow_tf:
+            if not self.config.follow_tf or agent in scene.tf_missing:
                 frame = MAP_FRAME
-                if point is not None:
-                    position = point
+                position = point or scene.agent_spec(agent, state, statuses.get(agent)).position
             out += icon_markers(agent, rows, frame, position, index * 10, level)
         said = (self._server_note, self._journal_note)
         notes = tuple(IconRow("server", text, WARN) for text in said if text)

@@ -1,4 +1,4 @@
-"""The recording commands: replay, at, timeline and tobag.
+"""The recording commands: replay, at, timeline, tobag and export.
 
 All but ``replay`` read the journal file only and work without a ROS master.
 Times are seconds since the recording started, as ``rosmc timeline`` draws them.
@@ -31,7 +31,15 @@ steer it through the service <prefix>/rosmc/replay/control
 
 AT_HELP = """\
 WHEN is seconds since the recording started (12.5) or a revision (r42).
-The mission shown is the one the mission server held then."""
+The mission shown is the one the mission server held then; a time past
+the recording's end is refused, like a revision it does not hold."""
+
+EXPORT_HELP = """\
+OUT.mcap holds every recorded topic in chunks with indexes and a summary,
+header stamps on the log clock, the robots drawn as markers in their TF
+frames (/rosmc/export/robots), and the mission as text: the schedule at
+every revision (/rosmc/export/schedule) and one line per change
+(/rosmc/export/changes)."""
 
 
 def add_commands(command: _Command) -> None:
@@ -73,6 +81,14 @@ def add_commands(command: _Command) -> None:
     tobag.add_argument("file", metavar="FILE", help="a mission journal (.mcap)")
     tobag.add_argument("bag", metavar="OUT.bag", help="the bag to write")
     tobag.add_argument("-f", "--force", action="store_true", help="overwrite OUT.bag")
+    export = command(
+        "export",
+        "write a recording as one indexed MCAP file for Foxglove and other MCAP tools",
+        EXPORT_HELP,
+    )
+    export.add_argument("file", metavar="FILE", help="a mission journal (.mcap)")
+    export.add_argument("out", metavar="OUT.mcap", help="the file to write")
+    export.add_argument("-f", "--force", action="store_true", help="overwrite OUT.mcap")
 
 
 def replay(ctx: Context) -> int:
@@ -111,22 +127,20 @@ def replay(ctx: Context) -> int:
 
 def at(ctx: Context) -> int:
     """Print the mission at a time (seconds since the start) or a revision (rN)."""
+    from ..recording.diff import resolve_when
     from ..recording.history import MissionHistory
     from ..text import format_markers, format_schedule, mission_to_json
     from .context import UsageError
 
     history = _history(MissionHistory.from_journal(ctx.args.file))
     when = ctx.args.when.strip()
-    match = re.fullmatch(r"[rR](\d+)", when)
-    if match:
-        state = history.at_revision(int(match.group(1)))
-    else:
+    if not re.fullmatch(r"[rR]\d+", when):
         try:
-            seconds = float(when)
+            float(when)
         except ValueError:
             raise UsageError(f"WHEN must be seconds or rN, got {when!r}") from None
-        state = history.at_time(seconds)
-        when = f"{seconds:g} s"
+    moment = resolve_when(history, when)  # refuses a revision or time it does not hold
+    state, when = moment.state, moment.label
     info = next(r for r in history.revisions if r.revision == state.revision)
     changed = history.seconds(info.log_time)
     last = f"{info.kind.name}: {info.summary}" if info.kind else "the recorded snapshot"
@@ -179,11 +193,26 @@ def tobag(ctx: Context) -> int:
     return 0
 
 
+def export(ctx: Context) -> int:
+    """Write the recording as one chunked, indexed MCAP file for Foxglove."""
+    from ..recording.export import export_recording
+
+    summary = export_recording(ctx.args.file, ctx.args.out, overwrite=ctx.args.force)
+    if summary.skipped:
+        print(f"rosmc: warning: {summary.skipped}", file=sys.stderr)
+    ctx.emit(
+        f"wrote {summary.path}: {summary.total} messages on {len(summary.counts)} topics",
+        {"path": str(summary.path), "counts": dict(summary.counts)},
+    )
+    return 0
+
+
 COMMANDS: dict[str, Callable[[Context], int]] = {
     "replay": replay,
     "at": at,
     "timeline": timeline,
     "tobag": tobag,
+    "export": export,
 }
 """The recording commands by name, for the dispatcher in :mod:`.main`."""
 

@@ -75,8 +75,12 @@ def markers(ctx: Context) -> int:
 
 
 def watch(ctx: Context) -> int:
-    """Print mission events (and robot states) until Ctrl-C or --count events."""
-    state = ctx.client.get_mission()  # fails fast (exit 3) if the server is not there
+    """Print mission events (and robot states) until Ctrl-C or --count events.
+
+    The revision it starts from is fetched once the subscriber is connected (as the
+    mirror does), so every event after it is heard: none falls between the two.
+    """
+    ctx.client.get_mission()  # fails fast (exit 3) if the server is not there
     init_node()
     interval = ctx.args.states
     watcher = MissionWatch(events=True, states=interval is not None)
@@ -85,12 +89,13 @@ def watch(ctx: Context) -> int:
             raise ServerUnavailable(
                 f"the mission server's topics did not connect within {ctx.client.timeout:g} s"
             )
+        state = ctx.client.get_mission()  # events up to here are in it; later ones are heard
         print(
             f"rosmc: watching mission events from revision {state.revision} (Ctrl-C to stop)",
             file=sys.stderr,
             flush=True,
         )
-        _watch_loop(ctx, watcher, interval)
+        _watch_loop(ctx, watcher, interval, state.revision)
     except KeyboardInterrupt:
         pass
     finally:
@@ -98,12 +103,22 @@ def watch(ctx: Context) -> int:
     return 0
 
 
-def _watch_loop(ctx: Context, watcher: MissionWatch, interval: float | None) -> None:
+def _watch_loop(ctx: Context, watcher: MissionWatch, interval: float | None, revision: int) -> None:
+    """Print the events after ``revision`` (those heard before the fetch are in it)."""
     remaining = ctx.args.count
     last_states = -float("inf")
+    printed = False
     while remaining is None or remaining > 0:
         event = watcher.next_event(timeout=0.2)
-        if event is not None:
+        if event is not None and (printed or event.revision > revision):
+            if event.revision > revision + 1:  # the server's publisher queue overflowed
+                print(
+                    f"rosmc: warning: revisions {revision + 1} to {event.revision - 1} were "
+                    "not heard; 'rosmc status' shows the mission",
+                    file=sys.stderr,
+                    flush=True,
+                )
+            revision, printed = event.revision, True
             _print_event(ctx, event)
             remaining = None if remaining is None else remaining - 1
         if interval is not None and time.monotonic() - last_states >= interval:

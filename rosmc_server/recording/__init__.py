@@ -4,9 +4,9 @@ The mission server appends each accepted change (``rosmc/MissionEvent``) and
 periodic full snapshots (``rosmc/Mission``) to an MCAP file in ROS 1 encoding
 with the ``rosmc`` message definitions embedded, so Foxglove and the ``mcap``
 tools read it; a long journal goes on in part files beside the first (see
-:mod:`._files`), which every reader follows. After a crash,
+:mod:`._mcap.files`), which every reader follows. After a crash,
 :meth:`JournalWriter.resume` recovers every intact record (skipping damaged
-bytes, see :mod:`._scan`) and continues the journal; :func:`latest_state` gives
+bytes, see :mod:`._mcap.scan`) and continues the journal; :func:`latest_state` gives
 the snapshot and events to rebuild the mission from, and the revisions lost.
 
 Typical use::
@@ -21,7 +21,7 @@ Typical use::
     state = latest_state(writer.recovered)
 """
 
-from rosmc_server.recording._files import default_journal_path
+from rosmc_server.recording._mcap.files import default_journal_path
 from rosmc_server.recording.channels import JOURNAL_TOPICS
 from rosmc_server.recording.errors import JournalError
 from rosmc_server.recording.reader import (

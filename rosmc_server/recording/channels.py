@@ -12,6 +12,7 @@ from typing import Final
 from rosmc_server.interface import (
     AGENT_STATES_TOPIC,
     EVENTS_TOPIC,
+    LIBRARY_TOPIC,
     MISSION_TOPIC,
     ROBOT_COMMANDS_TOPIC,
     ROBOT_REPORTS_TOPIC,
@@ -33,6 +34,7 @@ JOURNAL_TOPICS: Final[Mapping[str, str]] = MappingProxyType(
         # Added later, so last: older journals lack it and keep their channel ids.
         ROBOT_COMMANDS_TOPIC: "rosmc/CommandRecord",  # commands for robots: asked, delivered
         SITE_IN_FORCE_TOPIC: "rosmc/SiteInForce",  # the site map in force, its sender, when
+        LIBRARY_TOPIC: "rosmc/Library",  # the library the server ran with: once per part file
     }
 )
 """Every journal channel with the ROS message type it carries, in channel-id order."""
@@ -48,7 +50,13 @@ TELEMETRY_TOPICS: Final = (
 )
 """Channels of what the robots and the site did: written, never fsynced on their own."""
 
-LATCHED_TOPICS: Final = (MISSION_TOPIC, SCIENCE_TOPIC, WORLD_TOPIC, SITE_IN_FORCE_TOPIC)
+LATCHED_TOPICS: Final = (
+    MISSION_TOPIC,
+    SCIENCE_TOPIC,
+    WORLD_TOPIC,
+    SITE_IN_FORCE_TOPIC,
+    LIBRARY_TOPIC,
+)
 """Channels whose live publishers latch them (a replay and a converted bag latch them too)."""
 
 LIBRARY: Final = "rosmc-journal/1"

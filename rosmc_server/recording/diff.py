@@ -21,6 +21,7 @@ if TYPE_CHECKING:  # only for annotations: --help imports this module and stays 
     from .history import MissionHistory
 
 _T = TypeVar("_T")
+_SLACK = 1e-6  # seconds: a time printed to the nanosecond reads back a hair later
 _CLOCK = re.compile(r"(?:(\d+):)?(\d+):(\d+(?:\.\d*)?)")
 WHEN_HELP = (
     "rN (revision N), seconds since the start (90, 90s, 1:30, 1:02:03) "
@@ -77,7 +78,8 @@ def resolve_when(history: MissionHistory, text: str) -> Moment:
     """The mission at ``text`` (see :data:`WHEN_HELP`).
 
     Raises:
-        InvalidRequest: ``text`` is none of the accepted forms.
+        InvalidRequest: ``text`` is none of the accepted forms, or a time outside the
+            recording (before its start or after its end).
         NotFound: A revision the recording does not hold.
     """
     when = text.strip()
@@ -87,6 +89,11 @@ def resolve_when(history: MissionHistory, text: str) -> Moment:
         label = f"r{state.revision}"
     else:
         seconds = _seconds(history, when)
+        if not 0.0 <= seconds <= history.duration + _SLACK:
+            raise InvalidRequest(
+                f"{excerpt(when)} is outside the recording ({seconds:+.1f} s from its start; "
+                f"it lasts {history.duration:.1f} s)"
+            )
         state = history.at_time(seconds)
         label = when if "T" in when else f"{seconds:g} s"
     info = next(r for r in history.revisions if r.revision == state.revision)
@@ -108,13 +115,7 @@ def _seconds(history: MissionHistory, when: str) -> float:
         raise InvalidRequest(f"cannot read {excerpt(when)} as a time: give {WHEN_HELP}") from None
     if moment.tzinfo is None:
         moment = moment.replace(tzinfo=UTC)
-    offset = history.seconds(round(moment.timestamp() * 1e9))
-    if not 0.0 <= offset <= history.duration:
-        raise InvalidRequest(
-            f"{excerpt(when)} is outside the recording ({offset:+.1f} s from its start; "
-            f"it lasts {history.duration:.1f} s)"
-        )
-    return offset
+    return history.seconds(round(moment.timestamp() * 1e9))
 
 
 def diff_missions(before: Moment, after: Moment) -> MissionDiff:

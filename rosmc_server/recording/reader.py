@@ -6,9 +6,9 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from rosmc_server.interface import EVENTS_TOPIC, MISSION_TOPIC
-from rosmc_server.recording import _scan
-from rosmc_server.recording._codec import Decoder, RosMessage
-from rosmc_server.recording._files import journal_parts
+from rosmc_server.recording._mcap import scan as _scan
+from rosmc_server.recording._mcap.codec import Decoder, RosMessage
+from rosmc_server.recording._mcap.files import journal_parts
 from rosmc_server.recording.channels import LIBRARY
 from rosmc_server.recording.damage import Damage
 from rosmc_server.recording.errors import JournalError

@@ -11,15 +11,16 @@ from rosmc_server.core.errors import StorageFull
 from rosmc_server.interface import (
     AGENT_STATES_TOPIC,
     EVENTS_TOPIC,
+    LIBRARY_TOPIC,
     MISSION_TOPIC,
     ROBOT_COMMANDS_TOPIC,
     ROBOT_REPORTS_TOPIC,
 )
-from rosmc_server.recording import _format as fmt
-from rosmc_server.recording._codec import RosMessage, serialize
-from rosmc_server.recording._files import journal_parts, part_path
-from rosmc_server.recording._part import PartFile
-from rosmc_server.recording._resume import reopen
+from rosmc_server.recording._mcap import records as fmt
+from rosmc_server.recording._mcap.codec import RosMessage, serialize
+from rosmc_server.recording._mcap.files import journal_parts, part_path
+from rosmc_server.recording._mcap.reopen import reopen
+from rosmc_server.recording._mcap.write import PartFile
 from rosmc_server.recording.channels import JOURNAL_TOPICS, TELEMETRY_TOPICS
 from rosmc_server.recording.errors import JournalError
 from rosmc_server.recording.reader import JournalResult
@@ -68,7 +69,7 @@ class JournalWriter:
     complete, indexed MCAP file. Telemetry is skipped, and robot reports refused, near a
     full disk (:mod:`.space`); ask :meth:`require_space` before applying a change. A
     journal that grows past ``part_bytes`` goes on in part files beside the first (see
-    :mod:`._files`). Open one with :meth:`create` or :meth:`resume`. Thread-safe:
+    :mod:`._mcap.files`). Open one with :meth:`create` or :meth:`resume`. Thread-safe:
     appends from several threads are written one after the other. An advisory file
     lock keeps a second writer (in any process) off the same file.
     """
@@ -80,9 +81,12 @@ class JournalWriter:
         options: JournalOptions,
         recovered: JournalResult | None = None,
         damaged: bool = False,
+        library: RosMessage | None = None,
     ) -> None:
         """Wrap an open part file; use create or resume instead."""
         self._base = base
+        self._library = library
+        self._library_part = 0  # the part file the library was last written to
         self._part = part
         self._options = options
         self._channels = part.section.channel_ids()
@@ -104,8 +108,12 @@ class JournalWriter:
         snapshot: RosMessage,
         log_time_ns: int,
         options: JournalOptions = JournalOptions(),
+        library: RosMessage | None = None,
     ) -> "JournalWriter":
         """Start a new journal that opens with ``snapshot``; never overwrites a file.
+
+        ``library`` (``rosmc/Library``), the library the server runs with, follows the first
+        snapshot of every part file, so that a replay shows the recording with it.
 
         Raises:
             JournalError: The file (or a part file of that name) exists or cannot be written.
@@ -117,7 +125,8 @@ class JournalWriter:
                 f"cannot open journal {path}: part files of an older journal of that name "
                 f"exist ({parts[1][1].name})"
             )
-        writer = cls(path, PartFile.create(path, 1, options.chunked, options.fsync), options)
+        part = PartFile.create(path, 1, options.chunked, options.fsync)
+        writer = cls(path, part, options, library=library)
         try:
             writer.append_snapshot(snapshot, log_time_ns)
         except JournalError:
@@ -128,11 +137,15 @@ class JournalWriter:
 
     @classmethod
     def resume(
-        cls, path: str | Path, options: JournalOptions = JournalOptions()
+        cls,
+        path: str | Path,
+        options: JournalOptions = JournalOptions(),
+        library: RosMessage | None = None,
     ) -> "JournalWriter":
-        """Recover a journal and continue it.
+        """Recover a journal and continue it (``library``: as for :meth:`create`, written
+        with the next snapshot).
 
-        Reads the journal's last file (and the one before if needed, see :mod:`._resume`),
+        Reads the journal's last file (and the one before if needed, see :mod:`._mcap.reopen`),
         keeps every intact record and continues after the last one; a torn tail is cut off
         (and saved beside the file as ``<name>.dropped-<offset>``), as is the summary of a
         closed file. A last file with damage is left untouched and the journal goes on in
@@ -143,7 +156,9 @@ class JournalWriter:
             JournalError: The file is missing, locked by another writer, or not a journal.
         """
         reopened = reopen(Path(path), options.chunked, options.fsync)
-        writer = cls(reopened.base, reopened.part, options, reopened.recovered, reopened.damaged)
+        writer = cls(
+            reopened.base, reopened.part, options, reopened.recovered, reopened.damaged, library
+        )
         for record in reopened.recovered.records:
             if record.topic == MISSION_TOPIC:
                 writer._events_since_snapshot = 0
@@ -208,8 +223,15 @@ class JournalWriter:
         self._append(EVENTS_TOPIC, event, log_time_ns, sync=True)
 
     def append_snapshot(self, mission: RosMessage, log_time_ns: int) -> None:
-        """Record a full ``rosmc/Mission`` snapshot; durable when this returns."""
+        """Record a full ``rosmc/Mission`` snapshot (and the library, once per part file);
+        durable when this returns."""
         self._append(MISSION_TOPIC, mission, log_time_ns, sync=True)
+        with self._lock:
+            part = self._part.number
+            due = self._library is not None and self._library_part != part
+            self._library_part = part
+        if due:
+            self._append(LIBRARY_TOPIC, self._library, log_time_ns, sync=True)
 
     def append_due_snapshot(self, mission: RosMessage, log_time_ns: int) -> bool:
         """Record ``mission`` if a snapshot is due, the journal open and room left for it

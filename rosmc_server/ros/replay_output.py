@@ -40,6 +40,7 @@ TYPES: dict[str, Any] = {
     interface.SCIENCE_TOPIC: wire.ScienceState,
     interface.WORLD_TOPIC: MarkerArray,
     interface.SITE_IN_FORCE_TOPIC: wire.SiteInForce,
+    interface.LIBRARY_TOPIC: wire.Library,
 }
 """Every recorded topic with its message class."""
 

@@ -27,6 +27,7 @@ Services (behind ``prefix``):
     ``/rosmc/get_mission`` (rosmc/GetMission): the mission at the replay's position, so
     clients that start from it (``rosmc watch``, the GUIs) follow the replay as they follow
     a live server.
+    ``/rosmc/get_library`` (rosmc/GetLibrary): the library the recording ran with.
     ``/rosmc/replay/control`` (rosmc/ReplayControl): pause, resume, seek, rate.
 
 The replayer serves clients and ranks with the client in the layers. Its callers need no
@@ -56,6 +57,7 @@ from ..recording.playback import PlaybackClock, PlaybackStatus, Playlist
 from .graph_names import taken_names
 from .node_setup import init_node
 from .replay_control import ReplayControl
+from .replay_library import GET_LIBRARY, serve_library
 from .replay_output import TYPES, ReplayOutput, first_telemetry
 
 _log = logging.getLogger(__name__)
@@ -203,6 +205,7 @@ class RecordingReplayer:
             for name in (
                 *TYPES,
                 GET_MISSION,
+                GET_LIBRARY,
                 interface.REPLAY_CONTROL_SERVICE,
                 interface.REPLAY_STATE_TOPIC,
             )
@@ -228,6 +231,7 @@ class RecordingReplayer:
         service = rospy.Service(
             self._config.topic(GET_MISSION), wire_srv.GetMission, self._on_get_mission
         )
+        library = serve_library(self._playlist, self._config.prefix)  # the recorded one
         self._control = ReplayControl(self, self._config.prefix)
         rospy.on_shutdown(self.stop)
         try:
@@ -238,6 +242,7 @@ class RecordingReplayer:
                 self._handled.notify_all()
             self._control.close()
             service.shutdown()
+            library.shutdown()
             self._clock.close()
 
     def _play(self) -> int:

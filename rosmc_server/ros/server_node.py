@@ -69,6 +69,7 @@ from .. import interface
 from ..conversions import (
     event_from_msg,
     event_to_msg,
+    library_to_msg,
     mission_from_msg,
     mission_to_msg,
     time_to_msg,
@@ -276,16 +277,17 @@ class MissionServer:
     def _open_journal(self) -> tuple[Mission, JournalWriter]:
         options = JournalOptions(fsync=self.config.fsync, snapshot_every=self.config.snapshot_every)
         clock = rospy.get_time
+        library = library_to_msg(self.library)  # journaled: a replay shows the mission with it
         if self.config.resume:
             if self.config.journal is None:
                 raise ValueError("~resume needs ~journal: the journal file to continue")
-            writer = JournalWriter.resume(self.config.journal, options)
+            writer = JournalWriter.resume(self.config.journal, options, library)
             return self._resumed(writer), writer
         mission = Mission(self.library, MissionContent.empty(self.library), clock=clock)
         path = self.config.journal or default_journal_path(self.config.journal_dir)
         path.parent.mkdir(parents=True, exist_ok=True)
         snapshot = mission_to_msg(mission.state.content(), 0, time.time())
-        writer = JournalWriter.create(path, snapshot, time.time_ns(), options)
+        writer = JournalWriter.create(path, snapshot, time.time_ns(), options, library)
         self._marks = RevisionMark(path, first_mark(0), options.fsync)
         return mission, writer
 

@@ -49,6 +49,14 @@ CLIENT_ID = "/rviz_test/InteractiveMarkers"
 T = TypeVar("T")
 
 
+def scout_library(directory: Path) -> Path:
+    """A custom library: the shipped one with the drone called ``scout``."""
+    shipped = (REPO / "rosmc_server" / "config" / "mars_team.yaml").read_text()
+    path = directory / "scouts.yaml"
+    path.write_text(shipped.replace("\n  drone: {", "\n  scout: {"))
+    return path
+
+
 def label_of(marker: InteractiveMarker) -> str:
     """The text an interactive marker shows: its description or the text it draws."""
     drawn = (m.text for c in marker.controls for m in c.markers if m.type == m.TEXT_VIEW_FACING)

@@ -15,6 +15,7 @@ import signal
 import socket
 import subprocess
 import sys
+import threading
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -441,6 +442,33 @@ def test_watch_sees_concurrent_changes(server: Server, fresh: MissionClient) -> 
     first, second = out.splitlines()
     assert "SKILL_ADDED" in first and added in first and "drone" in first
     assert "MARKER_ADDED" in second and "'Here'" in second
+
+
+def test_watch_misses_no_event_while_it_starts(server: Server, fresh: MissionClient) -> None:
+    # Changes stream in while watch starts: it fetches its starting revision only once its
+    # subscriber is connected, so it prints every revision after that one, in order.
+    stop = threading.Event()
+
+    def flood() -> None:
+        for _ in range(2000):  # bounded: stops long before this unless the test hangs
+            if stop.is_set():
+                return
+            fresh.add_skill("drone", "land")
+
+    flooder = threading.Thread(target=flood, daemon=True)
+    flooder.start()
+    try:
+        wait_until(lambda: (fresh.revision or 0) >= 5, 30.0, "the first changes")
+        watcher = start_cli(server.env, ["watch", "--json", "--count", "20"])
+        out, err = watcher.communicate(timeout=120.0)
+    finally:
+        stop.set()
+        flooder.join(60.0)
+    assert watcher.returncode == 0, err
+    start = int(re.search(r"from revision (\d+)", err).group(1))  # type: ignore[union-attr]
+    revisions = [json.loads(line)["revision"] for line in out.splitlines()]
+    assert revisions == list(range(start + 1, start + 21)), (start, revisions)
+    assert "not heard" not in err
 
 
 def test_watch_stops_cleanly_on_ctrl_c(server: Server) -> None:

@@ -4,7 +4,9 @@ A real mission server journals a short planning session (markers added and moved
 :class:`MissionClient`); ``rosmc replay FILE --prefix /replay`` republishes it and the
 marker node runs with ``ns:=/replay`` as ``markers.launch ns:=/replay`` starts it. The test
 is rviz: it reads ``/replay/rosmc/markers/update_full`` and sends feedback on
-``/replay/rosmc/markers/feedback``, which must change nothing.
+``/replay/rosmc/markers/feedback``, which must change nothing. The session runs with a
+custom library (the drone is called ``scout``): the replay must show it with that library,
+which the journal recorded, not the shipped one.
 """
 
 from __future__ import annotations
@@ -33,7 +35,12 @@ from rosmc_rviz_markers import topics
 from rosmc_server.core import MarkerType, TaskMarker
 from rosmc_server.core import Pose as MissionPose
 from rosmc_server.ros.client import MissionClient
-from tests.integration.markers_fixtures import MarkerNodeProcess, label_of, wait_for
+from tests.integration.markers_fixtures import (
+    MarkerNodeProcess,
+    label_of,
+    scout_library,
+    wait_for,
+)
 
 pytest_plugins = ["tests.integration.server_fixtures"]
 
@@ -44,12 +51,13 @@ READ_ONLY_MODES = (InteractiveMarkerControl.NONE, InteractiveMarkerControl.BUTTO
 
 
 @pytest.fixture
-def journal(start_server: Any) -> Path:
-    """The journal of a short planning session on a real server (stopped afterwards)."""
-    server = start_server()
+def journal(start_server: Any, tmp_path: Path) -> Path:
+    """The journal of a short planning session on a real server with a custom library."""
+    server = start_server(library=str(scout_library(tmp_path)))
     client = MissionClient(10.0)
     try:
         client.get_mission()
+        client.add_skill("scout", "take_off")
         client.add_marker(TaskMarker("goal", MarkerType.POSE, MissionPose(3.0, 4.0)))
         area = tuple(MissionPose(x, y) for x, y in ((10, 0), (16, 0), (16, 6), (10, 6)))
         client.add_marker(TaskMarker("site", MarkerType.AREA, MissionPose(), area))
@@ -109,7 +117,7 @@ def replay_markers(client_node: Any, tmp_path: Path) -> Iterator[MarkerNodeProce
         dict(client_node.env), tmp_path / "markers.log", f"_ns:={NS}", f"__ns:={NS}/rosmc"
     )
     try:
-        wait_for(lambda: "markers for library" in node.log(), "the replay marker node", 30.0)
+        wait_for(lambda: "marker node ready" in node.log(), "the replay marker node", 30.0)
         yield node
     finally:
         node.stop()
@@ -133,7 +141,7 @@ def test_a_replay_shows_read_only_markers(
         def shown() -> dict[str, InteractiveMarker] | None:
             markers = view.markers()
             goal = markers.get("task/goal")
-            if goal is None or "task/site" not in markers or "robot/drone" not in markers:
+            if goal is None or "task/site" not in markers or "robot/scout" not in markers:
                 return None
             at = (goal.pose.position.x, goal.pose.position.y)
             return markers if math.dist(at, GOAL) < 1e-6 else None
@@ -152,15 +160,17 @@ def test_a_replay_shows_read_only_markers(
         view.send("task/goal", fb.MOUSE_DOWN, *GOAL)
         view.send("task/goal", fb.POSE_UPDATE, 20.0, 20.0)
         view.send("task/goal", fb.MOUSE_UP, 20.0, 20.0)
-        view.send("robot/drone", fb.MENU_SELECT, entry=1)
+        view.send("robot/scout", fb.MENU_SELECT, entry=1)
         wait_for(
             lambda: replay_markers.log().count("read-only") >= 2,
             "the node to refuse the drag and the menu",
         )
         goal = view.markers()["task/goal"]
         assert math.dist((goal.pose.position.x, goal.pose.position.y), GOAL) < 1e-6
+        assert "robot/drone" not in markers  # the shipped library's drone: not recorded
         assert replay.wait(30) == 0, (tmp_path / "replay.log").read_text()
         assert "Traceback" not in replay_markers.log()
+        assert "NotFound" not in replay_markers.log()
     finally:
         view.close()
         if replay.poll() is None:

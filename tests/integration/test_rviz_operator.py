@@ -22,6 +22,7 @@ import yaml
 
 from rosmc_rviz_markers.core import icons
 from rosmc_rviz_markers.core.icons import block_centre
+from rosmc_rviz_markers.core.scene import UNHEARD_AT
 from rosmc_server.core import MarkerType, Pose, TaskMarker
 from rosmc_server.ros.client import MissionClient
 from tests.conftest import LaunchProcess, RosMaster
@@ -144,3 +145,59 @@ def test_operator_rviz_shows_robots_markers_and_icons(
         or not ((empty[..., 0] > 150) & (empty[..., 1] > 100) & (empty[..., 2] < 100)).any()
     )
     del red, green, blue
+
+
+@pytest.fixture
+def spare_markers(
+    start_server: Any, launch_process: LaunchProcess, ros_master: RosMaster, tmp_path: Path
+) -> Iterator[Any]:
+    """A server whose library has a robot the sim does not run ("spare"), and the markers."""
+    shipped = (REPO / "rosmc_server" / "config" / "mars_team.yaml").read_text()
+    spare = "  spare: {kind: dynamic, model: drone_scout, description: Not started.}\n"
+    library = tmp_path / "spare.yaml"
+    library.write_text(shipped.replace("\nagents:\n", "\nagents:\n" + spare))
+    start_server(library=str(library))
+    node = launch_process(
+        [sys.executable, str(REPO / "scripts" / "markers_node")],
+        env=ros_master.env,
+        name="markers_node",
+        cwd=REPO,
+    )
+    wait_for(lambda: "agents without TF: spare" in node.log(), "the spare robot noticed", 30.0)
+    yield node
+
+
+@pytest.mark.usefixtures("gui_programs", "sim")
+def test_a_robot_without_tf_leaves_the_others_drawn(
+    spare_markers: Any, ros_master: RosMaster, tmp_path: Path
+) -> None:
+    # rviz draws no marker of an update until it can transform each one: the spare robot,
+    # which has no TF frame, must not keep the others from being drawn.
+    tool = load_tool()
+    background = tool.config_background(CONFIG)
+    output = tmp_path / "spare.png"
+    check = tool.DrawnCheck(background=background, min_colors=100, tolerance=20)
+    result = tool.take_screenshot(
+        CONFIG,
+        output,
+        timeout=40.0,
+        settle=3.0,
+        check=check,
+        env=ros_master.env,
+        log=tmp_path / "rviz.log",
+    )
+    assert not result.problems, result.problems
+    view = result.shot.view(background)
+    assert view is not None
+    px = view.pixels.astype(np.int16)
+    w, h = view.width, view.height
+    rover = near(px, project((*ROBOT_START["science_rover"], 0.4), w, h), 30)
+    yellow = (rover[..., 0] > 150) & (rover[..., 1] > 100) & (rover[..., 2] < 100)
+    # its body, not only the yellow text of the status icons beside it (about 80 pixels)
+    assert yellow.sum() > 500, "no science rover body where it stands"
+    # the spare drone waits, not heard, in the map frame beside the lander (its blue body)
+    spare = near(px, project((*UNHEARD_AT, 0.5), w, h), 35)
+    blue = (spare[..., 2] > 150) & (spare[..., 2] > spare[..., 0] + 60)
+    assert blue.sum() > 20, "the spare robot is not drawn where robots without TF wait"
+    assert "agents without TF: spare" in spare_markers.log()
+    print(f"screenshot: {output}")

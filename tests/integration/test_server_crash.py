@@ -49,7 +49,8 @@ from rosmc_server.core import (  # noqa: E402
     load_library,
     parse_mission,
 )
-from rosmc_server.recording import _scan, latest_state, read_journal  # noqa: E402
+from rosmc_server.recording import latest_state, read_journal  # noqa: E402
+from rosmc_server.recording._mcap import scan as _scan  # noqa: E402
 from tests.integration.server_fixtures import REPO, Client, ServerProcess, mission_key  # noqa: E402
 
 pytest_plugins = ["tests.integration.server_fixtures"]

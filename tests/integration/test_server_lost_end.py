@@ -20,7 +20,7 @@ import rosmc.msg as wire
 pytest.register_assert_rewrite("tests.integration.server_fixtures")
 
 from rosmc_server import interface  # noqa: E402
-from rosmc_server.recording import _scan  # noqa: E402
+from rosmc_server.recording._mcap import scan as _scan  # noqa: E402
 from rosmc_server.recording.high_water import read_mark  # noqa: E402
 from tests.conftest import wait_until  # noqa: E402
 from tests.integration.server_fixtures import Client, Recorder, ServerProcess  # noqa: E402

@@ -391,6 +391,9 @@ def test_cli_at_timeline_and_tobag_work_without_a_master(
     assert json.loads(capsys.readouterr().out)["revision"] == 30
     assert rosmc(["at", journal, "soon"]) == 2
     assert rosmc(["at", journal, "r999"]) == 1
+    capsys.readouterr()
+    assert rosmc(["at", journal, "9999"]) == 1  # past the end: refused, not the last revision
+    assert "'9999' is outside the recording" in capsys.readouterr().err
     assert rosmc(["timeline", journal, "-o", str(tmp_path / "t.svg")]) == 0
     ET.parse(tmp_path / "t.svg")
     assert rosmc(["tobag", journal, str(tmp_path / "m.bag")]) == 0

@@ -648,7 +648,8 @@ def test_journal_channels_are_the_graph_names() -> None:
         "/rosmc/sim/science",
         "/rosmc/sim/world",
         "/rosmc/robot_commands",  # added later: older journals keep their channel ids
-        "/rosmc/site_in_force",  # added last, likewise
+        "/rosmc/site_in_force",  # added later, likewise
+        "/rosmc/library",  # added last, likewise
     ]
     assert EVENTS_TOPIC == "/rosmc/mission_events" and MISSION_TOPIC == "/rosmc/mission"
 

@@ -29,7 +29,7 @@ from rosmc_server.recording import (  # noqa: E402
     latest_state,
     read_journal,
 )
-from rosmc_server.recording._format import (  # noqa: E402
+from rosmc_server.recording._mcap.records import (  # noqa: E402
     MAGIC,
     FormatError,
     iter_records,

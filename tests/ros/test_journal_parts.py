@@ -167,3 +167,25 @@ def test_the_writers_memory_stops_growing_with_the_number_of_changes(tmp_path: P
         writer.close()
     # 2000 more changes: about a megabyte if every change kept its index entry.
     assert after_3000 - after_1000 < 64_000
+
+
+def test_every_part_records_the_library_after_its_first_snapshot(tmp_path: Path) -> None:
+    from rosmc_server.conversions import library_from_msg, library_to_msg
+    from rosmc_server.core import load_library
+    from rosmc_server.interface import LIBRARY_TOPIC
+    from rosmc_server.ros.replay_library import SHIPPED_LIBRARY
+
+    library = library_to_msg(load_library(SHIPPED_LIBRARY))
+    path = tmp_path / "m.mcap"
+    options = JournalOptions(part_bytes=PART, snapshot_every=10**6)
+    writer = JournalWriter.create(path, mission(0), T0, options, library)
+    grow(writer, 1, 100)
+    writer.close()
+    files = [path, *sorted(tmp_path.glob("m.part*.mcap"))]
+    assert len(files) >= 2
+    for file in files:  # each part on its own says which library the mission ran with
+        with file.open("rb") as stream:
+            topics = [c.topic for _, c, _ in SeekingReader(stream).iter_messages()]
+        assert topics[:2] == [MISSION_TOPIC, LIBRARY_TOPIC] and topics.count(LIBRARY_TOPIC) == 1
+    record = next(r for r in read_journal(path).records if r.topic == LIBRARY_TOPIC)
+    assert library_from_msg(record.message) == load_library(SHIPPED_LIBRARY)

@@ -18,7 +18,7 @@ import rosbag  # noqa: E402
 
 from rosmc_server.cli import main as rosmc  # noqa: E402
 from rosmc_server.interface import EVENTS_TOPIC  # noqa: E402
-from rosmc_server.recording import _scan  # noqa: E402
+from rosmc_server.recording._mcap import scan as _scan  # noqa: E402
 from rosmc_server.recording.history import MissionHistory  # noqa: E402
 from tests.ros import test_history  # noqa: E402
 from tests.ros.test_history import Recording  # noqa: E402

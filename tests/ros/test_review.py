@@ -219,6 +219,22 @@ def test_every_way_to_name_a_moment(journal: Journal, history: MissionHistory) -
         resolve_when(history, "soon")
     with pytest.raises(InvalidRequest, match="outside the recording"):
         resolve_when(history, "2020-01-01T00:00:00")
+    # Past the end in every form (what `rosmc restore --at` and `rosmc at` take): refused.
+    end = history.duration
+    assert resolve_when(history, f"{end:.9f}").state.revision == history.revisions[-1].revision
+    for late in (f"{end + 1:g}", "9999s", "2:46:39"):
+        with pytest.raises(InvalidRequest, match="outside the recording"):
+            resolve_when(history, late)
+
+
+def test_restore_refuses_a_time_past_the_end_before_asking_the_server(
+    journal: Journal, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # No master runs here: the refusal comes from the recording alone, as for a revision.
+    assert rosmc(["restore", str(journal.path), "--at", "9999"]) == 1
+    assert "'9999' is outside the recording" in capsys.readouterr().err
+    assert rosmc(["restore", str(journal.path), "--at", "r9999"]) == 1
+    assert "holds no revision 9999" in capsys.readouterr().err
 
 
 def test_cli_diff_as_json(journal: Journal, capsys: pytest.CaptureFixture[str]) -> None:

@@ -20,7 +20,7 @@ from rosmc_server.cli import main as rosmc
 from rosmc_server.core import SkillStatus
 from rosmc_server.interface import EVENTS_TOPIC, MISSION_TOPIC
 from rosmc_server.recording import JOURNAL_TOPICS, JournalResult, read_journal
-from rosmc_server.recording._codec import schema_of
+from rosmc_server.recording._mcap.codec import schema_of
 from rosmc_server.recording.errors import JournalError
 from rosmc_server.recording.history import MissionHistory
 from tests.ros.recording_checks import (

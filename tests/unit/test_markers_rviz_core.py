@@ -53,7 +53,7 @@ from rosmc_server.core import (
     load_library,
 )
 from rosmc_server.core.changes import Change, PlacedSkill
-from rosmc_server.core.updates import MarkerPut, MirrorUpdate, SkillChanged
+from rosmc_server.core.updates import AgentStatusChanged, MarkerPut, MirrorUpdate, SkillChanged
 
 LIBRARY = load_library(
     Path(__file__).resolve().parents[2] / "rosmc_server" / "config" / "mars_team.yaml"
@@ -370,6 +370,27 @@ def test_scene_touches_only_what_changed() -> None:
     ), "highlight ring"
     robot = scene.agent_spec("science_rover", state, None)
     assert robot.frame == "science_rover/base_link" and robot.menu.entries
+
+
+def test_an_agent_without_tf_is_drawn_in_the_map_frame_as_not_heard() -> None:
+    # rviz draws no marker of an update until it can transform every one: an agent whose
+    # frame is missing must not be in its TF frame, or no robot is drawn at all.
+    scene = Scene(LIBRARY)
+    touched = scene.set_tf_missing({"drone", "lander"})
+    assert touched.agents == {"drone", "lander"}
+    drone = scene.agent_spec("drone", None, None)
+    assert drone.frame == "map" and drone.description == "drone: not heard"
+    lander = scene.agent_spec("lander", None, None)
+    assert lander.frame == "map" and lander.position != drone.position  # side by side
+    rover = scene.agent_spec("science_rover", None, None)
+    assert rover.frame == "science_rover/base_link" and "not heard" not in rover.description
+    heard = AgentStatus("drone", pose=Pose(5.0, 6.0, 3.0, 0.0, 0.0, 1.0))
+    assert scene.agent_spec("drone", None, heard).position == (5.0, 6.0, 3.0)
+    moved = MirrorUpdate(1, (AgentStatusChanged(None, heard),))
+    assert scene.touched(moved).agents == {"drone"}  # its reported pose moves it
+    assert scene.set_tf_missing({"lander"}).agents == {"drone"}  # its frame came back
+    assert scene.agent_spec("drone", None, heard).frame == "drone/base_link"
+    assert not scene.touched(moved).agents  # TF moves it now
 
 
 def test_replay_scene_places_agents_from_status() -> None:

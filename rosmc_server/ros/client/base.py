@@ -90,6 +90,12 @@ class ClientBase:
                 self._library = library_from_msg(self._caller.call("get_library").library)
             return self._library
 
+    def forget_library(self) -> None:
+        """Fetch the library anew when next needed (the server restarted, maybe with
+        another library)."""
+        with self._lock:
+            self._library = None
+
     def get_mission(self) -> MissionState:
         """The current mission; the client now knows its revision."""
         with self._lock:

@@ -120,9 +120,16 @@ class MissionFollower:
         self.mirror.start()
         self._watcher.start()
 
-    def library(self, on_done: Callable[[Outcome[Library]], None]) -> None:
-        """Fetch the skill library (once; later calls answer from the cache) without waiting."""
-        self._fetcher.submit(lambda client: client.library(), on_done)
+    def library(self, on_done: Callable[[Outcome[Library]], None], fresh: bool = False) -> None:
+        """Fetch the skill library without waiting (once; later calls answer from the cache,
+        unless ``fresh``: after the server restarted, maybe with another library)."""
+
+        def fetch(client: MissionClient) -> Library:
+            if fresh:
+                client.forget_library()
+            return client.library()
+
+        self._fetcher.submit(fetch, on_done)
 
     def refresh(self) -> None:
         """Fetch a new snapshot now (e.g. after a conflict the operator was told of)."""

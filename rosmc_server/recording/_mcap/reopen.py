@@ -16,10 +16,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from rosmc_server.interface import EVENTS_TOPIC, MISSION_TOPIC
-from rosmc_server.recording import _scan
-from rosmc_server.recording._files import journal_parts, open_locked, part_path, save_tail
-from rosmc_server.recording._part import PartFile
-from rosmc_server.recording._section import DataSection
+from rosmc_server.recording._mcap import scan as _scan
+from rosmc_server.recording._mcap.files import journal_parts, open_locked, part_path, save_tail
+from rosmc_server.recording._mcap.write import DataSection, PartFile
 from rosmc_server.recording.channels import JOURNAL_TOPICS, PROFILE
 from rosmc_server.recording.errors import JournalError
 from rosmc_server.recording.reader import JournalResult, decode_scan, join_results
@@ -110,7 +109,7 @@ def _reopen(
         save_tail(last, scan.data_end)
     os.ftruncate(fd, scan.data_end)
     offset = os.lseek(fd, 0, os.SEEK_END)
-    part = PartFile(last, number, fd, DataSection.from_scan(scan), offset, chunked, snapshots)
+    part = PartFile(last, number, fd, section_from_scan(scan), offset, chunked, snapshots)
     tail = part.section.restore_indexes(offset, scan.missing_indexes)
     tail += part.section.declare(JOURNAL_TOPICS)
     if tail:
@@ -133,3 +132,13 @@ def _needs_earlier(results: list[JournalResult]) -> bool:
         elif record.topic == EVENTS_TOPIC and first is not None and revision > first:
             return revision > first + 1
     return first is None
+
+
+def section_from_scan(scan: _scan.ScanResult) -> DataSection:
+    """Rebuild the state of the data section a scan found, to go on writing after it."""
+    section = DataSection(dict(scan.schemas), dict(scan.channels))
+    for index in scan.chunk_indexes:
+        section.add_index(index)
+    for msg in scan.messages:
+        section.count(msg.channel_id, msg.log_time)
+    return section

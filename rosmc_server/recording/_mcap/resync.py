@@ -19,7 +19,7 @@ from collections.abc import Callable
 
 from mcap.opcode import Opcode
 
-from rosmc_server.recording import _format as fmt
+from rosmc_server.recording._mcap import records as fmt
 
 KnownMessage = Callable[[int, int], bool]
 """(channel id, sequence) -> whether a bare message with them fits the file so far."""

@@ -5,7 +5,7 @@ journal on a failing disk may hold damaged bytes anywhere. The scan therefore
 never trusts the summary: it walks the records from the header on and keeps
 every intact one. A record cut short by the end of the file ends the walk (a
 torn tail, what a crash leaves). At a damaged record the scan searches forward
-for the next record it can trust (:mod:`._resync`), notes the damaged byte range
+for the next record it can trust (:mod:`.resync`), notes the damaged byte range
 and goes on, so one bad byte costs one record, not the rest of the file. A
 chunk whose content passes its CRC is kept even when its opcode or length field
 is damaged, and a bare message whose length field is damaged is cut back to
@@ -21,9 +21,9 @@ from pathlib import Path
 
 from mcap.opcode import Opcode
 
-from rosmc_server.recording import _format as fmt
-from rosmc_server.recording._records import Declarations, RecordDamage
-from rosmc_server.recording._resync import Resync
+from rosmc_server.recording._mcap import records as fmt
+from rosmc_server.recording._mcap.checks import Declarations, RecordDamage
+from rosmc_server.recording._mcap.resync import Resync
 from rosmc_server.recording.channels import LIBRARY
 from rosmc_server.recording.damage import Damage
 from rosmc_server.recording.errors import JournalError

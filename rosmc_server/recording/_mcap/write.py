@@ -1,4 +1,4 @@
-"""The data section of a journal being written: what it holds and how its records look.
+"""Writing a journal file: its data section and the open, locked part file it goes to.
 
 The writer hands every record to the file as soon as it exists; this class
 encodes the records that need bookkeeping (schemas, channels, chunks) and
@@ -9,19 +9,20 @@ are the only thing that grows with every append.
 
 from __future__ import annotations
 
+import os
 import zlib
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING
+from pathlib import Path
 
 from mcap.opcode import Opcode
 
-from rosmc_server.recording import _format as fmt
-from rosmc_server.recording._codec import schema_of
-from rosmc_server.recording.channels import JOURNAL_TOPICS, MESSAGE_ENCODING, SCHEMA_ENCODING
-
-if TYPE_CHECKING:
-    from rosmc_server.recording._scan import ScanResult
+from rosmc_server.core.durable import fsync_directory
+from rosmc_server.recording._mcap import layout
+from rosmc_server.recording._mcap import records as fmt
+from rosmc_server.recording._mcap.files import open_locked
+from rosmc_server.recording.channels import JOURNAL_TOPICS, LIBRARY, PROFILE
+from rosmc_server.recording.errors import JournalError
 
 
 @dataclass
@@ -38,25 +39,14 @@ class DataSection:
     _last_index: fmt.ChunkIndexRecord | None = None  # kept whole: resume may extend it
 
     @classmethod
-    def from_scan(cls, scan: ScanResult) -> DataSection:
-        """Rebuild the state of the data section a scan found."""
-        section = cls(dict(scan.schemas), dict(scan.channels))
-        for index in scan.chunk_indexes:
-            section.add_index(index)
-        for msg in scan.messages:
-            section.count(msg.channel_id, msg.log_time)
-        return section
-
-    @classmethod
     def journal(cls) -> DataSection:
         """The section of a new journal: every journal channel declared, in the fixed order.
 
         A journal's channel and schema ids follow from :data:`JOURNAL_TOPICS` alone, so
         a reader can still tell a channel whose declaration was damaged.
         """
-        section = cls()
-        section.declare(JOURNAL_TOPICS)
-        return section
+        schemas, channels = layout.journal_declarations()
+        return cls(schemas, channels)
 
     def add_index(self, index: fmt.ChunkIndexRecord) -> None:
         """Remember a written chunk for the summary."""
@@ -71,24 +61,7 @@ class DataSection:
 
     def declare(self, topics: Mapping[str, str]) -> bytes:
         """Register each topic (name -> message type) not declared yet; return its records."""
-        records = b""
-        declared = self.channel_ids()
-        schema_ids = {s.name: s.id for s in self.schemas.values()}
-        for topic, type_name in topics.items():
-            if topic in declared:
-                continue
-            if type_name not in schema_ids:
-                schema_id = schema_ids[type_name] = max(self.schemas, default=0) + 1
-                schema = fmt.SchemaRecord(
-                    schema_id, type_name, SCHEMA_ENCODING, schema_of(type_name)
-                )
-                self.schemas[schema_id] = schema
-                records += fmt.schema(schema)
-            channel_id = max(self.channels, default=0) + 1
-            channel = fmt.ChannelRecord(channel_id, schema_ids[type_name], topic, MESSAGE_ENCODING)
-            self.channels[channel_id] = channel
-            records += fmt.channel(channel)
-        return records
+        return layout.declare(self.schemas, self.channels, topics)
 
     def count(
         self, channel_id: int, log_time: int, chunk_index: fmt.ChunkIndexRecord | None = None
@@ -190,3 +163,100 @@ class DataSection:
     def _chunk_indexes(self) -> bytes:
         last = b"" if self._last_index is None else fmt.chunk_index(self._last_index)
         return bytes(self._indexes) + last
+
+
+@dataclass
+class PartFile:
+    """A locked journal file being appended to, positioned at its end.
+
+    Attributes:
+        path: The file.
+        number: Its place in the journal's chain (1 for the first file).
+        fd: The open descriptor (None once closed).
+        section: What its data section holds (for the summary written on close).
+        offset: Bytes handed to the operating system so far (the file size while open).
+        chunked: Whether each append is written as its own chunk.
+        snapshots: Snapshots in it (a part without one cannot start a mission).
+    """
+
+    path: Path
+    number: int
+    fd: int | None
+    section: DataSection
+    offset: int
+    chunked: bool
+    snapshots: int = 0
+
+    @classmethod
+    def create(cls, path: Path, number: int, chunked: bool, durable: bool) -> PartFile:
+        """Create a new file with the MCAP header and every journal channel declared.
+
+        Raises:
+            JournalError: The file exists or cannot be written.
+        """
+        fd = open_locked(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL)
+        part = cls(path, number, fd, DataSection(), 0, chunked)
+        preamble = fmt.MAGIC + fmt.header(PROFILE, LIBRARY) + part.section.declare(JOURNAL_TOPICS)
+        try:
+            part.write(preamble, sync=False, durable=False)
+            if durable:
+                fsync_directory(path.parent)
+        except (OSError, JournalError) as err:
+            part.abandon()
+            path.unlink()  # it holds nothing anybody was told about
+            if isinstance(err, JournalError):
+                raise
+            raise JournalError(f"cannot create journal {path}: {err.strerror}") from err
+        return part
+
+    def write(self, data: bytes, sync: bool, durable: bool) -> None:
+        """Write all of ``data`` at the end (fdatasync if ``sync and durable``).
+
+        On failure the file is cut back to where it was and JournalError raised.
+        """
+        fd = self.open_fd()
+        try:
+            view = memoryview(data)
+            while view:
+                view = view[os.write(fd, view) :]
+            if sync and durable:
+                os.fdatasync(fd)
+        except OSError as err:
+            try:  # a partial record must not stay in front of the next append
+                os.ftruncate(fd, self.offset)
+                os.lseek(fd, self.offset, os.SEEK_SET)
+            except OSError:
+                self.abandon()
+            raise JournalError(f"cannot write journal {self.path}: {err.strerror}") from err
+        self.offset += len(data)
+
+    def sync(self) -> None:
+        """fdatasync the file."""
+        try:
+            os.fdatasync(self.open_fd())
+        except OSError as err:
+            raise JournalError(f"cannot sync journal {self.path}: {err.strerror}") from err
+
+    def close(self) -> None:
+        """Write the summary and footer, sync and close: the file is complete MCAP."""
+        if self.fd is None:
+            return
+        try:
+            self.write(self.section.closing_bytes(self.offset), sync=False, durable=False)
+            os.fdatasync(self.open_fd())
+        except OSError as err:
+            raise JournalError(f"cannot close journal {self.path}: {err.strerror}") from err
+        finally:
+            self.abandon()
+
+    def abandon(self) -> None:
+        """Close the file without a summary, as a crash leaves it."""
+        if self.fd is not None:
+            os.close(self.fd)
+            self.fd = None
+
+    def open_fd(self) -> int:
+        """The descriptor; JournalError if the file is closed."""
+        if self.fd is None:
+            raise JournalError(f"journal {self.path} is closed")
+        return self.fd

@@ -1,7 +1,7 @@
 """The schemas and channels an MCAP file declares, and the checks its records must pass.
 
 A journal (an MCAP file whose header names :data:`~.channels.LIBRARY`) declares
-its channels in a fixed order (:meth:`DataSection.journal`), so when the
+its channels in a fixed order (:mod:`.layout`), so when the
 declaration of a channel or schema is lost to damage, the scan can still tell
 what a message on it is instead of losing every later message of the channel.
 """
@@ -14,8 +14,8 @@ from pathlib import Path
 
 from mcap.opcode import Opcode
 
-from rosmc_server.recording import _format as fmt
-from rosmc_server.recording._section import DataSection
+from rosmc_server.recording._mcap import layout
+from rosmc_server.recording._mcap import records as fmt
 from rosmc_server.recording.channels import JOURNAL_TOPICS
 
 
@@ -41,7 +41,7 @@ class Declarations:
         self.schemas = schemas
         self.channels = channels
         self._journal = journal
-        self._fixed: DataSection | None = None
+        self._fixed: tuple[dict[int, fmt.SchemaRecord], dict[int, fmt.ChannelRecord]] | None = None
         self._taken: dict[int, int] = {}  # messages taken per channel
         self._rebuilt: list[str] = []
 
@@ -117,8 +117,8 @@ class Declarations:
         if not self._journal:
             return {}
         if self._fixed is None:
-            self._fixed = DataSection.journal()
-        return self._fixed.channels
+            self._fixed = layout.journal_declarations()
+        return self._fixed[1]
 
     def _rebuild(self, channel_id: int) -> bool:
         chan = self._fixed_channels().get(channel_id)
@@ -135,7 +135,7 @@ class Declarations:
 
     def _rebuild_schema(self, schema_id: int) -> bool:
         self._fixed_channels()
-        schema = None if self._fixed is None else self._fixed.schemas.get(schema_id)
+        schema = None if self._fixed is None else self._fixed[0].get(schema_id)
         if schema is None:
             return False
         self.schemas[schema_id] = schema

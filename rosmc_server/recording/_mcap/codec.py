@@ -16,7 +16,7 @@ from typing import Any
 from mcap.records import Schema
 from mcap_ros1.decoder import DecoderFactory
 
-from rosmc_server.recording import _format as fmt
+from rosmc_server.recording._mcap import records as fmt
 from rosmc_server.recording.channels import JOURNAL_TOPICS, SCHEMA_ENCODING
 from rosmc_server.recording.errors import JournalError
 
