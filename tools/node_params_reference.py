@@ -27,7 +27,11 @@ NODES: tuple[tuple[str, str, dict[str, tuple[str, ...] | None]], ...] = (
     ),
     ("/<robot>/mission_executor", "rosmc_server/executor/ros/node.py", {STATION: ("~cwd",)}),
     ("/rosmc/sim", "rosmc_sim/ros/sim_node.py", {STATION: ("~cwd",)}),
-    ("/rosmc/markers", "rosmc_rviz_markers/ros/node.py", {}),
+    (
+        "/rosmc/markers",
+        "rosmc_rviz_markers/ros/node.py",
+        {"rosmc_rviz_markers/ros/config.py": None},
+    ),
     ("/rosmc/link_emulator", "rosmc_sim/ros/link_emulator.py", {}),
     ("/rosmc/demo_operator", "rosmc_sim/ros/demo_operator.py", {STATION: ("~cwd",)}),
 )

@@ -18,8 +18,6 @@ BEING_REMOVED = {
     frozenset(
         f"rosmc_server/core/{name}.py" for name in ("changes", "library", "policy", "site", "state")
     ),
-    # "replay": the private MCAP layer
-    frozenset(f"rosmc_server/recording/_{name}.py" for name in ("records", "scan", "section")),
 }
 
 
