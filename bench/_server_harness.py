@@ -25,7 +25,7 @@ import sys
 import threading
 import time
 import xmlrpc.client
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from types import FrameType
 from typing import Any
@@ -158,7 +158,14 @@ def ros_master(home: Path) -> Iterator[dict[str, str]]:
 class Server:
     """A mission_server process (optionally under cProfile, stopped with SIGUSR1 then)."""
 
-    def __init__(self, env: dict[str, str], work: Path, library: Path, profile: Path | None):
+    def __init__(
+        self,
+        env: dict[str, str],
+        work: Path,
+        library: Path,
+        profile: Path | None,
+        params: Sequence[str] = (),
+    ):
         self.journal_dir = work / "journal"
         self.mission_dir = work / "missions"  # where SaveMission and LoadMission take paths
         self.profiled = profile is not None
@@ -167,6 +174,7 @@ class Server:
             f"_library:={library}",
             f"_journal_dir:={self.journal_dir}",
             f"_mission_dir:={self.mission_dir}",
+            *params,
         ]
         env = dict(env)
         if profile is not None:

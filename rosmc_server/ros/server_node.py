@@ -7,7 +7,8 @@ Services: one per operator operation, see :mod:`rosmc_server.ros.operator_servic
 
 Publishes:
     ``/rosmc/mission_events`` (rosmc/MissionEvent): one per accepted change.
-    ``/rosmc/mission`` (rosmc/Mission, latched): full snapshot, coalesced.
+    ``/rosmc/mission`` (rosmc/Mission): the current snapshot to each subscriber as it
+        connects; after that only a replaced mission (see :mod:`.publishing`).
     ``/rosmc/agent_states`` (rosmc/AgentStates): every agent's state at ``~agent_state_rate``.
     The robot links' command and report_ack topics (see :mod:`.ground_link`).
 
@@ -32,6 +33,8 @@ Parameters (private):
     ``~agent_state_rate`` (float, Hz): rate of ``/rosmc/agent_states`` (2.0).
     ``~fsync`` (bool): fsync the journal on every change (survives power loss; true).
     ``~snapshot_every`` (int): mission events between two full snapshots in the journal (500).
+    ``~broadcast_snapshots`` (bool): also send ``/rosmc/mission`` to every subscriber after
+        changes (coalesced), as before per-subscriber snapshots (false; for benchmarks).
     ``~operators`` (list of str, or one string of names): nodes (full names, or prefixes
         ending in ``/`` or ``*``) that may call the operator services; empty (the default)
         lets every node in. Guards against mistakes, not attackers (see
@@ -122,6 +125,7 @@ class ServerConfig:
     mission_dir: Path = DEFAULT_MISSION_DIR
     snapshot_every: int = JournalOptions.snapshot_every
     operators: OperatorAllowList = field(default_factory=OperatorAllowList)
+    broadcast_snapshots: bool = False
 
     @classmethod
     def from_params(cls) -> ServerConfig:
@@ -154,6 +158,7 @@ class ServerConfig:
             ),
             snapshot_every=max(1, int(rospy.get_param("~snapshot_every", cls.snapshot_every))),
             operators=OperatorAllowList.of(rospy.get_param("~operators", [])),
+            broadcast_snapshots=bool(rospy.get_param("~broadcast_snapshots", False)),
         )
 
 
@@ -177,7 +182,10 @@ class MissionServer:
             self._journal.append_snapshot(self.snapshot_msg(), time.time_ns())
         self._events = rospy.Publisher(interface.EVENTS_TOPIC, wire.MissionEvent, queue_size=1000)
         self._snapshots = SnapshotPublisher(
-            interface.MISSION_TOPIC, self.snapshot_msg, on_published=self._journal_snapshot
+            interface.MISSION_TOPIC,
+            self.snapshot_msg,
+            on_built=self._journal_snapshot,
+            broadcast_changes=config.broadcast_snapshots,
         )
         self.link = GroundLink(self, library.dynamic_agents, timeout=config.link_timeout)
         self._recorder = TelemetryRecorder(lambda: self._journal, frozenset(library.dynamic_agents))
@@ -276,7 +284,7 @@ class MissionServer:
             self.link.send(spec)
 
     def _journal_snapshot(self, snapshot: wire.Mission) -> None:
-        """Journal a published snapshot when one is due, off the service path.
+        """Journal a snapshot built after changes when one is due, off the service path.
 
         Building a snapshot of a large mission takes far longer than a service
         call may; the journal's reader accepts events written before a snapshot

@@ -862,28 +862,37 @@ def test_event_size_does_not_grow_with_the_mission(fresh: Client, events: Any) -
     assert len(serialized(c.mission())) > 100 * sizes[1000][0]
 
 
-def test_latched_snapshot_is_current_after_a_burst(fresh: Client, client_node: Any) -> None:
+def test_the_mission_topic_gives_each_subscriber_the_current_mission_once(
+    fresh: Client, client_node: Any
+) -> None:
+    """A change is not resent to every subscriber (they follow the events): a late joiner
+    gets the current mission, and only a replaced mission goes to everyone."""
     c = fresh
-    snapshots = Recorder(interface.MISSION_TOPIC, wire.Mission)
+    early = Recorder(interface.MISSION_TOPIC, wire.Mission)
     try:
+        first = early.wait_for(bool, timeout=30.0)[0]
+        assert first.revision == c.revision()
         rev = c.revision()
-        for _ in range(200):
+        for _ in range(50):
             rev = accepted(
                 c.call(
                     "add_skill", base_revision=rev, agent="science_rover", skill="explore", index=-1
                 )
             ).revision
-        got = snapshots.wait_for(lambda m: bool(m) and m[-1].revision == rev, timeout=30.0)
-        assert mission_key(got[-1]) == mission_key(c.mission())
-        assert len(got) < 100, "snapshots were not coalesced under the burst"
+        late = Recorder(interface.MISSION_TOPIC, wire.Mission)
+        try:
+            joined = late.wait_for(bool, timeout=30.0)[0]
+            assert joined.revision == rev
+            assert mission_key(joined) == mission_key(c.mission())
+        finally:
+            late.close()
+        replaced = accepted(c.call("new_mission", base_revision=rev, keep_markers=False)).revision
+        got = early.wait_for(lambda m: m[-1].revision == replaced, timeout=30.0)
+        # Before, the burst's coalesced snapshot came between the two.
+        assert [m.revision for m in got] == [first.revision, replaced]
+        assert not got[-1].tasks or not any(t.skills for t in got[-1].tasks)
     finally:
-        snapshots.close()
-    late = Recorder(interface.MISSION_TOPIC, wire.Mission)
-    try:
-        first = late.wait_for(bool, timeout=30.0)[0]
-        assert mission_key(first) == mission_key(c.mission())
-    finally:
-        late.close()
+        early.close()
 
 
 def test_agent_states_keep_arriving_with_unknown_links(
