@@ -161,10 +161,12 @@ def main(argv: list[str] | None = None) -> int:
 
             rospy.init_node("bench_change_bytes", anonymous=True, disable_signals=True)
             for a, s in sizes:
+                modes = (("now", False), ("broadcast", True))
                 output["sizes"].append(
-                    {
+                    {"skills": a * s}
+                    | {
                         mode: bench_size(env, base / f"{a}x{s}{mode}", a, s, args, broadcast)
-                        for mode, broadcast in (("now", False), ("broadcast", True))
+                        for mode, broadcast in modes
                     }
                 )
             rospy.signal_shutdown("done")
