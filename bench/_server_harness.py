@@ -22,6 +22,7 @@ import socket
 import statistics
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 import xmlrpc.client
@@ -115,6 +116,25 @@ def _signal(process: subprocess.Popen[Any], signum: int) -> None:
             os.killpg(process.pid, signum)
         elif process.poll() is None:
             process.send_signal(signum)
+
+
+@contextlib.contextmanager
+def bench_node(prefix: str, name: str) -> Iterator[tuple[Path, dict[str, str]]]:
+    """A private rosmaster in a new temporary folder, and this process a node ``name`` of it.
+
+    Yields the folder (removed afterwards) and the environment for other nodes.
+    """
+    with tempfile.TemporaryDirectory(prefix=prefix) as tmp:
+        base = Path(tmp)
+        (base / "log").mkdir()
+        with ros_master(base) as env:
+            import rospy
+
+            rospy.init_node(name, anonymous=True, disable_signals=True)
+            try:
+                yield base, env
+            finally:
+                rospy.signal_shutdown("done")
 
 
 @contextlib.contextmanager

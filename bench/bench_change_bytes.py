@@ -22,7 +22,6 @@ from __future__ import annotations
 import argparse
 import statistics
 import sys
-import tempfile
 import threading
 import time
 from collections import Counter
@@ -33,7 +32,7 @@ from typing import Any
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _missions import library_yaml, mission_yaml
-from _server_harness import Server, figures_printed, ros_master, serialized_size
+from _server_harness import Server, bench_node, figures_printed, serialized_size
 from bench_server import Bench
 
 SERVER_NODE = "/rosmc/mission_server"
@@ -143,33 +142,21 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", default="2x500,20x500,50x1000", help="AGENTSxSKILLS,...")
     parser.add_argument("--changes", type=int, default=3, help="isolated changes per size")
-    parser.add_argument(
-        "--window",
-        type=float,
-        default=4.0,
-        help="seconds per window (a multiple of 2 s, the "
-        "heartbeat period of the report_ack topics)",
-    )
+    # The report_ack topics carry a heartbeat every 2 s: both windows hold as many.
+    parser.add_argument("--window", type=float, default=4.0, help="seconds (a multiple of 2)")
     args = parser.parse_args(argv)
     sizes = [tuple(int(x) for x in size.split("x")) for size in args.sizes.split(",")]
     output: dict[str, Any] = {"sizes": []}
-    with figures_printed(output), tempfile.TemporaryDirectory(prefix="bench_bytes_") as tmp:
-        base = Path(tmp)
-        (base / "log").mkdir()
-        with ros_master(base) as env:
-            import rospy
-
-            rospy.init_node("bench_change_bytes", anonymous=True, disable_signals=True)
-            for a, s in sizes:
-                modes = (("now", False), ("broadcast", True))
-                output["sizes"].append(
-                    {"skills": a * s}
-                    | {
-                        mode: bench_size(env, base / f"{a}x{s}{mode}", a, s, args, broadcast)
-                        for mode, broadcast in modes
-                    }
-                )
-            rospy.signal_shutdown("done")
+    with figures_printed(output), bench_node("bench_bytes_", "bench_change_bytes") as (base, env):
+        for a, s in sizes:
+            modes = (("now", False), ("broadcast", True))
+            output["sizes"].append(
+                {"skills": a * s}
+                | {
+                    mode: bench_size(env, base / f"{a}x{s}{mode}", a, s, args, broadcast)
+                    for mode, broadcast in modes
+                }
+            )
     return 0
 
 

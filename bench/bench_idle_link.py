@@ -24,10 +24,8 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import shutil
 import subprocess
 import sys
-import tempfile
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -37,11 +35,11 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(REPO / "bench"))
 
-from bench_executor import print_figures, team_library  # noqa: E402
-from bench_multihost import hold_skills  # noqa: E402
+from bench_executor import team_library  # noqa: E402
+from bench_multihost import hold_skills, run_in_lab  # noqa: E402
 
 from tests.integration.multihost_fixtures import LabSystem, lab_base_env  # noqa: E402
-from tests.integration.netns import ROBOT_RADIO, RadioLab, unavailable  # noqa: E402
+from tests.integration.netns import ROBOT_RADIO, RadioLab  # noqa: E402
 
 RATE = "10mbit"  # shaped only for the interface's counters: nothing idle comes near it
 
@@ -101,22 +99,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--settle", type=float, default=60.0, help="seconds idle before measuring")
     parser.add_argument("--seconds", type=float, default=30.0, help="seconds measured")
     parser.add_argument("--keep", action="store_true", help="keep the work directory")
-    args = parser.parse_args(argv)
-    reason = unavailable()
-    if reason:
-        print(json.dumps({"skipped": reason}))
-        return 0
-    work = Path(tempfile.mkdtemp(prefix="bench_idle_link_"))
-    began = time.monotonic()
-    try:
-        figures = measure(args, work)
-    finally:
-        if args.keep:
-            print(f"kept {work}", file=sys.stderr)
-        else:
-            shutil.rmtree(work, ignore_errors=True)
-    print_figures(figures, began)
-    return 0
+    return run_in_lab(parser.parse_args(argv), measure, "bench_idle_link_")
 
 
 if __name__ == "__main__":
