@@ -1,7 +1,8 @@
-"""The latched ``/rosmc/mission`` snapshot after a burst of changes (for bench_server.py).
+"""The ``/rosmc/mission`` snapshot after a burst of changes (for bench_server.py).
 
-``tests/integration/test_server_services.py`` checks the outcome (the snapshot is current
-once a burst ends, and coalesced during it); this module measures how long that takes.
+``tests/integration/test_server_services.py`` checks the outcome (a new subscriber gets the
+current mission; a change is not resent to the subscribers already there); this module
+measures how long a subscriber that joins right after a burst waits for it.
 """
 
 from __future__ import annotations
@@ -12,45 +13,64 @@ from typing import Any
 
 from _server_harness import ServerClient
 
-CONNECT_S = 2.0  # the subscriber connects and the latched snapshot arrives
+CONNECT_S = 2.0  # the subscriber connects and its first snapshot arrives
 GIVE_UP_S = 60.0  # the snapshot at the burst's revision never came: the figure says so
 
 
+class _Snapshots:
+    """A subscriber to ``/rosmc/mission`` that keeps (receive time, revision) of each."""
+
+    def __init__(self, client: ServerClient) -> None:
+        import rosmc.msg as wire
+
+        from rosmc_server import interface
+
+        self.arrived: list[tuple[float, int]] = []
+        self.landed = threading.Condition()
+        self.subscriber = client.rospy.Subscriber(
+            interface.MISSION_TOPIC, wire.Mission, self._on_snapshot
+        )
+
+    def _on_snapshot(self, msg: Any) -> None:
+        with self.landed:
+            self.arrived.append((time.perf_counter(), msg.revision))
+            self.landed.notify_all()
+
+    def first_at(self, revision: int) -> float | None:
+        """When the snapshot of ``revision`` arrived (waits for it; None if it never did)."""
+        with self.landed:
+            self.landed.wait_for(lambda: any(r == revision for _, r in self.arrived), GIVE_UP_S)
+            return next((t for t, r in self.arrived if r == revision), None)
+
+
 def snapshot_after_burst(client: ServerClient, agent: str, adds: int = 200) -> dict[str, Any]:
-    """Send ``adds`` add_skill calls back to back; then time the snapshot that catches up.
+    """Send ``adds`` add_skill calls back to back; then time a new subscriber's snapshot.
 
-    Returns ``ms_after_last_answer`` (the last answer → the snapshot at its revision, or
-    None if none came within a minute) and ``snapshots`` (how many the burst caused).
+    Returns ``ms_join_to_snapshot`` (a subscriber that joins after the burst → its first
+    snapshot, which is at the burst's revision; None if none came within a minute) and
+    ``snapshots``
+    (how many the burst sent a subscriber that was there before it: none since changes
+    are no longer broadcast).
     """
-    import rosmc.msg as wire
-
-    from rosmc_server import interface
-
-    arrived: list[tuple[float, int]] = []
-    landed = threading.Condition()
-
-    def on_snapshot(msg: Any) -> None:
-        with landed:
-            arrived.append((time.perf_counter(), msg.revision))
-            landed.notify_all()
-
-    subscriber = client.rospy.Subscriber(interface.MISSION_TOPIC, wire.Mission, on_snapshot)
+    early = _Snapshots(client)
     try:
         time.sleep(CONNECT_S)
-        before = len(arrived)
+        before = len(early.arrived)
         for _ in range(adds):
             client.call("add_skill", base_revision=client.rev, agent=agent, skill="wait", index=-1)
-        answered, last = time.perf_counter(), client.rev
-        with landed:
-            landed.wait_for(lambda: any(rev == last for _, rev in arrived), GIVE_UP_S)
-            caught_up = next((t for t, rev in arrived if rev == last), None)
-            during = len(arrived) - before
+        last = client.rev
+        time.sleep(CONNECT_S)  # what the burst sends it comes meanwhile
+        during = len(early.arrived) - before
     finally:
-        subscriber.unregister()
+        early.subscriber.unregister()  # the late joiner must connect afresh
+    joined = time.perf_counter()
+    late = _Snapshots(client)
+    try:
+        caught_up = late.first_at(last)
+    finally:
+        late.subscriber.unregister()
     return {
         "adds": adds,
-        "ms_after_last_answer": (
-            None if caught_up is None else round((caught_up - answered) * 1e3, 1)
-        ),
+        "ms_join_to_snapshot": None if caught_up is None else round((caught_up - joined) * 1e3, 1),
         "snapshots": during,
     }

@@ -22,10 +22,11 @@ import socket
 import statistics
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 import xmlrpc.client
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from types import FrameType
 from typing import Any
@@ -118,6 +119,25 @@ def _signal(process: subprocess.Popen[Any], signum: int) -> None:
 
 
 @contextlib.contextmanager
+def bench_node(prefix: str, name: str) -> Iterator[tuple[Path, dict[str, str]]]:
+    """A private rosmaster in a new temporary folder, and this process a node ``name`` of it.
+
+    Yields the folder (removed afterwards) and the environment for other nodes.
+    """
+    with tempfile.TemporaryDirectory(prefix=prefix) as tmp:
+        base = Path(tmp)
+        (base / "log").mkdir()
+        with ros_master(base) as env:
+            import rospy
+
+            rospy.init_node(name, anonymous=True, disable_signals=True)
+            try:
+                yield base, env
+            finally:
+                rospy.signal_shutdown("done")
+
+
+@contextlib.contextmanager
 def ros_master(home: Path) -> Iterator[dict[str, str]]:
     """A private rosmaster; yields the environment for nodes (this process uses it too)."""
     port = free_port()
@@ -158,7 +178,14 @@ def ros_master(home: Path) -> Iterator[dict[str, str]]:
 class Server:
     """A mission_server process (optionally under cProfile, stopped with SIGUSR1 then)."""
 
-    def __init__(self, env: dict[str, str], work: Path, library: Path, profile: Path | None):
+    def __init__(
+        self,
+        env: dict[str, str],
+        work: Path,
+        library: Path,
+        profile: Path | None,
+        params: Sequence[str] = (),
+    ):
         self.journal_dir = work / "journal"
         self.mission_dir = work / "missions"  # where SaveMission and LoadMission take paths
         self.profiled = profile is not None
@@ -167,6 +194,7 @@ class Server:
             f"_library:={library}",
             f"_journal_dir:={self.journal_dir}",
             f"_mission_dir:={self.mission_dir}",
+            *params,
         ]
         env = dict(env)
         if profile is not None:

@@ -50,7 +50,7 @@ import sys
 import tempfile
 import time
 from collections import Counter
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -197,12 +197,23 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--outages", type=int, default=3, help="runs of each cut scenario")
     parser.add_argument("--outage", type=float, default=15.0, help="seconds each cut lasts")
     parser.add_argument("--keep", action="store_true", help="keep the work directory")
-    args = parser.parse_args(argv)
+    return run_in_lab(parser.parse_args(argv), measure, "bench_multihost_")
+
+
+def run_in_lab(
+    args: argparse.Namespace,
+    measure: Callable[[argparse.Namespace, Path], dict[str, Any]],
+    prefix: str,
+) -> int:
+    """Print ``measure(args, work)``'s figures, or ``{"skipped": reason}`` without namespaces.
+
+    ``work`` is a new folder, removed afterwards unless ``args.keep``.
+    """
     reason = unavailable()
     if reason:
         print(json.dumps({"skipped": reason}))
         return 0
-    work = Path(tempfile.mkdtemp(prefix="bench_multihost_"))
+    work = Path(tempfile.mkdtemp(prefix=prefix))
     began = time.monotonic()
     try:
         figures = measure(args, work)

@@ -38,7 +38,6 @@ import io
 import pstats
 import random
 import sys
-import tempfile
 import time
 from pathlib import Path
 from typing import Any
@@ -52,6 +51,7 @@ from _server_harness import (
     REPO,
     Server,
     ServerClient,
+    bench_node,
     figures_printed,
     percentiles,
     ros_master,
@@ -294,24 +294,17 @@ def main(argv: list[str] | None = None) -> int:
     largest = max(sizes, key=lambda size: size[0] * size[1])
     options = Options(args.samples, args.whole_repeats)
     output: dict[str, Any] = {"target_at_20x500": TARGET, "sizes": []}
-    with figures_printed(output), tempfile.TemporaryDirectory(prefix="bench_server_") as tmp:
-        base = Path(tmp)
-        (base / "log").mkdir()
-        with ros_master(base) as env:
-            import rospy
-
-            rospy.init_node("bench_server", anonymous=True, disable_signals=True)
-            for a, s in sizes:
-                cpu_seconds = args.cpu_seconds if (a, s) == largest else 0.0
-                at_size = dataclasses.replace(options, cpu_seconds=cpu_seconds)
-                output["sizes"].append(bench_size(env, base / f"{a}x{s}", a, s, at_size))
-            if args.profile:
-                a, s = largest
-                stats = base / "server.prof"
-                profiled = dataclasses.replace(options, profile=stats)
-                bench_size(env, base / "profiled", a, s, profiled)
-                output["profile_top_tottime"] = profile_summary(stats)
-            rospy.signal_shutdown("done")
+    with figures_printed(output), bench_node("bench_server_", "bench_server") as (base, env):
+        for a, s in sizes:
+            cpu_seconds = args.cpu_seconds if (a, s) == largest else 0.0
+            at_size = dataclasses.replace(options, cpu_seconds=cpu_seconds)
+            output["sizes"].append(bench_size(env, base / f"{a}x{s}", a, s, at_size))
+        if args.profile:
+            a, s = largest
+            stats = base / "server.prof"
+            profiled = dataclasses.replace(options, profile=stats)
+            bench_size(env, base / "profiled", a, s, profiled)
+            output["profile_top_tottime"] = profile_summary(stats)
     return 0
 
 

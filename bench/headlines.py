@@ -84,6 +84,18 @@ HEADLINES: dict[str, tuple[str, ...]] = {
         "radio_cuts.*.restore_to_last_start.max_ms",
         "idle_radio.*.uplink_bytes_per_s",
     ),
+    "idle_link": (
+        "skills_on_robot",
+        "uplink_kbit_per_s",
+        "uplink_bytes_per_s",
+        "downlink_bytes_per_s",
+        "uplink_by_kind.*.bytes_per_s",
+    ),
+    "change_bytes": (
+        "sizes.*.now.bytes_per_change./rosmc/mission*",
+        "sizes.*.broadcast.bytes_per_change./rosmc/mission",
+        "sizes.*.now.late_joiner_snapshot_bytes",
+    ),
 }
 
 

@@ -6,8 +6,9 @@ Per dynamic agent, on the topics of :func:`rosmc_server.interface.ground_link`:
 * subscribes ``ack`` (rosmc/RobotAck), ``report`` (rosmc/RobotReport) and
   ``snapshot`` (rosmc/ExecutorSnapshot);
 * beacons to each robot over the radio side channel (UDP, :mod:`.radio`, registered as
-  ``/rosmc/radio/ground``); a robot's beacon after a silence reconnects its topics and
-  retransmits its pending commands at once, whatever TCP's backoff has grown to.
+  ``/rosmc/radio/ground``); a robot's beacon after a silence, or its first return beacon
+  (it did not hear the ground), reconnects its topics and retransmits its pending
+  commands at once, whatever TCP's backoff has grown to.
 
 Commands are retransmitted with backoff until acknowledged; while a robot is out of
 contact new commands wait unsent for it (:mod:`rosmc_server.core.waiting`); reports are
@@ -38,7 +39,7 @@ from ..core.link import (
     Outbox,
     Outgoing,
 )
-from ..core.radio import BEACON_PERIOD, ContactWatch
+from ..core.radio import BEACON_PERIOD, ROBOT_SILENCE, ContactWatch
 from ..core.waiting import collapse
 from ..interface import ground_link
 from .agent_link import AgentLink, LinkHost, Operation
@@ -48,7 +49,10 @@ from .snapshot_sync import SnapshotSync
 
 _log = logging.getLogger(__name__)
 
-HEARTBEAT_PERIOD = 1.0  # seconds between report-ack heartbeats to each robot
+# Seconds between stamped report acks to each robot: they refresh the round trip of a quiet
+# link (the robot echoes them). Ground contact for the robots' lost-link policies is the
+# server's Heartbeat (ROS time); the ground's asks for a whole queue go out when made.
+HEARTBEAT_PERIOD = 10.0
 
 
 class GroundLink:
@@ -66,7 +70,7 @@ class GroundLink:
         self._started = clock()
         self._links: dict[str, AgentLink] = {}
         self._next_heartbeat = self._next_beacon = 0.0
-        self._contact = ContactWatch()
+        self._contact = ContactWatch(silence=ROBOT_SILENCE)
         self._snapshots = SnapshotSync(
             host,
             clock,
@@ -189,9 +193,9 @@ class GroundLink:
             link.command_pub.publish(item.payload)
 
     # -- receiving -----------------------------------------------------------
-    def _on_beacon(self, sender: str) -> None:
+    def _on_beacon(self, sender: str, returning: bool) -> None:
         link = self._links.get(sender)
-        if link is None or not self._contact.heard(sender, self._clock()):
+        if link is None or not self._contact.heard(sender, self._clock(), returning):
             return
         # The robot is back after a silence. Its stalled connections would resume only
         # at TCP's next retransmission, which backs off to minutes: connect afresh.
@@ -295,8 +299,14 @@ class GroundLink:
 
     def _report_ack(self, agent: str, seq: int) -> wire.ReportAck:
         """A report ack stamped with the ground's clock (echoed back for the round trip)."""
-        want_full = self._links[agent].want_full
-        return wire.ReportAck(agent=agent, seq=seq, sent=self._clock(), want_full=want_full)
+        link = self._links[agent]
+        return wire.ReportAck(
+            agent=agent,
+            seq=seq,
+            sent=self._clock(),
+            want_full=link.want_full,
+            link_timeout=link.outbox.timeout,
+        )
 
     def _apply(self, operation: Operation) -> None:
         """Apply a robot-driven change; a refusal is logged, never raised into rospy."""

@@ -1,15 +1,19 @@
 """Publishing the mission to late joiners and the agents' state at a steady rate.
 
-:class:`SnapshotPublisher` publishes the full mission latched on
-``/rosmc/mission`` (rosmc/Mission). Under a burst of changes it coalesces:
-it waits until changes pause (``quiet``) or a burst has lasted ``max_delay``,
-so a multi-megabyte snapshot is not built per change, yet the latched
-snapshot is always current shortly after a burst ends. The snapshot is for late joiners,
-not a stream (clients follow ``/rosmc/mission_events``): after one is published the next
-waits at least ``min_period``, and during a long burst at least ``cost_factor`` times
-what the last one cost, so building and serializing a large mission takes a bounded share
-of the server's time (the service threads share one interpreter with it). A replaced
-mission (new or loaded) is published at once: its content is only in the snapshot.
+:class:`SnapshotPublisher` gives the full mission (rosmc/Mission) on ``/rosmc/mission`` to
+each subscriber as it connects, as a latched topic does, but it is current: the newest
+snapshot built, not the one last broadcast. A change is not broadcast to the subscribers
+already there: they follow ``/rosmc/mission_events``, and a snapshot to each of them per
+change would cost every change the whole mission on the wire (megabytes at 10,000 skills).
+Only a replaced mission (new or loaded), whose content is in no event, goes to everyone.
+
+Snapshots are still built after changes, for the journal's periodic snapshot
+(``on_built``) and for the next subscriber, coalesced: after a change it waits until
+changes pause (``quiet``) or a burst has lasted ``max_delay``; the next waits at least
+``min_period``, and during a long burst at least ``cost_factor`` times what the last one
+cost, so building a large mission takes a bounded share of the server's time (the service
+threads share one interpreter with it). A subscriber that connects meanwhile gets the
+mission of the current revision, built then (the build is cached per revision).
 """
 
 from __future__ import annotations
@@ -25,8 +29,16 @@ import rospy
 _log = logging.getLogger(__name__)
 
 
-class SnapshotPublisher:
-    """Coalescing publisher of the latched mission snapshot."""
+class SnapshotPublisher(rospy.SubscribeListener):  # type: ignore[misc]
+    """The mission snapshot for each new subscriber, and the coalesced builds after changes.
+
+    Args:
+        topic: Where to publish.
+        build: The snapshot of the current revision (cached by the caller per revision).
+        on_built: Called with each snapshot built after changes (on the builder thread).
+        broadcast_changes: Send every coalesced snapshot to every subscriber too (the
+            behaviour before per-subscriber snapshots; benchmarks compare the two).
+    """
 
     def __init__(
         self,
@@ -36,11 +48,19 @@ class SnapshotPublisher:
         max_delay: float = 0.25,
         cost_factor: float = 20.0,
         min_period: float = 0.5,
-        on_published: Callable[[wire.Mission], None] | None = None,
+        on_built: Callable[[wire.Mission], None] | None = None,
+        broadcast_changes: bool = False,
     ) -> None:
-        self._publisher = rospy.Publisher(topic, wire.Mission, queue_size=1, latch=True)
+        super().__init__()
+        # Not latched: rospy would send a new subscriber the last broadcast, which is stale
+        # once changes are no longer broadcast; peer_subscribe sends the current one instead.
+        self._publisher = rospy.Publisher(
+            topic, wire.Mission, subscriber_listener=self, queue_size=1
+        )
+        self._sending = threading.Lock()  # one snapshot on the wire at a time, in order
         self._build = build
-        self._on_published = on_published
+        self._on_built = on_built
+        self._broadcast_changes = broadcast_changes
         self._quiet = quiet
         self._max_delay = max_delay
         self._cost_factor = cost_factor
@@ -55,12 +75,22 @@ class SnapshotPublisher:
         self._thread = threading.Thread(target=self._run, name="snapshot", daemon=True)
 
     def start(self) -> None:
-        """Publish the first snapshot now and start following changes."""
-        self._publisher.publish(self._build())
+        """Start following changes (subscribers get the mission as they connect)."""
         self._thread.start()
 
+    def peer_subscribe(
+        self, topic_name: str, topic_publish: Callable[..., None], peer_publish: Callable[..., None]
+    ) -> None:
+        """A subscriber connected: send it the current snapshot (rospy's connection thread)."""
+        try:
+            with self._sending:
+                peer_publish(self._build())
+        except Exception:  # one subscriber's failure must not break rospy's accept thread
+            _log.exception("could not send the mission snapshot to a new subscriber")
+
     def changed(self, urgent: bool = False) -> None:
-        """The mission changed; a new snapshot will follow (``urgent``: as soon as it can)."""
+        """The mission changed; a new snapshot will be built (``urgent``: as soon as it can,
+        and sent to every subscriber: the mission was replaced)."""
         with self._changed:
             now = time.monotonic()
             self._urgent = self._urgent or urgent
@@ -85,15 +115,18 @@ class SnapshotPublisher:
                 if self._stopped:
                     return
                 self._wait_for_pause()
+                broadcast = self._urgent or self._broadcast_changes
                 self._dirty_since, self._urgent = None, False
             started = time.monotonic()
             try:
-                snapshot = self._build()
-                self._publisher.publish(snapshot)
-                if self._on_published is not None:
-                    self._on_published(snapshot)
-            except Exception:  # keep publishing later snapshots whatever happened
-                _log.exception("could not publish the mission snapshot")
+                with self._sending:
+                    snapshot = self._build()
+                    if broadcast:
+                        self._publisher.publish(snapshot)
+                if self._on_built is not None:
+                    self._on_built(snapshot)
+            except Exception:  # keep building later snapshots whatever happened
+                _log.exception("could not build or publish the mission snapshot")
             self._published = time.monotonic()
             self._cost = self._published - started
 

@@ -4,9 +4,11 @@ Each end (the mission server as ``ground``, each executor under its agent name) 
 UDP socket, on every address and an ephemeral port unless ``port`` is given, and registers
 ``host:port`` on the parameter server as ``/rosmc/radio/<name>`` (``host`` as ROS_IP or
 ROS_HOSTNAME give it, like every other address a node advertises). A background thread
-reads that directory through the master every :data:`DIRECTORY_PERIOD` seconds with a
-timeout, so a cut radio never blocks anything else; the address a datagram came from
-counts too (the newest wins).
+reads that directory through the master with a timeout, so a cut radio never blocks
+anything else: every :data:`~..core.radio.DIRECTORY_PERIOD` seconds after a change, less
+often while it stays the same (:func:`~..core.radio.next_directory_period`), and at once
+when asked (:meth:`Radio.refresh`); the address a datagram came from counts too (the
+newest wins).
 
 :class:`TopicListener` is a subscriber that can be reconnected: when a beacon shows a
 peer is back after a silence, the link's subscribers for it connect afresh at once,
@@ -18,6 +20,7 @@ from __future__ import annotations
 import logging
 import socket
 import threading
+import time
 import xmlrpc.client
 from collections.abc import Callable, Iterable
 from http.client import HTTPConnection
@@ -30,11 +33,17 @@ import rosmc.msg as wire
 import rospy
 
 from ..core import RosmcError
-from ..core.radio import DatagramKind, decode_datagram, encode_datagram, parse_endpoint
+from ..core.radio import (
+    DIRECTORY_PERIOD,
+    DatagramKind,
+    decode_datagram,
+    encode_datagram,
+    next_directory_period,
+    parse_endpoint,
+)
 from ..interface import RADIO_DIRECTORY
 
 _log = logging.getLogger(__name__)
-DIRECTORY_PERIOD = 2.0  # seconds between reads of the directory
 MASTER_TIMEOUT = 2.0  # seconds an XML-RPC call to the master may take
 GROUND = "ground"
 
@@ -57,7 +66,8 @@ class Radio:
 
     Args:
         name: ``ground`` or the agent's name.
-        on_beacon: Called with the sender's name for each beacon (on the receive thread).
+        on_beacon: Called with the sender's name for each beacon, and whether it was a
+            return beacon (on the receive thread).
         on_signal: Called with each barrier signal heard (on the receive thread).
         port: UDP port to bind (0: any free one).
     """
@@ -65,7 +75,7 @@ class Radio:
     def __init__(
         self,
         name: str,
-        on_beacon: Callable[[str], None],
+        on_beacon: Callable[[str, bool], None],
         on_signal: Callable[[wire.BarrierSignal], None] | None = None,
         port: int = 0,
     ) -> None:
@@ -81,6 +91,8 @@ class Radio:
         self._listed: dict[str, tuple[str, int]] = {}  # as last read from the directory
         self._lock = threading.Lock()
         self._closed = threading.Event()
+        self._wake = threading.Event()  # read the directory now
+        self._last_read = float("-inf")  # monotonic time of the last read of the directory
         self._registered = False
         self._master = xmlrpc.client.ServerProxy(
             rosgraph.get_master_uri(), transport=_TimeoutTransport(MASTER_TIMEOUT)
@@ -93,9 +105,13 @@ class Radio:
             thread.start()
 
     # -- sending ------------------------------------------------------------------------
-    def beacon(self, peer: str) -> None:
-        """Tell ``peer`` this end is here (nothing if its address is not known yet)."""
-        self._send(peer, encode_datagram(DatagramKind.BEACON, self.name.encode("utf-8")))
+    def beacon(self, peer: str, kind: DatagramKind = DatagramKind.BEACON) -> None:
+        """Tell ``peer`` this end is here (nothing if its address is not known yet).
+
+        ``kind`` is BEACON or RETURN_BEACON (this end does not hear ``peer``, or just did
+        again after a silence).
+        """
+        self._send(peer, encode_datagram(kind, self.name.encode("utf-8")))
 
     def signal(self, msg: wire.BarrierSignal, peers: Iterable[str]) -> None:
         """Send a barrier signal to each of ``peers`` whose address is known."""
@@ -139,10 +155,10 @@ class Radio:
     def _dispatch(self, data: bytes, source: tuple[str, int]) -> None:
         try:
             kind, payload = decode_datagram(data)
-            if kind is DatagramKind.BEACON:
+            if kind in (DatagramKind.BEACON, DatagramKind.RETURN_BEACON):
                 sender = payload.decode("utf-8")
                 self._learn(sender, source)
-                self._on_beacon(sender)
+                self._on_beacon(sender, kind is DatagramKind.RETURN_BEACON)
                 return
             msg = wire.BarrierSignal()
             msg.deserialize(payload)
@@ -164,20 +180,32 @@ class Radio:
                 self._addresses[name] = source
 
     # -- the directory on the parameter server -------------------------------------------
+    def refresh(self) -> None:
+        """Read the directory soon (a peer may have moved), unless it was read just now."""
+        if time.monotonic() - self._last_read > DIRECTORY_PERIOD:
+            self._wake.set()
+
     def _directory(self) -> None:
+        period = DIRECTORY_PERIOD
         while not self._closed.is_set():
+            self._last_read = time.monotonic()
             try:
-                self._read_directory()
+                changed = self._read_directory()
             except (OSError, xmlrpc.client.Error) as error:  # the master is out of reach
                 _log.debug("radio %s: directory unavailable: %s", self.name, error)
-            self._closed.wait(DIRECTORY_PERIOD)
+                changed = True  # try again soon
+            period = next_directory_period(period, changed)
+            self._wake.wait(period)
+            self._wake.clear()
 
-    def _read_directory(self) -> None:
+    def _read_directory(self) -> bool:
+        """Register this end and learn the others' endpoints; whether anything changed."""
         caller = rospy.get_name() if rospy.core.is_initialized() else f"/rosmc_radio_{self.name}"
         answer: Any = self._master.getParam(caller, RADIO_DIRECTORY)
         code, _, entries = answer
         entries = entries if code == 1 and isinstance(entries, dict) else {}
-        if entries.get(self.name) != self.endpoint:
+        changed = entries.get(self.name) != self.endpoint
+        if changed:
             self._master.setParam(caller, f"{RADIO_DIRECTORY}/{self.name}", self.endpoint)
         for name, text in entries.items():
             if name == self.name or not isinstance(text, str):
@@ -194,10 +222,13 @@ class Radio:
                 if self._listed.get(name) != address:
                     self._listed[name] = address
                     self._addresses[name] = address
+                    changed = True
+        return changed
 
     def close(self) -> None:
         """Stop receiving and close the socket (the directory entry stays for a restart)."""
         self._closed.set()
+        self._wake.set()
         self._socket.close()
 
 

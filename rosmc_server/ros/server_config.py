@@ -34,6 +34,7 @@ class ServerConfig:
     mission_dir: Path = DEFAULT_MISSION_DIR
     snapshot_every: int = JournalOptions.snapshot_every
     operators: OperatorAllowList = field(default_factory=OperatorAllowList)
+    broadcast_snapshots: bool = False
 
     @classmethod
     def from_params(cls) -> ServerConfig:
@@ -66,4 +67,5 @@ class ServerConfig:
             ),
             snapshot_every=max(1, int(rospy.get_param("~snapshot_every", cls.snapshot_every))),
             operators=OperatorAllowList.of(rospy.get_param("~operators", [])),
+            broadcast_snapshots=bool(rospy.get_param("~broadcast_snapshots", False)),
         )

@@ -7,7 +7,8 @@ Services: one per operator operation, see :mod:`rosmc_server.ros.operator_servic
 
 Publishes:
     ``/rosmc/mission_events`` (rosmc/MissionEvent): one per accepted change.
-    ``/rosmc/mission`` (rosmc/Mission, latched): full snapshot, coalesced.
+    ``/rosmc/mission`` (rosmc/Mission): the current snapshot to each subscriber as it
+        connects; after that only a replaced mission (see :mod:`.publishing`).
     ``/rosmc/agent_states`` (rosmc/AgentStates): every agent's state at ``~agent_state_rate``.
     The robot links' command and report_ack topics (see :mod:`.ground_link`).
 
@@ -32,6 +33,8 @@ Parameters (private):
     ``~agent_state_rate`` (float, Hz): rate of ``/rosmc/agent_states`` (2.0).
     ``~fsync`` (bool): fsync the journal on every change (survives power loss; true).
     ``~snapshot_every`` (int): mission events between two full snapshots in the journal (500).
+    ``~broadcast_snapshots`` (bool): also send ``/rosmc/mission`` to every subscriber after
+        changes (coalesced), as before per-subscriber snapshots (false; for benchmarks).
     ``~operators`` (list of str, or one string of names): nodes (full names, or prefixes
         ending in ``/`` or ``*``) that may call the operator services; empty (the default)
         lets every node in. Guards against mistakes, not attackers (see
@@ -122,7 +125,10 @@ class MissionServer:
             self._journal.append_snapshot(self.snapshot_msg(), time.time_ns())
         self._events = rospy.Publisher(interface.EVENTS_TOPIC, wire.MissionEvent, queue_size=1000)
         self._snapshots = SnapshotPublisher(
-            interface.MISSION_TOPIC, self.snapshot_msg, on_published=self._journal_snapshot
+            interface.MISSION_TOPIC,
+            self.snapshot_msg,
+            on_built=self._journal_snapshot,
+            broadcast_changes=config.broadcast_snapshots,
         )
         self.link = GroundLink(self, library.dynamic_agents, timeout=config.link_timeout)
         self._recorder = TelemetryRecorder(lambda: self._journal, frozenset(library.dynamic_agents))
@@ -221,7 +227,7 @@ class MissionServer:
             self.link.send(spec)
 
     def _journal_snapshot(self, snapshot: wire.Mission) -> None:
-        """Journal a published snapshot when one is due, off the service path.
+        """Journal a snapshot built after changes when one is due, off the service path.
 
         Building a snapshot of a large mission takes far longer than a service
         call may; the journal's reader accepts events written before a snapshot

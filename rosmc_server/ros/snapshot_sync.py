@@ -69,6 +69,8 @@ class SnapshotSync:
         if link.outbox.robot_numbering(msg.last_command_seq, self._clock()):
             _log.info("link %s: robot executed commands up to %d", agent, msg.last_command_seq)
         fresh = link.reports is None or msg.last_report_seq < link.reports.last
+        if not msg.policy and link.snapshot is not None:
+            msg.policy = link.snapshot.policy  # unchanged: the robot says it only now and then
         link.snapshot = msg
         if fresh:
             # Every report up to last_report_seq is reflected in the snapshot's statuses:
@@ -86,6 +88,10 @@ class SnapshotSync:
         self.check_hash(link)
         if msg.queue_omitted and caught_up:
             self._check_digest(link, msg)
+        if msg.queue_omitted and link.want_full and not fresh:
+            # Asked for the queue and not given it: the ask is new, lost, or crossed this
+            # snapshot. Ask (again) now, rather than with a later ack.
+            self._ack(link, link.reports.last)
         self._transmit(link)
 
     def expected_hash(self, agent: str) -> str:

@@ -20,12 +20,15 @@ class Heard:
 
     def __init__(self) -> None:
         self.beacons: list[str] = []
+        self.returns: list[str] = []  # senders of return beacons
         self.signals: list[wire.BarrierSignal] = []
         self.lock = threading.Lock()
 
-    def beacon(self, sender: str) -> None:
+    def beacon(self, sender: str, returning: bool) -> None:
         with self.lock:
             self.beacons.append(sender)
+            if returning:
+                self.returns.append(sender)
 
     def signal(self, msg: wire.BarrierSignal) -> None:
         with self.lock:
@@ -61,6 +64,13 @@ def test_endpoints_find_each_other_through_the_directory(ros_master: RosMaster) 
         assert (got.agent, got.barrier_id, got.kind) == ("radio_r1", "B3", 3)
         assert got.stamp == signal.stamp
         assert not heard["ground"].signals  # signals go to robots only
+        assert "radio_r2" not in heard["ground"].returns  # a plain beacon
+
+        def returned() -> bool:
+            radios["radio_r2"].beacon("ground", DatagramKind.RETURN_BEACON)
+            return "radio_r2" in heard["ground"].returns
+
+        wait_until(returned, 30.0, "a return beacon to arrive as one")
 
         # Stray datagrams never stop the receiver.
         buffer = BytesIO()

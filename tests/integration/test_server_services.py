@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import json
 import math
+import subprocess
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -862,28 +864,58 @@ def test_event_size_does_not_grow_with_the_mission(fresh: Client, events: Any) -
     assert len(serialized(c.mission())) > 100 * sizes[1000][0]
 
 
-def test_latched_snapshot_is_current_after_a_burst(fresh: Client, client_node: Any) -> None:
+_FIRST_MESSAGE = """
+import sys, rospy
+rospy.init_node("late_joiner", anonymous=True)
+msg = rospy.wait_for_message(sys.argv[1], rospy.AnyMsg, timeout=60.0)
+open(sys.argv[2], "wb").write(msg._buff)
+"""
+
+
+def first_message(topic: str, folder: Path) -> bytes:
+    """The first message a new subscriber in a process of its own gets on ``topic``."""
+    target = folder / "first_message.bin"
+    subprocess.run(
+        [sys.executable, "-c", _FIRST_MESSAGE, topic, str(target)], check=True, timeout=90.0
+    )
+    return target.read_bytes()
+
+
+def test_the_mission_topic_gives_each_subscriber_the_current_mission_once(
+    fresh: Client, client_node: Any, tmp_path: Path
+) -> None:
+    """A change is not resent to every subscriber (they follow the events): a late joiner
+    gets the current mission, and only a replaced mission goes to everyone."""
     c = fresh
-    snapshots = Recorder(interface.MISSION_TOPIC, wire.Mission)
+    early = Recorder(interface.MISSION_TOPIC, wire.Mission)
     try:
-        rev = c.revision()
-        for _ in range(200):
+        assert early.wait_for(bool, timeout=30.0)[0].revision <= c.revision()
+        # A replaced mission goes to every subscriber (and ends what was being built).
+        rev = accepted(c.call("new_mission", base_revision=c.revision(), keep_markers=False))
+        start = rev.revision
+        early.wait_for(lambda m: m[-1].revision == start, timeout=30.0)
+        for _ in range(50):
             rev = accepted(
                 c.call(
-                    "add_skill", base_revision=rev, agent="science_rover", skill="explore", index=-1
+                    "add_skill",
+                    base_revision=rev.revision,
+                    agent="science_rover",
+                    skill="explore",
+                    index=-1,
                 )
-            ).revision
-        got = snapshots.wait_for(lambda m: bool(m) and m[-1].revision == rev, timeout=30.0)
-        assert mission_key(got[-1]) == mission_key(c.mission())
-        assert len(got) < 100, "snapshots were not coalesced under the burst"
+            )
+        # Another process: this one's subscribers share one connection, and a late one
+        # here would connect afresh for both.
+        joined = wire.Mission().deserialize(first_message(interface.MISSION_TOPIC, tmp_path))
+        assert joined.revision == rev.revision
+        assert mission_key(joined) == mission_key(c.mission())
+        replaced = accepted(c.call("new_mission", base_revision=rev.revision, keep_markers=False))
+        got = early.wait_for(lambda m: m[-1].revision == replaced.revision, timeout=30.0)
+        # Before, the burst's coalesced snapshot came between the two.
+        assert [m.revision for m in got if m.revision >= start] == [start, replaced.revision]
+        assert not any(t.skills for t in got[-1].tasks)
     finally:
-        snapshots.close()
-    late = Recorder(interface.MISSION_TOPIC, wire.Mission)
-    try:
-        first = late.wait_for(bool, timeout=30.0)[0]
-        assert mission_key(first) == mission_key(c.mission())
-    finally:
-        late.close()
+        early.close()
 
 
 def test_agent_states_keep_arriving_with_unknown_links(

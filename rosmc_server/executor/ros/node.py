@@ -5,11 +5,14 @@ Subscribes:
 Publishes:
     ``<link>/ack`` (rosmc/RobotAck), ``<link>/report`` (rosmc/RobotReport, retransmitted
     until acknowledged), ``<link>/snapshot`` (rosmc/ExecutorSnapshot, every
-    ``~snapshot_period``; the whole queue in the first and when the ground asks, its
-    digest always), ``/rosmc/barriers`` (rosmc/BarrierSignal, a copy for observers).
+    ``~snapshot_period`` while anything in it changes, else every
+    ``~idle_snapshot_period`` but twice within the ground's link timeout
+    (:mod:`..core.pacing`); the whole queue in the first and when the ground asks,
+    its digest always), ``/rosmc/barriers`` (rosmc/BarrierSignal, a copy for observers).
 Radio side channel (UDP, :mod:`rosmc_server.ros.radio`, registered as
     ``/rosmc/radio/<robot>``): barrier signals to and from the other robots, and beacons
-    to and from the ground; a ground beacon after a silence reconnects the link's topics.
+    to and from the ground (:class:`~rosmc_server.core.radio.BeaconPlan`: seldom while it
+    hears the ground); a ground beacon after a silence reconnects the link's topics.
 
 ``<link>`` is ``/rosmc/link/<robot>`` (talking to the ground directly) or, with
 ``~robot_side:=true``, ``/<robot>/link`` (behind a link emulator).
@@ -23,7 +26,8 @@ Parameters (private):
     ``~pose_source`` (str): ``module:function`` returning the robot's pose source (where it
         is, remembered at each ground contact for the ``return_to_link`` policy); default:
         the skills module's ``pose_source`` if it has one, else none.
-    ``~snapshot_period`` (float, s, 1.0), ``~report_retry`` (float, s, 0.5),
+    ``~snapshot_period`` (float, s, 1.0), ``~idle_snapshot_period`` (float, s, 5.0),
+    ``~report_retry`` (float, s, 0.5),
     ``~tick_rate`` (float, Hz, 50), ``~robot_side`` (bool, false).
     ``~cwd`` (str): a relative ``~state_file`` is taken from there (launch files pass the
     directory roslaunch was typed in).
@@ -62,10 +66,11 @@ from ...conversions.robot_link import (
     snapshot_to_msg,
 )
 from ...core import RosmcError
-from ...core.radio import BEACON_PERIOD, ContactWatch
+from ...core.radio import BeaconPlan, ContactWatch
 from ...ros.radio import GROUND, Radio, TopicListener, reconnect_in_background
 from ..core import Command, Engine, Report, Signal, SkillType
 from ..core.lost_link import PoseSource, no_pose
+from ..core.pacing import IDLE_PERIOD, SnapshotPacer
 from ..core.state_file import load_state, save_state
 
 _log = logging.getLogger(__name__)
@@ -111,6 +116,7 @@ class ExecutorNode:
         # The whole queue goes in the first snapshot and again whenever the ground asks
         # (a new ground, or one whose statuses disagree with the digest).
         self._full_snapshot = True
+        self.pacer = SnapshotPacer()
         topics = interface.robot_link(agent) if robot_side else interface.ground_link(agent)
         self._ack_pub = rospy.Publisher(topics.ack, wire.RobotAck, queue_size=100)
         self._report_pub = rospy.Publisher(topics.report, wire.RobotReport, queue_size=1000)
@@ -137,6 +143,7 @@ class ExecutorNode:
             TopicListener(topics.report_ack, wire.ReportAck, self._on_report_ack, queue_size=100),
         ]
         self._contact = ContactWatch()
+        self._beacons = BeaconPlan()
         self.radio = Radio(agent, self._on_beacon, self._on_signal)
 
     # -- engine outputs (called with the lock held) ------------------------------------
@@ -150,6 +157,7 @@ class ExecutorNode:
     def signal(self, signal: Signal) -> None:
         """Send a barrier signal to the peers over the radio (and publish it for observers)."""
         msg = signal_to_msg(signal)
+        self.radio.refresh()  # a peer may have moved since the directory was last read
         self.radio.signal(msg, self.radio.robots())
         self._barrier_pub.publish(msg)
 
@@ -191,21 +199,34 @@ class ExecutorNode:
             with self._lock:
                 self.engine.report_acknowledged(msg.seq)
                 self._full_snapshot |= msg.want_full
+                if msg.link_timeout > 0.0:
+                    self.pacer.ground_timeout = float(msg.link_timeout)
                 if msg.sent > 0.0:  # echoed in the next snapshot: the ground's round trip
                     self._echo = (msg.sent, time.monotonic())
 
-    def _snapshot_msg(self) -> wire.ExecutorSnapshot:
-        # Most snapshots leave the queue out (its digest stands in): listing every skill
-        # held, every second, would take much of a radio's bandwidth.
-        msg = snapshot_to_msg(self.agent, self.engine.snapshot(full=self._full_snapshot))
+    def _snapshot_msg(self, now: float) -> wire.ExecutorSnapshot | None:
+        """The snapshot due at ``now``, or None (see :class:`SnapshotPacer`).
+
+        Most snapshots leave the queue out (its digest stands in): listing every skill
+        held, every second, would take much of a radio's bandwidth.
+        """
+        snapshot = self.pacer.due(self.engine.snapshot(full=self._full_snapshot), now)
+        if snapshot is None:
+            return None
+        msg = snapshot_to_msg(self.agent, snapshot)
         self._full_snapshot = False
         if self._echo is not None:
             sent, received = self._echo
             msg.echo_sent, msg.echo_held = sent, time.monotonic() - received
         return msg
 
-    def _on_beacon(self, sender: str) -> None:
-        if sender == GROUND and self._contact.heard(GROUND, time.monotonic()):
+    def _on_beacon(self, sender: str, returning: bool) -> None:
+        if sender != GROUND:
+            return
+        now = time.monotonic()
+        # (Read by the loop's thread without a lock: a stale read delays a beacon a tick.)
+        self._beacons.heard(now)
+        if self._contact.heard(GROUND, now):
             # The ground is back after a silence: its stalled connections would resume
             # only at TCP's next retransmission, which backs off to minutes.
             reconnect_in_background(self._listeners, f"{self.agent} hears the ground again")
@@ -220,15 +241,16 @@ class ExecutorNode:
             self.engine.hear(signal)
 
     # -- the loop ------------------------------------------------------------------------
-    def spin(self, tick_rate: float, snapshot_period: float, report_retry: float) -> None:
-        """Tick the engine, retransmit reports and publish snapshots until shutdown."""
-        next_snapshot = next_retry = next_beacon = 0.0
+    def spin(self, tick_rate: float, report_retry: float) -> None:
+        """Tick the engine, retransmit reports and publish snapshots (paced by
+        :attr:`pacer`) until shutdown."""
+        next_snapshot = next_retry = 0.0
         period = 1.0 / tick_rate
         while not rospy.is_shutdown():
             now = time.monotonic()
-            if now >= next_beacon:
-                next_beacon = now + BEACON_PERIOD
-                self.radio.beacon(GROUND)
+            beacon = self._beacons.due(now)
+            if beacon is not None:
+                self.radio.beacon(GROUND, beacon)
             with self._lock:
                 try:
                     self.engine.tick()
@@ -239,8 +261,10 @@ class ExecutorNode:
                     for report in self.engine.unacked:
                         self._report_pub.publish(report_to_msg(self.agent, report))
                 if now >= next_snapshot:
-                    next_snapshot = now + snapshot_period
-                    self._snapshot_pub.publish(self._snapshot_msg())
+                    snapshot = self._snapshot_msg(now)
+                    if snapshot is not None:
+                        self._snapshot_pub.publish(snapshot)
+                    next_snapshot = self.pacer.next_check(now)
                 self._persist()
             time.sleep(max(0.0, period - (time.monotonic() - now)))
         self.radio.close()
@@ -268,6 +292,7 @@ class ExecutorConfig:
     robot_side: bool = False
     tick_rate: float = 50.0
     snapshot_period: float = 1.0
+    idle_snapshot_period: float = IDLE_PERIOD
     report_retry: float = 0.5
 
     @classmethod
@@ -289,6 +314,7 @@ class ExecutorConfig:
             robot_side=bool(rospy.get_param("~robot_side", False)),
             tick_rate=float(rospy.get_param("~tick_rate", 50.0)),
             snapshot_period=float(rospy.get_param("~snapshot_period", 1.0)),
+            idle_snapshot_period=float(rospy.get_param("~idle_snapshot_period", IDLE_PERIOD)),
             report_retry=float(rospy.get_param("~report_retry", 0.5)),
         )
         for name in PRIVATE_PARAMS:
@@ -305,6 +331,7 @@ PRIVATE_PARAMS = (
     "robot_side",
     "tick_rate",
     "snapshot_period",
+    "idle_snapshot_period",
     "report_retry",
     "cwd",
 )
@@ -340,5 +367,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         ", ".join(sorted(skill_types)),
         "robot-side" if config.robot_side else "direct",
     )
-    node.spin(config.tick_rate, config.snapshot_period, config.report_retry)
+    node.pacer.period = config.snapshot_period
+    node.pacer.idle_period = config.idle_snapshot_period
+    node.spin(config.tick_rate, config.report_retry)
     return 0
