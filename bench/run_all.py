@@ -88,7 +88,13 @@ def last_json(text: str) -> Any:
 
 
 def run_one(script: Path, timeout: float) -> dict[str, Any]:
-    """Run one benchmark; its figures, wall time, exit code (and output tail on failure)."""
+    """Run one benchmark; its figures, wall time, exit code, the machine's load (and output
+    tail on failure).
+
+    The load average (1 min) is taken before and after: the machines are shared, and a
+    figure measured beside other work is only comparable with that said next to it.
+    """
+    load_before = os.getloadavg()[0]
     began = time.monotonic()
     process = subprocess.Popen(
         [sys.executable, str(script)],
@@ -115,6 +121,7 @@ def run_one(script: Path, timeout: float) -> dict[str, Any]:
         "seconds": round(time.monotonic() - began, 1),
         "returncode": process.returncode,
         "figures": figures,
+        "load_average": [round(load_before, 2), round(os.getloadavg()[0], 2)],
     }
     if process.returncode != 0 or figures is None:
         result["output_tail"] = output[-3000:]
@@ -131,7 +138,8 @@ def markdown(results: dict[str, Any]) -> str:
         "",
     ]
     for name, bench in results["benchmarks"].items():
-        title = f"**{name}** ({bench['seconds']:.0f} s, commit {bench.get('commit', '?')})"
+        commit = bench.get("commit", "?")
+        title = f"**{name}** ({bench['seconds']:.0f} s, commit {commit}{_load(bench)})"
         if bench["figures"] is None:
             lines += [f"{title}: failed (exit {bench['returncode']}), no figures.", ""]
             continue
@@ -149,6 +157,12 @@ def markdown(results: dict[str, Any]) -> str:
         lines += [f"| {row.label} | {row.value} |" for row in rows]
         lines.append("")
     return "\n".join(lines).rstrip() + "\n"
+
+
+def _load(bench: dict[str, Any]) -> str:
+    """ ", load average A → B" of a benchmark's run (older results have none)."""
+    load = bench.get("load_average")
+    return f", load average {load[0]:g} → {load[1]:g}" if load else ""
 
 
 def update_readme(text: str, table: str) -> str:

@@ -144,3 +144,13 @@ def test_the_scale_benchmark_is_shown_as_operations_by_mission_size() -> None:
     assert (
         "Edits 60 ms apart, p50 (p95) ms at 100: 0.9 (2.5), 700: 1 (3), 10,000: 0.9 (2.5)." in table
     )
+
+
+def test_each_benchmark_says_the_load_it_ran_under() -> None:
+    results = {
+        "machine": run_all.machine(),
+        "benchmarks": {
+            "busy": {"seconds": 3.0, "returncode": 1, "figures": None, "load_average": [4.5, 6]},
+        },
+    }
+    assert "**busy** (3 s, commit ?, load average 4.5 → 6): failed" in run_all.markdown(results)
