@@ -10,55 +10,24 @@ from __future__ import annotations
 import bisect
 import operator
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from fractions import Fraction
 
 from .changes import Change, SkillMove, moves_between
+from .content import MissionContent as MissionContent
+from .content import Sections as Sections
 from .errors import NotFound
-from .library import Library
 from .model import Barrier, SkillInstance, SkillStatus, TaskMarker, Transfer
+from .reorder import play_moves
 from .validation import excerpt
 
 # Spacing of the position keys given to a task's skills: room for 32 insertions at one
 # place before the task's keys are spread again.
 _KEY_SPACING = 1 << 32
+# From this many moves on, a reorder is decoded in one pass over the stretch it touches
+# (see :mod:`.reorder`) instead of shifting the task once per move.
+BULK_MOVES = 16
 _skill_id = operator.attrgetter("id")
-
-
-@dataclass
-class MissionContent:
-    """The content of a mission, without indexes: what files and snapshots hold."""
-
-    library: str
-    tasks: dict[str, list[SkillInstance]]
-    barriers: dict[str, Barrier] = field(default_factory=dict)
-    markers: dict[str, TaskMarker] = field(default_factory=dict)
-
-    @classmethod
-    def empty(cls, library: Library) -> MissionContent:
-        """A mission with an empty task for every dynamic agent of ``library``."""
-        return cls(library.name, {agent: [] for agent in library.dynamic_agents})
-
-    def copy(self) -> MissionContent:
-        """A copy whose tasks and mappings can change without touching this one."""
-        return MissionContent(
-            self.library,
-            {agent: list(task) for agent, task in self.tasks.items()},
-            dict(self.barriers),
-            dict(self.markers),
-        )
-
-
-@dataclass(frozen=True)
-class Sections:
-    """Where an agent's task splits.
-
-    ``task[:synced_end]`` is the synchronized section, ``task[synced_end:editable_start]``
-    the blueprint skills being uploaded, ``task[editable_start:]`` the editable blueprint.
-    """
-
-    synced_end: int
-    editable_start: int
 
 
 class MissionState:
@@ -205,8 +174,18 @@ class MissionState:
     def members_after_moves(self, agent: str, moves: Sequence[SkillMove]) -> list[str]:
         """``agent``'s barrier members in task order as they would be after ``moves``.
 
-        Nothing changes: the moves are played on a copy of the task's keys.
+        Nothing changes: many moves are decoded at once (:meth:`order_after_moves`), a
+        few are played on a copy of the task's keys.
         """
+        members = self._member_ids.get(agent, [])
+        played = self.order_after_moves(agent, moves) if len(moves) >= BULK_MOVES else None
+        if played is not None:
+            start, ids = played
+            keys, member_keys = self._keys[agent], self._member_keys.get(agent, [])
+            first = bisect.bisect_left(member_keys, keys[start])
+            last = bisect.bisect_right(member_keys, keys[start + len(ids) - 1])
+            inside = [skill_id for skill_id in ids if skill_id in self._barrier_of]
+            return [*members[:first], *inside, *members[last:]]
         keys: list[int | Fraction] = list(self._keys[agent])
         moved: dict[str, int | Fraction] = {}
         for move in moves:
@@ -218,8 +197,29 @@ class MissionState:
             high = keys[index] if index < len(keys) else low + 2
             moved[move.skill_id] = Fraction(low + high, 2)
             keys.insert(index, moved[move.skill_id])
-        members = self._member_ids.get(agent, [])
         return sorted(members, key=lambda skill_id: moved.get(skill_id, self._key_of[skill_id]))
+
+    def order_after_moves(
+        self, agent: str, moves: Sequence[SkillMove]
+    ) -> tuple[int, list[str]] | None:
+        """Where the stretch of ``agent``'s task that ``moves`` touch starts, and its ids
+        after them; None unless the moves are canonical (see :func:`.reorder.play_moves`).
+
+        Costs the stretch, once: nothing changes.
+        """
+        keys, key_of = self._keys[agent], self._key_of
+        places = []
+        for move in moves:
+            if self._agent_of.get(move.skill_id) != agent:
+                return None
+            places.append(bisect.bisect_left(keys, key_of[move.skill_id]))
+        targets = [move.index for move in moves]
+        start, end = min(*places, *targets), max(*places, *targets) + 1
+        if start < 0 or end > len(keys):
+            return None
+        stretch = list(map(_skill_id, self._content.tasks[agent][start:end]))
+        ids = play_moves(stretch, moves, start)
+        return None if ids is None else (start, ids)
 
     def moves_for_order(self, agent: str, order: Sequence[str]) -> tuple[SkillMove, ...]:
         """The moves that give the last ``len(order)`` skills of ``agent``'s task ``order``."""
@@ -267,8 +267,7 @@ class MissionState:
             moves = change.moves
             if not moves and change.blueprint_order:  # old journals: the whole new order
                 moves = self.moves_for_order(change.order_agent, change.blueprint_order)
-            for move in moves:
-                self._move_skill(move.skill_id, move.index)
+            self._move_skills(change.order_agent, moves)
         for barrier in change.put_barriers:
             self._drop_barrier(barrier.id)
             content.barriers[barrier.id] = barrier
@@ -323,6 +322,30 @@ class MissionState:
         self._bind(skill)
         if member:
             self._add_member(skill_id)
+
+    def _move_skills(self, agent: str, moves: Sequence[SkillMove]) -> None:
+        played = self.order_after_moves(agent, moves) if len(moves) >= BULK_MOVES else None
+        if played is None:
+            for move in moves:
+                self._move_skill(move.skill_id, move.index)
+            return
+        start, ids = played
+        end = start + len(ids)
+        task, keys, key_of = self._content.tasks[agent], self._keys[agent], self._key_of
+        by_id = {skill.id: skill for skill in task[start:end]}
+        task[start:end] = map(by_id.__getitem__, ids)
+        low = keys[start - 1] if start else 0
+        high = keys[end] if end < len(keys) else low + _KEY_SPACING * (len(ids) + 1)
+        step = (high - low) // (len(ids) + 1)
+        if step < 2:
+            self._spread_keys(agent)
+        else:
+            keys[start:end] = range(low + step, low + step * (len(ids) + 1), step)
+            key_of.update(zip(ids, keys[start:end], strict=True))
+        members = self._member_ids.get(agent)
+        if members:
+            members.sort(key=key_of.__getitem__)
+            self._member_keys[agent] = [key_of[skill_id] for skill_id in members]
 
     def _spread_keys(self, agent: str) -> None:
         """Give ``agent``'s skills evenly spaced keys again (same order)."""

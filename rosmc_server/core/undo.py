@@ -15,10 +15,18 @@ import re
 from dataclasses import dataclass, field, replace
 
 from .barriers import check_moves, find_deadlock
-from .changes import Change, EventKind, MissionEvent, PlacedSkill, Proposal, SkillMove
+from .changes import (
+    Change,
+    EventKind,
+    MissionEvent,
+    PlacedSkill,
+    Proposal,
+    SkillMove,
+    moves_between,
+)
 from .errors import InvalidRequest, NotFound, RuleViolation
 from .model import Barrier, SkillInstance, TaskMarker
-from .state import MissionState
+from .state import BULK_MOVES, MissionState
 
 # The event kind of an edit's inverse (an edit of either kind can be undone).
 _INVERSE_KIND = {
@@ -190,10 +198,17 @@ def _inverse_moves(
 ) -> tuple[SkillMove, ...]:
     """Moves that undo ``moves`` (applied one after the other), last one first.
 
-    Only the moved skills' indexes are followed, so the cost is the moves', not the task's.
+    A few moves: only the moved skills' indexes are followed, so the cost is the moves',
+    not the task's. Many: the stretch they reorder is decoded once and the moves back
+    are those between the two orders (linear in the stretch).
     """
     if not agent or not moves:
         return ()
+    played = before.order_after_moves(agent, moves) if len(moves) >= BULK_MOVES else None
+    if played is not None:
+        start, after = played
+        was = [skill.id for skill in before.task(agent)[start : start + len(after)]]
+        return moves_between(after, was, start)
     where = {move.skill_id: before.locate(move.skill_id)[1] for move in moves}
     back = []
     for move in moves:
