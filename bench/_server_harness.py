@@ -158,17 +158,27 @@ def ros_master(home: Path) -> Iterator[dict[str, str]]:
 class Server:
     """A mission_server process (optionally under cProfile, stopped with SIGUSR1 then)."""
 
-    def __init__(self, env: dict[str, str], work: Path, library: Path, profile: Path | None):
+    def __init__(
+        self,
+        env: dict[str, str],
+        work: Path,
+        library: Path,
+        profile: Path | None,
+        repo: Path = REPO,
+    ):
+        """Start the server of the checkout at ``repo`` (another checkout: a baseline)."""
         self.journal_dir = work / "journal"
         self.mission_dir = work / "missions"  # where SaveMission and LoadMission take paths
         self.profiled = profile is not None
         argv = [
-            str(REPO / "scripts" / "mission_server"),
+            str(repo / "scripts" / "mission_server"),
             f"_library:={library}",
             f"_journal_dir:={self.journal_dir}",
             f"_mission_dir:={self.mission_dir}",
         ]
         env = dict(env)
+        if repo != REPO:
+            env["PYTHONPATH"] = os.pathsep.join([str(repo), env.get("PYTHONPATH", "")])
         if profile is not None:
             env["BENCH_PROFILE"] = str(profile)
             argv = ["-c", PROFILED_SERVER, *argv]
@@ -177,7 +187,7 @@ class Server:
             self.process = subprocess.Popen(
                 [sys.executable, *argv],
                 env=env,
-                cwd=REPO,
+                cwd=repo,
                 stdout=log,
                 stderr=subprocess.STDOUT,
                 start_new_session=True,
