@@ -53,6 +53,9 @@ class MissionState:
         self._member_keys: dict[str, list[int]] = {}  # per agent, its barrier members' keys
         self._member_ids: dict[str, list[str]] = {}  # ... and their ids, in task order
         self._in_transfer: dict[str, set[str]] = {}  # per agent, skills awaiting the robot
+        # The last moves decoded and what they gave: planning, the undo history and
+        # applying a reorder each ask for it within one commit (cleared by every change).
+        self._played: tuple[Sequence[SkillMove], str, tuple[int, list[str]] | None] | None = None
         self._reindex()
 
     # -- queries ---------------------------------------------------------
@@ -207,19 +210,28 @@ class MissionState:
 
         Costs the stretch, once: nothing changes.
         """
+        if self._played is not None and self._played[0] is moves and self._played[1] == agent:
+            return self._played[2]
+        played = self._order_after_moves(agent, moves)
+        self._played = (moves, agent, played)
+        return played
+
+    def _order_after_moves(
+        self, agent: str, moves: Sequence[SkillMove]
+    ) -> tuple[int, list[str]] | None:
         keys, key_of = self._keys[agent], self._key_of
-        places = []
-        for move in moves:
-            if self._agent_of.get(move.skill_id) != agent:
-                return None
-            places.append(bisect.bisect_left(keys, key_of[move.skill_id]))
+        ids = [move.skill_id for move in moves]
+        if set(map(self._agent_of.get, ids)) != {agent}:
+            return None
+        moved_keys = list(map(key_of.__getitem__, ids))
         targets = [move.index for move in moves]
-        start, end = min(*places, *targets), max(*places, *targets) + 1
+        start = min(bisect.bisect_left(keys, min(moved_keys)), *targets)
+        end = max(bisect.bisect_left(keys, max(moved_keys)), *targets) + 1
         if start < 0 or end > len(keys):
             return None
         stretch = list(map(_skill_id, self._content.tasks[agent][start:end]))
-        ids = play_moves(stretch, moves, start)
-        return None if ids is None else (start, ids)
+        order = play_moves(stretch, moves, start)
+        return None if order is None else (start, order)
 
     def moves_for_order(self, agent: str, order: Sequence[str]) -> tuple[SkillMove, ...]:
         """The moves that give the last ``len(order)`` skills of ``agent``'s task ``order``."""
@@ -250,6 +262,12 @@ class MissionState:
     # -- the one way to change -------------------------------------------
     def apply(self, change: Change) -> None:
         """Apply a change that the operations have validated (see :class:`Change`)."""
+        try:
+            self._apply(change)
+        finally:
+            self._played = None
+
+    def _apply(self, change: Change) -> None:
         if change.replacement is not None:
             self._content = change.replacement.copy()
             self._reindex()
