@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import bisect
 import operator
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import replace
 from fractions import Fraction
 
@@ -18,6 +18,7 @@ from .content import MissionContent as MissionContent
 from .content import Sections as Sections
 from .errors import NotFound
 from .model import Barrier, SkillInstance, SkillStatus, TaskMarker, Transfer
+from .pair_index import PairIndex
 from .reorder import play_moves
 from .validation import excerpt
 
@@ -53,6 +54,7 @@ class MissionState:
         self._member_keys: dict[str, list[int]] = {}  # per agent, its barrier members' keys
         self._member_ids: dict[str, list[str]] = {}  # ... and their ids, in task order
         self._in_transfer: dict[str, set[str]] = {}  # per agent, skills awaiting the robot
+        self._pairs = PairIndex()  # barrier members by pair of agents they join
         # The last moves decoded and what they gave: planning, the undo history and
         # applying a reorder each ask for it within one commit (cleared by every change).
         self._played: tuple[Sequence[SkillMove], str, tuple[int, list[str]] | None] | None = None
@@ -113,6 +115,20 @@ class MissionState:
         if agent is None:
             raise NotFound(f"there is no skill {excerpt(skill_id)}")
         return agent, bisect.bisect_left(self._keys[agent], self._key_of[skill_id])
+
+    def order_key(self, skill_id: str) -> int:
+        """A number that grows along the skill's task: compares two skills of one task."""
+        return self._key_of[skill_id]
+
+    def partner_agents(self, agent: str) -> Iterable[str]:
+        """The agents whose tasks share (or shared) a barrier with ``agent``'s."""
+        return self._pairs.partners(agent)
+
+    def first_shared_after(self, skill_id: str, other: str) -> str | None:
+        """The first barrier member after ``skill_id`` on its task that shares a barrier
+        with ``other``'s task (a binary search; see :mod:`.pair_index`)."""
+        agent = self.agent_of(skill_id)
+        return self._pairs.first_after(agent, other, self._key_of[skill_id])
 
     def agent_of(self, skill_id: str) -> str:
         """The agent whose task holds the skill; NotFound if there is none."""
@@ -364,6 +380,7 @@ class MissionState:
         if members:
             members.sort(key=key_of.__getitem__)
             self._member_keys[agent] = [key_of[skill_id] for skill_id in members]
+            self._pairs.rekey(agent, key_of.__getitem__)
 
     def _spread_keys(self, agent: str) -> None:
         """Give ``agent``'s skills evenly spaced keys again (same order)."""
@@ -371,6 +388,7 @@ class MissionState:
         keys[:] = range(_KEY_SPACING, _KEY_SPACING * (len(task) + 1), _KEY_SPACING)
         self._key_of.update(zip(map(_skill_id, task), keys, strict=True))
         self._member_keys[agent] = [self._key_of[i] for i in self._member_ids.get(agent, [])]
+        self._pairs.rekey(agent, self._key_of.__getitem__)
 
     def _drop_barrier(self, barrier_id: str) -> None:
         old = self._content.barriers.pop(barrier_id, None)
@@ -390,11 +408,16 @@ class MissionState:
         if at == len(keys) or keys[at] != key:
             keys.insert(at, key)
             ids.insert(at, skill_id)
+        barrier = self._content.barriers.get(self._barrier_of.get(skill_id, ""))
+        if barrier is not None:
+            partners = (self._agent_of.get(member) for member in barrier.skill_ids)
+            self._pairs.add(skill_id, agent, key, [a for a in partners if a is not None])
 
     def _remove_member(self, skill_id: str) -> None:
         agent = self._agent_of.get(skill_id)
         if agent is None:
             return
+        self._pairs.remove(skill_id, self._key_of[skill_id])
         keys = self._member_keys.get(agent, [])
         at = bisect.bisect_left(keys, self._key_of[skill_id])
         if at < len(keys) and keys[at] == self._key_of[skill_id]:
@@ -425,6 +448,7 @@ class MissionState:
         self._member_keys.clear()
         self._member_ids.clear()
         self._in_transfer.clear()
+        self._pairs.clear()
         for agent, task in self._content.tasks.items():
             self._keys[agent] = []
             self._spread_keys(agent)

@@ -17,7 +17,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from rosmc_server.core import Change, MissionState, RuleViolation
-from rosmc_server.core.barriers import check_moves, find_deadlock
+from rosmc_server.core.barriers import check_moves, check_new_barrier, find_deadlock
 from rosmc_server.core.changes import SkillMove, moves_between
 from rosmc_server.core.reorder import play_moves, play_one_by_one
 from rosmc_server.core.state import BULK_MOVES
@@ -128,9 +128,29 @@ def test_many_moves_change_the_state_as_played_one_by_one(
     state.apply(Change(order_agent=agent, moves=moves))
     assert scanned(state) == after
     assert_indexes_agree(state, groups)
+    if find_deadlock(after, groups) is None:  # a new barrier's check reads the moved members
+        assert_new_barrier_checked_as_in_full(state, groups, data)
     state.apply(inverse)
     assert scanned(state) == tasks
     assert_indexes_agree(state, groups)
+
+
+def assert_new_barrier_checked_as_in_full(state: MissionState, groups: Groups, data: Any) -> None:
+    """A random new barrier is refused exactly when the check over whole tasks deadlocks."""
+    tasks = scanned(state)
+    members = {s for g in groups for s in g}
+    free = {a: [s for s in ids if s not in members] for a, ids in tasks.items()}
+    agents = [a for a in free if free[a]]
+    if len(agents) < 2:
+        return
+    chosen = data.draw(st.lists(st.sampled_from(agents), min_size=2, max_size=4, unique=True))
+    group = tuple(data.draw(st.sampled_from(free[a])) for a in chosen)
+    if find_deadlock(tasks, [*groups, group]) is None:
+        check_new_barrier(state, group)
+    else:
+        with pytest.raises(RuleViolation, match="deadlock") as refused:
+            check_new_barrier(state, group)
+        assert_names_a_real_cycle(refused.value, tasks, [*groups, group])
 
 
 def test_a_whole_random_order_is_decoded_not_played_move_by_move() -> None:
