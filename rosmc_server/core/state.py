@@ -200,9 +200,9 @@ class MissionState:
         played = self.order_after_moves(agent, moves) if len(moves) >= BULK_MOVES else None
         if played is not None:
             start, ids = played
-            keys, member_keys = self._keys[agent], self._member_keys.get(agent, [])
-            first = bisect.bisect_left(member_keys, keys[start])
-            last = bisect.bisect_right(member_keys, keys[start + len(ids) - 1])
+            task_keys, member_keys = self._keys[agent], self._member_keys.get(agent, [])
+            first = bisect.bisect_left(member_keys, task_keys[start])
+            last = bisect.bisect_right(member_keys, task_keys[start + len(ids) - 1])
             inside = [skill_id for skill_id in ids if skill_id in self._barrier_of]
             return [*members[:first], *inside, *members[last:]]
         keys: list[int | Fraction] = list(self._keys[agent])

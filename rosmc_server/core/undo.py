@@ -239,8 +239,8 @@ def _inverse_moves(
     played = before.order_after_moves(agent, moves) if len(moves) >= BULK_MOVES else None
     if played is not None:
         start, after = played
-        was = [skill.id for skill in before.task(agent)[start : start + len(after)]]
-        return moves_between(after, was, start)
+        before_ids = [skill.id for skill in before.task(agent)[start : start + len(after)]]
+        return moves_between(after, before_ids, start)
     where = {move.skill_id: before.locate(move.skill_id)[1] for move in moves}
     back = []
     for move in moves:
