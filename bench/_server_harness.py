@@ -185,18 +185,22 @@ class Server:
         library: Path,
         profile: Path | None,
         params: Sequence[str] = (),
+        repo: Path = REPO,
     ):
+        """Start the server of the checkout at ``repo`` (another checkout: a baseline)."""
         self.journal_dir = work / "journal"
         self.mission_dir = work / "missions"  # where SaveMission and LoadMission take paths
         self.profiled = profile is not None
         argv = [
-            str(REPO / "scripts" / "mission_server"),
+            str(repo / "scripts" / "mission_server"),
             f"_library:={library}",
             f"_journal_dir:={self.journal_dir}",
             f"_mission_dir:={self.mission_dir}",
             *params,
         ]
         env = dict(env)
+        if repo != REPO:
+            env["PYTHONPATH"] = os.pathsep.join([str(repo), env.get("PYTHONPATH", "")])
         if profile is not None:
             env["BENCH_PROFILE"] = str(profile)
             argv = ["-c", PROFILED_SERVER, *argv]
@@ -205,7 +209,7 @@ class Server:
             self.process = subprocess.Popen(
                 [sys.executable, *argv],
                 env=env,
-                cwd=REPO,
+                cwd=repo,
                 stdout=log,
                 stderr=subprocess.STDOUT,
                 start_new_session=True,

@@ -9,6 +9,7 @@ A:[x1, y1], B:[y2, x2] with barriers {x1, x2} and {y1, y2}.
 from __future__ import annotations
 
 from collections.abc import Iterable, Iterator, Sequence
+from dataclasses import dataclass
 
 from .changes import Change, EventKind, Proposal, SkillMove
 from .deadlock import OrderEdge as OrderEdge  # callers import the deadlock search from here
@@ -40,20 +41,54 @@ def check_no_deadlock(
 def check_new_barrier(state: MissionState, skill_ids: Sequence[str]) -> None:
     """Raise RuleViolation if a barrier over ``skill_ids`` (existing non-members) deadlocks.
 
-    The new barrier sits between the members just before and just after its
-    skills; any new cycle passes through it. The search follows "runs before"
-    edges from it among barrier members only: its cost is the number of barriers
-    after the new one, not the mission's size (none for a barrier at the tasks' ends).
+    Any new cycle passes through the new barrier. From a skill reached on one task, the
+    earliest skill reached on another task through one barrier is a binary search away
+    (see :mod:`.pair_index`), and an earlier skill reached on a task leads everywhere a
+    later one does: the search keeps the earliest per agent and stops when one comes
+    before the new barrier's member on its task. Its cost is a few binary searches per
+    pair of agents, whatever the mission's size and however dense its barriers.
     """
-    graph = _BarrierGraph(state)
-    for skill_id in skill_ids:
-        before, after = state.members_around(skill_id)
-        graph.next_member[skill_id] = after
-        if before is not None:
-            graph.next_member[before] = skill_id
-        graph.barrier_of[skill_id] = _NEW_BARRIER
-    graph.members[_NEW_BARRIER] = tuple(skill_ids)
-    _refuse_cycle(graph.cycle_through(_NEW_BARRIER))
+    first = {state.agent_of(skill_id): skill_id for skill_id in skill_ids}
+    reached = {agent: _Step(s, state.order_key(s)) for agent, s in first.items()}
+    target = {agent: step.key for agent, step in reached.items()}
+    work = list(reached)
+    while work:
+        agent = work.pop()
+        step = reached[agent]
+        for other in list(state.partner_agents(agent)):
+            after = state.first_shared_after(step.skill_id, other)
+            if after is None:
+                continue
+            barrier = state.barrier_of(after)
+            assert barrier is not None, f"member {after} without a barrier"
+            partner = next(m for m in barrier.skill_ids if state.agent_of(m) == other)
+            key = state.order_key(partner)
+            edge = OrderEdge(agent, step.skill_id, after)
+            if other in target and key < target[other]:
+                back = OrderEdge(other, partner, first[other])
+                _refuse_cycle([*step.path(), edge, back])
+            known = reached.get(other)
+            if known is None or key < known.key:
+                reached[other] = _Step(partner, key, step, edge)
+                work.append(other)
+
+
+@dataclass(frozen=True)
+class _Step:
+    """A skill the search reached, and how: the step before it and the edge from there."""
+
+    skill_id: str
+    key: int
+    parent: _Step | None = None
+    edge: OrderEdge | None = None
+
+    def path(self) -> list[OrderEdge]:
+        """The edges from the start to this step."""
+        edges, step = [], self
+        while step.parent is not None and step.edge is not None:
+            edges.append(step.edge)
+            step = step.parent
+        return edges[::-1]
 
 
 def check_moves(state: MissionState, agent: str, moves: Sequence[SkillMove]) -> None:
@@ -73,41 +108,30 @@ def check_moves(state: MissionState, agent: str, moves: Sequence[SkillMove]) -> 
         _refuse_cycle(graph.cycle_through(start))
 
 
-_NEW_BARRIER = ""  # the barrier being checked, before it has an id (ids are never empty)
-
-
 class _BarrierGraph:
-    """The barriers of a state as a graph, with a change laid over it.
+    """The barriers of a state as a graph, with one task's members reordered.
 
     A node is a barrier; an edge goes from a member to the next member on the
-    same task. ``next_member``, ``barrier_of`` and ``members`` hold what the
-    change makes different; everything else is read from the state's indexes.
+    same task. ``next_member`` holds what the reorder makes different; everything
+    else is read from the state's indexes.
     """
 
     def __init__(self, state: MissionState) -> None:
         self.state = state
         self.next_member: dict[str, str | None] = {}
-        self.barrier_of: dict[str, str] = {}
-        self.members: dict[str, tuple[str, ...]] = {}
 
     def edges_from(self, barrier_id: str) -> Iterator[tuple[str, OrderEdge]]:
         """(next barrier, the task-order edge to it) for each member of ``barrier_id``."""
-        members = self.members.get(barrier_id)
-        if members is None:
-            members = self.state.barrier(barrier_id).skill_ids
-        for skill_id in members:
+        for skill_id in self.state.barrier(barrier_id).skill_ids:
             if skill_id in self.next_member:
                 after = self.next_member[skill_id]
             else:
                 after = self.state.members_around(skill_id)[1]
             if after is None:
                 continue
-            target = self.barrier_of.get(after)
-            if target is None:
-                barrier = self.state.barrier_of(after)
-                assert barrier is not None, f"member {after} without a barrier"
-                target = barrier.id
-            yield target, OrderEdge(self.state.agent_of(skill_id), skill_id, after)
+            barrier = self.state.barrier_of(after)
+            assert barrier is not None, f"member {after} without a barrier"
+            yield barrier.id, OrderEdge(self.state.agent_of(skill_id), skill_id, after)
 
     def cycle_through(self, start: str) -> list[OrderEdge] | None:
         """The edges of a cycle from ``start`` back to it, or None (depth-first search)."""

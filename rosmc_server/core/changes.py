@@ -8,16 +8,13 @@ exactly, which is how the journal recovers after a crash.
 
 from __future__ import annotations
 
-import bisect
 import enum
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
+from .content import MissionContent
 from .model import Barrier, SkillInstance, TaskMarker
-
-if TYPE_CHECKING:
-    from .state import MissionContent
+from .reorder import canonical_moves
 
 
 class EventKind(enum.IntEnum):
@@ -117,61 +114,8 @@ def moves_between(
     Skills of a longest run already in the right relative order stay; each other
     skill, taken in its new order, moves to just after its new predecessor, so
     the moves apply one after the other. Indexes are ``offset`` plus the index in
-    the sequence (``current`` is a task's tail starting at ``offset``).
+    the sequence (``current`` is a task's tail starting at ``offset``). The cost is
+    linear in the orders (see :mod:`.reorder`).
     """
-    # Skills that keep their place at either end take no part (a drag and drop moves a
-    # few skills: this leaves only the stretch between where they were and now are).
-    pairs = zip(current, order, strict=True)
-    head = next((i for i, (was, now) in enumerate(pairs) if was != now), len(order))
-    tail = len(order)
-    while tail > head and current[tail - 1] == order[tail - 1]:
-        tail -= 1
-    current, order, offset = current[head:tail], order[head:tail], offset + head
-    position = {skill_id: index for index, skill_id in enumerate(order)}
-    targets = [position[skill_id] for skill_id in current]
-    staying = _longest_increasing(targets)
-    # Where each skill sits, as a number: first where it is now, (i + 1) * scale for
-    # index i; once moved, just after its new predecessor (a run of moved skills after
-    # the same staying skill counts up from that skill's number, below the next one).
-    scale = len(current) + 1
-    place_now = [0] * len(order)
-    for index, target in enumerate(targets):
-        place_now[target] = (index + 1) * scale
-    left: list[int] = []  # the places moved skills left, sorted
-    taken: list[int] = []  # the places they moved to, sorted
-    moves = []
-    anchor, run = 0, 0
-    for index, skill_id in enumerate(order):
-        if index in staying:
-            anchor, run = place_now[index], 0
-            continue
-        run += 1
-        place = anchor + run
-        bisect.insort(left, place_now[index])
-        below = (place - 1) // scale - bisect.bisect_left(left, place)
-        below += bisect.bisect_left(taken, place)
-        bisect.insort(taken, place)
-        moves.append(SkillMove(skill_id, offset + below))
-    return tuple(moves)
-
-
-def _longest_increasing(values: Sequence[int]) -> set[int]:
-    """The values of a longest increasing run (subsequence) of ``values``."""
-    tails: list[int] = []  # the smallest last value of an increasing run of each length
-    ends: list[int] = []  # where in ``values`` that run ends
-    previous: list[int] = []
-    for index, value in enumerate(values):
-        length = bisect.bisect_left(tails, value)
-        if length == len(tails):
-            tails.append(value)
-            ends.append(index)
-        else:
-            tails[length] = value
-            ends[length] = index
-        previous.append(ends[length - 1] if length else -1)
-    run: set[int] = set()
-    index = ends[-1] if ends else -1
-    while index >= 0:
-        run.add(values[index])
-        index = previous[index]
-    return run
+    moves = canonical_moves(current, order, offset)
+    return tuple(SkillMove(skill_id, index) for skill_id, index in moves)

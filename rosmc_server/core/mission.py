@@ -20,7 +20,7 @@ from .library import Library
 from .model import SkillStatus, TaskMarker, Transfer
 from .params import Pose
 from .reconcile import Reconciliation, RobotSkill, plan_reconcile
-from .site import SiteGuard
+from .site_guard import SiteGuard
 from .state import MissionContent, MissionState
 from .undo import UndoHistory
 from .updates import apply_event

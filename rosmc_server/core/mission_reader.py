@@ -181,7 +181,7 @@ class _TaskReader:
             return SkillInstance.assemble(
                 check_id(raw["id"]),
                 agent,
-                name,
+                spec.name,
                 label,
                 checked,
                 dict(bindings),
@@ -219,7 +219,8 @@ class _TaskReader:
                 return None
             param, quick_check = found
             quick = quick_check(value)
-            checked[name] = param.check(value, spec.name) if quick is None else quick
+            # Keyed by the library's name: one string shared by every skill, not one each.
+            checked[param.name] = param.check(value, spec.name) if quick is None else quick
         return checked
 
     def precise(self, raw: object, agent: str, key: str, seen: set[str]) -> SkillInstance:

@@ -27,16 +27,45 @@ from __future__ import annotations
 
 import enum
 import json
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 from .errors import InvalidRequest
-from .params import ParamType, Pose, check_json_data, value_to_data
+from .params import ParamType, Pose, Value, check_json_data, value_to_data
 from .validation import finite_float
 
-if TYPE_CHECKING:  # the library reads its default policies with this module
-    from .library import Library, SkillSpec
+
+class ParameterSchema(Protocol):
+    """What a policy's check needs of a skill parameter's schema (library.ParameterSpec)."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def type(self) -> ParamType: ...
+    def check(self, raw: object, skill: str) -> Value: ...
+
+
+class SkillSchema(Protocol):
+    """What a policy's check needs of a skill's schema (library.SkillSpec).
+
+    Structural, so that the library (which reads each model's default policy) and
+    this module do not import each other.
+    """
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def parameters(self) -> Sequence[ParameterSchema]: ...
+    def parameter(self, name: str) -> ParameterSchema: ...
+    def defaults(self) -> dict[str, Value]: ...
+
+
+class SkillSource(Protocol):
+    """Where a policy's skill is looked up (library.Library)."""
+
+    def skill(self, agent: str, skill: str) -> SkillSchema: ...
+
 
 DEFAULT_AFTER = 60.0
 """Seconds without the ground before a policy acts, unless the operator says otherwise."""
@@ -169,7 +198,7 @@ class LostLinkPolicy:
             data["when"] = self.when.value
         return data
 
-    def checked(self, library: Library, agent: str) -> LostLinkPolicy:
+    def checked(self, library: SkillSource, agent: str) -> LostLinkPolicy:
         """This policy with its safe skill checked against ``agent``'s skills in ``library``.
 
         The parameters are checked per the skill's schema; those not given take the
@@ -185,7 +214,7 @@ class LostLinkPolicy:
             return self
         return self.checked_against(library.skill(agent, self.skill))
 
-    def checked_against(self, spec: SkillSpec) -> LostLinkPolicy:
+    def checked_against(self, spec: SkillSchema) -> LostLinkPolicy:
         """This policy with its skill's parameters checked against ``spec`` (see checked)."""
         values = spec.defaults()
         values.update(

@@ -9,56 +9,26 @@ from __future__ import annotations
 
 import bisect
 import operator
-from collections.abc import Iterator, Sequence
-from dataclasses import dataclass, field, replace
+from collections.abc import Iterable, Iterator, Sequence
+from dataclasses import replace
 from fractions import Fraction
 
 from .changes import Change, SkillMove, moves_between
+from .content import MissionContent as MissionContent
+from .content import Sections as Sections
 from .errors import NotFound
-from .library import Library
 from .model import Barrier, SkillInstance, SkillStatus, TaskMarker, Transfer
+from .pair_index import PairIndex
+from .reorder import play_moves
 from .validation import excerpt
 
 # Spacing of the position keys given to a task's skills: room for 32 insertions at one
 # place before the task's keys are spread again.
 _KEY_SPACING = 1 << 32
+# From this many moves on, a reorder is decoded in one pass over the stretch it touches
+# (see :mod:`.reorder`) instead of shifting the task once per move.
+BULK_MOVES = 16
 _skill_id = operator.attrgetter("id")
-
-
-@dataclass
-class MissionContent:
-    """The content of a mission, without indexes: what files and snapshots hold."""
-
-    library: str
-    tasks: dict[str, list[SkillInstance]]
-    barriers: dict[str, Barrier] = field(default_factory=dict)
-    markers: dict[str, TaskMarker] = field(default_factory=dict)
-
-    @classmethod
-    def empty(cls, library: Library) -> MissionContent:
-        """A mission with an empty task for every dynamic agent of ``library``."""
-        return cls(library.name, {agent: [] for agent in library.dynamic_agents})
-
-    def copy(self) -> MissionContent:
-        """A copy whose tasks and mappings can change without touching this one."""
-        return MissionContent(
-            self.library,
-            {agent: list(task) for agent, task in self.tasks.items()},
-            dict(self.barriers),
-            dict(self.markers),
-        )
-
-
-@dataclass(frozen=True)
-class Sections:
-    """Where an agent's task splits.
-
-    ``task[:synced_end]`` is the synchronized section, ``task[synced_end:editable_start]``
-    the blueprint skills being uploaded, ``task[editable_start:]`` the editable blueprint.
-    """
-
-    synced_end: int
-    editable_start: int
 
 
 class MissionState:
@@ -84,6 +54,10 @@ class MissionState:
         self._member_keys: dict[str, list[int]] = {}  # per agent, its barrier members' keys
         self._member_ids: dict[str, list[str]] = {}  # ... and their ids, in task order
         self._in_transfer: dict[str, set[str]] = {}  # per agent, skills awaiting the robot
+        self._pairs = PairIndex()  # barrier members by pair of agents they join
+        # The last moves decoded and what they gave: planning, the undo history and
+        # applying a reorder each ask for it within one commit (cleared by every change).
+        self._played: tuple[Sequence[SkillMove], str, tuple[int, list[str]] | None] | None = None
         self._reindex()
 
     # -- queries ---------------------------------------------------------
@@ -141,6 +115,20 @@ class MissionState:
         if agent is None:
             raise NotFound(f"there is no skill {excerpt(skill_id)}")
         return agent, bisect.bisect_left(self._keys[agent], self._key_of[skill_id])
+
+    def order_key(self, skill_id: str) -> int:
+        """A number that grows along the skill's task: compares two skills of one task."""
+        return self._key_of[skill_id]
+
+    def partner_agents(self, agent: str) -> Iterable[str]:
+        """The agents whose tasks share (or shared) a barrier with ``agent``'s."""
+        return self._pairs.partners(agent)
+
+    def first_shared_after(self, skill_id: str, other: str) -> str | None:
+        """The first barrier member after ``skill_id`` on its task that shares a barrier
+        with ``other``'s task (a binary search; see :mod:`.pair_index`)."""
+        agent = self.agent_of(skill_id)
+        return self._pairs.first_after(agent, other, self._key_of[skill_id])
 
     def agent_of(self, skill_id: str) -> str:
         """The agent whose task holds the skill; NotFound if there is none."""
@@ -205,8 +193,18 @@ class MissionState:
     def members_after_moves(self, agent: str, moves: Sequence[SkillMove]) -> list[str]:
         """``agent``'s barrier members in task order as they would be after ``moves``.
 
-        Nothing changes: the moves are played on a copy of the task's keys.
+        Nothing changes: many moves are decoded at once (:meth:`order_after_moves`), a
+        few are played on a copy of the task's keys.
         """
+        members = self._member_ids.get(agent, [])
+        played = self.order_after_moves(agent, moves) if len(moves) >= BULK_MOVES else None
+        if played is not None:
+            start, ids = played
+            task_keys, member_keys = self._keys[agent], self._member_keys.get(agent, [])
+            first = bisect.bisect_left(member_keys, task_keys[start])
+            last = bisect.bisect_right(member_keys, task_keys[start + len(ids) - 1])
+            inside = [skill_id for skill_id in ids if skill_id in self._barrier_of]
+            return [*members[:first], *inside, *members[last:]]
         keys: list[int | Fraction] = list(self._keys[agent])
         moved: dict[str, int | Fraction] = {}
         for move in moves:
@@ -218,8 +216,38 @@ class MissionState:
             high = keys[index] if index < len(keys) else low + 2
             moved[move.skill_id] = Fraction(low + high, 2)
             keys.insert(index, moved[move.skill_id])
-        members = self._member_ids.get(agent, [])
         return sorted(members, key=lambda skill_id: moved.get(skill_id, self._key_of[skill_id]))
+
+    def order_after_moves(
+        self, agent: str, moves: Sequence[SkillMove]
+    ) -> tuple[int, list[str]] | None:
+        """Where the stretch of ``agent``'s task that ``moves`` touch starts, and its ids
+        after them; None unless the moves are canonical (see :func:`.reorder.play_moves`).
+
+        Costs the stretch, once: nothing changes.
+        """
+        if self._played is not None and self._played[0] is moves and self._played[1] == agent:
+            return self._played[2]
+        played = self._order_after_moves(agent, moves)
+        self._played = (moves, agent, played)
+        return played
+
+    def _order_after_moves(
+        self, agent: str, moves: Sequence[SkillMove]
+    ) -> tuple[int, list[str]] | None:
+        keys, key_of = self._keys[agent], self._key_of
+        ids = [move.skill_id for move in moves]
+        if set(map(self._agent_of.get, ids)) != {agent}:
+            return None
+        moved_keys = list(map(key_of.__getitem__, ids))
+        targets = [move.index for move in moves]
+        start = min(bisect.bisect_left(keys, min(moved_keys)), *targets)
+        end = max(bisect.bisect_left(keys, max(moved_keys)), *targets) + 1
+        if start < 0 or end > len(keys):
+            return None
+        stretch = list(map(_skill_id, self._content.tasks[agent][start:end]))
+        order = play_moves(stretch, moves, start)
+        return None if order is None else (start, order)
 
     def moves_for_order(self, agent: str, order: Sequence[str]) -> tuple[SkillMove, ...]:
         """The moves that give the last ``len(order)`` skills of ``agent``'s task ``order``."""
@@ -250,6 +278,12 @@ class MissionState:
     # -- the one way to change -------------------------------------------
     def apply(self, change: Change) -> None:
         """Apply a change that the operations have validated (see :class:`Change`)."""
+        try:
+            self._apply(change)
+        finally:
+            self._played = None
+
+    def _apply(self, change: Change) -> None:
         if change.replacement is not None:
             self._content = change.replacement.copy()
             self._reindex()
@@ -267,8 +301,7 @@ class MissionState:
             moves = change.moves
             if not moves and change.blueprint_order:  # old journals: the whole new order
                 moves = self.moves_for_order(change.order_agent, change.blueprint_order)
-            for move in moves:
-                self._move_skill(move.skill_id, move.index)
+            self._move_skills(change.order_agent, moves)
         for barrier in change.put_barriers:
             self._drop_barrier(barrier.id)
             content.barriers[barrier.id] = barrier
@@ -324,12 +357,38 @@ class MissionState:
         if member:
             self._add_member(skill_id)
 
+    def _move_skills(self, agent: str, moves: Sequence[SkillMove]) -> None:
+        played = self.order_after_moves(agent, moves) if len(moves) >= BULK_MOVES else None
+        if played is None:
+            for move in moves:
+                self._move_skill(move.skill_id, move.index)
+            return
+        start, ids = played
+        end = start + len(ids)
+        task, keys, key_of = self._content.tasks[agent], self._keys[agent], self._key_of
+        by_id = {skill.id: skill for skill in task[start:end]}
+        task[start:end] = map(by_id.__getitem__, ids)
+        low = keys[start - 1] if start else 0
+        high = keys[end] if end < len(keys) else low + _KEY_SPACING * (len(ids) + 1)
+        step = (high - low) // (len(ids) + 1)
+        if step < 2:
+            self._spread_keys(agent)
+        else:
+            keys[start:end] = range(low + step, low + step * (len(ids) + 1), step)
+            key_of.update(zip(ids, keys[start:end], strict=True))
+        members = self._member_ids.get(agent)
+        if members:
+            members.sort(key=key_of.__getitem__)
+            self._member_keys[agent] = [key_of[skill_id] for skill_id in members]
+            self._pairs.rekey(agent, key_of.__getitem__)
+
     def _spread_keys(self, agent: str) -> None:
         """Give ``agent``'s skills evenly spaced keys again (same order)."""
         task, keys = self._content.tasks[agent], self._keys[agent]
         keys[:] = range(_KEY_SPACING, _KEY_SPACING * (len(task) + 1), _KEY_SPACING)
         self._key_of.update(zip(map(_skill_id, task), keys, strict=True))
         self._member_keys[agent] = [self._key_of[i] for i in self._member_ids.get(agent, [])]
+        self._pairs.rekey(agent, self._key_of.__getitem__)
 
     def _drop_barrier(self, barrier_id: str) -> None:
         old = self._content.barriers.pop(barrier_id, None)
@@ -349,11 +408,16 @@ class MissionState:
         if at == len(keys) or keys[at] != key:
             keys.insert(at, key)
             ids.insert(at, skill_id)
+        barrier = self._content.barriers.get(self._barrier_of.get(skill_id, ""))
+        if barrier is not None:
+            partners = (self._agent_of.get(member) for member in barrier.skill_ids)
+            self._pairs.add(skill_id, agent, key, [a for a in partners if a is not None])
 
     def _remove_member(self, skill_id: str) -> None:
         agent = self._agent_of.get(skill_id)
         if agent is None:
             return
+        self._pairs.remove(skill_id, self._key_of[skill_id])
         keys = self._member_keys.get(agent, [])
         at = bisect.bisect_left(keys, self._key_of[skill_id])
         if at < len(keys) and keys[at] == self._key_of[skill_id]:
@@ -384,6 +448,7 @@ class MissionState:
         self._member_keys.clear()
         self._member_ids.clear()
         self._in_transfer.clear()
+        self._pairs.clear()
         for agent, task in self._content.tasks.items():
             self._keys[agent] = []
             self._spread_keys(agent)

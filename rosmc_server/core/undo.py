@@ -15,10 +15,18 @@ import re
 from dataclasses import dataclass, field, replace
 
 from .barriers import check_moves, find_deadlock
-from .changes import Change, EventKind, MissionEvent, PlacedSkill, Proposal, SkillMove
+from .changes import (
+    Change,
+    EventKind,
+    MissionEvent,
+    PlacedSkill,
+    Proposal,
+    SkillMove,
+    moves_between,
+)
 from .errors import InvalidRequest, NotFound, RuleViolation
 from .model import Barrier, SkillInstance, TaskMarker
-from .state import MissionState
+from .state import BULK_MOVES, MissionState
 
 # The event kind of an edit's inverse (an edit of either kind can be undone).
 _INVERSE_KIND = {
@@ -47,8 +55,22 @@ class Left:
 
     skills: dict[str, SkillInstance | None] = field(default_factory=dict)
     positions: dict[str, int] = field(default_factory=dict)
+    stretch: Stretch | None = None
     barriers: dict[str, Barrier | None] = field(default_factory=dict)
     markers: dict[str, TaskMarker | None] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Stretch:
+    """A stretch of a task a large reorder gave a new order: its start, ids before and after.
+
+    Its moves back are worked out only if the reorder is undone (they cost the stretch).
+    """
+
+    agent: str
+    start: int
+    before: tuple[str, ...]
+    after: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -72,6 +94,7 @@ class UndoHistory:
         self._entries: collections.OrderedDict[int, UndoEntry] = collections.OrderedDict()
         self._depth = depth
         self._undone: set[int] = set()
+        self._stretch: Stretch | None = None  # of the reorder between inverse() and keep()
 
     def inverse(self, state: MissionState, kind: EventKind, change: Change) -> Change | None:
         """The change that takes ``change`` back, from the ``state`` just before it.
@@ -84,13 +107,26 @@ class UndoHistory:
             return None
         if kind not in _INVERSE_KIND or (change.blueprint_order and not change.moves):
             return None  # not an edit (or a reorder journaled as a whole order, before moves)
+        self._stretch = None
+        if len(change.moves) >= BULK_MOVES and _is_reorder(change):
+            played = state.order_after_moves(change.order_agent, change.moves)
+            if played is not None:
+                start, after = played
+                task = state.task(change.order_agent)[start : start + len(after)]
+                before = tuple(skill.id for skill in task)
+                self._stretch = Stretch(change.order_agent, start, before, tuple(after))
+                return Change(order_agent=change.order_agent)
         return inverse_change(state, change)
 
     def keep(self, state: MissionState, event: MissionEvent, inverse: Change | None) -> None:
         """Remember a committed edit and its inverse (``state`` is just after it)."""
         if inverse is None:
             return
-        left = _left_by(state, event.change)
+        if self._stretch is not None:
+            left = replace(_left_by(state, Change()), stretch=self._stretch)
+            self._stretch = None
+        else:
+            left = _left_by(state, event.change)
         match = _UNDO_OF.match(event.summary)
         undoes = int(match.group(1)) if match else 0
         undone = self._entries.get(undoes)
@@ -144,6 +180,10 @@ class UndoHistory:
                         f"revision {revision}, so the barrier cannot come back"
                     )
         inverse = _placed_in_blueprint(state, entry.inverse)
+        stretch = entry.left.stretch
+        if stretch is not None:
+            moves = moves_between(stretch.after, stretch.before, stretch.start)
+            inverse = replace(inverse, moves=moves)
         _check_no_deadlock(state, inverse)
         return Proposal(
             _INVERSE_KIND[entry.kind],
@@ -190,10 +230,17 @@ def _inverse_moves(
 ) -> tuple[SkillMove, ...]:
     """Moves that undo ``moves`` (applied one after the other), last one first.
 
-    Only the moved skills' indexes are followed, so the cost is the moves', not the task's.
+    A few moves: only the moved skills' indexes are followed, so the cost is the moves',
+    not the task's. Many: the stretch they reorder is decoded once and the moves back
+    are those between the two orders (linear in the stretch).
     """
     if not agent or not moves:
         return ()
+    played = before.order_after_moves(agent, moves) if len(moves) >= BULK_MOVES else None
+    if played is not None:
+        start, after = played
+        before_ids = [skill.id for skill in before.task(agent)[start : start + len(after)]]
+        return moves_between(after, before_ids, start)
     where = {move.skill_id: before.locate(move.skill_id)[1] for move in moves}
     back = []
     for move in moves:
@@ -246,6 +293,8 @@ def _check_unchanged(state: MissionState, entry: UndoEntry) -> None:
             )
         if now != value:
             raise RuleViolation(f"skill '{skill_id}' was changed {since}; undo that change first")
+    if entry.left.stretch is not None:
+        _check_stretch_unchanged(state, entry.left.stretch, since)
     for skill_id, index in entry.left.positions.items():
         skill = state.skill(skill_id)
         if not skill.is_editable:
@@ -273,6 +322,26 @@ def _check_unchanged(state: MissionState, entry: UndoEntry) -> None:
         if bound - set(entry.left.skills):
             newly = sorted(bound - set(entry.left.skills))[0]
             raise RuleViolation(f"skill '{newly}' was bound to task marker '{name}' {since}")
+
+
+def _check_stretch_unchanged(state: MissionState, stretch: Stretch, since: str) -> None:
+    """Refuse unless the reordered stretch is as the reorder left it, still in the blueprint."""
+    task = state.task(stretch.agent)[stretch.start : stretch.start + len(stretch.after)]
+    now = tuple(skill.id for skill in task)
+    if now != stretch.after:
+        moved = next((a for a, b in zip(stretch.after, now, strict=False) if a != b), None)
+        moved = moved or stretch.after[-1]
+        raise RuleViolation(f"skill '{moved}' was moved {since}; undo that move first")
+    if task and not task[0].is_editable:  # a synchronized skill: every one before it is too
+        raise RuleViolation(
+            f"skill '{task[0].id}' has been sent to {task[0].agent} {since}, "
+            "so that reorder can no longer be undone"
+        )
+
+
+def _is_reorder(change: Change) -> bool:
+    """Whether ``change`` only moves skills of one agent."""
+    return change == Change(order_agent=change.order_agent, moves=change.moves)
 
 
 def _placed_in_blueprint(state: MissionState, inverse: Change) -> Change:

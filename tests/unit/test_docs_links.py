@@ -15,7 +15,6 @@ DOCS = [REPO / "README.md", REPO / "CONTRIBUTING.md", *sorted((REPO / "docs").gl
 # Pages written on other branches at the same time; a link to one is kept until it lands.
 PENDING = {
     "docs/writing-skills.md",
-    "docs/performance-notes.md",
 }
 LINK = re.compile(r"(?<!!)\[[^\]]*\]\(([^)\s]+)\)")
 IMAGE = re.compile(r"!\[[^\]]*\]\(([^)\s]+)\)")

@@ -1,9 +1,4 @@
-"""No import circles in the rosmc_* packages, and the finder finds the ones it should.
-
-Circles being taken apart on other branches of this round are listed in
-``BEING_REMOVED`` with who removes them; the test fails on any other circle, and on a
-listed one that is gone (so the list only shrinks and ends empty).
-"""
+"""No import circles in the rosmc_* packages, and the finder finds the ones it should."""
 
 from __future__ import annotations
 
@@ -13,22 +8,9 @@ import pytest
 
 from tests.unit.import_circles import import_circles, imported_modules
 
-BEING_REMOVED = {
-    # "perf": the mission core's state, changes, library and site
-    frozenset(
-        f"rosmc_server/core/{name}.py" for name in ("changes", "library", "policy", "site", "state")
-    ),
-}
 
-
-def test_no_new_import_circles() -> None:
-    circles = set(import_circles())
-    assert [sorted(c) for c in circles - BEING_REMOVED] == [], "modules that import each other"
-
-
-def test_the_circles_being_removed_are_still_there() -> None:
-    gone = [sorted(c) for c in BEING_REMOVED - set(import_circles())]
-    assert gone == [], "gone: remove these from BEING_REMOVED"
+def test_no_import_circles() -> None:
+    assert [sorted(c) for c in import_circles()] == [], "modules that import each other"
 
 
 # -- the finder on small made-up repositories ---------------------------------------------

@@ -259,7 +259,7 @@ def test_without_a_site_the_checks_are_skipped_and_that_is_said_once(
     library_data: dict[str, Any], caplog: pytest.LogCaptureFixture
 ) -> None:
     mission = Mission(checked_library(library_data), clock=lambda: 1.0)
-    with caplog.at_level(logging.INFO, logger="rosmc_server.core.site"):
+    with caplog.at_level(logging.INFO, logger="rosmc_server.core.site_guard"):
         mission.add_skill("alpha", "move", target(12.0, 3.5))
         mission.add_skill("alpha", "move", target(99.0, 0.0))
         mission.add_skill("alpha", "noop")

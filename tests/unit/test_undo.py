@@ -62,6 +62,33 @@ def test_undo_of_reorder_restores_the_order(mission: Any, drv: Any, accepted: An
     assert drv.ids("alpha") == ids
 
 
+def test_undo_of_a_large_reorder_restores_the_order_and_redo_gives_it_again(
+    mission: Any, drv: Any, accepted: Any
+) -> None:
+    # Enough moves that the undo history keeps the stretch, not the moves back.
+    first = drv.add("alpha")
+    ids = drv.adds("alpha", 40)
+    new = ids[::2][::-1] + ids[1::2]
+    moved = mission.reorder("alpha", [first, *new])  # the stretch starts after ``first``
+    assert len(moved.change.moves) >= 16
+    undo = accepted(mission, EventKind.SKILLS_REORDERED, mission.undo, moved.revision)
+    assert drv.ids("alpha") == [first, *ids]
+    accepted(mission, EventKind.SKILLS_REORDERED, mission.undo, undo.revision)  # the redo
+    assert drv.ids("alpha") == [first, *new]
+
+
+def test_undo_of_a_large_reorder_is_refused_once_a_skill_moved_or_was_sent(
+    mission: Any, drv: Any, rejected: Any
+) -> None:
+    ids = drv.adds("alpha", 40)
+    moved = mission.reorder("alpha", ids[::-1])
+    mission.reorder("alpha", [ids[0], *ids[:0:-1]])
+    rejected(mission, RuleViolation, mission.undo, moved.revision, match="was moved since")
+    again = mission.reorder("alpha", ids)  # the stretch starts at ids[1]: ids[0] stays
+    mission.synchronize("alpha", ids[1])
+    rejected(mission, RuleViolation, mission.undo, again.revision, match="has been sent")
+
+
 def test_undo_of_barrier_add_and_delete(mission: Any, drv: Any, accepted: Any) -> None:
     a, b = drv.add("alpha"), drv.add("bravo")
     added = mission.add_barrier([a, b])
