@@ -471,6 +471,7 @@ class RosmcSystem:
                 str(REPO_ROOT / "scripts" / "mission_executor"),
                 f"_agent:={agent}",
                 f"_state_file:={self.state_file(agent)}",
+                f"_library:={self.library}",  # the robots' skills must fit the server's library
                 *side,
                 *params,
             ],
