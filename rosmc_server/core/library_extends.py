@@ -44,9 +44,12 @@ def _merged_model(
     """A new model as given, or a base model with the extension's skills added."""
     if base is None:
         return raw
-    body = reader.mapping(raw, key, required={"skills"}, optional=set())
+    body = reader.mapping(raw, key)
+    others = sorted(str(name) for name in body if name != "skills")
+    if others:
+        reader.fail(key, f"is a model of the base: add skills to it, not {', '.join(others)}")
     skills = dict(base["skills"])
-    for name, skill in reader.mapping(body["skills"], f"{key}.skills").items():
+    for name, skill in reader.mapping(body.get("skills", {}), f"{key}.skills").items():
         if name in skills:
             reader.fail(f"{key}.skills.{name}", "is a skill of the base library already")
         skills[name] = skill
