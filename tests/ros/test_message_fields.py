@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import pytest
 from actionlib.msg import TestRequestGoal as RequestGoal
@@ -86,7 +87,7 @@ def test_constants_types_templates_and_success_fields_are_checked() -> None:
         message_class("nope/Nope", WHERE)
     text = Template.make("{message} ({success})", SetBoolResponse, WHERE)
     assert text.render(SetBoolResponse(True, "lit")) == "lit (True)"
-    with pytest.raises(SkillSetupError, match="the text '{message:d}' does not format"):
+    with pytest.raises(SkillSetupError, match=re.escape("the text '{message:d}' does not format")):
         Template.make("{message:d}", SetBoolResponse, WHERE)
     assert bool_field(SetBoolResponse, "success", WHERE) == "success"
     with pytest.raises(SkillSetupError, match="success field 'message' is no bool"):

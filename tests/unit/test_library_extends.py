@@ -61,7 +61,8 @@ def test_an_extension_adds_robot_kinds_agents_and_skills_to_its_base(tmp_path: P
 def test_extends_is_a_path_from_the_extending_file_and_chains(tmp_path: Path) -> None:
     (tmp_path / "team").mkdir()
     write(tmp_path / "team", "base.yaml", yaml.safe_load(MARS.read_text()))
-    write(tmp_path, "middle.yaml", {**extension(models={"heli": HELI}), "extends": "team/base.yaml"})
+    middle = {**extension(models={"heli": HELI}), "extends": "team/base.yaml"}
+    write(tmp_path, "middle.yaml", middle)
     top = write(
         tmp_path,
         "top.yaml",
