@@ -204,6 +204,15 @@ class Operator:
             wait_until(lambda: publisher.get_num_connections() > 0, 30.0, "the link emulator")
         publisher.publish(Bool(data=on))
 
+    def status_texts(self, skill_id: str) -> list[str]:
+        """Every status text ``/rosmc/mission_events`` carried for ``skill_id``, in order."""
+        return [
+            placed.skill.status_text
+            for _, event in self.events.since(0)
+            for placed in event.put_skills
+            if placed.skill.id == skill_id
+        ]
+
     # -- waiting --------------------------------------------------------------------
     def wait_mission(
         self, predicate: Callable[[MissionState], bool], timeout: float, what: str

@@ -118,16 +118,6 @@ def robot(ros_master: RosMaster, lab: Lab, tmp_path: Path) -> Iterator[Operator]
         print(system.log_tails())
 
 
-def texts_of(operator: Operator, skill_id: str) -> list[str]:
-    """Every status text the server published for ``skill_id``, in order."""
-    return [
-        placed.skill.status_text
-        for _, event in operator.events.since(0)
-        for placed in event.put_skills
-        if placed.skill.id == skill_id
-    ]
-
-
 def test_an_action_bound_skill_sends_goals_and_reports_feedback_and_result(
     robot: Operator, lab: Lab
 ) -> None:
@@ -139,7 +129,7 @@ def test_an_action_bound_skill_sends_goals_and_reports_feedback_and_result(
     state = robot.wait_status([refused], S.FAILURE)
     assert lab.goals == [4, -1]
     assert state.skill(counted).status_text == "reached 4"
-    assert any(text.startswith("counted ") for text in texts_of(robot, counted))
+    assert any(text.startswith("counted ") for text in robot.status_texts(counted))
     assert state.skill(refused).status_text == "the action server aborted the goal: reached -1"
 
 
@@ -200,7 +190,7 @@ MISFITS = {
     "a goal field does not match its parameter": (
         {"action": "/lab/count", "type": "actionlib/Test", "fields": {"goal": "label"}},
         "skill 'broken' bound to action /lab/count (actionlib/Test): field 'goal' of "
-        "actionlib/TestGoal is a int32, which parameter 'label' (string) cannot fill",
+        "actionlib/TestGoal is of type int32, which parameter 'label' (string) cannot fill",
     ),
     "a goal field does not exist": (
         {"service": "/lab/switch", "type": "std_srvs/SetBool", "fields": {"value": "target"}},

@@ -55,13 +55,13 @@ def test_an_area_fills_a_polygon() -> None:
         (
             "the_result",
             ParamType.STRING,
-            "field 'the_result' of actionlib/TestRequestGoal is a int32, which parameter 'p' "
+            "field 'the_result' of actionlib/TestRequestGoal is of type int32, which parameter 'p' "
             "(string) cannot fill",
         ),
         (
             "result_text.data",
             ParamType.STRING,
-            "field 'result_text' is a string, which has no fields",
+            "field 'result_text' is of type string, which has no fields",
         ),
         (
             "answer",

@@ -67,7 +67,7 @@ def field_type(cls: type[genpy.Message], path: str, where: str) -> str:
             return kind
         nested = None if "[" in kind or "/" not in kind else get_message_class(kind)
         if nested is None:
-            raise SkillSetupError(f"{where}: field '{part}' is a {kind}, which has no fields")
+            raise SkillSetupError(f"{where}: field '{part}' is of type {kind}, which has no fields")
         cls = nested
     raise AssertionError("a path has at least one part")
 
@@ -195,7 +195,7 @@ class MessageRecipe:
             convert = converter(ptype, kind)
             if convert is None:
                 raise SkillSetupError(
-                    f"{where}: field '{source.field}' of {message._type} is a {kind}, "
+                    f"{where}: field '{source.field}' of {message._type} is of type {kind}, "
                     f"which {what} ({ptype.name.lower()}) cannot fill"
                 )
             fillers.append(Filler(source.field, convert, source.parameter, source.constant))
