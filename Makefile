@@ -24,14 +24,15 @@ SYSTEM_PYTHON := /usr/bin/python3
 VENV := .venv
 BUILD := build
 
-# ROS 1 from Debian, message generation, Qt bindings; rviz, a virtual screen and imagemagick
-# for the GUIs and their screenshots; xdotool drives them with a real mouse in tests;
-# rostest's CMake module (add_rostest), rosdep, catkin_lint and catkin_tools (`catkin build`).
+# ROS 1 from Debian (actionlib for skills bound to action servers), message generation, Qt
+# bindings; rviz, a virtual screen and imagemagick for the GUIs and their screenshots; xdotool
+# drives them with a real mouse in tests; rostest's CMake module (add_rostest), rosdep,
+# catkin_lint and catkin_tools (`catkin build`).
 APT_PACKAGES := \
 	python3-rospy python3-rosmaster python3-interactive-markers python3-visualization-msgs \
 	python3-geometry-msgs python3-std-msgs python3-std-srvs python3-rosbag python3-rostest \
 	python3-roslaunch python3-rosservice python3-rostopic python3-rosnode catkin python3-genpy python3-genmsg \
-	python3-nav-msgs \
+	python3-nav-msgs python3-actionlib python3-actionlib-msgs \
 	ros-message-generation ros-message-runtime python3-tf2-ros python3-python-qt-binding \
 	ros-geometry-msgs ros-std-msgs ros-visualization-msgs ros-std-srvs rosbash \
 	python3-venv cmake make \

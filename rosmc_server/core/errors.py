@@ -80,5 +80,10 @@ class LibraryError(RosmcError):
     """A skill library file is malformed; the message names the file and the key."""
 
 
+class SkillSetupError(RosmcError):
+    """A robot's skill implementations or bindings do not fit its library: the executor
+    refuses to start, and the message says which skill and why."""
+
+
 class MissionFileError(RosmcError):
     """A mission file cannot be loaded; the message names the file and the problem."""

@@ -15,8 +15,10 @@ from pathlib import Path
 
 import yaml
 
+from .bindings import BindingSpec, read_binding
 from .documents import DocumentReader, load_yaml, yaml_problem
 from .errors import InvalidRequest, LibraryError, NotFound, RuleViolation
+from .library_extends import merge_extension
 from .params import (
     COMPATIBLE_MARKERS,
     MARKER_PARAM_TYPE,
@@ -85,6 +87,8 @@ class SkillSpec:
     parameters: tuple[ParameterSpec, ...] = ()
     description: str = ""
     estimated_duration: float = 0.0
+    binding: BindingSpec | None = None
+    """Set when the skill runs through a ROS action, service or topic (no code)."""
 
     def parameter(self, name: str) -> ParameterSpec:
         """The parameter called ``name``; NotFound if the skill has none."""
@@ -168,10 +172,19 @@ def check_polygon(value: object, what: str) -> None:
 
 
 def load_library(path: str | Path) -> Library:
-    """Read a library YAML file; LibraryError names the file, key and problem."""
+    """Read a library YAML file; LibraryError names the file, key and problem.
+
+    A library with ``extends: OTHER.yaml`` (a path from its own folder) is that library
+    plus its own agents, models and skills (see :mod:`.library_extends`).
+    """
+    return library_from_dict(_library_data(Path(path), ()), str(path))
+
+
+def _library_data(path: Path, chain: tuple[Path, ...]) -> object:
+    """The file's parsed data, with the libraries it extends merged in and checked."""
     source = str(path)
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8")
     except OSError as error:
         raise LibraryError(f"{source}: cannot read the library file ({error.strerror})") from error
     except UnicodeDecodeError as error:
@@ -180,7 +193,16 @@ def load_library(path: str | Path) -> Library:
         data = load_yaml(text)
     except yaml.YAMLError as error:
         raise LibraryError(f"{source}: not valid YAML ({yaml_problem(error)})") from error
-    return library_from_dict(data, source)
+    if not isinstance(data, Mapping) or "extends" not in data:
+        return data
+    reader = DocumentReader(source, LibraryError)
+    base_path = path.parent / reader.text(data["extends"], "extends")
+    chain = (*chain, path.resolve())
+    if base_path.resolve() in chain:
+        reader.fail("extends", f"{base_path.name} extends this library again (a loop)")
+    base = _library_data(base_path, chain)
+    library_from_dict(base, str(base_path))  # its own mistakes are named in its own file
+    return merge_extension(base, data, reader)
 
 
 def library_from_dict(data: object, source: str = "<library>") -> Library:
@@ -255,18 +277,21 @@ def _read_model(reader: DocumentReader, raw: object, key: str) -> dict[str, Skil
 
 def _read_skill(reader: DocumentReader, name: str, raw: object, key: str) -> SkillSpec:
     body = reader.mapping(
-        raw, key, optional={"description", "duration", "parameters"}, allow_none=True
+        raw, key, optional={"description", "duration", "parameters", "binding"}, allow_none=True
     )
     params_raw = reader.mapping(body.get("parameters") or {}, f"{key}.parameters")
     parameters = tuple(
         _read_parameter(reader, name, pname, entry, f"{key}.parameters.{pname}")
         for pname, entry in params_raw.items()
     )
+    binding = None
+    if "binding" in body:
+        binding = read_binding(reader, body["binding"], f"{key}.binding", params_raw)
     duration = reader.number(body.get("duration", 0.0), f"{key}.duration")
     if duration < 0:
         reader.fail(f"{key}.duration", "must not be negative")
     description = reader.text(body.get("description", ""), f"{key}.description", empty=True)
-    return SkillSpec(name, parameters, description, duration)
+    return SkillSpec(name, parameters, description, duration, binding)
 
 
 def _read_parameter(

@@ -10,8 +10,6 @@ They make the executor usable without a simulator (and are what the tests run):
 
 from __future__ import annotations
 
-from rosmc_server.core import ParamType
-
 from .core import Outcome, SkillBehavior, SkillContext, SkillType, ThreadedSkill
 
 
@@ -83,19 +81,14 @@ class Count(SkillBehavior):
 
 
 def skill_types(agent: str = "") -> list[SkillType]:
-    """The basic skills, for the executor's ``~skills`` parameter (any agent)."""
+    """The basic skills, for the executor's ``~skills`` parameter (any agent).
+
+    Their parameters are declared by the library the executor is given (``~library``),
+    as ``tests/data/test_team.yaml`` does: ``wait(duration: float)``,
+    ``probe(duration: float, fail: bool)``, ``count(steps: int, period: float)``.
+    """
     return [
-        SkillType("wait", Wait, {"duration": ParamType.FLOAT}, "Wait some seconds."),
-        SkillType(
-            "probe",
-            Probe,
-            {"duration": ParamType.FLOAT, "fail": ParamType.BOOL},
-            "Work, then fail if asked.",
-        ),
-        SkillType(
-            "count",
-            Count,
-            {"steps": ParamType.INT, "period": ParamType.FLOAT},
-            "Count steps with progress.",
-        ),
+        SkillType("wait", Wait, description="Wait some seconds."),
+        SkillType("probe", Probe, description="Work, then fail if asked."),
+        SkillType("count", Count, description="Count steps with progress."),
     ]

@@ -9,7 +9,8 @@ real robot would register skills of the same names that call its own stack.
 Use one function per robot kind as the executor's ``~skills`` parameter:
 ``rosmc_sim.ros.robot_skills:drone_skills`` (or ``science_rover_skills``,
 ``manipulator_rover_skills``). The module's :func:`pose_source` (the robot's
-odometry) is the executor's default ``~pose_source``.
+odometry) is the executor's default ``~pose_source``, and its :func:`library` (the Mars
+team's) the default ``~library``: it declares the skills' parameters.
 """
 
 from __future__ import annotations
@@ -19,37 +20,29 @@ import itertools
 import threading
 import time
 from collections.abc import Mapping
+from pathlib import Path
 
 import rosmc.msg as wire
 import rospy
 
 from rosmc_server.conversions import param_to_msg
-from rosmc_server.core import ParamType, Value
+from rosmc_server.core import Value
 from rosmc_server.executor.core import Outcome, SkillBehavior, SkillContext, SkillType
 
 from ..core.skills_registry import TASKS
 from .robot_pose import pose_source
 from .topics import task_status_topic, task_topic
 
-__all__ = ["drone_skills", "manipulator_rover_skills", "pose_source", "science_rover_skills"]
+__all__ = [
+    "drone_skills",
+    "library",
+    "manipulator_rover_skills",
+    "pose_source",
+    "science_rover_skills",
+]
 
+LIBRARY = Path(__file__).resolve().parents[2] / "rosmc_server" / "config" / "mars_team.yaml"
 RESEND_AFTER = 1.0  # wall seconds without any status before a START is sent again
-
-P = ParamType
-_PARAMS: Mapping[str, Mapping[str, ParamType]] = {
-    "navigate_to": {"target": P.POSE},
-    "take_off": {"altitude": P.FLOAT},
-    "land": {},
-    "fly_over": {"area": P.LIST},
-    "explore": {"area": P.LIST},
-    "return_to_lander": {},
-    "recharge": {"level": P.FLOAT},
-    "identify_stones": {"position": P.POSE},
-    "pick_stone": {"position": P.POSE},
-    "deposit_at_lander": {},
-    "pick_box": {"box": P.STRING},
-    "place_box": {"target": P.POSE},
-}
 
 
 class RobotController:
@@ -157,10 +150,15 @@ class ForwardedSkill(SkillBehavior):
 def _skills(agent: str, kind: str) -> list[SkillType]:
     controller = RobotController(agent)
     return [
-        SkillType(name, functools.partial(ForwardedSkill, controller, name), _PARAMS[name])
+        SkillType(name, functools.partial(ForwardedSkill, controller, name))
         for name, task in TASKS.items()
         if kind in task.kinds
     ]
+
+
+def library(agent: str) -> Path:
+    """The simulated team's library: it declares the parameters of these skills."""
+    return LIBRARY
 
 
 def drone_skills(agent: str) -> list[SkillType]:

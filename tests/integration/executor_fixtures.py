@@ -204,6 +204,15 @@ class Operator:
             wait_until(lambda: publisher.get_num_connections() > 0, 30.0, "the link emulator")
         publisher.publish(Bool(data=on))
 
+    def status_texts(self, skill_id: str) -> list[str]:
+        """Every status text ``/rosmc/mission_events`` carried for ``skill_id``, in order."""
+        return [
+            placed.skill.status_text
+            for _, event in self.events.since(0)
+            for placed in event.put_skills
+            if placed.skill.id == skill_id
+        ]
+
     # -- waiting --------------------------------------------------------------------
     def wait_mission(
         self, predicate: Callable[[MissionState], bool], timeout: float, what: str
@@ -471,6 +480,7 @@ class RosmcSystem:
                 str(REPO_ROOT / "scripts" / "mission_executor"),
                 f"_agent:={agent}",
                 f"_state_file:={self.state_file(agent)}",
+                f"_library:={self.library}",  # the robots' skills must fit the server's library
                 *side,
                 *params,
             ],

@@ -62,9 +62,11 @@ class TeamSettings:
         link_timeout: Wall seconds of silence before the server calls a link DOWN.
         snapshot_period: Wall seconds between the executors' snapshots (their heartbeat).
         latency: One-way latency of the emulated links.
+        library: The skill library of the server and of the executors.
     """
 
     scenario: Path = SCENARIO
+    library: Path = LIBRARY
     real_time_factor: float = 100.0
     step: float = 0.1
     link_timeout: float = 1.0
@@ -98,7 +100,7 @@ class Team:
         self._start(
             "server",
             "mission_server",
-            library=LIBRARY,
+            library=self.settings.library,
             journal_dir=self.journal_dir,
             link_timeout=self.settings.link_timeout,
             agent_state_rate=10.0,
@@ -118,6 +120,7 @@ class Team:
                 {"ROS_NAMESPACE": f"/{robot}"},
                 agent=robot,
                 skills=f"rosmc_sim.ros.robot_skills:{robot}_skills",
+                library=self.settings.library,
                 robot_side=True,
                 state_file="",
                 snapshot_period=self.settings.snapshot_period,

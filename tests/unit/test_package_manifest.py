@@ -17,6 +17,8 @@ REPO = Path(__file__).resolve().parents[2]
 
 # Import name -> the rosdep key that installs it.
 IMPORT_KEYS = {
+    "actionlib": "actionlib",  # skills bound to action servers
+    "actionlib_msgs": "actionlib_msgs",
     "genpy": "genpy",
     "geometry_msgs": "geometry_msgs",
     "interactive_markers": "interactive_markers",
@@ -29,6 +31,7 @@ IMPORT_KEYS = {
     "rosbag": "rosbag",
     "rosgraph": "rosgraph",
     "rosgraph_msgs": "rosgraph_msgs",
+    "roslib": "roslib",  # message classes of bound skills, by name
     "rospy": "rospy",
     "std_msgs": "std_msgs",
     "tf2_msgs": "tf2_msgs",

@@ -23,6 +23,9 @@ Parameters (private):
         (default: the basic skills, ``rosmc_server.executor.basic_skills:skill_types``).
     ``~state_file`` (str): where the executor keeps its state across restarts
         (default ``$ROS_HOME/rosmc/<agent>_executor.json``; "" = keep nothing).
+    ``~library`` (str): the skill library (YAML) this robot's skills must fit; it declares
+        their parameters and may bind skills to ROS actions, services and topics (default:
+        the skills module's ``library(agent)`` if it has one, else none: nothing checked).
     ``~pose_source`` (str): ``module:function`` returning the robot's pose source (where it
         is, remembered at each ground contact for the ``return_to_link`` policy); default:
         the skills module's ``pose_source`` if it has one, else none.
@@ -65,13 +68,14 @@ from ...conversions.robot_link import (
     signal_to_msg,
     snapshot_to_msg,
 )
-from ...core import RosmcError
+from ...core import LibraryError, RosmcError, SkillSetupError
 from ...core.radio import BeaconPlan, ContactWatch
 from ...ros.radio import GROUND, Radio, TopicListener, reconnect_in_background
 from ..core import Command, Engine, Report, Signal, SkillType
 from ..core.lost_link import PoseSource, no_pose
 from ..core.pacing import IDLE_PERIOD, SnapshotPacer
 from ..core.state_file import load_state, save_state
+from .skill_setup import default_library, robot_skill_types
 
 _log = logging.getLogger(__name__)
 DEFAULT_SKILLS = "rosmc_server.executor.basic_skills:skill_types"
@@ -287,6 +291,7 @@ class ExecutorConfig:
 
     agent: str
     skills: str = DEFAULT_SKILLS
+    library: str = ""
     pose_source: str = ""
     state_file: Path | None = None
     robot_side: bool = False
@@ -309,6 +314,7 @@ class ExecutorConfig:
         config = cls(
             agent=agent,
             skills=str(rospy.get_param("~skills", DEFAULT_SKILLS)),
+            library=str(rospy.get_param("~library", "")),
             pose_source=str(rospy.get_param("~pose_source", "")),
             state_file=launch_path(state) if state else None,
             robot_side=bool(rospy.get_param("~robot_side", False)),
@@ -326,6 +332,7 @@ class ExecutorConfig:
 PRIVATE_PARAMS = (
     "agent",
     "skills",
+    "library",
     "pose_source",
     "state_file",
     "robot_side",
@@ -355,8 +362,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         skill_types = load_skill_types(config.skills, config.agent)
         pose_source = load_pose_source(config.pose_source, config.skills, config.agent)
+        library = config.library or default_library(config.skills, config.agent)
     except (ImportError, AttributeError, ValueError) as error:
         _log.critical("mission executor %s: cannot load skills: %s", config.agent, error)
+        return 1
+    try:
+        skill_types = robot_skill_types(
+            config.agent, skill_types, launch_path(library) if library else None
+        )
+    except (LibraryError, SkillSetupError) as error:
+        _log.critical("mission executor %s: %s", config.agent, error)
         return 1
     node = ExecutorNode(
         config.agent, skill_types, config.state_file, config.robot_side, pose_source
