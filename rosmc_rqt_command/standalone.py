@@ -12,6 +12,7 @@ import os
 import signal
 import sys
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any
 
 import rospy
@@ -22,9 +23,9 @@ from rosmc_server.ros.client import init_node
 
 from .core.view_state import ViewUpdate
 from .qt.command_widget import CommandWidget
-from .qt.replay_mode import ReplayHooks, ReplayMode
+from .qt.replay_mode import ReplayHooks, ReplayMode, ReplaySteering
+from .qt.startup_report import StartupReport
 from .ros_bridge import RosBridge
-from .ros_replay import ReplayLink
 
 
 def _wiring(widget: CommandWidget, bridge: RosBridge) -> list[tuple[Any, Any]]:
@@ -67,8 +68,15 @@ def replay_hooks(widget: CommandWidget, timeout: float) -> ReplayHooks:
         attach=lambda bridge: connect(widget, bridge),
         detach=lambda bridge: disconnect(widget, bridge),
         close=lambda bridge: bridge.close(),
-        steer=ReplayLink,
+        steer=_replay_link,
     )
+
+
+def _replay_link(prefix: str) -> ReplaySteering:
+    """The link that steers a replay (its recording modules load with the first replay)."""
+    from .ros_replay import ReplayLink
+
+    return ReplayLink(prefix)
 
 
 class CommandWindow(QMainWindow):  # type: ignore[misc]
@@ -121,12 +129,25 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument(
         "--ns", default="", help="follow a replay served under this prefix, read-only (/replay)"
     )
+    parser.add_argument(
+        "--startup-report",
+        type=Path,
+        metavar="FILE",
+        help="write when each start-up stage ended to FILE, as JSON lines (for benchmarks)",
+    )
     options = parser.parse_args(args)
+    report = StartupReport(options.startup_report) if options.startup_report else None
+    if report is not None:
+        report.mark("main")
     app = QApplication.instance() or QApplication([sys.argv[0]])
     init_node(f"rosmc_command_{os.getpid()}")
+    if report is not None:
+        report.mark("node")
     widget, bridge = build(options.ns)
     title = "ROSMC command" + (f" — following {options.ns} (read-only)" if bridge.read_only else "")
     window = CommandWindow(widget, title)
+    if report is not None:
+        report.watch(window, bridge.updated)
     window.show()
     # Ctrl-C in the terminal closes the window (Qt otherwise never lets Python see it).
     signal.signal(signal.SIGINT, lambda *_: window.close())
