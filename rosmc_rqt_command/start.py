@@ -6,8 +6,10 @@ later is imported when first used (the replay bar and recordings, see
 :mod:`.qt.replay_mode`); the one cost no module of ours controls is numpy, which
 ``genpy`` imports only to accept numpy scalars in messages (its ``import numpy`` is
 optional). The window never puts numpy values in a message, and numpy's import (with its
-BLAS threads) cost 60-250 ms on the 2-core machine, so genpy is imported here while numpy
-is hidden; numpy itself stays importable for whoever needs it later.
+BLAS threads) cost 60-250 ms on the 2-core machine, so the window's modules are imported
+here while numpy is hidden; numpy itself stays importable for whoever needs it later (a
+module of the window that imported numpy unconditionally would fail to start, which the
+start-up test would show).
 """
 
 from __future__ import annotations
@@ -43,6 +45,5 @@ def hidden(module: str) -> Iterator[None]:
 def main(argv: Sequence[str] | None = None) -> int:
     """Open the command window (:func:`rosmc_rqt_command.standalone.main`)."""
     with hidden(SKIPPED_BY_GENPY):
-        importlib.import_module("genpy")
-    standalone = importlib.import_module("rosmc_rqt_command.standalone")
+        standalone = importlib.import_module("rosmc_rqt_command.standalone")
     return cast(int, standalone.main(argv))

@@ -24,6 +24,7 @@ from python_qt_binding.QtCore import QEvent, QObject, QTimer
 from python_qt_binding.QtWidgets import QAbstractItemView, QApplication, QWidget
 
 from ..core.view_state import ViewUpdate
+from .schedule_widget import ScheduleWidget
 
 
 class StartupReport(QObject):  # type: ignore[misc]
@@ -41,15 +42,16 @@ class StartupReport(QObject):  # type: ignore[misc]
         self._path = path
         self._marked: set[str] = set()
         self._window: QWidget | None = None
-        self._whole = False  # the first whole mission is in the tables
+        self._whole = False  # the first whole mission arrived
+        self._schedule: ScheduleWidget | None = None
         path.write_text("")
 
-    def mark(self, stage: str) -> None:
-        """``stage`` ended now."""
+    def mark(self, stage: str, when: float | None = None) -> None:
+        """``stage`` ended ``when`` (``time.monotonic()`` seconds; default: now)."""
         if stage in self._marked:
             return
         self._marked.add(stage)
-        line: dict[str, Any] = {"stage": stage, "t": time.monotonic()}
+        line: dict[str, Any] = {"stage": stage, "t": time.monotonic() if when is None else when}
         if stage == "all":
             line["modules"] = sorted(sys.modules)
         with self._path.open("a") as out:
@@ -59,19 +61,29 @@ class StartupReport(QObject):  # type: ignore[misc]
         """``stage`` ends when the event loop is next idle (the paint in progress is done)."""
         QTimer.singleShot(0, lambda: self.mark(stage))
 
-    def watch(self, window: QWidget, updated: Any) -> None:
-        """Mark ``window`` (its first paint), ``rows`` (the first table painted with rows),
-        ``snapshot`` and ``all`` (the first whole mission, as ``updated`` hands it over)."""
+    def watch(self, window: QWidget) -> None:
+        """Mark ``window`` (its first paint) and ``rows`` (the first table painted with rows)."""
         self._window = window
         QApplication.instance().installEventFilter(self)
+
+    def follow(self, updated: Any, schedule: ScheduleWidget) -> None:
+        """Mark ``snapshot`` (when it was read) and ``all`` (every row of the first mission
+        in ``schedule``) as the bridge's ``updated`` signal hands them over."""
+        self._schedule = schedule
         updated.connect(self._on_updated)
+        schedule.columns_added.connect(lambda _agents: self._mark_all_when_shown())
 
     def _on_updated(self, batch: Sequence[ViewUpdate]) -> None:
-        if any(update.reset for update in batch):
-            self.mark("snapshot")
+        resets = [update.received for update in batch if update.reset]
+        if resets:
+            self.mark("snapshot", resets[0])
             self._whole = True
-            if "rows" in self._marked:
-                self.mark_soon("all")
+            self._mark_all_when_shown()
+
+    def _mark_all_when_shown(self) -> None:
+        schedule = self._schedule
+        if self._whole and "rows" in self._marked and schedule is not None and schedule.complete:
+            self.mark_soon("all")
 
     def eventFilter(self, watched: QObject, event: QEvent) -> bool:
         """Note the paints the stages wait for; never consumes an event."""
@@ -82,8 +94,7 @@ class StartupReport(QObject):  # type: ignore[misc]
             self.mark_soon("window")
         if _shows_rows(watched.parentWidget()):
             self.mark_soon("rows")
-            if self._whole:
-                self.mark_soon("all")
+            QTimer.singleShot(0, self._mark_all_when_shown)
             QApplication.instance().removeEventFilter(self)
         return False
 
