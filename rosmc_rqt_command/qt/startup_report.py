@@ -30,8 +30,9 @@ from .schedule_widget import ScheduleWidget
 class StartupReport(QObject):  # type: ignore[misc]
     """Appends each stage's end to ``path`` once (later marks of a stage are ignored).
 
-    The ``all`` line also lists the modules the process had imported by then
-    (``modules``), so a test can tell what the start did not import.
+    The ``rows`` and ``all`` lines also say how many robots' columns and rows the schedule
+    held then (``columns``, ``rows``), and the ``all`` line lists the modules the process had
+    imported by then (``modules``), so a test can tell what the start did not import.
 
     Args:
         path: The file to write (created anew).
@@ -52,6 +53,10 @@ class StartupReport(QObject):  # type: ignore[misc]
             return
         self._marked.add(stage)
         line: dict[str, Any] = {"stage": stage, "t": time.monotonic() if when is None else when}
+        if stage in ("rows", "all") and self._schedule is not None:
+            tables = list(self._schedule.tables())
+            line["columns"] = len(self._schedule.columns)
+            line["rows"] = sum(table.section.rowCount() for table in tables)
         if stage == "all":
             line["modules"] = sorted(sys.modules)
         with self._path.open("a") as out:
