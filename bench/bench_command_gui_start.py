@@ -14,8 +14,8 @@ process is spawned it times (median of the runs, seconds):
 Python's bytecode cache is kept in a private folder (``PYTHONPYCACHEPREFIX``) even where
 ``PYTHONDONTWRITEBYTECODE`` is set, as an installed program has its modules compiled: the
 first run of each size compiles them (``cold_first_rows_s``), the ``--repeats`` after it
-read the cache. Beside it, in the same run, the cost floor no GUI can go below: a process that imports
-``rospy`` and ``rosmc.msg`` and paints an empty Qt window (``floor_s``), and
+read the cache. Beside it, in the same run, the cost floor no GUI can go below: a process
+that imports ``rospy`` and ``rosmc.msg`` and paints an empty Qt window (``floor_s``), and
 ``overhead_over_floor_s`` = ``first_rows_s`` - ``floor_s``. The snapshot's own costs are
 measured in this process: ``fetch_ms`` (GetMission answered, bytes undecoded) and
 ``decode_ms`` (those bytes read into core objects as the window reads them).

@@ -142,6 +142,9 @@ class NodeStart(QObject):  # type: ignore[misc]
         super().__init__()
         self._thread = threading.Thread(target=self._run, args=(name,), daemon=True)
         self._thread.name = "rosmc-node-start"
+
+    def start(self) -> None:
+        """Start registering (connect :attr:`ready` first: it may come at once)."""
         self._thread.start()
 
     def _run(self, name: str) -> None:
@@ -198,6 +201,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     widget = CommandWidget(PendingBackend(options.ns))
     live = _Live(widget, options.ns, report)
     node.ready.connect(live.on_node_ready)
+    node.start()
     replay = follows_replay(options.ns)
     title = "ROSMC command" + (f" — following {options.ns} (read-only)" if replay else "")
     window = CommandWindow(widget, title)
