@@ -7,8 +7,8 @@ A private rosmaster and a real ``mission_server`` hold a mission of each ``--siz
 process is spawned it times (median of the runs, seconds):
 
 * ``main``: the imports done (``main()`` entered); ``node``: the ROS node registered;
-* ``window``: the empty window painted; ``snapshot``: the mission snapshot handed to the
-  window; ``rows``: the first rows painted (``first_rows_s``, the figure of issue 23,
+* ``window``: the empty window painted; ``snapshot``: the mission snapshot fetched and
+  read into the process (before the window takes it); ``rows``: the first rows painted (``first_rows_s``, the figure of issue 23,
   wanted <= 1.0 s); ``all``: every row of the mission shown (``all_rows_s``).
 
 Python's bytecode cache is kept in a private folder (``PYTHONPYCACHEPREFIX``) even where
