@@ -8,14 +8,17 @@ process is spawned it times (median of the runs, seconds):
 
 * ``main``: the imports done (``main()`` entered); ``node``: the ROS node registered;
 * ``window``: the empty window painted; ``snapshot``: the mission snapshot fetched and
-  read into the process (before the window takes it); ``rows``: the first rows painted (``first_rows_s``, the figure of issue 23,
-  wanted <= 1.0 s); ``all``: every row of the mission shown (``all_rows_s``).
+  read into the process (before the window takes it);
+* ``rows``: the first rows painted (``first_rows_s``, the figure of issue 23, wanted
+  <= 1.0 s); ``all``: every row of the mission shown (``all_rows_s``).
 
 Python's bytecode cache is kept in a private folder (``PYTHONPYCACHEPREFIX``) even where
-``PYTHONDONTWRITEBYTECODE`` is set, as an installed program has its modules compiled: the
-first run of each size compiles them (``cold_first_rows_s``), the ``--repeats`` after it
-read the cache. Beside it, in the same run, the cost floor no GUI can go below: a process
-that imports ``rospy`` and ``rosmc.msg`` and paints an empty Qt window (``floor_s``), and
+``PYTHONDONTWRITEBYTECODE`` is set, as an installed program has its modules compiled: a
+first run fills it, the ``--repeats`` after it read it (without it, compiling the
+project's modules adds about 0.3 s to every start).
+
+Beside it, in the same run, the cost floor no GUI can go below: a process that imports
+``rospy`` and ``rosmc.msg`` and paints an empty Qt window (``floor_s``), and
 ``overhead_over_floor_s`` = ``first_rows_s`` - ``floor_s``. The snapshot's own costs are
 measured in this process: ``fetch_ms`` (GetMission answered, bytes undecoded) and
 ``decode_ms`` (those bytes read into core objects as the window reads them).
@@ -142,7 +145,8 @@ def bench_size(
             client.get_mission()
             client.load_mission(mission_yaml(agents, skills))
         env = dict(env, PYTHONPYCACHEPREFIX=str(work / f"pycache_{agents}x{skills}"))
-        cold = run_window(env, work)  # compiles into the new cache
+        env.pop("PYTHONDONTWRITEBYTECODE", None)
+        run_window(env, work)  # fills the cache
         runs = [run_window(env, work) for _ in range(repeats)]
         floors = [run_floor(env) for _ in range(repeats)]
         costs = snapshot_costs(repeats)
@@ -159,7 +163,6 @@ def bench_size(
         "overhead_over_floor_s": round(stages["rows"] - floor, 3),
         "stages_s": stages,
         "first_rows_runs_s": [round(r["rows"], 3) for r in runs],
-        "cold_first_rows_s": round(cold["rows"], 3),
         **costs,
     }
 
@@ -173,7 +176,6 @@ def main() -> int:
     figures: dict[str, Any] = {"target_first_rows_s": TARGET_FIRST_ROWS_S, "sizes": {}}
     with tempfile.TemporaryDirectory() as tmp, ros_master(Path(tmp)) as env:
         env = dict(env, QT_QPA_PLATFORM="offscreen")
-        env.pop("PYTHONDONTWRITEBYTECODE", None)
         import rospy
 
         rospy.init_node("bench_command_gui_start", anonymous=True, disable_signals=True)

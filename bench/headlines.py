@@ -96,7 +96,6 @@ HEADLINES: dict[str, tuple[str, ...]] = {
         "sizes.*.all_rows_s",
         "sizes.*.floor_s",
         "sizes.*.overhead_over_floor_s",
-        "sizes.*.cold_first_rows_s",
         "sizes.*.decode_ms",
     ),
     "change_bytes": (
