@@ -91,6 +91,13 @@ HEADLINES: dict[str, tuple[str, ...]] = {
         "downlink_bytes_per_s",
         "uplink_by_kind.*.bytes_per_s",
     ),
+    "command_gui_start": (
+        "sizes.*.first_rows_s",
+        "sizes.*.all_rows_s",
+        "sizes.*.floor_s",
+        "sizes.*.overhead_over_floor_s",
+        "sizes.*.decode_ms",
+    ),
     "change_bytes": (
         "sizes.*.now.bytes_per_change./rosmc/mission*",
         "sizes.*.broadcast.bytes_per_change./rosmc/mission",

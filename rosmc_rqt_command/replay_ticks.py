@@ -9,10 +9,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import Enum
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from rosmc_server.core import SkillStatus
-from rosmc_server.recording.history import MissionHistory
-from rosmc_server.recording.overlays import timeline_with_overlays
+
+if TYPE_CHECKING:  # the reader is imported when a recording is opened, not at the start
+    from rosmc_server.recording.history import MissionHistory
 
 
 class TickKind(Enum):
@@ -57,6 +59,8 @@ def outline_of(path: str | Path) -> RecordingOutline:
     Raises:
         RosmcError: The file is not a readable recording (the reader's error).
     """
+    from rosmc_server.recording.overlays import timeline_with_overlays
+
     history, timeline = timeline_with_overlays(path)
     ticks = [
         ReplayTick(mark.time, TickKind.OPERATOR, f"operator: {mark.summary}")

@@ -43,6 +43,7 @@ from rosmc_server.ros.client import (
     SiteWatch,
 )
 
+from .core.pending_backend import follows_replay
 from .core.requests import Answer, Request
 from .core.view_state import ViewUpdate, view_update
 
@@ -74,7 +75,7 @@ class RosBridge(QObject):  # type: ignore[misc]
     def __init__(self, prefix: str = "", timeout: float = 5.0) -> None:
         super().__init__()
         self.prefix = prefix
-        self.read_only = bool(prefix.strip().strip("/"))
+        self.read_only = follows_replay(prefix)
         self._follower = MissionFollower(
             prefix,
             timeout=timeout,

@@ -11,20 +11,23 @@ import gc
 import os
 import signal
 import sys
+import threading
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any
 
 import rospy
-from python_qt_binding.QtCore import QTimer
+from python_qt_binding.QtCore import QObject, QTimer, Signal
 from python_qt_binding.QtWidgets import QApplication, QMainWindow, QWidget
 
 from rosmc_server.ros.client import init_node
 
+from .core.pending_backend import PendingBackend, follows_replay
 from .core.view_state import ViewUpdate
 from .qt.command_widget import CommandWidget
-from .qt.replay_mode import ReplayHooks, ReplayMode
+from .qt.replay_mode import ReplayHooks, ReplayMode, ReplaySteering
+from .qt.startup_report import StartupReport
 from .ros_bridge import RosBridge
-from .ros_replay import ReplayLink
 
 
 def _wiring(widget: CommandWidget, bridge: RosBridge) -> list[tuple[Any, Any]]:
@@ -67,8 +70,15 @@ def replay_hooks(widget: CommandWidget, timeout: float) -> ReplayHooks:
         attach=lambda bridge: connect(widget, bridge),
         detach=lambda bridge: disconnect(widget, bridge),
         close=lambda bridge: bridge.close(),
-        steer=ReplayLink,
+        steer=_replay_link,
     )
+
+
+def _replay_link(prefix: str) -> ReplaySteering:
+    """The link that steers a replay (its recording modules load with the first replay)."""
+    from .ros_replay import ReplayLink
+
+    return ReplayLink(prefix)
 
 
 class CommandWindow(QMainWindow):  # type: ignore[misc]
@@ -107,11 +117,66 @@ def build(
     """A command widget fed by a started bridge (the process must be a ROS node)."""
     bridge = RosBridge(prefix, timeout)
     widget = CommandWidget(bridge, parent)
+    follow(widget, bridge, timeout)
+    return widget, bridge
+
+
+def follow(widget: CommandWidget, bridge: RosBridge, timeout: float = 5.0) -> None:
+    """Feed ``widget`` (whose backend is ``bridge``) from the started bridge; add replays."""
     connect(widget, bridge)
     bridge.updated.connect(freeze_after_reset)
     bridge.start()
     widget.replay = ReplayMode(widget, replay_hooks(widget, timeout))
-    return widget, bridge
+
+
+class NodeStart(QObject):  # type: ignore[misc]
+    """Makes the process a ROS node on a thread; :attr:`ready` is emitted on the GUI thread.
+
+    rospy waits at least 100 ms for its registration with the master (and as long as no
+    master runs): the window is built and painted meanwhile.
+    """
+
+    ready = Signal()
+
+    def __init__(self, name: str) -> None:
+        super().__init__()
+        self._thread = threading.Thread(target=self._run, args=(name,), daemon=True)
+        self._thread.name = "rosmc-node-start"
+
+    def start(self) -> None:
+        """Start registering (connect :attr:`ready` first: it may come at once)."""
+        self._thread.start()
+
+    def _run(self, name: str) -> None:
+        init_node(name)
+        self.ready.emit()  # queued: this object lives on the GUI thread
+
+
+class _Live:
+    """The standalone window's bridge, once the node has started."""
+
+    def __init__(self, widget: CommandWidget, prefix: str, report: StartupReport | None):
+        self.widget, self.prefix, self.report = widget, prefix, report
+        self.bridge: RosBridge | None = None
+
+    def on_node_ready(self) -> None:
+        """Make the bridge, hand it what the window asked meanwhile, start following."""
+        if self.report is not None:
+            self.report.mark("node")
+        pending = self.widget.backend
+        self.bridge = bridge = RosBridge(self.prefix)
+        if self.report is not None:
+            self.report.follow(bridge.updated, self.widget.schedule)
+        self.widget.set_backend(bridge)
+        follow(self.widget, bridge)
+        if isinstance(pending, PendingBackend):
+            pending.hand_over(bridge)
+
+    def close(self) -> None:
+        """Stop following (if the node ever started)."""
+        if self.bridge is not None:
+            self.widget.replay.close()
+            self.bridge.close()
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -121,12 +186,27 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument(
         "--ns", default="", help="follow a replay served under this prefix, read-only (/replay)"
     )
+    parser.add_argument(
+        "--startup-report",
+        type=Path,
+        metavar="FILE",
+        help="write when each start-up stage ended to FILE, as JSON lines (for benchmarks)",
+    )
     options = parser.parse_args(args)
+    report = StartupReport(options.startup_report) if options.startup_report else None
+    if report is not None:
+        report.mark("main")
     app = QApplication.instance() or QApplication([sys.argv[0]])
-    init_node(f"rosmc_command_{os.getpid()}")
-    widget, bridge = build(options.ns)
-    title = "ROSMC command" + (f" — following {options.ns} (read-only)" if bridge.read_only else "")
+    node = NodeStart(f"rosmc_command_{os.getpid()}")
+    widget = CommandWidget(PendingBackend(options.ns))
+    live = _Live(widget, options.ns, report)
+    node.ready.connect(live.on_node_ready)
+    node.start()
+    replay = follows_replay(options.ns)
+    title = "ROSMC command" + (f" — following {options.ns} (read-only)" if replay else "")
     window = CommandWindow(widget, title)
+    if report is not None:
+        report.watch(window)
     window.show()
     # Ctrl-C in the terminal closes the window (Qt otherwise never lets Python see it).
     signal.signal(signal.SIGINT, lambda *_: window.close())
@@ -136,6 +216,5 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(app.exec_())
     finally:
-        widget.replay.close()
-        bridge.close()
+        live.close()
         rospy.signal_shutdown("command window closed")

@@ -94,6 +94,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.schedule.add_requested.connect(self._on_schedule_add_requested)
         self.schedule.policy_chosen.connect(self._on_schedule_policy_chosen)
         self.schedule.reorder_requested.connect(self._on_schedule_reorder_requested)
+        self.schedule.columns_added.connect(self._on_schedule_columns_added)
         self.parameters.edit_requested.connect(self._on_parameters_edit_requested)
         self.parameters.rename_marker_requested.connect(self._on_parameters_rename_requested)
         self.parameters.problem.connect(lambda text: self.messages.say(text, "warning"))
@@ -288,6 +289,10 @@ class CommandWidget(QWidget):  # type: ignore[misc]
 
     def _on_schedule_reorder_requested(self, agent: str, order: list[str]) -> None:
         self.dispatcher.call(lambda c: c.reorder, f"reorder {agent}'s plan")(agent, order)
+
+    def _on_schedule_columns_added(self, agents: list[str]) -> None:
+        self.team.refresh()
+        self.enabling.update(agents)
 
     def _on_parameters_edit_requested(self, skill_id: str, fields: dict[str, Any]) -> None:
         skill = self.view.skill(skill_id)

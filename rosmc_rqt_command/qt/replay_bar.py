@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from python_qt_binding.QtCore import QPoint, QRect, QSize, Qt, QTimer, Signal
 from python_qt_binding.QtGui import QColor, QPainter, QPen
@@ -22,9 +23,10 @@ from python_qt_binding.QtWidgets import (
     QWidget,
 )
 
-from rosmc_server.recording.playback import MAX_RATE, MIN_RATE, PlaybackStatus
-
 from ..replay_ticks import RecordingOutline, ReplayTick, TickKind
+
+if TYPE_CHECKING:  # the recording modules load when a replay starts, not with the window
+    from rosmc_server.recording.playback import PlaybackStatus
 
 TICK_COLOURS = {
     TickKind.OPERATOR: QColor("#1f5fbf"),
@@ -222,6 +224,8 @@ class ReplayBar(QFrame):  # type: ignore[misc]
 
     def show_status(self, shown: ShownStatus) -> None:
         """Show where the replay is (newer than what is shown)."""
+        from rosmc_server.recording.playback import MAX_RATE, MIN_RATE
+
         if self.shown is not None and shown.stamp < self.shown.stamp:
             return  # an answer overtaken by the state topic
         self.shown = shown

@@ -11,14 +11,28 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 
-from python_qt_binding.QtCore import QItemSelection, QItemSelectionModel, QPoint, Qt, Signal
+from python_qt_binding.QtCore import (
+    QItemSelection,
+    QItemSelectionModel,
+    QPoint,
+    Qt,
+    QTimer,
+    Signal,
+)
 from python_qt_binding.QtWidgets import QApplication, QHBoxLayout, QScrollArea, QWidget
 
 from rosmc_server.core import AgentStatus, Library
 
 from ..core.mission_view import MissionView
 from ..core.view_state import ViewUpdate, delta_agent
-from .agent_column import AgentColumn, SectionTable
+from .agent_column import COMPACT_WIDTH, AgentColumn, SectionTable
+
+# A mission's first columns are built at once, as many as fit on screen (at least this
+# many); the others follow in groups of LATER_COLUMNS, LATER_MS apart (a zero timer could
+# run before the window has painted the first ones).
+FIRST_COLUMNS = 6
+LATER_COLUMNS = 4
+LATER_MS = 10
 
 
 class ScheduleWidget(QScrollArea):  # type: ignore[misc]
@@ -30,6 +44,7 @@ class ScheduleWidget(QScrollArea):  # type: ignore[misc]
     add_requested = Signal(str, str)  # agent, skill
     policy_chosen = Signal(str, object)  # agent, LostLinkPolicy
     reorder_requested = Signal(str, list)  # agent, new blueprint order
+    columns_added = Signal(list)  # robots whose columns came after the first paint
 
     def __init__(self, view: MissionView, parent: QWidget | None = None) -> None:
         super().__init__(parent)
@@ -38,6 +53,7 @@ class ScheduleWidget(QScrollArea):  # type: ignore[misc]
         self._selected: list[str] = []
         self._syncing = False
         self._library: Library | None = None
+        self._later: list[str] = []  # robots whose columns are yet to be added
         self._inner = QWidget()
         self._row = QHBoxLayout(self._inner)
         self._row.setContentsMargins(2, 2, 2, 2)
@@ -47,6 +63,11 @@ class ScheduleWidget(QScrollArea):  # type: ignore[misc]
         self.setHorizontalScrollBarPolicy(Qt.ScrollBarAsNeeded)
 
     # -- content --------------------------------------------------------------------------
+    @property
+    def complete(self) -> bool:
+        """Every robot of the mission has its column (none is waiting to be added)."""
+        return not self._later
+
     @property
     def selected_ids(self) -> list[str]:
         """The selected skills, robot by robot, top to bottom."""
@@ -138,31 +159,54 @@ class ScheduleWidget(QScrollArea):  # type: ignore[misc]
 
     # -- columns --------------------------------------------------------------------------
     def _ensure_columns(self, agents: list[str]) -> None:
-        if list(self.columns) == agents:
+        """One column per robot, in order: those that fit on screen now, the rest after
+        the window has painted them (a column costs milliseconds to build and show)."""
+        if list(self.columns) + self._later == agents:
             return
         for column in self.columns.values():
             self._row.removeWidget(column)
             column.deleteLater()
         self.columns = {}
-        for position, agent in enumerate(agents):
-            column = AgentColumn(agent, self._view, self._inner)
-            self._row.insertWidget(position, column, 1)
-            self.columns[agent] = column
-            column.robot_action.connect(self.robot_action)
-            column.add_requested.connect(self.add_requested)
-            column.policy_chosen.connect(self.policy_chosen)
-            column.blueprint_model.reorder_requested.connect(self.reorder_requested)
-            column.show_status(self._view.statuses.get(agent))
-            self._offer_skills(agent, column)
-            for table in column.tables:
-                table.selectionModel().selectionChanged.connect(
-                    lambda *_args, t=table: self._on_table_selection_changed(t)
-                )
-                table.empty_clicked.connect(self.clear_selection)
-                table.plain_clicked.connect(lambda t=table: self._on_table_plain_clicked(t))
-                table.customContextMenuRequested.connect(
-                    lambda pos, t=table: self._on_table_context_menu(t, pos)
-                )
+        first = max(FIRST_COLUMNS, self.viewport().width() // COMPACT_WIDTH + 1)
+        for agent in agents[:first]:
+            self._add_column(agent)
+        self._later = agents[first:]
+        if self._later:
+            QTimer.singleShot(LATER_MS, self._on_later_timeout)
+
+    def _on_later_timeout(self) -> None:
+        """Add the next few columns that did not fit on screen, showing their tasks."""
+        if not self._later:  # a newer mission's columns were all built meanwhile
+            return
+        added = [self._add_column(agent) for agent in self._later[:LATER_COLUMNS]]
+        del self._later[:LATER_COLUMNS]
+        for column in added:
+            column.show_task(self._view.view(column.agent))
+        self._restore(added)
+        if self._later:
+            QTimer.singleShot(LATER_MS, self._on_later_timeout)
+        self.columns_added.emit([column.agent for column in added])
+
+    def _add_column(self, agent: str) -> AgentColumn:
+        column = AgentColumn(agent, self._view, self._inner)
+        self._row.insertWidget(len(self.columns), column, 1)
+        self.columns[agent] = column
+        column.robot_action.connect(self.robot_action)
+        column.add_requested.connect(self.add_requested)
+        column.policy_chosen.connect(self.policy_chosen)
+        column.blueprint_model.reorder_requested.connect(self.reorder_requested)
+        column.show_status(self._view.statuses.get(agent))
+        self._offer_skills(agent, column)
+        for table in column.tables:
+            table.selectionModel().selectionChanged.connect(
+                lambda *_args, t=table: self._on_table_selection_changed(t)
+            )
+            table.empty_clicked.connect(self.clear_selection)
+            table.plain_clicked.connect(lambda t=table: self._on_table_plain_clicked(t))
+            table.customContextMenuRequested.connect(
+                lambda pos, t=table: self._on_table_context_menu(t, pos)
+            )
+        return column
 
     def _offer_skills(self, agent: str, column: AgentColumn) -> None:
         if self._library is not None and agent in self._library.dynamic_agents:
