@@ -34,6 +34,7 @@ from geometry_msgs.msg import (
 from geometry_msgs.msg import Pose as PoseMsg
 from roslib.message import get_message_class
 
+from rosmc_server.conversions.values import value_type
 from rosmc_server.core import ParamType, Pose, SkillSetupError, Value
 from rosmc_server.core.bindings import FieldSource, template_fields
 from rosmc_server.interface import MAP_FRAME
@@ -136,19 +137,6 @@ def converter(ptype: ParamType, kind: str) -> Convert | None:
     return found
 
 
-def constant_type(value: Value) -> ParamType:
-    """The parameter type a constant of a binding has."""
-    if isinstance(value, bool):
-        return ParamType.BOOL
-    if isinstance(value, int):
-        return ParamType.INT
-    if isinstance(value, float):
-        return ParamType.FLOAT
-    if isinstance(value, str):
-        return ParamType.STRING
-    return ParamType.LIST if isinstance(value, list) else ParamType.DICT
-
-
 @dataclass(frozen=True)
 class Filler:
     """One field of a message and where its value comes from."""
@@ -191,7 +179,7 @@ class MessageRecipe:
                 ptype, what = parameters[source.parameter], f"parameter '{source.parameter}'"
             else:
                 assert source.constant is not None
-                ptype, what = constant_type(source.constant), f"the constant {source.constant!r}"
+                ptype, what = value_type(source.constant), f"the constant {source.constant!r}"
             convert = converter(ptype, kind)
             if convert is None:
                 raise SkillSetupError(
