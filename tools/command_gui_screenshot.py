@@ -163,7 +163,7 @@ def run(
         )
         if args.out_of_contact:
             silenced = cut_off(client, widget, args.out_of_contact, wait)
-        widget.schedule.select_ids([ids["identify"]])
+        widget.tasks.select_ids([ids["identify"]])
         status = 0
     except TimeoutError as error:
         print(f"command_gui_screenshot: {error}", file=sys.stderr)
@@ -273,7 +273,7 @@ def stage(client: object, wait: Callable[..., None]) -> dict[str, str]:
             and not client.get_mission().skill(i).is_editable
             for i in (drone_last, science_last, manipulator_last)
         ),
-        "the robots confirm their plans",
+        "the robots confirm their tasks",
         30,
     )
     return ids

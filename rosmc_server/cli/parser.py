@@ -103,7 +103,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _add_views(command: _Command) -> None:
-    status = command("status", "print every robot's schedule, link and telemetry")
+    status = command("status", "print every robot's task, link and telemetry")
     status.add_argument("-v", "--verbose", action="store_true", help="show parameter values")
     status.add_argument(
         "--no-states",

@@ -176,8 +176,8 @@ def drive() -> None:
     press("F5")
     report["F5"] = "refreshed" if backend.refreshes == refreshes + 1 else "not refreshed"
     press("Escape")
-    if widget.schedule.selected_ids:
-        report["Escape"] = ["still selected", widget.schedule.selected_ids]
+    if widget.tasks.selected_ids:
+        report["Escape"] = ["still selected", widget.tasks.selected_ids]
     # The file dialogs: each key opens its dialog (closed again with Escape).
     widget.files.ask = lambda doing: "discard"
     for keys in ("Ctrl+O", "Ctrl+Shift+O", "Ctrl+Shift+S", "Ctrl+Alt+S"):

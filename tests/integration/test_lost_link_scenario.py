@@ -1,4 +1,4 @@
-"""A rover whose synchronized plan ends out of coverage, on the real simulated team.
+"""A rover whose synchronized task ends out of coverage, on the real simulated team.
 
 With its library default (``return_to_link`` after 60 s idle without a link) it drives
 back to where it last had a link, the ground hears it again, and it holds; work the operator

@@ -337,7 +337,7 @@ def near(telemetry: Any, point: tuple[float, float], within: float = 0.3) -> boo
 def test_out_of_coverage_the_robot_goes_on_and_a_wifi_box_brings_it_back(op: Operator) -> None:
     c = op.client
     # With its library default it would drive back to its link once idle a minute
-    # (test_lost_link_scenario.py); here it waits where its plan ends.
+    # (test_lost_link_scenario.py); here it waits where its task ends.
     c.set_robot_options(SCIENCE, LostLinkPolicy())
     # The last leg is slow: at a factor of 100 the emulator may apply a blackout a tenth of a
     # wall second late (its blackout and relay callbacks are separate threads), so the skill

@@ -1,4 +1,4 @@
-"""The schedule panel: one :class:`AgentColumn` per robot, side by side, scrolling sideways.
+"""The task panel: one :class:`AgentColumn` per robot, side by side, scrolling sideways.
 
 Owns the selection across columns: a plain click selects in one table only; Ctrl or
 Shift keep what other columns have selected (a barrier spans robots). The selection is
@@ -21,8 +21,8 @@ from ..core.view_state import ViewUpdate, delta_agent
 from .agent_column import AgentColumn, SectionTable
 
 
-class ScheduleWidget(QScrollArea):  # type: ignore[misc]
-    """Every robot's schedule; emits the selection and the operator's requests."""
+class TaskWidget(QScrollArea):  # type: ignore[misc]
+    """Every robot's task; emits the selection and the operator's requests."""
 
     selection_changed = Signal(list)  # selected skill ids
     context_menu_requested = Signal(object, QPoint)  # table, global position
