@@ -63,7 +63,7 @@ class Dispatcher:
         self, pick: Callable[[MissionClient], Callable[P, object]], what: str
     ) -> Callable[P, None]:
         """A sender of one call of the client method ``pick`` chooses, against the revision
-        shown: ``call(lambda c: c.retry, "retry 'go'")(skill_id)``."""
+        shown: ``call(lambda c: c.retry_skill, "retry 'go'")(skill_id)``."""
         make = ask(pick, what, self._view.revision)
 
         def send(*args: P.args, **kwargs: P.kwargs) -> None:
@@ -95,7 +95,7 @@ class Dispatcher:
     def _move(self, kind: Action, selected: Sequence[SkillInstance], names: str) -> None:
         agent = selected[0].agent
         order = moved([s.id for s in self._view.view(agent).editable], selected, kind)
-        self.call(lambda c: c.reorder, f"move {names}")(agent, order)
+        self.call(lambda c: c.reorder_skills, f"move {names}")(agent, order)
 
     def _sync(self, _: Action, selected: Sequence[SkillInstance], names: str) -> None:
         view = self._view
@@ -116,9 +116,9 @@ class Dispatcher:
 
     def _resolve(self, kind: Action, selected: Sequence[SkillInstance], names: str) -> None:
         if kind is Action.RETRY:
-            self.call(lambda c: c.retry, f"retry {names}")(selected[0].id)
+            self.call(lambda c: c.retry_skill, f"retry {names}")(selected[0].id)
         else:
-            self.call(lambda c: c.skip, f"skip {names}")(selected[0].id)
+            self.call(lambda c: c.skip_skill, f"skip {names}")(selected[0].id)
 
     def _barrier(self, _: Action, selected: Sequence[SkillInstance], names: str) -> None:
         self.call(lambda c: c.add_barrier, f"start {names} together")([s.id for s in selected])

@@ -287,7 +287,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.dispatcher.call(lambda c: c.set_robot_options, what)(agent, policy)
 
     def _on_tasks_reorder_requested(self, agent: str, order: list[str]) -> None:
-        self.dispatcher.call(lambda c: c.reorder, f"reorder {agent}'s task")(agent, order)
+        self.dispatcher.call(lambda c: c.reorder_skills, f"reorder {agent}'s task")(agent, order)
 
     def _on_parameters_edit_requested(self, skill_id: str, fields: dict[str, Any]) -> None:
         skill = self.view.skill(skill_id)
@@ -298,7 +298,8 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.send(ask(lambda c: c.edit_skill, what, self.view.revision, revert)(skill_id, **fields))
 
     def _on_parameters_rename_requested(self, old: str, new: str) -> None:
-        self.dispatcher.call(lambda c: c.rename_marker, f"rename marker {old} to {new}")(old, new)
+        what = f"rename marker {old} to {new}"
+        self.dispatcher.call(lambda c: c.rename_task_marker, what)(old, new)
 
     def _on_refresh_triggered(self) -> None:
         self.backend.refresh()

@@ -335,7 +335,7 @@ def test_compose_edit_reorder_barrier(server: Server, fresh: MissionClient) -> N
 
 def build_mission(client: MissionClient) -> dict[str, str]:
     """A small mission made through the client API; the skill ids by role."""
-    client.add_marker(TaskMarker("RSS A", MarkerType.POSITION, Pose(10.0, 6.0)))
+    client.add_task_marker(TaskMarker("RSS A", MarkerType.POSITION, Pose(10.0, 6.0)))
     return {
         "climb": client.add_skill("drone", "take_off", {"altitude": 12}).skill_id,
         "cover": client.add_skill("drone", "fly_over", {"altitude": 9.5}).skill_id,
@@ -352,7 +352,7 @@ def test_every_error_class_exits_1_with_one_line(
 ) -> None:
     broken = tmp_path / "broken.yaml"
     broken.write_text("rosmc_mission: 1\ntasks: []\n")
-    fresh.add_marker(TaskMarker("RSS A", MarkerType.POSITION, Pose(10.0, 6.0)))
+    fresh.add_task_marker(TaskMarker("RSS A", MarkerType.POSITION, Pose(10.0, 6.0)))
     first = fresh.add_skill("science_rover", "navigate_to").skill_id
     second = fresh.add_skill("science_rover", "explore").skill_id
     cases = {
@@ -436,7 +436,7 @@ def test_watch_sees_concurrent_changes(server: Server, fresh: MissionClient) -> 
     assert ready.startswith("rosmc: watching mission events from revision"), ready
     added = rosmc(server, "add", "drone", "land").strip()
     fresh.get_mission()
-    fresh.add_marker(TaskMarker("Here", MarkerType.POSITION, Pose(1.0, 2.0)))
+    fresh.add_task_marker(TaskMarker("Here", MarkerType.POSITION, Pose(1.0, 2.0)))
     out, err = watcher.communicate(timeout=60.0)
     assert watcher.returncode == 0, err
     first, second = out.splitlines()
@@ -664,7 +664,7 @@ def test_diff_and_restore_a_past_moment(server: Server, fresh: MissionClient) ->
     planned = mission_to_json(fresh.get_mission())
     fresh.edit_skill(ids["cover"], {"altitude": 4.5})
     fresh.delete_skills([ids["land"]])
-    fresh.add_marker(TaskMarker("Late", MarkerType.POSITION, Pose(3.0, 4.0)))
+    fresh.add_task_marker(TaskMarker("Late", MarkerType.POSITION, Pose(3.0, 4.0)))
     added = fresh.add_skill("drone", "land").skill_id
     now = fresh.revision
     journal = str(journal_of(server))

@@ -258,7 +258,7 @@ def test_operator_builds_edits_runs_and_adapts_a_two_robot_mission(team: Any) ->
 
     # -- a task marker: bind by choosing it, rename by typing --------------------------------
     client = MissionClient(5.0)
-    client.add_marker(TaskMarker("rock", MarkerType.POSE, Pose(7.0, 8.0)))
+    client.add_task_marker(TaskMarker("rock", MarkerType.POSE, Pose(7.0, 8.0)))
     picker = wait_until(
         lambda: (
             w.parameters.pickers["target"].findText("rock") > 0 and w.parameters.pickers["target"]

@@ -254,7 +254,7 @@ def test_two_windows_stay_consistent_and_a_stale_edit_is_a_conflict(
     # (nothing runs the second window's event loop in between).
     client = MissionClient(5.0)
     try:
-        client.reorder("drone", [land, take_off], base_revision=before)
+        client.reorder_skills("drone", [land, take_off], base_revision=before)
     finally:
         client.close()
     assert second.w.view.revision == before
