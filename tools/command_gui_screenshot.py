@@ -257,8 +257,8 @@ def stage(client: object, wait: Callable[..., None]) -> dict[str, str]:
     manipulator_last = add("manipulator_rover", "deposit_at_lander", label="bring it home").skill_id
     add("manipulator_rover", "return_to_lander", label="back to the lander")
     client.add_barrier([ids["film"], ids["partner"]])
-    client.set_robot_options("science_rover", LostLinkPolicy(LostLinkKind.HOLD, 30.0))
-    client.set_robot_options(
+    client.set_lost_link_policy("science_rover", LostLinkPolicy(LostLinkKind.HOLD, 30.0))
+    client.set_lost_link_policy(
         "drone", LostLinkPolicy(LostLinkKind.SAFE_SKILL, 20.0, "return_to_lander")
     )
     for agent, last in (

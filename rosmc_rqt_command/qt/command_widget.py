@@ -284,7 +284,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
 
     def _on_tasks_policy_chosen(self, agent: str, policy: LostLinkPolicy) -> None:
         what = f"set {agent}'s policy ({policy.describe()})"
-        self.dispatcher.call(lambda c: c.set_robot_options, what)(agent, policy)
+        self.dispatcher.call(lambda c: c.set_lost_link_policy, what)(agent, policy)
 
     def _on_tasks_reorder_requested(self, agent: str, order: list[str]) -> None:
         self.dispatcher.call(lambda c: c.reorder_skills, f"reorder {agent}'s task")(agent, order)

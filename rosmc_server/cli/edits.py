@@ -147,7 +147,7 @@ def control(ctx: Context) -> int:
     return ctx.emit_result(result, f"{ctx.args.command} sent to {', '.join(result.agents)}")
 
 
-def policy(ctx: Context) -> int:
+def lost_link_policy(ctx: Context) -> int:
     """Set a robot's lost-link policy."""
     args = ctx.args
     kind = LostLinkKind(args.kind)
@@ -161,7 +161,7 @@ def policy(ctx: Context) -> int:
         if bindings:
             raise InvalidRequest("safe-skill parameters cannot be bound to task markers")
     chosen = LostLinkPolicy(kind, args.after, args.skill, values, LostLinkTrigger(args.when))
-    result = ctx.client.set_robot_options(args.agent, chosen)
+    result = ctx.client.set_lost_link_policy(args.agent, chosen)
     return ctx.emit_result(result, f"{args.agent}: {chosen.describe()} (sent to the robot)")
 
 
@@ -252,7 +252,7 @@ COMMANDS: dict[str, Callable[[Context], int]] = {
     "pause": control,
     "resume": control,
     "stop": control,
-    "policy": policy,
+    "lost-link-policy": lost_link_policy,
     "retry": retry,
     "skip": skip,
     "marker": marker,

@@ -209,7 +209,9 @@ def _add_execution(command: _Command) -> None:
         control = command(name, summary)
         control.add_argument("agent", nargs="?", metavar="ROBOT")
     policy = command(
-        "policy", "set what a robot does when it stops hearing the ground station", POLICY_HELP
+        "lost-link-policy",
+        "set what a robot does when it stops hearing the ground station",
+        POLICY_HELP,
     )
     policy.add_argument("agent", metavar="ROBOT")
     policy.add_argument("kind", choices=[kind.value for kind in LostLinkKind], metavar="POLICY",

@@ -808,7 +808,7 @@ def test_lost_link_policy_hold_set_by_the_operator(rosmc: Start) -> None:
     robot_side = LinkEnd("r1", "ground", robot_names=True)  # hears r1 behind the emulator
     wait_until(robot_side.connected, 30.0, "r1's side of the link")
     with MissionClient(timeout=60.0) as client:
-        client.set_robot_options("r1", LostLinkPolicy(LostLinkKind.HOLD, after=1.0))
+        client.set_lost_link_policy("r1", LostLinkPolicy(LostLinkKind.HOLD, after=1.0))
     op.wait_mission(
         lambda m: "hold after 1 s" in op.agent_state("r1").policy, 30.0, "the policy to be in force"
     )
@@ -977,8 +977,8 @@ def test_commands_for_a_robot_out_of_contact_wait_and_arrive_once_in_order(rosmc
     assert answer.note.startswith("queued for r1: out of contact"), answer.note
     op.change("unsynchronize", agent="r1", from_id=drop)  # take the second one back
     with MissionClient(timeout=60.0) as client:
-        client.set_robot_options("r1", LostLinkPolicy(LostLinkKind.HOLD, after=30.0))
-        client.set_robot_options("r1", LostLinkPolicy(LostLinkKind.HOLD, after=45.0))
+        client.set_lost_link_policy("r1", LostLinkPolicy(LostLinkKind.HOLD, after=30.0))
+        client.set_lost_link_policy("r1", LostLinkPolicy(LostLinkKind.HOLD, after=45.0))
     state = op.mission()
     assert state.skill(keep).transfer is Transfer.UPLOADING, describe(state)
     assert state.skill(drop).is_editable, describe(state)

@@ -338,7 +338,7 @@ def test_out_of_coverage_the_robot_goes_on_and_a_wifi_box_brings_it_back(op: Ope
     c = op.client
     # With its library default it would drive back to its link once idle a minute
     # (test_lost_link_scenario.py); here it waits where its task ends.
-    c.set_robot_options(SCIENCE, LostLinkPolicy())
+    c.set_lost_link_policy(SCIENCE, LostLinkPolicy())
     # The last leg is slow: at a factor of 100 the emulator may apply a blackout a tenth of a
     # wall second late (its blackout and relay callbacks are separate threads), so the skill
     # the server must not hear of ends well after the robot left coverage.

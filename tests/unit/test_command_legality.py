@@ -195,7 +195,7 @@ def test_the_lost_link_policy_is_chosen_among_the_robots_skills(gui: Gui) -> Non
     QTest.mouseClick(column.policy_button, Qt.LeftButton)
     assert offered == [["move", "noop", "scan", "wait"]]
     [request] = gui.backend.requests
-    assert request.operation == "set_robot_options"
+    assert request.operation == "set_lost_link_policy"
     assert request.args == ("alpha", LostLinkPolicy(LostLinkKind.SAFE_SKILL, 45.0, "wait"))
     assert "run wait after 45 s" in request.what
     column.ask_policy = lambda *_: None  # the operator cancels

@@ -242,7 +242,7 @@ class MissionClient(ClientBase):
         raise_for(response, response.revision)
         return ControlSent(response.revision, tuple(response.agents), response.note)
 
-    def set_robot_options(self, agent: str, policy: LostLinkPolicy) -> Result:
+    def set_lost_link_policy(self, agent: str, policy: LostLinkPolicy) -> Result:
         """Set ``agent``'s lost-link policy (what it does when it stops hearing the ground).
 
         The safe skill's parameters are checked against the library here and on the
@@ -255,7 +255,7 @@ class MissionClient(ClientBase):
             self._parameters(agent, policy.skill, policy.params, {}) if policy.skill else []
         )
         response = self._caller.call(
-            "set_robot_options", agent=agent, **policy_to_request(policy, parameters)
+            "set_lost_link_policy", agent=agent, **policy_to_request(policy, parameters)
         )
         raise_for(response, response.revision)
         return Result(response.revision)
