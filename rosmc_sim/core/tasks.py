@@ -1,6 +1,6 @@
 """What the simulated robots can do: one task per skill, stepped with the simulation.
 
-A *robot task* here is the simulated controllers' run of one skill (``rosmc/RobotTask``
+A *robot task* here is the simulated controllers' run of one skill (``rosmc/SkillRun``
 asks for it), not the mission's *task* of an agent (its skills in order).
 
 Each task is a generator that sets the robot moving or working and yields
