@@ -27,7 +27,7 @@ from rosmc_server.conversions import param_to_msg
 from rosmc_server.core import ParamType, Value
 from rosmc_server.executor.core import Outcome, SkillBehavior, SkillContext, SkillType
 
-from ..core.skills_registry import TASKS
+from ..core.skills_registry import SIM_SKILLS
 from .robot_pose import pose_source
 from .topics import skill_run_status_topic, skill_run_topic
 
@@ -158,8 +158,8 @@ def _skills(agent: str, kind: str) -> list[SkillType]:
     controller = RobotController(agent)
     return [
         SkillType(name, functools.partial(ForwardedSkill, controller, name), _PARAMS[name])
-        for name, task in TASKS.items()
-        if kind in task.kinds
+        for name, sim_skill in SIM_SKILLS.items()
+        if kind in sim_skill.kinds
     ]
 
 

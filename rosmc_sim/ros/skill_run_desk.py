@@ -16,8 +16,8 @@ from enum import IntEnum
 from typing import Any
 
 from ..core.sim import Robot, Simulation
-from ..core.skills_registry import task_for
-from ..core.tasks import TaskFailed, TaskRunner
+from ..core.skill_runs import SkillFailed, SkillRunner
+from ..core.skills_registry import sim_skill_for
 
 HISTORY = 64  # finished runs remembered per robot, to answer retransmitted requests
 
@@ -51,7 +51,7 @@ class SkillRunDesk:
     def __init__(self, sim: Simulation, robot: Robot) -> None:
         self.sim = sim
         self.robot = robot
-        self._runner: TaskRunner | None = None
+        self._runner: SkillRunner | None = None
         self._current: RunStatus | None = None
         self._finished: OrderedDict[str, RunStatus] = OrderedDict()
 
@@ -78,10 +78,10 @@ class SkillRunDesk:
             return [known]
         out = self._preempt(run_id)
         try:
-            kind = task_for(skill, self.robot.kind)
-        except TaskFailed as reason:
+            kind = sim_skill_for(skill, self.robot.kind)
+        except SkillFailed as reason:
             return [*out, self._finish(run_id, RunState.FAILED, str(reason))]
-        self._runner = TaskRunner(self.sim, self.robot, kind.function, params, kind.needs_power)
+        self._runner = SkillRunner(self.sim, self.robot, kind.function, params, kind.needs_power)
         self._current = RunStatus(run_id, RunState.RUNNING, f"starting {skill}")
         return [*out, self._current]
 
