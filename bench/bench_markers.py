@@ -196,7 +196,7 @@ def run(args: argparse.Namespace, work: Path) -> int:
     client.get_mission()
     names = []
     for i in range(MARKERS):
-        name = client.add_marker(
+        name = client.add_task_marker(
             TaskMarker(f"m{i:03d}", MarkerType.POSE, Pose(i % 20, i // 20))
         ).name
         names.append(name)
@@ -212,7 +212,7 @@ def run(args: argparse.Namespace, work: Path) -> int:
     for k in range(args.samples):
         name = names[k % MARKERS]
         before = len(watcher.updates.get(f"task/{name}", []))
-        result = client.move_marker(name, Pose(k % 20 + 0.5, k // 20 % 10, yaw=0.1 * k))
+        result = client.move_task_marker(name, Pose(k % 20 + 0.5, k // 20 % 10, yaw=0.1 * k))
         arrived = watcher.wait_update(f"task/{name}", before + 1)
         latencies.append(arrived - watcher.event_time(result.revision))
         seen[name] = before + 1
@@ -224,7 +224,7 @@ def run(args: argparse.Namespace, work: Path) -> int:
     for k in range(args.burst):
         name = names[(k * 7) % MARKERS]
         before = len(watcher.updates.get(f"task/{name}", []))
-        result = client.move_marker(name, Pose(k % 20 + 0.25, (k // 20) % 10, yaw=0.2 * k))
+        result = client.move_task_marker(name, Pose(k % 20 + 0.25, (k // 20) % 10, yaw=0.2 * k))
         burst.append((name, result.revision, before))
         last = (name, before)
     assert last is not None

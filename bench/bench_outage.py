@@ -98,7 +98,7 @@ def operate(op: Operator, agent: str, skills: Sequence[str]) -> int:
         lambda: op.change("unsynchronize", agent=agent, from_id=skills[1]),
         *(
             lambda after=after: op.call(
-                "set_robot_options",
+                "set_lost_link_policy",
                 agent=agent,
                 **policy_to_request(LostLinkPolicy(LostLinkKind.HOLD, after=after), []),
             )

@@ -9,7 +9,7 @@ around the obstacles), and measures over a window of wall time:
   subscribes to, as every ``/use_sim_time`` node does);
 * ``cpu_s_per_robot_per_sim_s``: the node's CPU seconds (user + system, from
   ``/proc/<pid>/stat``) per robot per sim second;
-* ``tasks_finished``: tasks that ended in the window (they keep being replaced).
+* ``tasks_finished``: skill runs that ended in the window (they keep being replaced).
 
 Runs at ``~real_time_factor`` 0 (as fast as possible) and, to check pacing, at the
 targets (20 with 3 robots, 2 with 20), with ``/use_sim_time`` true as in the launch
@@ -51,7 +51,7 @@ from rosgraph_msgs.msg import Clock
 from rosmc_server.conversions import param_to_msg
 from rosmc_server.core import Pose
 from rosmc_sim.core.scenario import Scenario, load_scenario
-from rosmc_sim.ros.topics import task_status_topic, task_topic
+from rosmc_sim.ros.topics import skill_run_status_topic, skill_run_topic
 
 REPO = Path(__file__).resolve().parents[1]
 SCENARIOS = {
@@ -93,7 +93,7 @@ def cpu_seconds(pid: int) -> float:
 
 
 class Driver:
-    """Keeps every robot of a scenario busy with tasks and watches ``/clock``."""
+    """Keeps every robot of a scenario busy with skill runs and watches ``/clock``."""
 
     def __init__(self, scenario: Scenario) -> None:
         self.sim_time = 0.0
@@ -106,11 +106,11 @@ class Driver:
         self._robots = {r.name: r for r in scenario.robots}
         self._legs = dict.fromkeys(self._robots, 0)
         for name in self._robots:
-            self._pubs[name] = rospy.Publisher(task_topic(name), wire.RobotTask, queue_size=10)
+            self._pubs[name] = rospy.Publisher(skill_run_topic(name), wire.SkillRun, queue_size=10)
             self._handles.append(
                 rospy.Subscriber(
-                    task_status_topic(name),
-                    wire.RobotTaskStatus,
+                    skill_run_status_topic(name),
+                    wire.SkillRunStatus,
                     self._on_status,
                     callback_args=name,
                 )
@@ -120,12 +120,12 @@ class Driver:
         self.sim_time = msg.clock.to_sec()
 
     def start(self) -> None:
-        """Send every robot its first task."""
+        """Send every robot its first skill run."""
         for name in self._robots:
             self._next(name)
 
     def _on_status(self, msg: Any, robot: str) -> None:
-        if msg.state in (msg.SUCCEEDED, msg.FAILED) and msg.task_id == self._current(robot):
+        if msg.state in (msg.SUCCEEDED, msg.FAILED) and msg.run_id == self._current(robot):
             with self._lock:
                 self.finished += 1
                 self.failed += msg.state == msg.FAILED
@@ -146,10 +146,10 @@ class Driver:
             x, y = CORNERS[index % len(CORNERS)] if leg % 2 == 0 else (spec.x, spec.y)
             skill, params = "navigate_to", {"target": Pose(x, y)}
         self._pubs[robot].publish(
-            wire.RobotTask(
+            wire.SkillRun(
                 robot=robot,
-                task_id=self._current(robot),
-                action=wire.RobotTask.START,
+                run_id=self._current(robot),
+                action=wire.SkillRun.START,
                 skill=skill,
                 parameters=[param_to_msg(k, v) for k, v in params.items()],
             )
@@ -198,7 +198,7 @@ def measure(
         deadline = time.monotonic() + 20.0
         while driver.sim_time == 0.0 and time.monotonic() < deadline:
             time.sleep(0.05)
-        time.sleep(0.5)  # let the subscriptions connect before the first tasks go out
+        time.sleep(0.5)  # let the subscriptions connect before the first skill runs go out
         driver.start()
         time.sleep(WARM_UP)
         wall0, sim0, cpu0 = time.monotonic(), driver.sim_time, cpu_seconds(node.pid)

@@ -166,7 +166,7 @@ class _Live:
         pending = self.widget.backend
         self.bridge = bridge = RosBridge(self.prefix)
         if self.report is not None:
-            self.report.follow(bridge.updated, self.widget.schedule)
+            self.report.follow(bridge.updated, self.widget.tasks)
         self.widget.set_backend(bridge)
         follow(self.widget, bridge)
         if isinstance(pending, PendingBackend):

@@ -1,4 +1,4 @@
-"""Scripted mission run through the mission core, printing each robot's schedule.
+"""Scripted mission run through the mission core, printing each robot's task.
 
 This is the main job until the simulated team exists: it plans the paper's
 sample-return mission, synchronizes part of it, plays the robots' reports,
@@ -16,14 +16,14 @@ from pathlib import Path
 
 from .core import Mission, MissionEvent, Pose, SkillStatus, TaskMarker, load_library
 from .core.params import MarkerType
-from .text import format_schedule
+from .text import format_tasks
 
 LIBRARY = Path(__file__).resolve().parent / "config" / "mars_team.yaml"
 
 
-def print_schedule(mission: Mission, title: str) -> None:
+def print_tasks(mission: Mission, title: str) -> None:
     """Print every robot's task: synchronized section, a rule, then the blueprint."""
-    print("\n" + format_schedule(mission.state, title))
+    print("\n" + format_tasks(mission.state, title))
 
 
 def run(out_events: list[MissionEvent]) -> Mission:
@@ -66,7 +66,7 @@ def run(out_events: list[MissionEvent]) -> Mission:
     added(mission.add_skill("manipulator_rover", "pick_stone", bindings={"position": "RSS A"}))
     added(mission.add_skill("manipulator_rover", "deposit_at_lander"))
     do(mission.add_barrier([ident_sci, ident_man]))
-    print_schedule(mission, "Blueprint ready")
+    print_tasks(mission, "Blueprint ready")
 
     print("\nSynchronizing the first skills and letting the robots work")
     for agent, upto in (("drone", None), ("science_rover", go_sci), ("manipulator_rover", place)):
@@ -77,7 +77,7 @@ def run(out_events: list[MissionEvent]) -> Mission:
         do(mission.report_status(skill_id, SkillStatus.RUNNING))
         do(mission.report_status(skill_id, SkillStatus.SUCCESS))
     do(mission.report_status(place, SkillStatus.RUNNING))
-    print_schedule(mission, "Robots at work")
+    print_tasks(mission, "Robots at work")
 
     print("\nAdapting: the Wi-Fi spot is not traversable; pull it back, move it, re-sync")
     do(mission.stop("manipulator_rover"))
@@ -90,7 +90,7 @@ def run(out_events: list[MissionEvent]) -> Mission:
     do(mission.synchronize("science_rover"))
     pending = [s.id for s in mission.state.task("science_rover") if s.transfer]
     do(mission.confirm_synchronized("science_rover", pending))
-    print_schedule(mission, "Adapted mission, fully synchronized")
+    print_tasks(mission, "Adapted mission, fully synchronized")
     return mission
 
 
@@ -105,7 +105,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="rosmc_demo",
         description="Plan, synchronize and adapt the sample-return mission in the mission "
-        "core, printing each robot's schedule.",
+        "core, printing each robot's task.",
     )
     parser.parse_args([a for a in (argv if argv is not None else sys.argv[1:]) if ":=" not in a])
     events: list[MissionEvent] = []

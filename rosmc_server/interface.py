@@ -58,7 +58,7 @@ SERVICES = {
     "synchronize_team": "SynchronizeTeam",
     "unsynchronize": "Unsynchronize",
     "control": "Control",
-    "set_robot_options": "SetRobotOptions",
+    "set_lost_link_policy": "SetLostLinkPolicy",
     "retry_skill": "RetrySkill",
     "skip_skill": "SkipSkill",
     "add_barrier": "AddBarrier",

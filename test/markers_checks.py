@@ -57,7 +57,7 @@ class MarkerNodeChecks(unittest.TestCase):
             self.names.clear()
         with MissionClient(timeout=30.0) as client:
             client.get_mission()
-            added = client.add_marker(
+            added = client.add_task_marker(
                 TaskMarker("rostest_flag", MarkerType.POSITION, Pose(3.0, -2.0, 0.0))
             )
         wait_for("the new task marker", lambda: self._seen(task_name(added.name)))

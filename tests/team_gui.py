@@ -26,13 +26,13 @@ def settle(widget: CommandWidget) -> None:
 
 
 def on_screen(widget: CommandWidget) -> list[str]:
-    """Robots whose whole column is inside the schedule's viewport now."""
-    schedule = widget.schedule
-    viewport = schedule.viewport().rect()
+    """Robots whose whole column is inside the task panel's viewport now."""
+    panel = widget.tasks
+    viewport = panel.viewport().rect()
     shown = []
-    for agent, column in schedule.columns.items():
+    for agent, column in panel.columns.items():
         if column.isVisible():
-            top_left = column.mapTo(schedule.viewport(), QPoint(0, 0))
+            top_left = column.mapTo(panel.viewport(), QPoint(0, 0))
             if viewport.contains(QRect(top_left, column.size())):
                 shown.append(agent)
     return shown
@@ -40,7 +40,7 @@ def on_screen(widget: CommandWidget) -> list[str]:
 
 def step_right(widget: CommandWidget) -> None:
     """Click the scroll bar's right arrow, as with the mouse."""
-    bar = widget.schedule.horizontalScrollBar()
+    bar = widget.tasks.horizontalScrollBar()
     arrow = bar.height()  # the arrow buttons are square
     arrow_centre = QPoint(bar.width() - arrow // 2, arrow // 2)
     QTest.mouseClick(bar, Qt.LeftButton, Qt.NoModifier, arrow_centre)
@@ -54,7 +54,7 @@ def team(widget: CommandWidget) -> TeamBar:
 
 
 def click(widget: CommandWidget, name: str) -> None:
-    """Click the widget named ``name`` and let the schedule settle."""
+    """Click the widget named ``name`` and let the task panel settle."""
     target = widget.findChild(object, name)
     assert target is not None, name
     QTest.mouseClick(target, Qt.LeftButton)
@@ -76,5 +76,5 @@ def tick(widget: CommandWidget, agent: str) -> None:
 
 def columns(widget: CommandWidget) -> dict[str, AgentColumn]:
     """The robots' columns, in order."""
-    cols: dict[str, AgentColumn] = widget.schedule.columns
+    cols: dict[str, AgentColumn] = widget.tasks.columns
     return cols

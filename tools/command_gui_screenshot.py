@@ -163,7 +163,7 @@ def run(
         )
         if args.out_of_contact:
             silenced = cut_off(client, widget, args.out_of_contact, wait)
-        widget.schedule.select_ids([ids["identify"]])
+        widget.tasks.select_ids([ids["identify"]])
         status = 0
     except TimeoutError as error:
         print(f"command_gui_screenshot: {error}", file=sys.stderr)
@@ -257,8 +257,8 @@ def stage(client: object, wait: Callable[..., None]) -> dict[str, str]:
     manipulator_last = add("manipulator_rover", "deposit_at_lander", label="bring it home").skill_id
     add("manipulator_rover", "return_to_lander", label="back to the lander")
     client.add_barrier([ids["film"], ids["partner"]])
-    client.set_robot_options("science_rover", LostLinkPolicy(LostLinkKind.HOLD, 30.0))
-    client.set_robot_options(
+    client.set_lost_link_policy("science_rover", LostLinkPolicy(LostLinkKind.HOLD, 30.0))
+    client.set_lost_link_policy(
         "drone", LostLinkPolicy(LostLinkKind.SAFE_SKILL, 20.0, "return_to_lander")
     )
     for agent, last in (
@@ -273,7 +273,7 @@ def stage(client: object, wait: Callable[..., None]) -> dict[str, str]:
             and not client.get_mission().skill(i).is_editable
             for i in (drone_last, science_last, manipulator_last)
         ),
-        "the robots confirm their plans",
+        "the robots confirm their tasks",
         30,
     )
     return ids

@@ -35,4 +35,4 @@ def send_waiting_work(client: object, agent: str) -> None:
     from rosmc_server.core import LostLinkKind, LostLinkPolicy
 
     client.synchronize(agent)  # type: ignore[attr-defined]
-    client.set_robot_options(agent, LostLinkPolicy(LostLinkKind.HOLD, 60.0))  # type: ignore[attr-defined]
+    client.set_lost_link_policy(agent, LostLinkPolicy(LostLinkKind.HOLD, 60.0))  # type: ignore[attr-defined]

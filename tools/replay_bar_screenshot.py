@@ -103,7 +103,7 @@ def run(args: argparse.Namespace, display: str, size: tuple[int, int]) -> int:
         wait(lambda: widget.view.revision == revision, f"the mission at r{revision}")
         wait(lambda: widget.view.statuses, "the robots reported")
         agent = next(a for a, v in widget.view.agents.items() if v.skills)
-        widget.schedule.select_ids([widget.view.view(agent).skills[0].id])
+        widget.tasks.select_ids([widget.view.view(agent).skills[0].id])
         status = 0
     except (TimeoutError, StopIteration) as error:
         print(f"replay_bar_screenshot: {error!r}", file=sys.stderr)

@@ -74,7 +74,7 @@ def take(args: argparse.Namespace) -> int:
         client = MissionClient(timeout=30.0)
         stack.callback(client.close)
         client.get_mission()
-        client.set_robot_options(ROBOT, LostLinkPolicy())  # it stays out there
+        client.set_lost_link_policy(ROBOT, LostLinkPolicy())  # it stays out there
         x, y = OUT_THERE
         client.add_skill(ROBOT, "navigate_to", {"target": {"x": x, "y": y}, "speed": 1.0})
         client.synchronize(ROBOT)

@@ -121,13 +121,13 @@ def plan_mission(client: object) -> dict[str, str]:
     assert isinstance(client, MissionClient)
     client.get_mission()
     area = tuple(Pose(x, y) for x, y in SURVEY)
-    client.add_marker(TaskMarker("Survey area", MarkerType.AREA, Pose(), area))
+    client.add_task_marker(TaskMarker("Survey area", MarkerType.AREA, Pose(), area))
     x, y, yaw = OUTCROP_VIEW
-    client.add_marker(TaskMarker("Outcrop view", MarkerType.POSE, Pose(x, y, yaw=yaw)))
-    client.add_marker(TaskMarker("Sample site", MarkerType.POSITION, Pose(*SAMPLE_SITE)))
+    client.add_task_marker(TaskMarker("Outcrop view", MarkerType.POSE, Pose(x, y, yaw=yaw)))
+    client.add_task_marker(TaskMarker("Sample site", MarkerType.POSITION, Pose(*SAMPLE_SITE)))
     x, y, yaw = WIFI_SPOT
-    client.add_marker(TaskMarker("Wi-Fi spot", MarkerType.POSE, Pose(x, y, yaw=yaw)))
-    client.add_marker(TaskMarker("Stone B", MarkerType.POSITION, Pose(*STONE_B)))
+    client.add_task_marker(TaskMarker("Wi-Fi spot", MarkerType.POSE, Pose(x, y, yaw=yaw)))
+    client.add_task_marker(TaskMarker("Stone B", MarkerType.POSITION, Pose(*STONE_B)))
     ids = {}
     client.add_skill("drone", "take_off", {"altitude": 6.0})
     ids["survey"] = client.add_skill(

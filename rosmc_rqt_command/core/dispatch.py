@@ -1,7 +1,7 @@
 """What each operator action asks of the mission server, as :class:`~.requests.Request` values.
 
 :class:`Dispatcher` turns a skill action on the selection, or a robot action, into the
-request(s) that carry it out, in words the message area can repeat ("send alpha's plan
+request(s) that carry it out, in words the message area can repeat ("send alpha's task
 up to 'go to A'"). It checks legality first (a shortcut may fire while its button is
 disabled) and asks before sending a barrier member whose partners stay behind.
 """
@@ -63,7 +63,7 @@ class Dispatcher:
         self, pick: Callable[[MissionClient], Callable[P, object]], what: str
     ) -> Callable[P, None]:
         """A sender of one call of the client method ``pick`` chooses, against the revision
-        shown: ``call(lambda c: c.retry, "retry 'go'")(skill_id)``."""
+        shown: ``call(lambda c: c.retry_skill, "retry 'go'")(skill_id)``."""
         make = ask(pick, what, self._view.revision)
 
         def send(*args: P.args, **kwargs: P.kwargs) -> None:
@@ -95,7 +95,7 @@ class Dispatcher:
     def _move(self, kind: Action, selected: Sequence[SkillInstance], names: str) -> None:
         agent = selected[0].agent
         order = moved([s.id for s in self._view.view(agent).editable], selected, kind)
-        self.call(lambda c: c.reorder, f"move {names}")(agent, order)
+        self.call(lambda c: c.reorder_skills, f"move {names}")(agent, order)
 
     def _sync(self, _: Action, selected: Sequence[SkillInstance], names: str) -> None:
         view = self._view
@@ -106,7 +106,7 @@ class Dispatcher:
         last = max(view.position(s) for s in selected)
         sending = [s for s in view.view(agent).editable if view.position(s) <= last]
         if self._barriers_ok(sending):
-            what = f"send {agent}'s plan up to {names}"
+            what = f"send {agent}'s task up to {names}"
             self.call(lambda c: c.synchronize, what)(agent, sending[-1].id)
 
     def _unsync(self, _: Action, selected: Sequence[SkillInstance], names: str) -> None:
@@ -116,9 +116,9 @@ class Dispatcher:
 
     def _resolve(self, kind: Action, selected: Sequence[SkillInstance], names: str) -> None:
         if kind is Action.RETRY:
-            self.call(lambda c: c.retry, f"retry {names}")(selected[0].id)
+            self.call(lambda c: c.retry_skill, f"retry {names}")(selected[0].id)
         else:
-            self.call(lambda c: c.skip, f"skip {names}")(selected[0].id)
+            self.call(lambda c: c.skip_skill, f"skip {names}")(selected[0].id)
 
     def _barrier(self, _: Action, selected: Sequence[SkillInstance], names: str) -> None:
         self.call(lambda c: c.add_barrier, f"start {names} together")([s.id for s in selected])
@@ -138,21 +138,21 @@ class Dispatcher:
             self.send_team(whole_team(self._view))
         elif kind is RobotAction.SYNC_ALL and agent is not None:
             if self._barriers_ok(self._view.view(agent).editable):
-                self.call(lambda c: c.synchronize, f"send {agent}'s whole plan")(agent, None)
+                self.call(lambda c: c.synchronize, f"send {agent}'s whole task")(agent, None)
         elif kind is RobotAction.UNSYNC_ALL and agent is not None:
-            self.call(lambda c: c.unsynchronize, f"take back {agent}'s plan")(agent, None)
+            self.call(lambda c: c.unsynchronize, f"take back {agent}'s task")(agent, None)
         elif kind in CONTROLS:
             self.call(lambda c: c.control, f"{kind.value} {who}")(CONTROLS[kind], agent)
 
     def send_team(self, uploads: dict[str, str | None]) -> None:
-        """Send several robots' plans in one change, after one question listing every warning."""
+        """Send several robots' tasks in one change, after one question listing every warning."""
         send = plan_team_send(self._view, uploads)
         if send is None:
             return
         text, warnings = team_question(self._view, send)
         if self.confirm_team(text, warnings):
             robots = ", ".join(send.sending)
-            what = f"send the plans of {robots}"
+            what = f"send the tasks of {robots}"
             self.call(lambda c: c.synchronize_team, what)(dict(send.uploads))
 
     def _barriers_ok(self, sending: Sequence[SkillInstance]) -> bool:

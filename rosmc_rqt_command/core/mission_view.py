@@ -1,4 +1,4 @@
-"""The GUI thread's picture of the mission: the latest :class:`AgentView` of every robot.
+"""The GUI thread's picture of the mission: the latest :class:`TaskView` of every robot.
 
 :class:`MissionView` takes :class:`~.view_state.ViewUpdate` values in order (applying each
 update's skill deltas to its own task lists) and answers the read-only questions panels
@@ -19,10 +19,11 @@ from rosmc_server.core import (
     SkillStatus,
     TaskMarker,
 )
+from rosmc_server.core.legality import TaskView
 from rosmc_server.core.updates import SkillAdded, SkillChanged, SkillRemoved
 
 from . import presentation
-from .view_state import AgentView, ViewUpdate, apply_delta, barrier_tags, delta_agent
+from .view_state import ViewUpdate, apply_delta, barrier_tags, delta_agent
 
 
 class MissionView:
@@ -32,7 +33,7 @@ class MissionView:
         self.revision = -1
         self.library: Library | None = None
         self.library_name = ""
-        self.agents: dict[str, AgentView] = {}  # each over its task list in _tasks
+        self.agents: dict[str, TaskView] = {}  # each over its task list in _tasks
         self._tasks: dict[str, list[SkillInstance]] = {}
         self.barriers: tuple[Barrier, ...] = ()
         self.markers: dict[str, TaskMarker] = {}
@@ -79,7 +80,7 @@ class MissionView:
                 self._skills[delta.skill.id] = delta.skill
         for bounds in update.bounds:
             agent = bounds.agent
-            self.agents[agent] = AgentView(
+            self.agents[agent] = TaskView(
                 agent,
                 self._tasks.setdefault(agent, []),
                 bounds.synced_end,
@@ -107,9 +108,9 @@ class MissionView:
         tag = self._tags.get(skill_id)
         return 0 if tag is None else tag[0]
 
-    def view(self, agent: str) -> AgentView:
+    def view(self, agent: str) -> TaskView:
         """``agent``'s task (empty if unknown)."""
-        return self.agents.get(agent) or AgentView(agent)
+        return self.agents.get(agent) or TaskView(agent)
 
     def position(self, skill: SkillInstance) -> int:
         """The skill's index in its robot's task (-1 if it is not there)."""

@@ -1,6 +1,6 @@
-"""Which robots' columns the schedule shows: a filter by name and by how the robot is.
+"""Which robots' columns the task panel shows: a filter by name and by how the robot is.
 
-With a large team (20 robots) the operator narrows the schedule to the robots that need
+With a large team (20 robots) the operator narrows the task panel to the robots that need
 attention: those whose names match a text (``drone`` or ``rover_1, rover_2``), minus the
 robots unticked in the robot list, and optionally only the robots with an unresolved
 failure, with something waiting (at a barrier, or commands waiting for contact) or out of

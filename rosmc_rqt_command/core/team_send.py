@@ -1,4 +1,4 @@
-"""Sending several robots' plans in one step, and the one question asked before it.
+"""Sending several robots' tasks in one step, and the one question asked before it.
 
 A barrier plan is only safe once every robot in it holds its part: sending the robots one
 by one asked one question per robot about partners not sent yet. :func:`plan_team_send`
@@ -40,7 +40,7 @@ class TeamSend:
         out = []
         for agent, skills in self.sending.items():
             last = skills[-1]
-            how = "its whole plan" if self.uploads[agent] is None else "up to"
+            how = "its whole task" if self.uploads[agent] is None else "up to"
             out.append(f"{agent}: {len(skills)} skill(s), {how} '{last.label or last.skill}'")
         return out
 

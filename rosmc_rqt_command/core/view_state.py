@@ -31,7 +31,6 @@ from rosmc_server.core.updates import (
     SkillsMoved,
 )
 
-AgentView = TaskView  # one robot's task as the panels show it (the rules read the same)
 SkillDelta = SkillAdded | SkillChanged | SkillRemoved | SkillsMoved
 
 
@@ -68,7 +67,7 @@ class ViewUpdate:
     revision: int
     reset: bool = False
     library: str = ""
-    agents: tuple[AgentView, ...] = ()
+    agents: tuple[TaskView, ...] = ()
     deltas: tuple[SkillDelta, ...] = ()
     bounds: tuple[TaskBounds, ...] = ()
     barriers: tuple[Barrier, ...] | None = None
@@ -97,7 +96,7 @@ def view_update(update: MirrorUpdate, state: MissionState | None) -> ViewUpdate:
             update.revision,
             reset=True,
             library=state.library,
-            agents=tuple(AgentView.of(state, agent) for agent in state.agents),
+            agents=tuple(TaskView.of(state, agent) for agent in state.agents),
             barriers=tuple(state.barriers),
             markers=tuple(state.markers),
             statuses=statuses,

@@ -46,7 +46,7 @@ ALL_ROBOT_ACTIONS: dict[RobotAction, tuple[str, str, str]] = {
     RobotAction.SYNC_ALL: (
         "Send all robots",
         "F4",
-        "Synchronize every robot's whole plan in one step (one question, all or nothing)",
+        "Synchronize every robot's whole task in one step (one question, all or nothing)",
     ),
     RobotAction.START: ("Start all", "F6", "Start every robot"),
     RobotAction.PAUSE: ("Pause all", "F7", "Pause every robot"),

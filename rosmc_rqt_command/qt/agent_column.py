@@ -1,4 +1,4 @@
-"""One robot's column of the schedule: header, synchronized section, blueprint, buttons.
+"""One robot's column of the task panel: header, synchronized section, blueprint, buttons.
 
 The header names the robot and says how it is (link, seconds since heard, battery, Wi-Fi,
 lost-link policy). Above the line: what is on the robot; below: the blueprint, which
@@ -28,19 +28,20 @@ from python_qt_binding.QtWidgets import (
 )
 
 from rosmc_server.core import AgentStatus, LostLinkPolicy, SkillStatus
+from rosmc_server.core.legality import TaskView
 from rosmc_server.core.updates import SkillAdded, SkillChanged, SkillRemoved
 
 from ..core import presentation
 from ..core.legality import RobotAction
 from ..core.mission_view import MissionView
-from ..core.view_state import AgentView, SkillDelta
+from ..core.view_state import SkillDelta
 from .coverage_warning import coverage_warning_label, show_coverage_warning
 from .policy_dialog import ask_policy
 from .row_delegate import RowDelegate
-from .schedule_model import NUMBER, PARAMS, SKILL, STATUS, TAG, SectionModel
+from .task_model import NUMBER, PARAMS, SKILL, STATUS, TAG, TaskModel
 
 ROW_HEIGHT = 22
-# A column is at least this wide (more robots than fit: the schedule scrolls sideways)
+# A column is at least this wide (more robots than fit: the task panel scrolls sideways)
 # and at most that wide (few robots: the columns share the width).
 COLUMN_WIDTH = 330
 MAX_COLUMN_WIDTH = 460
@@ -65,7 +66,7 @@ class SectionTable(QTableView):  # type: ignore[misc]
     empty_clicked = Signal()
     plain_clicked = Signal()  # a row clicked without Ctrl or Shift
 
-    def __init__(self, model: SectionModel, parent: QWidget | None = None) -> None:
+    def __init__(self, model: TaskModel, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.last_modifiers = Qt.NoModifier  # of the last click or key press here
         self.setModel(model)
@@ -96,9 +97,9 @@ class SectionTable(QTableView):  # type: ignore[misc]
             self.setDefaultDropAction(Qt.MoveAction)
 
     @property
-    def section(self) -> SectionModel:
+    def section(self) -> TaskModel:
         """The model shown."""
-        model: SectionModel = self.model()
+        model: TaskModel = self.model()
         return model
 
     def set_compact(self, compact: bool) -> None:
@@ -131,7 +132,7 @@ class SectionTable(QTableView):  # type: ignore[misc]
 
 
 class AgentColumn(QFrame):  # type: ignore[misc]
-    """The schedule column of one robot."""
+    """The task column of one robot."""
 
     robot_action = Signal(str, object)  # agent, RobotAction
     add_requested = Signal(str, str)  # agent, skill name
@@ -147,8 +148,8 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         self.setMinimumWidth(COLUMN_WIDTH)
         self.setMaximumWidth(MAX_COLUMN_WIDTH)
         self.setSizePolicy(QSizePolicy.Expanding, QSizePolicy.Preferred)
-        self.synced_model = SectionModel(agent, False, view, self)
-        self.blueprint_model = SectionModel(agent, True, view, self)
+        self.synced_model = TaskModel(agent, False, view, self)
+        self.blueprint_model = TaskModel(agent, True, view, self)
         self.synced_table = SectionTable(self.synced_model, self)
         self.blueprint_table = SectionTable(self.blueprint_model, self)
         self.synced_table.setObjectName(f"synced_{agent}")
@@ -251,12 +252,12 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         self.blueprint_caption.setText(BLUEPRINT_CAPTION[compact])
         self._bar.setSpacing(1 if compact else -1)  # -1: the style's spacing
 
-    def show_task(self, task: AgentView) -> None:
+    def show_task(self, task: TaskView) -> None:
         """Show the robot's task (only rows that changed are touched)."""
         self.synced_model.set_rows(task.synced, 0)
         self.blueprint_model.set_rows(task.blueprint, task.synced_end)
 
-    def apply(self, task: AgentView, deltas: Sequence[SkillDelta]) -> None:
+    def apply(self, task: TaskView, deltas: Sequence[SkillDelta]) -> None:
         """Show ``task`` after ``deltas``: row by row where the sections keep their bounds
         (a status report, a blueprint edit), else by comparing rows (:meth:`show_task`)."""
         synced_end = len(self.synced_model.rows)
@@ -303,9 +304,7 @@ class AgentColumn(QFrame):  # type: ignore[misc]
             self.policy_chosen.emit(self.agent, policy)
 
 
-def _row_edit(
-    delta: SkillDelta, synced_end: int, synced: SectionModel, blueprint: SectionModel
-) -> bool:
+def _row_edit(delta: SkillDelta, synced_end: int, synced: TaskModel, blueprint: TaskModel) -> bool:
     """Make ``delta`` as a row edit if it keeps the sections' bounds; False if it cannot."""
     if isinstance(delta, SkillChanged):
         if (delta.old.status is SkillStatus.IDLE) != (delta.new.status is SkillStatus.IDLE):

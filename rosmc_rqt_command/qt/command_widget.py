@@ -1,4 +1,4 @@
-"""The command GUI: schedule, parameter and control panels, warnings, messages and menus.
+"""The command GUI: task, parameter and control panels, warnings, messages and menus.
 
 A plain Qt widget (the rqt plugin and the standalone window both host it). It knows the
 outside world only as a :class:`~.requests.Backend`: it receives mission updates, the
@@ -32,7 +32,7 @@ from .file_menu import FileController
 from .message_area import MessageArea
 from .parameter_panel import ParameterPanel
 from .repaints import Repaints
-from .schedule_widget import ScheduleWidget
+from .task_widget import TaskWidget
 from .team_bar import TeamBar
 from .team_dialog import ask_send_anyway, ask_team_send
 from .undo_history import UndoHistory
@@ -42,7 +42,7 @@ from .window_layout import Panels, lay_out
 class CommandWidget(QWidget):  # type: ignore[misc]
     """The operator's command window: a composition of small parts.
 
-    The panels (schedule, team bar, parameters, control, messages), the file menu's
+    The panels (tasks, team bar, parameters, control, messages), the file menu's
     controller, the undo history, the :class:`~..core.dispatch.Dispatcher` (actions to
     requests), :class:`~.enabling.Enabling` (what is enabled) and
     :class:`~.repaints.Repaints` (timed repaints and warnings); :func:`~.window_layout.lay_out`
@@ -56,14 +56,14 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.backend = backend
         self.view = view = MissionView()
         self.actions_ = CommandActions(self)
-        self.schedule = ScheduleWidget(view)
+        self.tasks = TaskWidget(view)
         self.parameters = ParameterPanel(view)
         self.control = ControlPanel(self.actions_)
         self.messages = MessageArea()
         self.files = FileController(self, self.actions_, view, self.messages, self.send)
         self.history = UndoHistory(self, view, self.send)
-        self.team = TeamBar(self.schedule, view)
-        self.enabling = Enabling(view, self.actions_, self.schedule, self.history)
+        self.team = TeamBar(self.tasks, view)
+        self.enabling = Enabling(view, self.actions_, self.tasks, self.history)
         self.repaints = Repaints(view, self.messages, self._show_statuses)
         self.dispatcher = Dispatcher(
             view, self.send, self._confirm, self.enabling.legal_for_all, self._confirm_team
@@ -71,7 +71,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         panels = Panels(
             self.actions_,
             self.history,
-            self.schedule,
+            self.tasks,
             self.team,
             self.parameters,
             self.control,
@@ -88,13 +88,13 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.set_backend(backend)
 
     def _connect(self) -> None:
-        self.schedule.selection_changed.connect(self._on_schedule_selection_changed)
-        self.schedule.context_menu_requested.connect(self._on_schedule_context_menu_requested)
-        self.schedule.robot_action.connect(self._on_schedule_robot_action)
-        self.schedule.add_requested.connect(self._on_schedule_add_requested)
-        self.schedule.policy_chosen.connect(self._on_schedule_policy_chosen)
-        self.schedule.reorder_requested.connect(self._on_schedule_reorder_requested)
-        self.schedule.columns_added.connect(self._on_schedule_columns_added)
+        self.tasks.selection_changed.connect(self._on_tasks_selection_changed)
+        self.tasks.context_menu_requested.connect(self._on_tasks_context_menu_requested)
+        self.tasks.robot_action.connect(self._on_tasks_robot_action)
+        self.tasks.add_requested.connect(self._on_tasks_add_requested)
+        self.tasks.policy_chosen.connect(self._on_tasks_policy_chosen)
+        self.tasks.reorder_requested.connect(self._on_tasks_reorder_requested)
+        self.tasks.columns_added.connect(self._on_tasks_columns_added)
         self.parameters.edit_requested.connect(self._on_parameters_edit_requested)
         self.parameters.rename_marker_requested.connect(self._on_parameters_rename_requested)
         self.parameters.problem.connect(lambda text: self.messages.say(text, "warning"))
@@ -103,7 +103,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         for robot_action, action in self.actions_.all_robots.items():
             action.triggered.connect(lambda _=False, r=robot_action: self.do_robot(None, r))
         self.actions_.refresh.triggered.connect(self._on_refresh_triggered)
-        self.actions_.clear_selection.triggered.connect(self.schedule.clear_selection)
+        self.actions_.clear_selection.triggered.connect(self.tasks.clear_selection)
 
     # -- from the backend ---------------------------------------------------------------------
     def on_update(self, update: ViewUpdate) -> None:
@@ -124,7 +124,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
             first = first or (not self.view.loaded and update.reset)
             reset = reset or update.reset
             self.view.apply(update)
-            self.schedule.apply(update)
+            self.tasks.apply(update)
             agents.update(update.touched)
             changed |= update.changed_ids
             refresh_parameters = refresh_parameters or bool(
@@ -134,7 +134,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         if refresh_parameters:
             self.parameters.refresh(force=reset or any(u.markers is not None for u in updates))
         if self._select_when_seen and all(self.view.skill(i) for i in self._select_when_seen):
-            self.schedule.select_ids(self._select_when_seen)
+            self.tasks.select_ids(self._select_when_seen)
             self._select_when_seen = []
         self.repaints.checker.note(None if reset else changed)
         self.enabling.update(None if reset else agents)
@@ -151,7 +151,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
     def on_library(self, library: Library) -> None:
         """The skill library arrived: offer each robot's skills."""
         self.view.library = library
-        self.schedule.set_library(library)
+        self.tasks.set_library(library)
         self.parameters.refresh(force=True)
         self.repaints.checker.note(None)
         self.enabling.update()
@@ -205,8 +205,8 @@ class CommandWidget(QWidget):  # type: ignore[misc]
                 bound = self.view.skills_bound_to(name)
                 if bound:
                     ids.append(bound[0].id)
-        if ids != self.schedule.selected_ids:
-            self.schedule.select_ids(ids)
+        if ids != self.tasks.selected_ids:
+            self.tasks.select_ids(ids)
 
     def set_backend(self, backend: Backend) -> None:
         """Talk to ``backend`` from now on (a replay's, or the live one again)."""
@@ -229,7 +229,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
     def do(self, kind: Action) -> None:
         """Run a skill action on the selection (if it is legal now)."""
         if not self.backend.read_only:
-            self.dispatcher.skill_action(kind, self.view.skills(self.schedule.selected_ids))
+            self.dispatcher.skill_action(kind, self.view.skills(self.tasks.selected_ids))
 
     def do_robot(self, agent: str | None, kind: RobotAction) -> None:
         """Run a robot action on ``agent`` (None: every robot), if it is legal now."""
@@ -245,13 +245,13 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         return ask_team_send(self, text, warnings)
 
     # -- slots ----------------------------------------------------------------------------------
-    def _on_schedule_selection_changed(self, ids: list[str]) -> None:
+    def _on_tasks_selection_changed(self, ids: list[str]) -> None:
         self.parameters.show_selection(ids)
         self.enabling.update()
         selected = self.view.skills(ids)
         self.backend.publish_selection(ids, self.view.bound_markers(selected))
 
-    def _on_schedule_context_menu_requested(self, table: SectionTable, pos: QPoint) -> None:
+    def _on_tasks_context_menu_requested(self, table: SectionTable, pos: QPoint) -> None:
         self.context_menu(table).exec_(pos)
 
     def context_menu(self, table: SectionTable) -> QMenu:
@@ -261,7 +261,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
             if action.isEnabled():
                 menu.addAction(action)
         agent = table.section.agent
-        column = self.schedule.columns.get(agent)
+        column = self.tasks.columns.get(agent)
         if table.section.blueprint and column is not None and column.add_button.isEnabled():
             menu.addSeparator()
             menu.addMenu(column.add_menu).setText(f"Add skill to {agent}")
@@ -269,28 +269,28 @@ class CommandWidget(QWidget):  # type: ignore[misc]
             menu.addAction("Nothing can be done to this selection").setEnabled(False)
         return menu
 
-    def _on_schedule_robot_action(self, agent: str, kind: RobotAction) -> None:
+    def _on_tasks_robot_action(self, agent: str, kind: RobotAction) -> None:
         self.do_robot(agent, kind)
 
-    def _on_schedule_add_requested(self, agent: str, skill: str) -> None:
+    def _on_tasks_add_requested(self, agent: str, skill: str) -> None:
         def select_new(answer: Answer) -> None:
             if answer.ok:
                 self._select_when_seen = [answer.value.skill_id]
                 if self.view.skill(answer.value.skill_id) is not None:
-                    self.schedule.select_ids(self._select_when_seen)
+                    self.tasks.select_ids(self._select_when_seen)
                     self._select_when_seen = []
 
         what = f"add {skill} to {agent}"
         self.send(ask(lambda c: c.add_skill, what, self.view.revision, select_new)(agent, skill))
 
-    def _on_schedule_policy_chosen(self, agent: str, policy: LostLinkPolicy) -> None:
+    def _on_tasks_policy_chosen(self, agent: str, policy: LostLinkPolicy) -> None:
         what = f"set {agent}'s policy ({policy.describe()})"
-        self.dispatcher.call(lambda c: c.set_robot_options, what)(agent, policy)
+        self.dispatcher.call(lambda c: c.set_lost_link_policy, what)(agent, policy)
 
-    def _on_schedule_reorder_requested(self, agent: str, order: list[str]) -> None:
-        self.dispatcher.call(lambda c: c.reorder, f"reorder {agent}'s plan")(agent, order)
+    def _on_tasks_reorder_requested(self, agent: str, order: list[str]) -> None:
+        self.dispatcher.call(lambda c: c.reorder_skills, f"reorder {agent}'s task")(agent, order)
 
-    def _on_schedule_columns_added(self, agents: list[str]) -> None:
+    def _on_tasks_columns_added(self, agents: list[str]) -> None:
         self.team.refresh()
         self.enabling.update(agents)
 
@@ -303,7 +303,8 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.send(ask(lambda c: c.edit_skill, what, self.view.revision, revert)(skill_id, **fields))
 
     def _on_parameters_rename_requested(self, old: str, new: str) -> None:
-        self.dispatcher.call(lambda c: c.rename_marker, f"rename marker {old} to {new}")(old, new)
+        what = f"rename marker {old} to {new}"
+        self.dispatcher.call(lambda c: c.rename_task_marker, what)(old, new)
 
     def _on_refresh_triggered(self) -> None:
         self.backend.refresh()
@@ -311,6 +312,6 @@ class CommandWidget(QWidget):  # type: ignore[misc]
 
     def _show_statuses(self, statuses: list[AgentStatus]) -> None:
         """The robots' latest reports, collected by the status timer: headers and buttons."""
-        self.schedule.show_statuses(statuses)
+        self.tasks.show_statuses(statuses)
         self.team.refresh()
         self.enabling.update(status.agent for status in statuses)

@@ -21,7 +21,7 @@ from python_qt_binding.QtWidgets import (
 from ..core.legality import Action, RobotAction
 from .actions import CommandActions
 
-# Three to a row, so the panel stays narrow and the schedule gets the width.
+# Three to a row, so the panel stays narrow and the task panel gets the width.
 SKILL_ROWS = (
     (Action.SYNC, Action.UNSYNC, Action.DELETE),
     (Action.MOVE_UP, Action.MOVE_DOWN, Action.BARRIER),

@@ -1,7 +1,7 @@
-"""The non-modal warning in a robot's column that its plan ends out of coverage.
+"""The non-modal warning in a robot's column that its task ends out of coverage.
 
 The server words the warning (``AgentStatus.coverage_warning``): the robot's synchronized
-plan ends where the radio does not reach, and its lost-link policy would leave it there.
+task ends where the radio does not reach, and its lost-link policy would leave it there.
 The label stays hidden while there is nothing to say.
 """
 
@@ -32,7 +32,7 @@ def show_coverage_warning(label: QLabel, status: AgentStatus | None) -> None:
     warning = status.coverage_warning if status is not None else ""
     label.setText(f"⚠ {warning[:1].upper()}{warning[1:]}" if warning else "")
     label.setToolTip(
-        "Change the robot's lost-link policy (Link loss…) or its plan, before it leaves "
+        "Change the robot's lost-link policy (Link loss…) or its task, before it leaves "
         "coverage: out there nothing reaches it."
         if warning
         else ""

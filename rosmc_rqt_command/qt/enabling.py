@@ -13,7 +13,7 @@ from collections.abc import Iterable
 from ..core.legality import RobotAction, RobotLegality, legal_actions
 from ..core.mission_view import MissionView
 from .actions import CommandActions
-from .schedule_widget import ScheduleWidget
+from .task_widget import TaskWidget
 from .undo_history import UndoHistory
 
 # What a window that follows a replay still offers (saving what it shows).
@@ -27,12 +27,12 @@ class Enabling:
         self,
         view: MissionView,
         actions: CommandActions,
-        schedule: ScheduleWidget,
+        tasks: TaskWidget,
         history: UndoHistory,
     ) -> None:
         self._view = view
         self._actions = actions
-        self._schedule = schedule
+        self._tasks = tasks
         self._history = history
         self.robots = RobotLegality()
         self.read_only = False
@@ -47,7 +47,7 @@ class Enabling:
         self._history.set_read_only(read_only)
         agents = None if agents is None else list(agents)
         self.robots.update(self._view, agents)
-        selected = self._view.skills(self._schedule.selected_ids)
+        selected = self._view.skills(self._tasks.selected_ids)
         legal = set() if read_only else legal_actions(self._view, selected)
         for kind, action in self._actions.skill.items():
             action.setEnabled(kind in legal)
@@ -56,7 +56,7 @@ class Enabling:
             action.setEnabled(robot_action in everyone)
         for name, action in self._actions.file.items():
             action.setEnabled(not read_only or name in READ_ONLY_FILE_ITEMS)
-        for agent in self._schedule.columns if agents is None else agents:
-            column = self._schedule.columns.get(agent)
+        for agent in self._tasks.columns if agents is None else agents:
+            column = self._tasks.columns.get(agent)
             if column is not None:
                 column.set_legal(self.robots.of(agent), read_only)

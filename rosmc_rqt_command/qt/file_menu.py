@@ -2,7 +2,7 @@
 
 A local file is read here and sent as a document (``load_mission(document=...)``), or
 written here from the server's document (``save_mission()``); a server file is named by
-its path on the server's host. Before New or Open replaces a plan that changed since it
+its path on the server's host. Before New or Open replaces a mission that changed since it
 was last saved or loaded, the operator is asked whether to save it first.
 """
 
@@ -24,7 +24,7 @@ FILTER = "Mission files (*.yaml *.yml);;All files (*)"
 Send = Callable[[Request], None]
 
 
-Plan = tuple[
+Content = tuple[
     str,
     tuple[tuple[str, Sequence[SkillInstance]], ...],
     tuple[Barrier, ...],
@@ -32,15 +32,15 @@ Plan = tuple[
 ]
 
 
-def plan_of(view: MissionView) -> Plan:
-    """The plan as it is now (skills are immutable values; only the task lists are copied)."""
+def mission_of(view: MissionView) -> Content:
+    """The mission as it is now (skills are immutable values; only the task lists are copied)."""
     tasks = tuple((agent, tuple(task.skills)) for agent, task in view.agents.items())
     return (view.library_name, tasks, view.barriers, tuple(view.markers.values()))
 
 
-def plan_fingerprint(plan: Plan) -> tuple[object, ...]:
-    """What a mission file keeps of a plan (ignores statuses and robot progress)."""
-    library, tasks, barriers, markers = plan
+def mission_fingerprint(mission: Content) -> tuple[object, ...]:
+    """What a mission file keeps of a mission (ignores statuses and robot progress)."""
+    library, tasks, barriers, markers = mission
     steps = tuple(
         (
             agent,
@@ -68,7 +68,7 @@ class FileController:
         self._messages = messages
         self._send = send
         self.location: tuple[str, str] | None = None  # ("local" | "server", path)
-        self._saved: Plan | None = None
+        self._saved: Content | None = None
         self._after_save: Callable[[], None] | None = None  # closes the window once saved
         self.ask: Callable[[str], str] = self._ask_save_changes
         handlers = {
@@ -84,16 +84,16 @@ class FileController:
 
     # -- unsaved changes ------------------------------------------------------------------------
     def mark_saved(self) -> None:
-        """The plan as it is now counts as saved (after a load, save or new mission)."""
-        self._saved = plan_of(self._view)
+        """The mission as it is now counts as saved (after a load, save or new mission)."""
+        self._saved = mission_of(self._view)
 
     @property
     def dirty(self) -> bool:
-        """The plan changed since it was last saved, loaded or started anew."""
+        """The mission changed since it was last saved, loaded or started anew."""
         if self._saved is None:
             return any(view.skills for view in self._view.agents.values())
-        now = plan_of(self._view)
-        return now != self._saved and plan_fingerprint(now) != plan_fingerprint(self._saved)
+        now = mission_of(self._view)
+        return now != self._saved and mission_fingerprint(now) != mission_fingerprint(self._saved)
 
     def confirm_discard(self, doing: str) -> bool:
         """Ask to save unsaved changes before ``doing``; False if the operator cancels."""
@@ -184,7 +184,7 @@ class FileController:
 
     def save_local(self, path: str) -> None:
         """Save the mission to a file on this computer."""
-        fingerprint = plan_of(self._view)
+        fingerprint = mission_of(self._view)
         self._send(
             ask(
                 lambda c: c.save_mission,
@@ -195,7 +195,7 @@ class FileController:
 
     def save_server(self, path: str) -> None:
         """Save the mission to a file on the server's computer."""
-        fingerprint = plan_of(self._view)
+        fingerprint = mission_of(self._view)
         self._send(
             ask(
                 lambda c: c.save_mission,
@@ -227,7 +227,7 @@ class FileController:
             self._mark_at = None
             self.mark_saved()
 
-    def _on_saved_document(self, answer: Answer, path: str, fingerprint: Plan) -> None:
+    def _on_saved_document(self, answer: Answer, path: str, fingerprint: Content) -> None:
         if answer.ok:
             try:
                 Path(path).write_text(answer.value.document, encoding="utf-8")
@@ -238,7 +238,7 @@ class FileController:
             self._messages.say(f"Saved the mission to {path}.", "ok")
         self._on_saved(answer, ("local", path), fingerprint)
 
-    def _on_saved(self, answer: Answer, location: tuple[str, str], fingerprint: Plan) -> None:
+    def _on_saved(self, answer: Answer, location: tuple[str, str], fingerprint: Content) -> None:
         if not answer.ok:
             self._closing_failed()
             return

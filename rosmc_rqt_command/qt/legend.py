@@ -1,4 +1,4 @@
-"""A one-line key of the row colours, under the schedule: what each colour means.
+"""A one-line key of the row colours, under the task panel: what each colour means.
 
 Built from :mod:`.presentation`, so the key always matches the rows.
 """

@@ -2,7 +2,7 @@
 
 :class:`ReplayMode` starts the replay's child processes (:mod:`.replay_process`), points
 the window at the replay's prefix with a fresh read-only backend, and shows the timeline
-bar (:mod:`.replay_bar`) above the schedule. "Return to live" (or the replay leaving on
+bar (:mod:`.replay_bar`) above the task panel. "Return to live" (or the replay leaving on
 its own) ends the children and points the window at the live mission again. The window's
 live backend is only set aside meanwhile, so the way back needs no reconnection.
 
@@ -95,7 +95,7 @@ class ReplayMode(QObject):  # type: ignore[misc]
         self._ended_said = False
         self.bar = ReplayBar()
         self.bar.hide()
-        widget.layout().insertWidget(1, self.bar)  # under the banner, above the schedule
+        widget.layout().insertWidget(1, self.bar)  # under the banner, above the task panel
         self.open_action = QAction("Open &recording…", widget)
         self.open_action.setObjectName("open_recording")
         self.open_action.setToolTip("Replay a mission recording (.mcap) in this window and rviz")

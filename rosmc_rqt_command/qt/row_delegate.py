@@ -1,4 +1,4 @@
-"""Paints schedule rows so that a selected row keeps its status colour.
+"""Paints task rows so that a selected row keeps its status colour.
 
 Qt's usual selection fills the row with the highlight colour, which would hide what
 matters most: a selected failure must still look red. This delegate paints the row as

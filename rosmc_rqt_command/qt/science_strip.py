@@ -1,4 +1,4 @@
-"""The science strip above the schedule: the score, the stones delivered, the regions.
+"""The science strip above the task panel: the score, the stones delivered, the regions.
 
 Fed from ``/rosmc/sim/science`` by the ROS bridge (as a core
 :class:`~rosmc_server.core.science.Science`); says "no score published" until the

@@ -24,13 +24,13 @@ from python_qt_binding.QtCore import QEvent, QObject, QTimer
 from python_qt_binding.QtWidgets import QAbstractItemView, QApplication, QWidget
 
 from ..core.view_state import ViewUpdate
-from .schedule_widget import ScheduleWidget
+from .task_widget import TaskWidget
 
 
 class StartupReport(QObject):  # type: ignore[misc]
     """Appends each stage's end to ``path`` once (later marks of a stage are ignored).
 
-    The ``rows`` and ``all`` lines also say how many robots' columns and rows the schedule
+    The ``rows`` and ``all`` lines also say how many robots' columns and rows the task
     held then (``columns``, ``rows``), and the ``all`` line lists the modules the process had
     imported by then (``modules``), so a test can tell what the start did not import.
 
@@ -44,7 +44,7 @@ class StartupReport(QObject):  # type: ignore[misc]
         self._marked: set[str] = set()
         self._window: QWidget | None = None
         self._whole = False  # the first whole mission arrived
-        self._schedule: ScheduleWidget | None = None
+        self._tasks: TaskWidget | None = None
         path.write_text("")
 
     def mark(self, stage: str, when: float | None = None) -> None:
@@ -53,9 +53,9 @@ class StartupReport(QObject):  # type: ignore[misc]
             return
         self._marked.add(stage)
         line: dict[str, Any] = {"stage": stage, "t": time.monotonic() if when is None else when}
-        if stage in ("rows", "all") and self._schedule is not None:
-            tables = list(self._schedule.tables())
-            line["columns"] = len(self._schedule.columns)
+        if stage in ("rows", "all") and self._tasks is not None:
+            tables = list(self._tasks.tables())
+            line["columns"] = len(self._tasks.columns)
             line["rows"] = sum(table.section.rowCount() for table in tables)
         if stage == "all":
             line["modules"] = sorted(sys.modules)
@@ -71,12 +71,12 @@ class StartupReport(QObject):  # type: ignore[misc]
         self._window = window
         QApplication.instance().installEventFilter(self)
 
-    def follow(self, updated: Any, schedule: ScheduleWidget) -> None:
+    def follow(self, updated: Any, tasks: TaskWidget) -> None:
         """Mark ``snapshot`` (when it was read) and ``all`` (every row of the first mission
-        in ``schedule``) as the bridge's ``updated`` signal hands them over."""
-        self._schedule = schedule
+        in ``tasks``) as the bridge's ``updated`` signal hands them over."""
+        self._tasks = tasks
         updated.connect(self._on_updated)
-        schedule.columns_added.connect(lambda _agents: self._mark_all_when_shown())
+        tasks.columns_added.connect(lambda _agents: self._mark_all_when_shown())
 
     def _on_updated(self, batch: Sequence[ViewUpdate]) -> None:
         resets = [update.received for update in batch if update.reset]
@@ -86,8 +86,8 @@ class StartupReport(QObject):  # type: ignore[misc]
             self._mark_all_when_shown()
 
     def _mark_all_when_shown(self) -> None:
-        schedule = self._schedule
-        if self._whole and "rows" in self._marked and schedule is not None and schedule.complete:
+        tasks = self._tasks
+        if self._whole and "rows" in self._marked and tasks is not None and tasks.complete:
             self.mark_soon("all")
 
     def eventFilter(self, watched: QObject, event: QEvent) -> bool:
@@ -105,7 +105,7 @@ class StartupReport(QObject):  # type: ignore[misc]
 
 
 def _shows_rows(widget: QWidget | None) -> bool:
-    """``widget`` is a schedule table with rows (its viewport is being painted)."""
+    """``widget`` is a task table with rows (its viewport is being painted)."""
     return (
         isinstance(widget, QAbstractItemView)
         and widget.objectName().startswith(("synced_", "blueprint_"))

@@ -1,6 +1,6 @@
-"""The bar above the schedule for large teams: filter robots by name and status, compact mode.
+"""The bar above the task panel for large teams: filter robots by name and status, compact mode.
 
-With 20 robots the schedule holds more columns than a screen: it scrolls sideways, and
+With 20 robots the task panel holds more columns than a screen: it scrolls sideways, and
 this bar narrows it. A text field matches robot names, the *Robots* list ticks robots on
 and off (it stays open while the operator ticks), the status buttons keep only robots
 with a failure, something waiting or no contact, and *Compact* makes every column
@@ -23,7 +23,7 @@ from python_qt_binding.QtWidgets import (
 
 from ..core.mission_view import MissionView
 from ..core.team_filter import StatusFilter, TeamFilter, visible_agents
-from .schedule_widget import ScheduleWidget
+from .task_widget import TaskWidget
 
 
 class StayOpenMenu(QMenu):  # type: ignore[misc]
@@ -39,14 +39,12 @@ class StayOpenMenu(QMenu):  # type: ignore[misc]
 
 
 class TeamBar(QWidget):  # type: ignore[misc]
-    """Filter and compact controls for the schedule's robot columns."""
+    """Filter and compact controls for the task panel's robot columns."""
 
-    def __init__(
-        self, schedule: ScheduleWidget, view: MissionView, parent: QWidget | None = None
-    ) -> None:
+    def __init__(self, tasks: TaskWidget, view: MissionView, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("team_bar")
-        self._schedule = schedule
+        self._tasks = tasks
         self._view = view
         self.chosen = TeamFilter()
         self._agents: list[str] = []
@@ -56,7 +54,7 @@ class TeamBar(QWidget):  # type: ignore[misc]
         self.text.setClearButtonEnabled(True)
         self.text.setToolTip("Names or parts of names, separated by commas: drone, rover_3")
         self.text.setMaximumWidth(220)
-        # Not the window's first focus: the schedule's shortcuts (Delete, arrows) stay live.
+        # Not the window's first focus: the task panel's shortcuts (Delete, arrows) stay live.
         self.text.setFocusPolicy(Qt.ClickFocus)
         self.text.textChanged.connect(self._on_text_text_changed)
         self.robot_menu = StayOpenMenu(self)
@@ -101,13 +99,13 @@ class TeamBar(QWidget):  # type: ignore[misc]
 
     def refresh(self) -> None:
         """Apply the filter and compact mode to the columns (after updates and reports)."""
-        agents = list(self._schedule.columns)
+        agents = list(self._tasks.columns)
         if agents != self._agents:
             self._agents = agents
             self._fill_robot_menu()
         compact = self.compact.isChecked()
         shown = set(visible_agents(self._view, agents, self.chosen))
-        for agent, column in self._schedule.columns.items():
+        for agent, column in self._tasks.columns.items():
             column.set_compact(compact)
             column.setVisible(agent in shown)
         self.count.setText(f"{len(shown)} of {len(agents)} robots shown")
@@ -115,7 +113,7 @@ class TeamBar(QWidget):  # type: ignore[misc]
 
     def visible(self) -> list[str]:
         """The robots whose columns are shown now, in order."""
-        return [a for a, c in self._schedule.columns.items() if not c.isHidden()]
+        return [a for a, c in self._tasks.columns.items() if not c.isHidden()]
 
     def _fill_robot_menu(self) -> None:
         self.robot_menu.clear()

@@ -10,7 +10,7 @@ def ask_team_send(parent: QWidget, text: str, warnings: list[str]) -> bool:
     box = QMessageBox(parent)
     box.setObjectName("team_send_question")
     box.setIcon(QMessageBox.Warning if warnings else QMessageBox.Question)
-    box.setWindowTitle("Send the team's plans")
+    box.setWindowTitle("Send the team's tasks")
     if warnings:
         text += "\n\nWarnings:\n" + "\n".join(f"  • {w}" for w in warnings)
     box.setText(text + "\n\nSend?")

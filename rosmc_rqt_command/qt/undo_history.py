@@ -23,14 +23,13 @@ UNDOABLE = frozenset(
         "add_skill",
         "edit_skill",
         "delete_skills",
-        "reorder",
-        "move_skills",
+        "reorder_skills",
         "add_barrier",
         "delete_barrier",
-        "add_marker",
-        "move_marker",
-        "rename_marker",
-        "delete_marker",
+        "add_task_marker",
+        "move_task_marker",
+        "rename_task_marker",
+        "delete_task_marker",
     }
 )
 
@@ -103,7 +102,7 @@ class UndoHistory(QObject):  # type: ignore[misc]
 
         self._waiting = True
         self._update()
-        self._send(ask(lambda c: c.undo, words, self._view.revision, answered)(revision))
+        self._send(ask(lambda c: c.undo_edit, words, self._view.revision, answered)(revision))
 
     def set_read_only(self, read_only: bool) -> None:
         """A window that follows a replay undoes nothing."""

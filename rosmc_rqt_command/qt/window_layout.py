@@ -1,4 +1,4 @@
-"""Where the command window's parts sit: menus, banner, schedule on the left, panels right."""
+"""Where the command window's parts sit: menus, banner, tasks on the left, panels right."""
 
 from __future__ import annotations
 
@@ -12,9 +12,9 @@ from .control_panel import ControlPanel
 from .legend import StatusLegend
 from .message_area import MessageArea
 from .parameter_panel import ParameterPanel
-from .schedule_widget import ScheduleWidget
 from .science_strip import ScienceStrip
 from .site_strip import SiteStrip
+from .task_widget import TaskWidget
 from .team_bar import TeamBar
 from .undo_history import UndoHistory
 
@@ -28,7 +28,7 @@ class Panels:
 
     actions: CommandActions
     history: UndoHistory
-    schedule: ScheduleWidget
+    tasks: TaskWidget
     team: TeamBar
     parameters: ParameterPanel
     control: ControlPanel
@@ -65,7 +65,7 @@ def lay_out(window: QWidget, panels: Panels) -> Layout:
     left_layout = QVBoxLayout(left)
     left_layout.setContentsMargins(0, 0, 0, 0)
     left_layout.setSpacing(2)
-    for widget, stretch in ((science, 0), (site, 0), (panels.team, 0), (panels.schedule, 1)):
+    for widget, stretch in ((science, 0), (site, 0), (panels.team, 0), (panels.tasks, 1)):
         left_layout.addWidget(widget, stretch)
     left_layout.addWidget(legend)
     splitter = QSplitter(Qt.Horizontal)

@@ -174,9 +174,9 @@ class Interaction:
     def _menu_call(action: EditAction, parsed: Parsed, library: Any, pose: Pose | None) -> Call:
         name = parsed.name
         if isinstance(action, RenameMarker):
-            return lambda c: c.rename_marker(name, action.new_name)
+            return lambda c: c.rename_task_marker(name, action.new_name)
         if isinstance(action, DeleteMarker):
-            return lambda c: c.delete_marker(name)
+            return lambda c: c.delete_task_marker(name)
         if action.from_robot:
             plan = robot_skill_plan(library, action.agent, action.skill, pose)
         else:
@@ -194,7 +194,7 @@ class Interaction:
         revision, what = entry
         keep = self.history.redone if redo else self.history.undone
         self._submit(
-            lambda c: c.undo(revision),
+            lambda c: c.undo_edit(revision),
             f"{word} {what}",
             record=lambda result: keep(result.revision, what),
         )
@@ -253,7 +253,7 @@ class Interaction:
         if pose == marker.pose and tuple(vertices) == marker.vertices:
             return
         self._submit(
-            lambda c: c.move_marker(parsed.name, pose, vertices),
+            lambda c: c.move_task_marker(parsed.name, pose, vertices),
             f"move '{parsed.name}'",
             revision,
             on_error=lambda: self._node.snap_back(name),
@@ -320,7 +320,7 @@ class Interaction:
             _log.warning("ignored a new %s marker: %s", what, error)
             return
         revision = self._node.mirror.revision
-        self._submit(lambda c: c.add_marker(marker), f"new {what} marker", revision)
+        self._submit(lambda c: c.add_task_marker(marker), f"new {what} marker", revision)
 
     def on_reset(self, revision: int) -> None:
         """A snapshot came; one older than this node's last result means a new server."""
@@ -365,7 +365,7 @@ def _add_planned(client: MissionClient, plan: SkillPlan) -> Any:
     created: list[tuple[str, str]] = []
     try:
         for param, marker in plan.new_markers:
-            added = client.add_marker(marker)
+            added = client.add_task_marker(marker)
             created.append((param, added.name))
         return client.add_skill(
             plan.agent,
@@ -376,5 +376,5 @@ def _add_planned(client: MissionClient, plan: SkillPlan) -> Any:
     except RosmcError:
         for _, name in created:
             with contextlib.suppress(RosmcError):
-                client.delete_marker(name)
+                client.delete_task_marker(name)
         raise

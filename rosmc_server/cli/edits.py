@@ -74,7 +74,7 @@ def delete(ctx: Context) -> int:
 def reorder(ctx: Context) -> int:
     """Give a robot's blueprint a new order."""
     args = ctx.args
-    return ctx.emit_result(ctx.client.reorder(args.agent, args.order, **ctx.against()))
+    return ctx.emit_result(ctx.client.reorder_skills(args.agent, args.order, **ctx.against()))
 
 
 def barrier(ctx: Context) -> int:
@@ -91,7 +91,7 @@ def delete_barrier(ctx: Context) -> int:
 
 def undo(ctx: Context) -> int:
     """Undo an edit (the latest not undone, or the one that produced REVISION)."""
-    result = ctx.client.undo(ctx.args.undo_revision, **ctx.against())
+    result = ctx.client.undo_edit(ctx.args.undo_revision, **ctx.against())
     return ctx.emit_result(result, f"revision {result.revision}: {result.summary}")
 
 
@@ -147,7 +147,7 @@ def control(ctx: Context) -> int:
     return ctx.emit_result(result, f"{ctx.args.command} sent to {', '.join(result.agents)}")
 
 
-def policy(ctx: Context) -> int:
+def lost_link_policy(ctx: Context) -> int:
     """Set a robot's lost-link policy."""
     args = ctx.args
     kind = LostLinkKind(args.kind)
@@ -161,19 +161,19 @@ def policy(ctx: Context) -> int:
         if bindings:
             raise InvalidRequest("safe-skill parameters cannot be bound to task markers")
     chosen = LostLinkPolicy(kind, args.after, args.skill, values, LostLinkTrigger(args.when))
-    result = ctx.client.set_robot_options(args.agent, chosen)
+    result = ctx.client.set_lost_link_policy(args.agent, chosen)
     return ctx.emit_result(result, f"{args.agent}: {chosen.describe()} (sent to the robot)")
 
 
 def retry(ctx: Context) -> int:
     """Retry a failed skill; print the new instance's id."""
-    result = ctx.client.retry(ctx.args.skill_id, **ctx.against())
+    result = ctx.client.retry_skill(ctx.args.skill_id, **ctx.against())
     return ctx.emit_result(result, result.new_skill_id)
 
 
 def skip(ctx: Context) -> int:
     """Skip a failed skill."""
-    return ctx.emit_result(ctx.client.skip(ctx.args.skill_id, **ctx.against()))
+    return ctx.emit_result(ctx.client.skip_skill(ctx.args.skill_id, **ctx.against()))
 
 
 def marker(ctx: Context) -> int:
@@ -182,16 +182,16 @@ def marker(ctx: Context) -> int:
     if args.marker_command == "add":
         kind = MarkerType[args.type.upper()]
         pose, vertices = marker_shape(kind, args.where, f"the {args.type} of the marker")
-        added = client.add_marker(TaskMarker(args.name, kind, pose, vertices), **base)
+        added = client.add_task_marker(TaskMarker(args.name, kind, pose, vertices), **base)
         return ctx.emit_result(added, added.name)
     if args.marker_command == "move":
         old = next((m for m in client.fetch_mission().markers if m.name == args.name), None)
         kind = old.type if old is not None else MarkerType.POSE  # the server names a missing one
         pose, vertices = marker_shape(kind, args.where, f"the new place of '{args.name}'")
-        return ctx.emit_result(client.move_marker(args.name, pose, vertices, **base))
+        return ctx.emit_result(client.move_task_marker(args.name, pose, vertices, **base))
     if args.marker_command == "rename":
-        return ctx.emit_result(client.rename_marker(args.name, args.new_name, **base))
-    return ctx.emit_result(client.delete_marker(args.name, **base))
+        return ctx.emit_result(client.rename_task_marker(args.name, args.new_name, **base))
+    return ctx.emit_result(client.delete_task_marker(args.name, **base))
 
 
 def new(ctx: Context) -> int:
@@ -252,7 +252,7 @@ COMMANDS: dict[str, Callable[[Context], int]] = {
     "pause": control,
     "resume": control,
     "stop": control,
-    "policy": policy,
+    "lost-link-policy": lost_link_policy,
     "retry": retry,
     "skip": skip,
     "marker": marker,

@@ -103,7 +103,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _add_views(command: _Command) -> None:
-    status = command("status", "print every robot's schedule, link and telemetry")
+    status = command("status", "print every robot's task, link and telemetry")
     status.add_argument("-v", "--verbose", action="store_true", help="show parameter values")
     status.add_argument(
         "--no-states",
@@ -209,7 +209,9 @@ def _add_execution(command: _Command) -> None:
         control = command(name, summary)
         control.add_argument("agent", nargs="?", metavar="ROBOT")
     policy = command(
-        "policy", "set what a robot does when it stops hearing the ground station", POLICY_HELP
+        "lost-link-policy",
+        "set what a robot does when it stops hearing the ground station",
+        POLICY_HELP,
     )
     policy.add_argument("agent", metavar="ROBOT")
     policy.add_argument("kind", choices=[kind.value for kind in LostLinkKind], metavar="POLICY",

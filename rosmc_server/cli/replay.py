@@ -37,8 +37,8 @@ the recording's end is refused, like a revision it does not hold."""
 EXPORT_HELP = """\
 OUT.mcap holds every recorded topic in chunks with indexes and a summary,
 header stamps on the log clock, the robots drawn as markers in their TF
-frames (/rosmc/export/robots), and the mission as text: the schedule at
-every revision (/rosmc/export/schedule) and one line per change
+frames (/rosmc/export/robots), and the mission as text: the task panel at
+every revision (/rosmc/export/tasks) and one line per change
 (/rosmc/export/changes)."""
 
 
@@ -129,7 +129,7 @@ def at(ctx: Context) -> int:
     """Print the mission at a time (seconds since the start) or a revision (rN)."""
     from ..recording.diff import resolve_when
     from ..recording.history import MissionHistory
-    from ..text import format_markers, format_schedule, mission_to_json
+    from ..text import format_markers, format_tasks, mission_to_json
     from .context import UsageError
 
     history = _history(MissionHistory.from_journal(ctx.args.file))
@@ -145,7 +145,7 @@ def at(ctx: Context) -> int:
     changed = history.seconds(info.log_time)
     last = f"{info.kind.name}: {info.summary}" if info.kind else "the recorded snapshot"
     title = f"{history.path.name} at {when}"
-    text = format_schedule(state, title, verbose=ctx.args.verbose)
+    text = format_tasks(state, title, verbose=ctx.args.verbose)
     text += f"\n  last change at {changed:.2f} s: {last}"
     if state.markers:
         markers = format_markers(state.markers).splitlines()

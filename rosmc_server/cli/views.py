@@ -16,7 +16,7 @@ from ..text import (
     format_event,
     format_library,
     format_markers,
-    format_schedule,
+    format_tasks,
     library_to_json,
     marker_to_json,
     mission_to_json,
@@ -26,7 +26,7 @@ from .context import Context
 
 
 def status(ctx: Context) -> int:
-    """Every robot's schedule with its link and telemetry line, the science score if published,
+    """Every robot's task with its link and telemetry line, the science score if published,
     the site map in force (and a journal alert first)."""
     state = ctx.client.get_mission()
     library = ctx.client.library()
@@ -39,8 +39,8 @@ def status(ctx: Context) -> int:
         data["site"] = site_to_json(site) if site else None
         ctx.emit("", {**data, "science": science.to_dict() if science else None})
         return 0
-    text = format_schedule(state, statuses=statuses, verbose=ctx.args.verbose)
-    if science is not None:  # what the mission is for, under the schedule's first line
+    text = format_tasks(state, statuses=statuses, verbose=ctx.args.verbose)
+    if science is not None:  # what the mission is for, under the tasks' first line
         first, _, rest = text.partition("\n")
         text = "\n".join([first, *science.lines(), rest])
     if alert:  # first, where nobody misses it

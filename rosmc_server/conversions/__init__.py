@@ -17,7 +17,7 @@ Modules:
   (import it from the module);
 * :mod:`.library`: the skill library, both ways;
 * :mod:`.agents`: agent states (``rosmc/AgentStates``) as core ``AgentStatus``;
-* :mod:`.policy`: the lost-link policy <-> ``rosmc/SetRobotOptions`` request fields;
+* :mod:`.policy`: the lost-link policy <-> ``rosmc/SetLostLinkPolicy`` request fields;
 * :mod:`.site`: the site map (``rosmc/SiteMap``) the server checks skill targets against;
 * :mod:`.robot_link`: the robot link's protocol (commands, acks, reports, barrier
   signals, snapshots); import it from the module.

@@ -1,4 +1,4 @@
-"""The lost-link policy <-> the fields of ``rosmc/SetRobotOptions`` requests.
+"""The lost-link policy <-> the fields of ``rosmc/SetLostLinkPolicy`` requests.
 
 Part of :mod:`rosmc_server.conversions`, the one boundary between the ``rosmc``
 messages and the core. The request names the policy's kind in ``lost_link_policy``
@@ -30,7 +30,7 @@ def policy_to_request(
 
 
 def policy_from_request(request: Any) -> LostLinkPolicy:
-    """The policy a ``rosmc/SetRobotOptions`` request asks for (an empty kind: continue).
+    """The policy a ``rosmc/SetLostLinkPolicy`` request asks for (an empty kind: continue).
 
     The safe skill's parameters come as given; :meth:`LostLinkPolicy.checked` checks
     them against the library.

@@ -25,7 +25,7 @@ class AgentStatus:
     way). ``policy`` is the lost-link policy the robot reports in force (and whether it
     triggered), as the robot words it; "" if the robot has not said. ``commands_waiting``
     commands wait for contact with the robot, the oldest for ``waiting_for`` seconds (-1:
-    none waits). ``coverage_warning`` is the server's warning that the synchronized plan ends
+    none waits). ``coverage_warning`` is the server's warning that the synchronized task ends
     out of coverage under a policy that would leave the robot there ("" if none).
     """
 

@@ -1,5 +1,5 @@
 """Where the radio reaches: robots' signal readings, a radio model's prediction, and the
-check that warns when a robot's synchronized plan ends out of coverage.
+check that warns when a robot's synchronized task ends out of coverage.
 
 :class:`RadioMap` keeps the newest reading per grid cell (it grows as robots report
 from where they go), each robot's newest reading with a link (its last-link position),
@@ -142,7 +142,7 @@ def reading_text(reading: Reading, now: float) -> str:
 
 
 def plan_end(task: Sequence[SkillInstance]) -> Pose | None:
-    """Where the robot's synchronized plan takes it: the pose of the last skill still to
+    """Where the robot's synchronized task takes it: the pose of the last skill still to
     run (synchronized, not settled) that has a pose parameter; None if none has one.
 
     A skill without a pose parameter after it (say ``return_to_lander``) is not known to
@@ -172,7 +172,7 @@ def coverage_warning(
     policy_text: str,
     default: LostLinkPolicy | None,
 ) -> str:
-    """One sentence if the plan ends out of coverage under a policy that leaves the robot
+    """One sentence if the task ends out of coverage under a policy that leaves the robot
     there; "" otherwise (also when nothing is known of the coverage there)."""
     end = plan_end(task)
     if end is None or not leaves_robot_out(policy_text, default):
@@ -182,6 +182,6 @@ def coverage_warning(
         return ""
     source = "measured" if estimate.measured else "predicted"
     return (
-        f"the plan ends out of coverage at ({end.x:.1f}, {end.y:.1f}) ({source} "
+        f"the task ends out of coverage at ({end.x:.1f}, {end.y:.1f}) ({source} "
         f"{estimate.dbm:.0f} dBm) and the lost-link policy would leave the robot there"
     )

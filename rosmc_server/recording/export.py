@@ -12,8 +12,8 @@ package's own writer:
   sim time, which would leave a viewer's 3D panel without transforms at the log times;
 - the robots and objects drawn as markers in their TF frames (:data:`ROBOTS_TOPIC`,
   ``visualization_msgs/MarkerArray``, the bodies rviz shows), at every recorded TF;
-- the mission as text (``std_msgs/String``): the schedule at every revision
-  (:data:`SCHEDULE_TOPIC`, as ``rosmc at`` prints it) and one line per change
+- the mission as text (``std_msgs/String``): the task panel at every revision
+  (:data:`TASKS_TOPIC`, as ``rosmc at`` prints it) and one line per change
   (:data:`CHANGES_TOPIC`, as ``rosmc watch`` prints it).
 """
 
@@ -37,7 +37,7 @@ from ..conversions import event_from_msg, library_from_msg
 from ..conversions.primitives import primitive_msg
 from ..core import RosmcError
 from ..interface import EVENTS_TOPIC, LIBRARY_TOPIC, MISSION_TOPIC, TF_TOPIC, WORLD_TOPIC
-from ..text import format_event, format_schedule
+from ..text import format_event, format_tasks
 from .errors import JournalError
 from .history import MissionHistory
 from .reader import JournalRecord, read_journal
@@ -45,7 +45,7 @@ from .reader import JournalRecord, read_journal
 CHUNK_BYTES = 512 * 1024
 """Uncompressed bytes per chunk: a few chunks for a short mission, seeks stay cheap."""
 ROBOTS_TOPIC = "/rosmc/export/robots"
-SCHEDULE_TOPIC = "/rosmc/export/schedule"
+TASKS_TOPIC = "/rosmc/export/tasks"
 CHANGES_TOPIC = "/rosmc/export/changes"
 LABEL_HEIGHT = 0.6  # m: the name above each body
 LABEL_Z = 3.0
@@ -126,7 +126,7 @@ def _mission_text(record: JournalRecord, history: MissionHistory) -> Iterator[tu
     except RosmcError:
         return  # a revision the history could not rebuild (see ExportSummary.skipped)
     title = f"{history.path.name} at {history.seconds(record.log_time):.1f} s"
-    yield SCHEDULE_TOPIC, String(data=format_schedule(state, title))
+    yield TASKS_TOPIC, String(data=format_tasks(state, title))
 
 
 def _event_line(msg: Any) -> str:

@@ -2,7 +2,7 @@
 
 Feeds a :class:`~rosmc_server.core.radio_map.RadioMap` with the robots' telemetry (the
 server's agent-state publisher hands each message on) and the radio model's prediction,
-and says per robot whether its synchronized plan ends out of coverage under a lost-link
+and says per robot whether its synchronized task ends out of coverage under a lost-link
 policy that would leave it there (``rosmc/AgentState.coverage_warning``).
 
 Subscribes ``/rosmc/sim/coverage`` (rosmc/CoverageGrid, latched; only with the simulator).
@@ -22,7 +22,7 @@ from ..core.radio_map import RadioMap, coverage_warning
 
 
 class CoverageWatch:
-    """The ground's radio map and the plan-ends-out-of-coverage check."""
+    """The ground's radio map and the task-ends-out-of-coverage check."""
 
     def __init__(self, library: Library) -> None:
         self._library = library
@@ -44,7 +44,7 @@ class CoverageWatch:
             self._radio.add(reading)
 
     def warning(self, state: MissionState, agent: str, policy_text: str) -> str:
-        """The warning about ``agent``'s plan ("" if none)."""
+        """The warning about ``agent``'s task ("" if none)."""
         default = self._library.default_policy(agent)
         with self._lock:
             return coverage_warning(state.task(agent), self._radio, policy_text, default)

@@ -288,7 +288,7 @@ class OperatorServices:
         resp.agents = agents
         return None
 
-    def _set_robot_options(self, req: Any, resp: Any) -> None:
+    def _set_lost_link_policy(self, req: Any, resp: Any) -> None:
         agent = _text(req.agent, "the agent name")
         policy = policy_from_request(req).checked(self._server.library, agent)
         with self._server.locked():

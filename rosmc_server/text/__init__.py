@@ -2,7 +2,7 @@
 
 Pure functions over core objects (no rospy): the ``rosmc`` command line, the
 scripted demo and tests share them. :mod:`.plain` renders text for people
-(each robot's schedule, status marks, tags); :mod:`.data` returns plain data
+(each robot's task, status marks, tags); :mod:`.data` returns plain data
 with stable keys for ``--json`` output.
 """
 
@@ -21,7 +21,7 @@ from .plain import (
     format_library,
     format_markers,
     format_params,
-    format_schedule,
+    format_tasks,
     format_value,
 )
 
@@ -33,7 +33,7 @@ __all__ = [
     "format_library",
     "format_markers",
     "format_params",
-    "format_schedule",
+    "format_tasks",
     "format_value",
     "library_to_json",
     "marker_to_json",

@@ -1,6 +1,6 @@
 """Missions, libraries, markers and events as text for people.
 
-One robot's schedule under another (synchronized section, a rule, the
+One robot's task under another (synchronized section, a rule, the
 blueprint), status marks and tags; values in the ``key=value`` form that
 ``rosmc add`` reads back.
 """
@@ -29,7 +29,7 @@ from ..core.vocabulary import STATUS_MARKS, dbm, number, percent
 _RULE = "    " + "-" * 56
 
 
-def format_schedule(
+def format_tasks(
     state: MissionState,
     title: str | None = None,
     statuses: Mapping[str, AgentStatus] | None = None,

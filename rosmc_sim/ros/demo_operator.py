@@ -73,10 +73,10 @@ class DemoOperator:
         client = self.client
         client.get_mission()
         say("planning: survey, Wi-Fi box, science rover on its way")
-        client.add_marker(
+        client.add_task_marker(
             TaskMarker("Survey area", MarkerType.AREA, Pose(), tuple(Pose(x, y) for x, y in SURVEY))
         )
-        client.add_marker(TaskMarker("Wi-Fi spot", MarkerType.POSE, WIFI_SPOT_PLANNED))
+        client.add_task_marker(TaskMarker("Wi-Fi spot", MarkerType.POSE, WIFI_SPOT_PLANNED))
         client.add_skill("drone", "take_off", {"altitude": 8.0})
         client.add_skill(
             "drone", "fly_over", {"altitude": 8.0, "spacing": 4.0}, bindings={"area": "Survey area"}
@@ -95,7 +95,7 @@ class DemoOperator:
         say("started; the planned Wi-Fi spot lies in the ridge's radio shadow: adapting")
         client.unsynchronize("manipulator_rover", place)
         self._wait("the manipulator rover gave place_box back", lambda: self._editable(place))
-        client.move_marker("Wi-Fi spot", WIFI_SPOT_ADAPTED)
+        client.move_task_marker("Wi-Fi spot", WIFI_SPOT_ADAPTED)
         client.synchronize("manipulator_rover")
         region = self._wait("the drone discovered a region", self._discovered_region)
         if region is None:
@@ -107,7 +107,8 @@ class DemoOperator:
 
     def _plan_sampling(self, region: wire.SampleRegion) -> None:
         client = self.client
-        client.add_marker(TaskMarker(region.name, MarkerType.POSITION, Pose(region.x, region.y)))
+        at = Pose(region.x, region.y)
+        client.add_task_marker(TaskMarker(region.name, MarkerType.POSITION, at))
         near = region.radius + 1.0
         sci_spot = {"x": region.x - near, "y": region.y - 1.0}
         man_spot = {"x": region.x + near * 0.3, "y": region.y - near}

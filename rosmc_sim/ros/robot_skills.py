@@ -1,9 +1,9 @@
 """The simulated robots' skills, as the mission executor sees them.
 
 Each skill forwards its execution to the robot's controllers (played by the
-simulator) with the robot-task protocol: START with the typed parameters,
-PAUSE, RESUME and CANCEL on ``/<robot>/sim/task`` (rosmc/RobotTask), progress
-and outcome back on ``/<robot>/sim/task_status`` (rosmc/RobotTaskStatus). A
+simulator) with the skill-run protocol: START with the typed parameters,
+PAUSE, RESUME and CANCEL on ``/<robot>/sim/skill_run`` (rosmc/SkillRun), progress
+and outcome back on ``/<robot>/sim/skill_run_status`` (rosmc/SkillRunStatus). A
 real robot would register skills of the same names that call its own stack.
 
 Use one function per robot kind as the executor's ``~skills`` parameter:
@@ -29,9 +29,9 @@ from rosmc_server.conversions import param_to_msg
 from rosmc_server.core import Value
 from rosmc_server.executor.core import Outcome, SkillBehavior, SkillContext, SkillType
 
-from ..core.skills_registry import TASKS
+from ..core.skills_registry import SIM_SKILLS
 from .robot_pose import pose_source
-from .topics import task_status_topic, task_topic
+from .topics import skill_run_status_topic, skill_run_topic
 
 __all__ = [
     "drone_skills",
@@ -46,24 +46,24 @@ RESEND_AFTER = 1.0  # wall seconds without any status before a START is sent aga
 
 
 class RobotController:
-    """One robot's task channel to its controllers (shared by all its skills)."""
+    """One robot's skill-run channel to its controllers (shared by all its skills)."""
 
     def __init__(self, robot: str) -> None:
         self.robot = robot
         self._lock = threading.Lock()
-        self._status: dict[str, wire.RobotTaskStatus] = {}
+        self._status: dict[str, wire.SkillRunStatus] = {}
         self._runs = itertools.count(1)
-        self._publisher = rospy.Publisher(task_topic(robot), wire.RobotTask, queue_size=100)
+        self._publisher = rospy.Publisher(skill_run_topic(robot), wire.SkillRun, queue_size=100)
         self._subscriber = rospy.Subscriber(
-            task_status_topic(robot), wire.RobotTaskStatus, self._on_status, queue_size=100
+            skill_run_status_topic(robot), wire.SkillRunStatus, self._on_status, queue_size=100
         )
 
-    def _on_status(self, msg: wire.RobotTaskStatus) -> None:
+    def _on_status(self, msg: wire.SkillRunStatus) -> None:
         with self._lock:
-            self._status[msg.task_id] = msg
+            self._status[msg.run_id] = msg
 
-    def new_task_id(self, skill_id: str, attempt: int) -> str:
-        """A task id for one run of a skill, never used before by this controller.
+    def new_run_id(self, skill_id: str, attempt: int) -> str:
+        """A run id for one run of a skill, never used before by this controller.
 
         A stopped skill runs again under the same skill id and attempt when the robot is
         started again; the controllers' answer about the cancelled run must not be taken
@@ -71,24 +71,24 @@ class RobotController:
         """
         return f"{skill_id}#{attempt}.{next(self._runs)}"
 
-    def forget(self, task_id: str) -> None:
-        """Drop what was heard about a task that is over (keeps the table small)."""
+    def forget(self, run_id: str) -> None:
+        """Drop what was heard about a run that is over (keeps the table small)."""
         with self._lock:
-            self._status.pop(task_id, None)
+            self._status.pop(run_id, None)
 
-    def status(self, task_id: str) -> wire.RobotTaskStatus | None:
-        """The latest status heard for a task."""
+    def status(self, run_id: str) -> wire.SkillRunStatus | None:
+        """The latest status heard for a run."""
         with self._lock:
-            return self._status.get(task_id)
+            return self._status.get(run_id)
 
     def send(
-        self, task_id: str, action: int, skill: str = "", params: Mapping[str, Value] | None = None
+        self, run_id: str, action: int, skill: str = "", params: Mapping[str, Value] | None = None
     ) -> None:
-        """Publish a task request."""
+        """Publish a skill-run request."""
         parameters = [param_to_msg(name, value) for name, value in (params or {}).items()]
         self._publisher.publish(
-            wire.RobotTask(
-                robot=self.robot, task_id=task_id, action=action, skill=skill, parameters=parameters
+            wire.SkillRun(
+                robot=self.robot, run_id=run_id, action=action, skill=skill, parameters=parameters
             )
         )
 
@@ -100,34 +100,34 @@ class ForwardedSkill(SkillBehavior):
         self._controller = controller
         self._skill = skill
         self._ctx: SkillContext | None = None
-        self._task_id = ""
+        self._run_id = ""
         self._sent = 0.0
         self._last_text = ""
 
     def start(self, ctx: SkillContext) -> None:
         """Ask the controllers to start."""
         self._ctx = ctx
-        self._task_id = self._controller.new_task_id(ctx.skill_id, ctx.attempt)
+        self._run_id = self._controller.new_run_id(ctx.skill_id, ctx.attempt)
         self._send_start()
 
     def _send_start(self) -> None:
         assert self._ctx is not None
-        self._controller.send(self._task_id, wire.RobotTask.START, self._skill, self._ctx.params)
+        self._controller.send(self._run_id, wire.SkillRun.START, self._skill, self._ctx.params)
         self._sent = time.monotonic()
 
     def update(self, now: float) -> Outcome | None:
         """Follow the controllers' status; resend START if nothing was heard yet."""
         assert self._ctx is not None
-        status = self._controller.status(self._task_id)
+        status = self._controller.status(self._run_id)
         if status is None:
             if time.monotonic() - self._sent > RESEND_AFTER:
                 self._send_start()
             return None
-        if status.state == wire.RobotTaskStatus.SUCCEEDED:
-            self._controller.forget(self._task_id)
+        if status.state == wire.SkillRunStatus.SUCCEEDED:
+            self._controller.forget(self._run_id)
             return Outcome.ok(status.text)
-        if status.state == wire.RobotTaskStatus.FAILED:
-            self._controller.forget(self._task_id)
+        if status.state == wire.SkillRunStatus.FAILED:
+            self._controller.forget(self._run_id)
             return Outcome.failed(status.text or "failed")
         if status.text and status.text != self._last_text:
             self._last_text = status.text
@@ -136,23 +136,23 @@ class ForwardedSkill(SkillBehavior):
 
     def pause(self) -> None:
         """Ask the controllers to hold still."""
-        self._controller.send(self._task_id, wire.RobotTask.PAUSE)
+        self._controller.send(self._run_id, wire.SkillRun.PAUSE)
 
     def resume(self) -> None:
         """Ask the controllers to go on."""
-        self._controller.send(self._task_id, wire.RobotTask.RESUME)
+        self._controller.send(self._run_id, wire.SkillRun.RESUME)
 
     def cancel(self) -> None:
         """Ask the controllers to stop."""
-        self._controller.send(self._task_id, wire.RobotTask.CANCEL)
+        self._controller.send(self._run_id, wire.SkillRun.CANCEL)
 
 
 def _skills(agent: str, kind: str) -> list[SkillType]:
     controller = RobotController(agent)
     return [
         SkillType(name, functools.partial(ForwardedSkill, controller, name))
-        for name, task in TASKS.items()
-        if kind in task.kinds
+        for name, sim_skill in SIM_SKILLS.items()
+        if kind in sim_skill.kinds
     ]
 
 

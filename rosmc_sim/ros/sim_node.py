@@ -7,9 +7,9 @@ after every step (other nodes run with ``/use_sim_time`` true).
 Topics (names in :mod:`rosmc_sim.ros.topics`; stamps are sim time):
 
 * ``/clock`` (rosgraph_msgs/Clock): every step;
-* per robot, ``/<robot>/sim/task`` (rosmc/RobotTask, subscribed) and
-  ``/<robot>/sim/task_status`` (rosmc/RobotTaskStatus, latched): the robot-task
-  protocol (:mod:`rosmc_sim.ros.task_channel`);
+* per robot, ``/<robot>/sim/skill_run`` (rosmc/SkillRun, subscribed) and
+  ``/<robot>/sim/skill_run_status`` (rosmc/SkillRunStatus, latched): the skill-run
+  protocol (:mod:`rosmc_sim.ros.skill_run_channel`);
 * ``/tf``, ``/<robot>/odom`` (nav_msgs/Odometry), ``/<robot>/telemetry``
   (rosmc/Telemetry), ``/<robot>/link/blackout`` (std_msgs/Bool, latched)
   (:mod:`rosmc_sim.ros.robot_state`);
@@ -59,8 +59,8 @@ from .coverage_publisher import CoveragePublisher
 from .robot_state import RobotStatePublisher
 from .science import SciencePublisher
 from .site_publisher import SitePublisher
-from .task_channel import TaskChannel
-from .task_desk import TaskDesk
+from .skill_run_channel import SkillRunChannel
+from .skill_run_desk import SkillRunDesk
 from .timing import Pacer, Throttle
 from .world_markers import WorldPublisher
 
@@ -170,7 +170,8 @@ class SimNode:
         self.config = config
         self.world = World(scenario, gui=config.gui)
         self.sim = Simulation(scenario, self.world, seed=config.seed)
-        self.channels = [TaskChannel(TaskDesk(self.sim, r)) for r in self.sim.robots.values()]
+        robots = self.sim.robots.values()
+        self.channels = [SkillRunChannel(SkillRunDesk(self.sim, r)) for r in robots]
         self.state = RobotStatePublisher(self.sim)
         self.science = SciencePublisher(self.sim)
         self.world_markers = WorldPublisher(self.sim)
@@ -180,7 +181,7 @@ class SimNode:
         self.steps = 0
 
     def step(self) -> None:
-        """One step: take requests, advance tasks and the world, publish what is due."""
+        """One step: take requests, advance skill runs and the world, publish what is due."""
         now = time.monotonic()
         for channel in self.channels:
             channel.handle_requests(now)
@@ -211,7 +212,7 @@ class SimNode:
         )
 
     def close(self) -> None:
-        """Cancel running tasks and disconnect pybullet."""
+        """Cancel running skill runs and disconnect pybullet."""
         for channel in self.channels:
             channel.close()
         self.world.close()

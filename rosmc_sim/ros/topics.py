@@ -11,14 +11,14 @@ __all__ = ["SCIENCE_TOPIC", "SIM_NODE", "SITE_TOPIC", "WORLD_TOPIC"]
 SIM_NODE = "/rosmc/sim"
 
 
-def task_topic(robot: str) -> str:
-    """rosmc/RobotTask requests to a robot's controllers."""
-    return f"/{robot}/sim/task"
+def skill_run_topic(robot: str) -> str:
+    """rosmc/SkillRun requests to a robot's controllers."""
+    return f"/{robot}/sim/skill_run"
 
 
-def task_status_topic(robot: str) -> str:
-    """rosmc/RobotTaskStatus from a robot's controllers."""
-    return f"/{robot}/sim/task_status"
+def skill_run_status_topic(robot: str) -> str:
+    """rosmc/SkillRunStatus from a robot's controllers."""
+    return f"/{robot}/sim/skill_run_status"
 
 
 def blackout_topic(agent: str) -> str:

@@ -212,8 +212,9 @@ DOC_COMMANDS: dict[str, Evidence] = {
     "rosmc start drone": _cli("test_sync_shows_uploading", '["start", "drone"]'),
     "rosmc status": _cli("test_sync_shows_uploading", 'rosmc(server, "status")'),
     "rosmc unsync drone": _cli("test_sync_shows_uploading", '[["unsync", "drone"]]'),
-    "rosmc policy drone safe_skill --after 60 --skill return_to_lander": _cli(
-        "test_policy_is_checked_and_sent", '"safe_skill", "--skill"'
+    "rosmc lost-link-policy drone safe_skill --after 60 --skill return_to_lander": _cli(
+        "test_lost_link_policy_is_checked_and_sent",
+        '["lost-link-policy", "drone", "safe_skill", "--after", "60", "--skill"',
     ),
     "rosmc watch": _cli("test_watch_sees_concurrent_changes", '["watch", "--count", "2"]'),
     "rosmc save mission.yaml && rosmc load mission.yaml": _cli(

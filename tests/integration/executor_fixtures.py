@@ -183,11 +183,11 @@ class Operator:
         """Let the robot(s) execute."""
         self.control(agent, srv.ControlRequest.START)
 
-    def retry(self, skill_id: str) -> str:
+    def retry_skill(self, skill_id: str) -> str:
         """Retry a failed skill; returns the fresh instance's id."""
         return str(self.change("retry_skill", skill_id=skill_id).new_skill_id)
 
-    def skip(self, skill_id: str) -> None:
+    def skip_skill(self, skill_id: str) -> None:
         """Skip a failed skill."""
         self.change("skip_skill", skill_id=skill_id)
 

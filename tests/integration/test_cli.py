@@ -335,7 +335,7 @@ def test_compose_edit_reorder_barrier(server: Server, fresh: MissionClient) -> N
 
 def build_mission(client: MissionClient) -> dict[str, str]:
     """A small mission made through the client API; the skill ids by role."""
-    client.add_marker(TaskMarker("RSS A", MarkerType.POSITION, Pose(10.0, 6.0)))
+    client.add_task_marker(TaskMarker("RSS A", MarkerType.POSITION, Pose(10.0, 6.0)))
     return {
         "climb": client.add_skill("drone", "take_off", {"altitude": 12}).skill_id,
         "cover": client.add_skill("drone", "fly_over", {"altitude": 9.5}).skill_id,
@@ -352,7 +352,7 @@ def test_every_error_class_exits_1_with_one_line(
 ) -> None:
     broken = tmp_path / "broken.yaml"
     broken.write_text("rosmc_mission: 1\ntasks: []\n")
-    fresh.add_marker(TaskMarker("RSS A", MarkerType.POSITION, Pose(10.0, 6.0)))
+    fresh.add_task_marker(TaskMarker("RSS A", MarkerType.POSITION, Pose(10.0, 6.0)))
     first = fresh.add_skill("science_rover", "navigate_to").skill_id
     second = fresh.add_skill("science_rover", "explore").skill_id
     cases = {
@@ -436,7 +436,7 @@ def test_watch_sees_concurrent_changes(server: Server, fresh: MissionClient) -> 
     assert ready.startswith("rosmc: watching mission events from revision"), ready
     added = rosmc(server, "add", "drone", "land").strip()
     fresh.get_mission()
-    fresh.add_marker(TaskMarker("Here", MarkerType.POSITION, Pose(1.0, 2.0)))
+    fresh.add_task_marker(TaskMarker("Here", MarkerType.POSITION, Pose(1.0, 2.0)))
     out, err = watcher.communicate(timeout=60.0)
     assert watcher.returncode == 0, err
     first, second = out.splitlines()
@@ -510,21 +510,24 @@ def test_undo_walks_back_and_redoes(server: Server, fresh: MissionClient) -> Non
     assert_refused(refused, "revision 1 is not one of the last")
 
 
-def test_policy_is_checked_and_sent(server: Server) -> None:
+def test_lost_link_policy_is_checked_and_sent(server: Server) -> None:
     """The robots never answer here: the server sends the policy (exit 0) or refuses it."""
     sent = run_many(
         server.env,
         [
-            ["policy", "manipulator_rover", "hold", "--after", "5"],
-            ["policy", "science_rover", "safe_skill", "--skill", "navigate_to", "--param",
+            ["lost-link-policy", "manipulator_rover", "hold", "--after", "5"],
+            ["lost-link-policy", "science_rover", "safe_skill", "--skill", "navigate_to", "--param",
              "speed=0.2", "--after", "30"],
-            ["--json", "policy", "science_rover", "continue"],
+            ["--json", "lost-link-policy", "science_rover", "continue"],
             # docs/operator-guide.md, "Lost-link policy"
-            ["policy", "manipulator_rover", "return_to_link", "--skill", "navigate_to",
+            ["lost-link-policy", "manipulator_rover", "return_to_link", "--skill", "navigate_to",
              "--when", "idle", "--after", "90"],
+            # docs/operator-guide.md, "Command line"
+            ["lost-link-policy", "drone", "safe_skill", "--after", "60", "--skill",
+             "return_to_lander"],
         ],
     )  # fmt: skip
-    assert [result.returncode for result in sent] == [0, 0, 0, 0], [r.stderr for r in sent]
+    assert [result.returncode for result in sent] == [0] * 5, [r.stderr for r in sent]
     assert sent[0].stdout == "manipulator_rover: on link loss: hold after 5 s (sent to the robot)\n"
     assert "run navigate_to after 30 s, then hold" in sent[1].stdout
     assert set(json.loads(sent[2].stdout)) == {"revision"}
@@ -532,24 +535,25 @@ def test_policy_is_checked_and_sent(server: Server) -> None:
         "manipulator_rover: on link loss: return to the last link position (navigate_to) "
         "after 90 s idle without a link, then hold (sent to the robot)\n"
     )
+    verb = "lost-link-policy"
     refused = {
-        ("policy", "lander", "hold"): "static agent",
-        ("policy", "drone", "safe_skill", "--skill", "teleport"): "no skill 'teleport'",
-        ("policy", "drone", "safe_skill", "--skill", "navigate_to", "--param=speed=99"): "speed",
-        ("policy", "drone", "return_to_link", "--skill", "land"): "exactly one pose parameter",
+        (verb, "lander", "hold"): "static agent",
+        (verb, "drone", "safe_skill", "--skill", "teleport"): "no skill 'teleport'",
+        (verb, "drone", "safe_skill", "--skill", "navigate_to", "--param=speed=99"): "speed",
+        (verb, "drone", "return_to_link", "--skill", "land"): "exactly one pose parameter",
     }
     for result, needle in zip(run_many(server.env, list(refused)), refused.values(), strict=True):
         assert_refused(result, needle)
     usage = run_many(
         server.env,
         [
-            ["policy", "drone", "hold", "--skill", "land"],
-            ["policy", "drone", "safe_skill"],
-            ["policy", "drone", "hold", "--param", "speed=1"],
-            ["policy", "drone", "panic"],
-            ["policy", "drone", "hold", "--after", "0"],
-            ["policy", "drone", "return_to_link"],
-            ["policy", "drone", "hold", "--when", "soon"],
+            ["lost-link-policy", "drone", "hold", "--skill", "land"],
+            ["lost-link-policy", "drone", "safe_skill"],
+            ["lost-link-policy", "drone", "hold", "--param", "speed=1"],
+            ["lost-link-policy", "drone", "panic"],
+            ["lost-link-policy", "drone", "hold", "--after", "0"],
+            ["lost-link-policy", "drone", "return_to_link"],
+            ["lost-link-policy", "drone", "hold", "--when", "soon"],
         ],
     )
     assert [result.returncode for result in usage] == [2] * 7, [r.stderr for r in usage]
@@ -664,7 +668,7 @@ def test_diff_and_restore_a_past_moment(server: Server, fresh: MissionClient) ->
     planned = mission_to_json(fresh.get_mission())
     fresh.edit_skill(ids["cover"], {"altitude": 4.5})
     fresh.delete_skills([ids["land"]])
-    fresh.add_marker(TaskMarker("Late", MarkerType.POSITION, Pose(3.0, 4.0)))
+    fresh.add_task_marker(TaskMarker("Late", MarkerType.POSITION, Pose(3.0, 4.0)))
     added = fresh.add_skill("drone", "land").skill_id
     now = fresh.revision
     journal = str(journal_of(server))

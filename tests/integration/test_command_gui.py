@@ -25,7 +25,7 @@ from python_qt_binding.QtWidgets import QApplication, QMessageBox
 from rosmc_rqt_command.core import presentation
 from rosmc_rqt_command.qt.agent_column import SectionTable
 from rosmc_rqt_command.qt.command_widget import CommandWidget
-from rosmc_rqt_command.qt.schedule_model import SKILL, STATUS, TAG
+from rosmc_rqt_command.qt.task_model import SKILL, STATUS, TAG
 from rosmc_rqt_command.ros_bridge import RosBridge
 from rosmc_rqt_command.standalone import build
 from rosmc_server.core import MarkerType, Pose, SkillStatus, TaskMarker
@@ -78,7 +78,7 @@ class Gui:
         self.bridge = bridge
 
     def column(self, agent: str) -> Any:
-        return self.widget.schedule.columns[agent]
+        return self.widget.tasks.columns[agent]
 
     def table(self, agent: str, blueprint: bool) -> SectionTable:
         column = self.column(agent)
@@ -201,7 +201,7 @@ def test_operator_builds_edits_runs_and_adapts_a_two_robot_mission(team: Any) ->
     mission = operator.mission()
     assert [s.skill for s in mission.task("r1")] == ["probe", "wait"]
     assert [s.skill for s in mission.task("r2")] == ["wait", "wait"]
-    assert w.schedule.selected_ids == [long_wait]  # a new skill is selected for editing
+    assert w.tasks.selected_ids == [long_wait]  # a new skill is selected for editing
 
     # -- edit every parameter type of the probe ---------------------------------------------
     gui.click_row("r1", True, 0)
@@ -258,7 +258,7 @@ def test_operator_builds_edits_runs_and_adapts_a_two_robot_mission(team: Any) ->
 
     # -- a task marker: bind by choosing it, rename by typing --------------------------------
     client = MissionClient(5.0)
-    client.add_marker(TaskMarker("rock", MarkerType.POSE, Pose(7.0, 8.0)))
+    client.add_task_marker(TaskMarker("rock", MarkerType.POSE, Pose(7.0, 8.0)))
     picker = wait_until(
         lambda: (
             w.parameters.pickers["target"].findText("rock") > 0 and w.parameters.pickers["target"]
@@ -286,7 +286,7 @@ def test_operator_builds_edits_runs_and_adapts_a_two_robot_mission(team: Any) ->
     gui.click("button_move_down")
     wait_until(lambda: [s.id for s in gui.rows("r1", True)] == [first, probe], 30, "moved")
     assert [s.id for s in operator.mission().task("r1")] == [first, probe]
-    assert w.schedule.selected_ids == [probe]  # the selection followed the row
+    assert w.tasks.selected_ids == [probe]  # the selection followed the row
     model = gui.table("r1", True).section
     model.dropMimeData(model.mimeData([model.index(1, 0)]), Qt.MoveAction, 0, 0, QModelIndex())
     wait_until(lambda: [s.id for s in gui.rows("r1", True)] == [probe, first], 30, "dropped")
@@ -296,7 +296,7 @@ def test_operator_builds_edits_runs_and_adapts_a_two_robot_mission(team: Any) ->
     # -- a barrier across robots with Ctrl-click ------------------------------------------------
     gui.click_row("r1", True, 0)
     gui.click_row("r2", True, 0, Qt.ControlModifier)
-    assert w.schedule.selected_ids == [first, partner]
+    assert w.tasks.selected_ids == [first, partner]
     gui.click("button_barrier")
     wait_until(lambda: operator.mission().barrier_of(first) is not None, 30, "barrier")
     assert set(operator.mission().barrier_of(first).skill_ids) == {first, partner}
@@ -312,7 +312,7 @@ def test_operator_builds_edits_runs_and_adapts_a_two_robot_mission(team: Any) ->
     gui.said("wait at a barrier for ever")
     wait_until(lambda: gui.rows("r1", False) and gui.rows("r1", False)[0].id == first, 30, "synced")
     assert operator.mission().skill(first).status is S.IDLE_SYNCHRONIZED
-    assert w.schedule.selected_ids == [first]  # followed into the synchronized table
+    assert w.tasks.selected_ids == [first]  # followed into the synchronized table
     # Send r2's wait (with its long duration first set) with the column's Sync all button.
     gui.click_row("r2", True, 1)
     wait_until(lambda: w.parameters.skill and w.parameters.skill.id == long_wait, 30, "shown")

@@ -36,9 +36,9 @@ pytest_plugins = ["tests.integration.server_fixtures"]
 
 
 def press(window: Window, key: int, modifiers: Any = Qt.ControlModifier) -> None:
-    """A key press on the focused schedule of the active command window."""
+    """A key press on the focused task panel of the active command window."""
     QApplication.setActiveWindow(window.w)
-    target = QApplication.focusWidget() or window.w.schedule
+    target = QApplication.focusWidget() or window.w.tasks
     QTest.keyClick(target, key, modifiers)
 
 

@@ -97,7 +97,7 @@ def recorded_statuses(history: MissionHistory, seconds: float) -> dict[str, str]
 def select_first_skill(widget: Any) -> Any:
     """Click the first row of the first robot with skills; return its column."""
     agent = next(a for a, v in widget.view.agents.items() if v.skills)
-    column = widget.schedule.columns[agent]
+    column = widget.tasks.columns[agent]
     synced = column.synced_table
     table = synced if synced.section.rowCount() else column.blueprint_table
     rect = table.visualRect(table.section.index(0, 2))
@@ -112,11 +112,11 @@ def read_only_controls_disabled(window: Window) -> None:
     enabled = [a.text() for a in widget.actions_.skill.values() if a.isEnabled()]
     enabled += [a.text() for a in widget.actions_.all_robots.values() if a.isEnabled()]
     enabled += [n for n, a in widget.actions_.file.items() if a.isEnabled() and n != "save_as"]
-    for agent, column in widget.schedule.columns.items():
+    for agent, column in widget.tasks.columns.items():
         buttons = [*column.buttons.values(), column.add_button, column.policy_button]
         enabled += [f"{agent}: {b.text()}" for b in buttons if b.isEnabled()]
         if column.blueprint_table.dragEnabled():
-            enabled.append(f"{agent}: dragging the plan")
+            enabled.append(f"{agent}: dragging the task")
     panel = widget.parameters
     for editor in (panel.label_edit, panel.timeout_spin, panel.retries_spin):
         if editor.isEnabled():
@@ -189,7 +189,7 @@ def test_open_a_recording_seek_to_an_event_play_to_the_end_and_return_to_live(
     QTest.mouseClick(bar.live_button, Qt.LeftButton)
     wait_until(lambda: window.ids("drone") == live_ids, 20, "the live mission again")
     assert not bar.isVisible() and not widget.backend.read_only and mode.process is None
-    column = widget.schedule.columns["drone"]
+    column = widget.tasks.columns["drone"]
     wait_until(lambda: column.add_button.isEnabled(), 10, "adding skills enabled again")
     assert column.blueprint_table.dragEnabled()
     for pid in children:
@@ -229,7 +229,7 @@ def test_following_a_replay_greys_out_what_cannot_act(
     widget.resize(1400, 800)
     widget.show()
     try:
-        wait_until(lambda: widget.view.loaded and widget.schedule.columns, 30, "the replay shown")
+        wait_until(lambda: widget.view.loaded and widget.tasks.columns, 30, "the replay shown")
         column = select_first_skill(widget)
         assert not widget.parameters.label_edit.isEnabled()
         assert not column.blueprint_table.dragEnabled()

@@ -76,7 +76,7 @@ def test_after_a_restart_the_window_says_so_and_shows_the_new_servers_robots(
     connected(window)
     window.add("drone", "take_off")
     wait_until(lambda: window.ids("drone"), 10, "take_off shown")
-    header = window.w.schedule.columns["drone"].status_label
+    header = window.w.tasks.columns["drone"].status_label
     wait_until(lambda: "link up" in header.text(), 30, "the drone's link up")
     revision = window.bridge.mirror_revision
     assert revision is not None

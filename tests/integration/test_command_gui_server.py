@@ -1,5 +1,5 @@
 """The command GUI when the mission server is gone, slow or restarted; two windows; files;
-sending the whole team's plans with the mouse; the science score in view.
+sending the whole team's tasks with the mouse; the science score in view.
 
 A real master and real ``mission_server`` processes; the real widget and ROS bridge
 (offscreen Qt). While the server is stopped (or frozen with SIGSTOP) the operator keeps
@@ -36,9 +36,9 @@ from python_qt_binding.QtWidgets import (
 
 from rosmc_rqt_command.core.legality import Action, RobotAction
 from rosmc_rqt_command.qt.command_widget import CommandWidget
-from rosmc_rqt_command.qt.schedule_model import STATUS
 from rosmc_rqt_command.qt.science_strip import NO_SCORE
 from rosmc_rqt_command.qt.site_strip import NO_SITE
+from rosmc_rqt_command.qt.task_model import STATUS
 from rosmc_rqt_command.standalone import build
 from rosmc_server.conversions.science import science_to_msg
 from rosmc_server.conversions.site import site_to_msg
@@ -94,11 +94,11 @@ class Window:
         return [s.id for s in self.widget.view.view(agent).skills]
 
     def add(self, agent: str, skill: str) -> None:
-        column = self.widget.schedule.columns[agent]
+        column = self.widget.tasks.columns[agent]
         next(a for a in column.add_menu.actions() if a.text() == skill).trigger()
 
     def click_row(self, agent: str, row: int, blueprint: bool = True) -> None:
-        column = self.widget.schedule.columns[agent]
+        column = self.widget.tasks.columns[agent]
         table = column.blueprint_table if blueprint else column.synced_table
         rect = table.visualRect(table.section.index(row, 2))
         QTest.mouseClick(table.viewport(), Qt.LeftButton, Qt.NoModifier, rect.center())
@@ -138,7 +138,7 @@ def windows(client_node: Any) -> Iterator[Callable[[], Window]]:
 def shown(window: Window, timeout: float = 20.0) -> None:
     """The window shows a mission and knows the skill library."""
     wait_until(
-        lambda: window.w.view.loaded and window.w.view.library and window.w.schedule.columns,
+        lambda: window.w.view.loaded and window.w.view.library and window.w.tasks.columns,
         timeout,
         "the mission is shown",
     )
@@ -187,7 +187,7 @@ def test_server_gone_then_back(start_server: StartServer, windows: Any) -> None:
     # The operator goes on: adds, deletes, starts. Each ends as a sentence.
     window.add("drone", "land")
     window.click_row("drone", 0)
-    QTest.keyClick(window.w.schedule.table_of(old[0]), Qt.Key_Delete)
+    QTest.keyClick(window.w.tasks.table_of(old[0]), Qt.Key_Delete)
     window.w.do(Action.DELETE)
     window.said("Could not add land to drone: the mission server did not answer")
     window.said("Could not delete 'take_off'")
@@ -218,7 +218,7 @@ def test_a_frozen_server_does_not_freeze_the_window(
         ticked = beat.ticks
         # The operator waits, scrolls, clicks: the loop runs on while both calls wait.
         wait_until(lambda: beat.ticks >= ticked + 20, 60, "twenty ticks of the event loop")
-        window.w.schedule.columns["drone"].blueprint_table.viewport().update()
+        window.w.tasks.columns["drone"].blueprint_table.viewport().update()
         answers = [m for m in window.w.messages.messages() if any(c in m for c in calls)]
         assert answers == [], "an answer from a frozen server"
     finally:
@@ -248,13 +248,13 @@ def test_two_windows_stay_consistent_and_a_stale_edit_is_a_conflict(
     assert second.ids("drone") == [take_off, land]
 
     second.click_row("drone", 0)
-    assert second.w.schedule.selected_ids == [take_off]
+    assert second.w.tasks.selected_ids == [take_off]
     before = second.w.view.revision
     # The first operator moves the skills while the second window has not heard yet
     # (nothing runs the second window's event loop in between).
     client = MissionClient(5.0)
     try:
-        client.reorder("drone", [land, take_off], base_revision=before)
+        client.reorder_skills("drone", [land, take_off], base_revision=before)
     finally:
         client.close()
     assert second.w.view.revision == before
@@ -267,7 +267,7 @@ def test_two_windows_stay_consistent_and_a_stale_edit_is_a_conflict(
 
     # The lost-link policy goes through the client's typed call (the server keeps it for
     # the robot, which is not running here).
-    column = first.w.schedule.columns["drone"]
+    column = first.w.tasks.columns["drone"]
     column.ask_policy = lambda *_: LostLinkPolicy(LostLinkKind.HOLD, 30.0)
     QTest.mouseClick(column.policy_button, Qt.LeftButton)
     message = first.said("set drone's policy (on link loss: hold after 30 s)")
@@ -296,7 +296,7 @@ class Questions:
 
 
 def ctrl_click_row(window: Window, agent: str, row: int) -> None:
-    table = window.w.schedule.columns[agent].blueprint_table
+    table = window.w.tasks.columns[agent].blueprint_table
     rect = table.visualRect(table.section.index(row, 2))
     QTest.mouseClick(table.viewport(), Qt.LeftButton, Qt.ControlModifier, rect.center())
 
@@ -337,12 +337,12 @@ def test_a_two_robot_barrier_plan_goes_out_with_one_click_and_one_question(
         before = window.w.view.revision
         # Send all robots: one question for the team (no robot listed twice), then one change.
         QTest.mouseClick(window.w.control.buttons["send_all"], Qt.LeftButton)
-        message = window.said("Done: send the plans of drone, science_rover")
+        message = window.said("Done: send the tasks of drone, science_rover")
     finally:
         questions.stop()
     assert len(questions.asked) == 2, questions.asked
     team = questions.asked[1]
-    assert "drone: 2 skill(s), its whole plan" in team and "science_rover: 2 skill(s)" in team
+    assert "drone: 2 skill(s), its whole task" in team and "science_rover: 2 skill(s)" in team
     assert "Warnings" not in team, team
     assert f"(revision {before + 1})" in message, message
     wait_until(
@@ -350,7 +350,7 @@ def test_a_two_robot_barrier_plan_goes_out_with_one_click_and_one_question(
             window.w.view.view(agent).editable == () for agent in ("drone", "science_rover")
         ),
         30,
-        "both plans in transfer",
+        "both tasks in transfer",
     )
     no_traceback(window)
 
@@ -480,7 +480,7 @@ def test_a_send_to_a_robot_out_of_contact_is_shown_waiting(
     shown(window)
     window.add("drone", "take_off")
     wait_until(lambda: window.ids("drone"), 30, "take_off shown")
-    column = window.w.schedule.columns["drone"]
+    column = window.w.tasks.columns["drone"]
     send = column.buttons[RobotAction.SYNC_ALL]
     wait_until(send.isEnabled, 30, "Sync all enabled")
     QTest.mouseClick(send, Qt.LeftButton)

@@ -49,15 +49,15 @@ def test_shortcuts_fire_in_a_real_window(tmp_path: Path) -> None:
     assert pressed == {
         "active": True,
         "Delete": [["delete_skills", [["alpha-3"]]]],
-        "Alt+Up": [["reorder", ["alpha", ["alpha-2", "alpha-1", "alpha-4"]]]],
-        "Ctrl+Up": [["reorder", ["alpha", ["alpha-2", "alpha-1", "alpha-4"]]]],
-        "Ctrl+Down": [["reorder", ["alpha", ["alpha-1", "alpha-4", "alpha-2"]]]],
+        "Alt+Up": [["reorder_skills", ["alpha", ["alpha-2", "alpha-1", "alpha-4"]]]],
+        "Ctrl+Up": [["reorder_skills", ["alpha", ["alpha-2", "alpha-1", "alpha-4"]]]],
+        "Ctrl+Down": [["reorder_skills", ["alpha", ["alpha-1", "alpha-4", "alpha-2"]]]],
         "Ctrl+Return": [["synchronize", ["alpha", "alpha-2"]]],
         "Ctrl+B": [["add_barrier", [["alpha-1", "bravo-5"]]]],
         "Ctrl+Shift+B": [["delete_barrier", ["barrier-6"]]],
         "Ctrl+Backspace": [["unsynchronize", ["alpha", "alpha-1"]]],
-        "Ctrl+R": [["retry", ["alpha-1"]]],
-        "Ctrl+K": [["skip", ["alpha-1"]]],
+        "Ctrl+R": [["retry_skill", ["alpha-1"]]],
+        "Ctrl+K": [["skip_skill", ["alpha-1"]]],
         "F4": [["synchronize_team", [{"alpha": None, "bravo": None}]]],
         "F6": [["control", ["START", None]]],
         "F7": [["control", ["PAUSE", None]]],
@@ -71,8 +71,8 @@ def test_shortcuts_fire_in_a_real_window(tmp_path: Path) -> None:
         "Ctrl+N": "asked: starting a new mission",
         "F5": "refreshed",
         "Escape": [],
-        "Ctrl+Z": [["undo", [41]]],
-        "Ctrl+Shift+Z": [["undo", [42]]],
+        "Ctrl+Z": [["undo_edit", [41]]],
+        "Ctrl+Shift+Z": [["undo_edit", [42]]],
     }
 
 
@@ -176,8 +176,8 @@ def drive() -> None:
     press("F5")
     report["F5"] = "refreshed" if backend.refreshes == refreshes + 1 else "not refreshed"
     press("Escape")
-    if widget.schedule.selected_ids:
-        report["Escape"] = ["still selected", widget.schedule.selected_ids]
+    if widget.tasks.selected_ids:
+        report["Escape"] = ["still selected", widget.tasks.selected_ids]
     # The file dialogs: each key opens its dialog (closed again with Escape).
     widget.files.ask = lambda doing: "discard"
     for keys in ("Ctrl+O", "Ctrl+Shift+O", "Ctrl+Shift+S", "Ctrl+Alt+S"):

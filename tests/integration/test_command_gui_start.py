@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from bench._missions import library_yaml, mission_yaml
-from rosmc_rqt_command.qt.schedule_widget import FIRST_COLUMNS
+from rosmc_rqt_command.qt.task_widget import FIRST_COLUMNS
 from tests import conftest
 from tests.integration.executor_fixtures import Operator, RosmcSystem
 

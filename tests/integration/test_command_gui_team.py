@@ -74,14 +74,14 @@ def test_twenty_robots_scroll_compact_and_filter(window: Any) -> None:
     conftest.wait_until(
         lambda: all(c.blueprint_table.section.rows for c in columns(widget).values()),
         20,
-        "every robot's plan shown",
+        "every robot's task shown",
         pause=conftest.qt_pause,
     )
     settle(widget)
     # Every robot can be reached with the scroll bar.
     wide = on_screen(widget)
     seen = list(wide)
-    bar = widget.schedule.horizontalScrollBar()
+    bar = widget.tasks.horizontalScrollBar()
     while bar.value() < bar.maximum():
         step_right(widget)
         seen += [agent for agent in on_screen(widget) if agent not in seen]

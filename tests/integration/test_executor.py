@@ -422,7 +422,7 @@ def test_a_member_that_failed_at_its_barrier_is_retried_and_starts_with_its_part
     system, op = rosmc(agents=("r1", "r2"))
     member, partner, barrier = failed_at_the_barrier(op)
     mark = len(op.events)
-    fresh = op.retry(member)
+    fresh = op.retry_skill(member)
     state = op.wait_status([fresh, partner], S.SUCCESS)
     assert state.barrier(barrier).skill_ids == (fresh, partner)
     retried = next(m for _, m in op.events.since(mark) if m.kind == wire.MissionEvent.SKILL_RETRIED)
@@ -446,7 +446,7 @@ def test_skipping_a_member_that_failed_at_its_barrier_lets_its_partner_go_on(
 ) -> None:
     _, op = rosmc(agents=("r1", "r2"))
     member, partner, _ = failed_at_the_barrier(op)
-    op.skip(member)
+    op.skip_skill(member)
     state = op.wait_status([partner], S.SUCCESS)
     assert state.barriers == ()
     assert state.skill(member).resolution is Resolution.SKIPPED
@@ -472,17 +472,17 @@ def test_failure_retry_skip_and_a_retry_that_succeeds(rosmc: Start) -> None:
         op.edit(probe, {"fail": False})
     assert refused.value.code == ErrorCode.RULE
 
-    fresh = op.retry(probe)
+    fresh = op.retry_skill(probe)
     state = op.wait_status([fresh], S.FAILURE)
     again = state.skill(fresh)
     assert again.attempt == 2 and again.id != probe
     assert state.skill(probe).resolution is Resolution.RETRIED
     assert [s.id for s in state.task("r1")] == [probe, fresh, after]
-    op.skip(fresh)
+    op.skip_skill(fresh)
     op.wait_status([after], S.SUCCESS)
 
     op.control("r2", srv.ControlRequest.STOP)  # so the fresh instance waits on the robot
-    fresh2 = op.retry(probe2)
+    fresh2 = op.retry_skill(probe2)
     op.wait_status([fresh2], S.IDLE_SYNCHRONIZED)
     assert op.unsync("r2", fresh2) == [fresh2, after2]
     op.wait_status([fresh2, after2], S.IDLE)
@@ -808,7 +808,7 @@ def test_lost_link_policy_hold_set_by_the_operator(rosmc: Start) -> None:
     robot_side = LinkEnd("r1", "ground", robot_names=True)  # hears r1 behind the emulator
     wait_until(robot_side.connected, 30.0, "r1's side of the link")
     with MissionClient(timeout=60.0) as client:
-        client.set_robot_options("r1", LostLinkPolicy(LostLinkKind.HOLD, after=1.0))
+        client.set_lost_link_policy("r1", LostLinkPolicy(LostLinkKind.HOLD, after=1.0))
     op.wait_mission(
         lambda m: "hold after 1 s" in op.agent_state("r1").policy, 30.0, "the policy to be in force"
     )
@@ -977,8 +977,8 @@ def test_commands_for_a_robot_out_of_contact_wait_and_arrive_once_in_order(rosmc
     assert answer.note.startswith("queued for r1: out of contact"), answer.note
     op.change("unsynchronize", agent="r1", from_id=drop)  # take the second one back
     with MissionClient(timeout=60.0) as client:
-        client.set_robot_options("r1", LostLinkPolicy(LostLinkKind.HOLD, after=30.0))
-        client.set_robot_options("r1", LostLinkPolicy(LostLinkKind.HOLD, after=45.0))
+        client.set_lost_link_policy("r1", LostLinkPolicy(LostLinkKind.HOLD, after=30.0))
+        client.set_lost_link_policy("r1", LostLinkPolicy(LostLinkKind.HOLD, after=45.0))
     state = op.mission()
     assert state.skill(keep).transfer is Transfer.UPLOADING, describe(state)
     assert state.skill(drop).is_editable, describe(state)

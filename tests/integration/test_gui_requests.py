@@ -75,19 +75,19 @@ def setup_mission() -> tuple[str, str, str]:
     with MissionClient(5.0) as other:
         first = other.add_skill("drone", "take_off").skill_id
         second = other.add_skill("drone", "land").skill_id
-        marker = other.add_marker(POINT).name
+        marker = other.add_task_marker(POINT).name
     return first, second, marker
 
 
 CALLS: dict[str, Callable[[str, str, str, int], Request]] = {
-    "move_skills": lambda a, b, m, seen: ask(lambda c: c.move_skills, "move", seen)(
-        "drone", [(b, 0)]
+    "reorder_skills": lambda a, b, m, seen: ask(lambda c: c.reorder_skills, "move", seen)(
+        "drone", moves=[(b, 0)]
     ),
-    "add_marker": lambda a, b, m, seen: ask(lambda c: c.add_marker, "new marker", seen)(POINT),
-    "move_marker": lambda a, b, m, seen: ask(lambda c: c.move_marker, "move marker", seen)(
+    "add_task_marker": lambda a, b, m, seen: ask(lambda c: c.add_task_marker, "new", seen)(POINT),
+    "move_task_marker": lambda a, b, m, seen: ask(lambda c: c.move_task_marker, "move", seen)(
         m, Pose(5.0, 5.0)
     ),
-    "delete_marker": lambda a, b, m, seen: ask(lambda c: c.delete_marker, "delete", seen)(m),
+    "delete_task_marker": lambda a, b, m, seen: ask(lambda c: c.delete_task_marker, "del", seen)(m),
     "delete_skills": lambda a, b, m, seen: ask(lambda c: c.delete_skills, "delete", seen)([a]),
 }
 
@@ -128,7 +128,7 @@ def test_a_second_quick_request_is_made_against_the_first_ones_result(
     """Two clicks on one view: the second is not refused because of the first."""
     first, _second, marker = setup_mission()
     seen, _ = mission_now()
-    bridge.request(ask(lambda c: c.delete_marker, "delete", seen)(marker))
+    bridge.request(ask(lambda c: c.delete_task_marker, "delete", seen)(marker))
     answer = answer_of(bridge, ask(lambda c: c.delete_skills, "delete", seen)([first]))
     assert answer.ok, answer
     assert mission_now()[0] == seen + 2
@@ -144,8 +144,8 @@ def test_the_marker_nodes_worker_fills_the_base_revision_too(
     worker = AsyncMissionClient(MissionClient(5.0), "test-markers")
     outcomes: list[Outcome[Any]] = []
     try:
-        worker.submit(lambda c: c.delete_marker(marker), outcomes.append, seen).exception(30)
-        worker.submit(lambda c: c.delete_marker(marker), outcomes.append, seen + 1).result(30)
+        worker.submit(lambda c: c.delete_task_marker(marker), outcomes.append, seen).exception(30)
+        worker.submit(lambda c: c.delete_task_marker(marker), outcomes.append, seen + 1).result(30)
     finally:
         worker.close()
     refused, accepted = outcomes
@@ -165,13 +165,13 @@ def test_after_a_fresh_server_requests_are_made_against_its_revisions(
     try:
         for _ in range(3):
             seen = bridge.mirror_revision
-            assert answer_of(bridge, ask(lambda c: c.add_marker, "new", seen)(POINT)).ok
+            assert answer_of(bridge, ask(lambda c: c.add_task_marker, "new", seen)(POINT)).ok
         server.stop()
         start_server("second")  # an empty mission at revision 0
         conftest.wait_until(
             lambda: bridge.mirror_revision == 0, 60, "the new mission", pause=conftest.qt_pause
         )
-        answer = answer_of(bridge, ask(lambda c: c.add_marker, "new", 0)(POINT))
+        answer = answer_of(bridge, ask(lambda c: c.add_task_marker, "new", 0)(POINT))
         assert answer.ok, answer
         assert mission_now()[0] == 1
     finally:

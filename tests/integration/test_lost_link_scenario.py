@@ -1,4 +1,4 @@
-"""A rover whose synchronized plan ends out of coverage, on the real simulated team.
+"""A rover whose synchronized task ends out of coverage, on the real simulated team.
 
 With its library default (``return_to_link`` after 60 s idle without a link) it drives
 back to where it last had a link, the ground hears it again, and it holds; work the operator
@@ -117,8 +117,8 @@ def test_work_sent_while_out_of_contact_reaches_the_rover_when_its_default_bring
     assert set(sent.skill_ids) == {home, extra}
     assert sent.note.startswith(f"queued for {ARM}: out of contact"), sent.note
     c.unsynchronize(ARM, extra)  # take one back while it waits
-    c.set_robot_options(ARM, LostLinkPolicy(LostLinkKind.HOLD, after=600.0))
-    c.set_robot_options(ARM, LostLinkPolicy())  # a second change replaces the first
+    c.set_lost_link_policy(ARM, LostLinkPolicy(LostLinkKind.HOLD, after=600.0))
+    c.set_lost_link_policy(ARM, LostLinkPolicy())  # a second change replaces the first
     waiting = wait_until(  # one upload and one policy, shown with their age
         lambda: (s := op.agent_state(ARM)) is not None and s.commands_waiting == 2 and s,
         30.0,
@@ -147,7 +147,7 @@ def test_work_sent_while_out_of_contact_reaches_the_rover_when_its_default_bring
 
 
 def test_with_policy_continue_the_rover_stays_out(op: Operator) -> None:
-    op.client.set_robot_options(ARM, LostLinkPolicy())
+    op.client.set_lost_link_policy(ARM, LostLinkPolicy())
     wait_until(
         lambda: (s := op.agent_state(ARM)) and s.policy == "on link loss: continue",
         30.0,

@@ -34,7 +34,7 @@ def skills_of(client: MissionClient, agent: str) -> list[Any]:
 
 
 def add_marker(client: MissionClient, rviz: Rviz, marker: TaskMarker) -> str:
-    name = client.add_marker(marker).name
+    name = client.add_task_marker(marker).name
     rviz.marker(f"task/{name}")
     return name
 
@@ -131,7 +131,7 @@ def test_drag_moves_the_marker_and_its_bound_skills(mission: Any, rviz: Rviz) ->
     for skill_id in (first.skill_id, second.skill_id):
         assert state.skill(skill_id).params["target"] == expected
     # an edit of the bound parameter elsewhere (a move through the server) moves the marker
-    mission.move_marker(name, Pose(-4.0, 2.0), base_revision=state.revision)
+    mission.move_task_marker(name, Pose(-4.0, 2.0), base_revision=state.revision)
     rviz.marker(f"task/{name}", at(-4.0, 2.0))
 
 

@@ -58,11 +58,11 @@ def journal(start_server: Any, tmp_path: Path) -> Path:
     try:
         client.get_mission()
         client.add_skill("scout", "take_off")
-        client.add_marker(TaskMarker("goal", MarkerType.POSE, MissionPose(3.0, 4.0)))
+        client.add_task_marker(TaskMarker("goal", MarkerType.POSE, MissionPose(3.0, 4.0)))
         area = tuple(MissionPose(x, y) for x, y in ((10, 0), (16, 0), (16, 6), (10, 6)))
-        client.add_marker(TaskMarker("site", MarkerType.AREA, MissionPose(), area))
+        client.add_task_marker(TaskMarker("site", MarkerType.AREA, MissionPose(), area))
         client.add_skill("science_rover", "navigate_to", bindings={"target": "goal"})
-        client.move_marker("goal", MissionPose(*GOAL))
+        client.move_task_marker("goal", MissionPose(*GOAL))
     finally:
         client.close()
     server.stop()

@@ -58,11 +58,11 @@ def test_the_mirror_follows_changes_made_through_the_services(
     follower.mirror.subscribe(updates.append)
     with MissionClient(timeout=30.0) as client:
         wait_until(lambda: follower.mirror.state is not None, 30.0, "the first snapshot")
-        client.add_marker(TaskMarker("rss", MarkerType.POSE, Pose(4.0, 2.0)))
+        client.add_task_marker(TaskMarker("rss", MarkerType.POSE, Pose(4.0, 2.0)))
         first = client.add_skill("drone", "take_off", {"altitude": 6.0}).skill_id
         second = client.add_skill("drone", "navigate_to", bindings={"target": "rss"}).skill_id
-        client.reorder("drone", [second, first])
-        client.move_marker("rss", Pose(7.0, 1.0))
+        client.reorder_skills("drone", [second, first])
+        client.move_task_marker("rss", Pose(7.0, 1.0))
         client.edit_skill(first, {"altitude": 9.0}, label="higher")
         wait_until(lambda: mirrored(follower, client), 30.0, "the mirror to catch up")
     assert follower.mirror.snapshots_requested == 1

@@ -180,14 +180,14 @@ def _session(
         return ids[0]
 
     site.score(0.0, 1)
-    step(lambda: client.add_marker(TaskMarker("RSS A", MarkerType.POSITION, Pose(3.0, 4.0))))
+    step(lambda: client.add_task_marker(TaskMarker("RSS A", MarkerType.POSITION, Pose(3.0, 4.0))))
     take_off = added("drone", "take_off", params={"altitude": 8.0})
     land = added("drone", "land")
     identify = added("science_rover", "identify_stones", bindings={"position": "RSS A"})
     explore = added("science_rover", "explore")
     step(lambda: client.add_barrier([land, identify]))
     step(lambda: client.edit_skill(take_off, {"altitude": 12.0}, label="higher"))
-    step(lambda: client.move_marker("RSS A", Pose(6.0, 2.0)))
+    step(lambda: client.move_task_marker("RSS A", Pose(6.0, 2.0)))
     time.sleep(0.6)  # the robots move on: TF and agent states are journaled meanwhile
     robot.announce()
     step(lambda: client.synchronize("drone", take_off))
@@ -197,8 +197,8 @@ def _session(
     site.score(0.5, 2)
     time.sleep(0.6)
     step(lambda: robot.report(2, take_off, wire.SkillStatus.SUCCESS))
-    step(lambda: client.reorder("science_rover", [explore, identify]))
-    step(lambda: client.rename_marker("RSS A", "RSS B"))
+    step(lambda: client.reorder_skills("science_rover", [explore, identify]))
+    step(lambda: client.rename_task_marker("RSS A", "RSS B"))
     step(lambda: client.delete_skills([explore]))
     site.score(1.0, 3)
     time.sleep(0.6)

@@ -164,7 +164,7 @@ def test_pose_marker_moves_by_its_arrow_and_turns_by_its_ring(
 ) -> None:
     client = MissionClient(10.0)
     client.get_mission()
-    name = client.add_marker(TaskMarker("goal", MarkerType.POSE, Pose(*POSE_AT))).name
+    name = client.add_task_marker(TaskMarker("goal", MarkerType.POSE, Pose(*POSE_AT))).name
     time.sleep(2.0)  # rviz shows the new marker
     x, y = POSE_AT
 

@@ -94,7 +94,7 @@ def test_operator_rviz_shows_robots_markers_and_icons(
 ) -> None:
     client = MissionClient(10.0)
     client.get_mission()
-    name = client.add_marker(TaskMarker("goal", MarkerType.POSE, Pose(*POSE_MARKER))).name
+    name = client.add_task_marker(TaskMarker("goal", MarkerType.POSE, Pose(*POSE_MARKER))).name
     client.add_skill("science_rover", "navigate_to", bindings={"target": name})
     tool = load_tool()
     background = tool.config_background(CONFIG)

@@ -240,7 +240,7 @@ def test_collaborative_identification_scores_the_region_maximum(op: Operator) ->
     start_score = op.science.score()
     assert op.science.region("RSS North") is None, "regions stay hidden until explored"
     # About 12 s of the drone's 30 s of flight.
-    c.add_marker(area("north survey", square(0.0, 9.0, 2.0)))
+    c.add_task_marker(area("north survey", square(0.0, 9.0, 2.0)))
     survey = [
         c.add_skill(DRONE, "recharge", {"level": 1.0}).skill_id,
         c.add_skill(DRONE, "take_off", {"altitude": 2.0}).skill_id,
@@ -258,7 +258,7 @@ def test_collaborative_identification_scores_the_region_maximum(op: Operator) ->
 
     region = wait_until(lambda: op.science.region("RSS North"), 30.0, "the drone finds RSS North")
     assert region.identified_by == "" and region.stones_left == 1
-    c.add_marker(TaskMarker("RSS North", MarkerType.POSITION, Pose(region.x, region.y)))
+    c.add_task_marker(TaskMarker("RSS North", MarkerType.POSITION, Pose(region.x, region.y)))
     at_rss = {"position": "RSS North"}
     sci = c.add_skill(SCIENCE, "identify_stones", bindings=at_rss).skill_id
     arm = c.add_skill(ARM, "identify_stones", bindings=at_rss).skill_id
@@ -282,12 +282,12 @@ def test_collaborative_identification_scores_the_region_maximum(op: Operator) ->
 def test_without_identification_a_stone_scores_the_minimum(op: Operator) -> None:
     c = op.client
     start_score = op.science.score()
-    c.add_marker(area("west", square(-8.0, 0.0, 2.5)))
+    c.add_task_marker(area("west", square(-8.0, 0.0, 2.5)))
     explore = c.add_skill(SCIENCE, "explore", bindings={"area": "west"}).skill_id
     op.sync_and_start([SCIENCE])
 
     region = wait_until(lambda: op.science.region("RSS West"), 60.0, "the rover finds RSS West")
-    c.add_marker(TaskMarker("RSS West", MarkerType.POSITION, Pose(region.x, region.y)))
+    c.add_task_marker(TaskMarker("RSS West", MarkerType.POSITION, Pose(region.x, region.y)))
     fetch = [
         c.add_skill(ARM, "pick_stone", bindings={"position": "RSS West"}).skill_id,
         c.add_skill(ARM, "deposit_at_lander").skill_id,
@@ -337,8 +337,8 @@ def near(telemetry: Any, point: tuple[float, float], within: float = 0.3) -> boo
 def test_out_of_coverage_the_robot_goes_on_and_a_wifi_box_brings_it_back(op: Operator) -> None:
     c = op.client
     # With its library default it would drive back to its link once idle a minute
-    # (test_lost_link_scenario.py); here it waits where its plan ends.
-    c.set_robot_options(SCIENCE, LostLinkPolicy())
+    # (test_lost_link_scenario.py); here it waits where its task ends.
+    c.set_lost_link_policy(SCIENCE, LostLinkPolicy())
     # The last leg is slow: at a factor of 100 the emulator may apply a blackout a tenth of a
     # wall second late (its blackout and relay callbacks are separate threads), so the skill
     # the server must not hear of ends well after the robot left coverage.
@@ -359,7 +359,7 @@ def test_out_of_coverage_the_robot_goes_on_and_a_wifi_box_brings_it_back(op: Ope
     assert state.skill(out[1]).status is not S.SUCCESS, "the server cannot know yet"
 
     # The manipulator deploys the Wi-Fi box between the lander and the far spot.
-    c.add_marker(TaskMarker("wifi spot", MarkerType.POSE, Pose(*WIFI_SPOT)))
+    c.add_task_marker(TaskMarker("wifi spot", MarkerType.POSE, Pose(*WIFI_SPOT)))
     deploy = [
         c.add_skill(ARM, "pick_box", {"box": "wifi_box"}).skill_id,
         c.add_skill(ARM, "place_box", bindings={"target": "wifi spot"}).skill_id,
@@ -389,7 +389,7 @@ def test_a_drone_that_flies_too_long_runs_empty_and_recharges_at_the_lander(op: 
     c = op.client
     # Passes over the lander (the area lies within its charging radius): a quick one with
     # lanes 1.5 m apart takes 9 s of the 30 s battery, a thorough one 0.5 m apart 21 s.
-    c.add_marker(area("pad", square(0.0, 0.0, 3.0)))
+    c.add_task_marker(area("pad", square(0.0, 0.0, 3.0)))
     flight = [
         c.add_skill(DRONE, "recharge", {"level": 1.0}).skill_id,
         c.add_skill(DRONE, "take_off", {"altitude": 2.0}).skill_id,
@@ -406,10 +406,10 @@ def test_a_drone_that_flies_too_long_runs_empty_and_recharges_at_the_lander(op: 
     assert down.battery == 0.0 and math.hypot(down.pose.x, down.pose.y) < 4.5
 
     # A retry fails at once (the battery is still empty); skip it, recharge, fly home.
-    again = c.retry(flight[-1]).new_skill_id
+    again = c.retry_skill(flight[-1]).new_skill_id
     state = op.wait_status([again], S.FAILURE, timeout=30.0)
     assert state.skill(again).status_text == "battery empty"
-    c.skip(again)
+    c.skip_skill(again)
     home = [
         c.add_skill(DRONE, "recharge", {"level": 1.0}).skill_id,
         c.add_skill(DRONE, "take_off", {"altitude": 2.0}).skill_id,
@@ -479,15 +479,16 @@ def _edit_under_latency(op: Operator) -> None:
     c = op.client
     t = op.timed
     rock = {"position": "rock"}
-    t("add_task_marker", lambda: c.add_marker(TaskMarker("rock", MarkerType.POSITION, Pose(5, 5))))
+    rock_at = TaskMarker("rock", MarkerType.POSITION, Pose(5, 5))
+    t("add_task_marker", lambda: c.add_task_marker(rock_at))
     a = t("add_skill", lambda: c.add_skill(ARM, "navigate_to", target(4.0, 4.0))).skill_id
     b = t("add_skill", lambda: c.add_skill(ARM, "pick_stone", bindings=rock))
     d = t("add_skill", lambda: c.add_skill(SCIENCE, "identify_stones", bindings=rock))
     e = t("add_skill", lambda: c.add_skill(SCIENCE, "return_to_lander")).skill_id
     t("edit_skill", lambda: c.edit_skill(a, {"target": {"x": 4.5, "y": 3.5}}))
-    t("move_task_marker", lambda: c.move_marker("rock", Pose(5.5, 5.0)))
+    t("move_task_marker", lambda: c.move_task_marker("rock", Pose(5.5, 5.0)))
     t("add_barrier", lambda: c.add_barrier([b.skill_id, d.skill_id]))
-    t("reorder_skills", lambda: c.reorder(SCIENCE, [e, d.skill_id]))
+    t("reorder_skills", lambda: c.reorder_skills(SCIENCE, [e, d.skill_id]))
     t("delete_skills", lambda: c.delete_skills([e]))
     t("get_mission", c.get_mission)
     state = c.get_mission()

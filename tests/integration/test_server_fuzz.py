@@ -38,7 +38,7 @@ E = wire.ErrorCode
 PV = wire.ParameterValue
 CURRENT = object()  # stands for the current revision, filled in at call time
 # Requests that do not change the mission when they succeed.
-NO_CHANGE = {"control", "set_robot_options", "save_mission"}
+NO_CHANGE = {"control", "set_lost_link_policy", "save_mission"}
 FUZZED = [op for op in interface.SERVICES if op not in ("get_mission", "get_library")]
 KNOWN_NAMES = [
     "drone",

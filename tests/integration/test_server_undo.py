@@ -28,7 +28,7 @@ def test_undo_is_journaled_and_survives_a_crash(
         client.get_mission()
         added = client.add_skill("drone", "take_off", {"altitude": 12.0})
         edited = client.edit_skill(added.skill_id, {"altitude": 20.0})
-        undone = client.undo()
+        undone = client.undo_edit()
         assert undone.revision == edited.revision + 1
         assert undone.summary == (
             f"undo of revision {edited.revision} ('{added.skill_id}' (take_off) edited)"
@@ -41,10 +41,10 @@ def test_undo_is_journaled_and_survives_a_crash(
         mission = client.get_mission()
         assert mission.revision == undone.revision
         assert client.skill(added.skill_id).params["altitude"] == 12.0
-        redone = client.undo(undone.revision)  # the resumed server still knows the undo
+        redone = client.undo_edit(undone.revision)  # the resumed server still knows the undo
         assert client.skill(added.skill_id).params["altitude"] == 20.0
         with pytest.raises(RuleViolation) as refused:  # the skill changed since it was added
-            client.undo(added.revision)
+            client.undo_edit(added.revision)
         assert str(refused.value) == (
             f"skill '{added.skill_id}' was changed since revision {added.revision}; "
             "undo that change first"

@@ -39,8 +39,8 @@ from rosmc_sim.ros.topics import (
     WORLD_TOPIC,
     blackout_topic,
     odom_topic,
-    task_status_topic,
-    task_topic,
+    skill_run_status_topic,
+    skill_run_topic,
 )
 from tests.conftest import wait_until
 
@@ -49,7 +49,7 @@ MARS = REPO / "rosmc_sim" / "scenarios" / "mars_sample_return.yaml"
 ROBOTS = ("drone", "science_rover", "manipulator_rover")
 RTF = 20.0
 TIMEOUT = 60.0
-S = wire.RobotTaskStatus
+S = wire.SkillRunStatus
 AREA_A = [{"x": 10, "y": 4}, {"x": 22, "y": 4}, {"x": 22, "y": 14}, {"x": 10, "y": 14}]
 
 
@@ -79,41 +79,41 @@ class Latest:
 
 
 class Robot:
-    """One robot's task topics, odometry and link state, as the executor would see them."""
+    """One robot's skill-run topics, odometry and link state, as the executor would see them."""
 
     def __init__(self, name: str) -> None:
         self.name = name
-        self._task = rospy.Publisher(task_topic(name), wire.RobotTask, queue_size=10)
-        self.status = Latest(task_status_topic(name), wire.RobotTaskStatus)
+        self._runs = rospy.Publisher(skill_run_topic(name), wire.SkillRun, queue_size=10)
+        self.status = Latest(skill_run_status_topic(name), wire.SkillRunStatus)
         self.odom = Latest(odom_topic(name), Odometry)
         self.telemetry = Latest(f"/{name}/telemetry", wire.Telemetry)
         self.blackout = Latest(blackout_topic(name), Bool)
         wait_until(
-            lambda: self._task.get_num_connections() > 0, TIMEOUT, f"{name}'s task subscriber"
+            lambda: self._runs.get_num_connections() > 0, TIMEOUT, f"{name}'s skill-run subscriber"
         )
 
-    def send(self, task_id: str, action: int, skill: str = "", **params: Any) -> None:
-        self._task.publish(
-            wire.RobotTask(
+    def send(self, run_id: str, action: int, skill: str = "", **params: Any) -> None:
+        self._runs.publish(
+            wire.SkillRun(
                 robot=self.name,
-                task_id=task_id,
+                run_id=run_id,
                 action=action,
                 skill=skill,
                 parameters=[param_to_msg(name, value) for name, value in params.items()],
             )
         )
 
-    def start(self, task_id: str, skill: str, **params: Any) -> None:
-        self.send(task_id, wire.RobotTask.START, skill, **params)
+    def start(self, run_id: str, skill: str, **params: Any) -> None:
+        self.send(run_id, wire.SkillRun.START, skill, **params)
 
-    def statuses(self, task_id: str) -> list[Any]:
-        return [m for m in self.status.all() if m.task_id == task_id]
+    def statuses(self, run_id: str) -> list[Any]:
+        return [m for m in self.status.all() if m.run_id == run_id]
 
-    def wait_state(self, task_id: str, *states: int, timeout: float = TIMEOUT) -> Any:
+    def wait_state(self, run_id: str, *states: int, timeout: float = TIMEOUT) -> Any:
         def reached() -> Any:
-            return next((m for m in self.statuses(task_id) if m.state in states), None)
+            return next((m for m in self.statuses(run_id) if m.state in states), None)
 
-        return wait_until(reached, timeout, f"{self.name} {task_id} in state {states}")
+        return wait_until(reached, timeout, f"{self.name} {run_id} in state {states}")
 
     def still(self) -> bool:
         """The latest odometry says the robot stands still (no odometry from before a stop)."""
@@ -128,7 +128,7 @@ class Robot:
         return (p.x, p.y, p.z)
 
     def close(self) -> None:
-        self._task.unregister()
+        self._runs.unregister()
         for latest in (self.status, self.odom, self.telemetry, self.blackout):
             latest.close()
 
@@ -240,18 +240,18 @@ def test_pause_resume_cancel_preempt(sim: dict[str, Robot]) -> None:
     arm = sim["manipulator_rover"]
     arm.start("p1", "navigate_to", target=Pose(-20.0, -3.5))
     wait_until(lambda: arm.position()[0] < -5.0, TIMEOUT, "the rover driving")
-    arm.send("p1", wire.RobotTask.PAUSE)
+    arm.send("p1", wire.SkillRun.PAUSE)
     assert arm.wait_state("p1", S.PAUSED).text.startswith("paused")
     wait_until(arm.still, TIMEOUT, "the paused rover to stand still")
     held = arm.position()
     time.sleep(0.5)  # and it stays where it is
     assert math.dist(arm.position(), held) < 1e-6
-    arm.send("p1", wire.RobotTask.RESUME)
+    arm.send("p1", wire.SkillRun.RESUME)
     wait_until(lambda: math.dist(arm.position(), held) > 0.5, TIMEOUT, "the rover going on")
     assert arm.statuses("p1")[-1].state == S.RUNNING
     arm.start("p2", "navigate_to", target=Pose(-6.0, -6.0))  # preempts p1
     assert arm.wait_state("p1", S.FAILED).text == "preempted by p2"
-    arm.send("p2", wire.RobotTask.CANCEL)
+    arm.send("p2", wire.SkillRun.CANCEL)
     assert arm.wait_state("p2", S.FAILED).text == "cancelled"
     wait_until(arm.still, TIMEOUT, "the cancelled rover to stand still")
     where = arm.position()

@@ -121,9 +121,9 @@ def test_the_server_refuses_targets_the_simulated_site_rules_out(
         assert client.get_mission().skill(drive).params["target"] == Pose(12.0, 0.0)
 
         # marker move: a bound target follows the marker, so the marker cannot go into the ridge
-        client.add_marker(TaskMarker("spot", MarkerType.POSE, Pose(14.0, -2.0)))
+        client.add_task_marker(TaskMarker("spot", MarkerType.POSE, Pose(14.0, -2.0)))
         bound = client.add_skill(ARM, "navigate_to", bindings={"target": "spot"}).skill_id
-        message = refused(client.move_marker, "spot", Pose(22.0, -9.0))
+        message = refused(client.move_task_marker, "spot", Pose(22.0, -9.0))
         assert message == (
             f"target (22.0, -9.0) of manipulator_rover's 'navigate_to' ({bound}), bound to "
             "marker 'spot', lies inside obstacle 'ridge'; pick a point outside it"
@@ -131,7 +131,7 @@ def test_the_server_refuses_targets_the_simulated_site_rules_out(
         state = client.get_mission()
         assert state.marker("spot").pose == Pose(14.0, -2.0)
         assert state.skill(bound).params["target"] == Pose(14.0, -2.0)
-        client.move_marker("spot", Pose(14.0, 2.0))
+        client.move_task_marker("spot", Pose(14.0, 2.0))
 
         # load: a saved mission whose blueprint drives into the outcrop
         client.delete_skills(early)

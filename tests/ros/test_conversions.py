@@ -334,7 +334,7 @@ def test_every_agent_state_field_reaches_the_agent_status() -> None:
         executor_state="waiting",
         waiting_on="drone",
         policy="on link loss: hold after 30 s",
-        coverage_warning="the plan ends out of coverage",
+        coverage_warning="the task ends out of coverage",
     )
     status = agent_status_from_msg(over_the_wire(msg))
     assert_no_default_field(status)
@@ -358,7 +358,7 @@ def test_every_agent_state_field_reaches_the_agent_status() -> None:
         executor_state="waiting",
         waiting_on="drone",
         policy="on link loss: hold after 30 s",
-        coverage_warning="the plan ends out of coverage",
+        coverage_warning="the task ends out of coverage",
     )
     nan = wire.AgentState(agent="lander", telemetry=wire.Telemetry(battery=math.nan))
     assert agent_status_from_msg(nan).battery is None

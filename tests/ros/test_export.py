@@ -22,10 +22,10 @@ from rosmc_server.recording.export import (
     CHANGES_TOPIC,
     CHUNK_BYTES,
     ROBOTS_TOPIC,
-    SCHEDULE_TOPIC,
+    TASKS_TOPIC,
 )
 from rosmc_server.recording.history import MissionHistory
-from rosmc_server.text import format_schedule
+from rosmc_server.text import format_tasks
 from tests.ros.recording_checks import SAMPLE
 
 Decoded = list[tuple[str, int, int, Any]]  # topic, log time, publish time, message
@@ -112,11 +112,11 @@ def test_the_mission_as_readable_text(decoded: Decoded, journal: JournalResult) 
     events = [msg for topic, _, _, msg in decoded if topic == EVENTS_TOPIC]
     assert len(changes) == len(events)
     assert [line.split()[0] for line in changes] == [f"r{e.revision}" for e in events]
-    schedules = [(log, msg.data) for topic, log, _, msg in decoded if topic == SCHEDULE_TOPIC]
-    last_log, last = schedules[-1]
+    texts = [(log, msg.data) for topic, log, _, msg in decoded if topic == TASKS_TOPIC]
+    last_log, last = texts[-1]
     final = history.at_revision(history.revisions[-1].revision)
     title = f"{SAMPLE.name} at {history.seconds(last_log):.1f} s"
-    assert last == format_schedule(final, title)
+    assert last == format_tasks(final, title)
     assert all(skill.id in last for skill in final.skills())
 
 

@@ -174,7 +174,7 @@ def recording(tmp_path_factory: pytest.TempPathFactory) -> Recording:
 
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(demo, "Mission", Recorded)
-        patch.setattr(demo, "print_schedule", lambda *_: None)
+        patch.setattr(demo, "print_tasks", lambda *_: None)
         demo.run(rec)
     second_act(rec)
     assert rec.writer is not None

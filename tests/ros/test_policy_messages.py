@@ -1,4 +1,4 @@
-"""The lost-link policy through ``rosmc/SetRobotOptions`` requests and back (no master)."""
+"""The lost-link policy through ``rosmc/SetLostLinkPolicy`` requests and back (no master)."""
 
 from __future__ import annotations
 
@@ -18,10 +18,10 @@ POLICIES = [
 ]
 
 
-def _over_the_wire(request: srv.SetRobotOptionsRequest) -> srv.SetRobotOptionsRequest:
+def _over_the_wire(request: srv.SetLostLinkPolicyRequest) -> srv.SetLostLinkPolicyRequest:
     buffer = BytesIO()
     request.serialize(buffer)
-    back = srv.SetRobotOptionsRequest()
+    back = srv.SetLostLinkPolicyRequest()
     back.deserialize(buffer.getvalue())
     return back
 
@@ -30,12 +30,12 @@ def _over_the_wire(request: srv.SetRobotOptionsRequest) -> srv.SetRobotOptionsRe
 def test_every_field_survives(policy: LostLinkPolicy) -> None:
     typed = {n: Pose.from_any(v, n) if isinstance(v, dict) else v for n, v in policy.params.items()}
     parameters = [param_to_msg(name, value) for name, value in typed.items()]
-    request = srv.SetRobotOptionsRequest(agent="r1", **policy_to_request(policy, parameters))
+    request = srv.SetLostLinkPolicyRequest(agent="r1", **policy_to_request(policy, parameters))
     assert policy_from_request(_over_the_wire(request)) == policy
 
 
 def test_an_empty_kind_is_continue() -> None:
-    request = srv.SetRobotOptionsRequest(agent="r1", after=5.0)
+    request = srv.SetLostLinkPolicyRequest(agent="r1", after=5.0)
     assert policy_from_request(request) == LostLinkPolicy(after=5.0)
 
 
@@ -58,5 +58,5 @@ def test_an_empty_kind_is_continue() -> None:
 )
 def test_a_bad_request_is_refused(fields: dict[str, object], needle: str) -> None:
     with pytest.raises(InvalidRequest) as caught:
-        policy_from_request(srv.SetRobotOptionsRequest(agent="r1", **fields))
+        policy_from_request(srv.SetLostLinkPolicyRequest(agent="r1", **fields))
     assert needle in str(caught.value)

@@ -1,4 +1,4 @@
-"""The command GUI (real widget, offscreen) warns in the robot's column when its plan ends
+"""The command GUI (real widget, offscreen) warns in the robot's column when its task ends
 out of coverage, and its policy dialog shows the policy in force and offers the return."""
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from rosmc_server.core import (
 from tests.unit.test_command_harness import Gui, open_gui
 
 WARNING = (
-    "the plan ends out of coverage at (17.0, 0.0) (predicted -71 dBm) and the lost-link "
+    "the task ends out of coverage at (17.0, 0.0) (predicted -71 dBm) and the lost-link "
     "policy would leave the robot there"
 )
 DEFAULT = (
@@ -36,7 +36,7 @@ def gui(mission: Mission, library: Library) -> Iterator[Gui]:
 
 
 def test_the_column_warns_while_the_server_does(gui: Gui) -> None:
-    column = gui.widget.schedule.columns["alpha"]
+    column = gui.widget.tasks.columns["alpha"]
     assert not column.warning_label.isVisibleTo(gui.widget)
     gui.feed.statuses(AgentStatus("alpha", link="up", policy="on link loss: continue",
                                   coverage_warning=WARNING))  # fmt: skip
@@ -44,7 +44,7 @@ def test_the_column_warns_while_the_server_does(gui: Gui) -> None:
     assert column.warning_label.isVisibleTo(gui.widget)
     assert column.warning_label.text() == "⚠ T" + WARNING[1:]
     assert "Link loss" in column.warning_label.toolTip()
-    other = gui.widget.schedule.columns["bravo"]
+    other = gui.widget.tasks.columns["bravo"]
     assert not other.warning_label.isVisibleTo(gui.widget)
     gui.feed.statuses(AgentStatus("alpha", link="up", policy=DEFAULT))  # the operator fixed it
     gui.widget.repaints.show_statuses_now()
@@ -52,7 +52,7 @@ def test_the_column_warns_while_the_server_does(gui: Gui) -> None:
 
 
 def test_the_dialog_shows_the_policy_in_force_and_offers_the_return(gui: Gui) -> None:
-    column = gui.widget.schedule.columns["alpha"]
+    column = gui.widget.tasks.columns["alpha"]
     gui.feed.statuses(AgentStatus("alpha", link="up", policy=DEFAULT))
     gui.widget.repaints.show_statuses_now()
     shown: list[str] = []

@@ -29,7 +29,7 @@ from rosmc_rqt_command.core.requests import Request
 from rosmc_rqt_command.core.view_state import ViewUpdate, view_update
 from rosmc_rqt_command.qt.agent_column import SectionTable
 from rosmc_rqt_command.qt.command_widget import CommandWidget
-from rosmc_rqt_command.qt.schedule_model import SKILL, STATUS
+from rosmc_rqt_command.qt.task_model import SKILL, STATUS
 from rosmc_server.core import AgentStatus, Library, Mission, MissionEvent, MissionState
 from rosmc_server.core.mirror import MissionMirror
 from rosmc_server.core.updates import MirrorUpdate
@@ -132,7 +132,7 @@ class Gui:
 
     def table(self, agent: str, blueprint: bool) -> SectionTable:
         """One robot's blueprint or synchronized table."""
-        column = self.widget.schedule.columns[agent]
+        column = self.widget.tasks.columns[agent]
         return column.blueprint_table if blueprint else column.synced_table
 
     def ids(self, agent: str, blueprint: bool) -> list[str]:
@@ -186,7 +186,7 @@ def test_the_widget_shows_the_mission_the_mirror_follows(gui: Gui) -> None:
     assert gui.ids("alpha", False) == [first]
     assert gui.ids("alpha", True) == [second]
     assert gui.widget.view.revision == gui.feed.mission.revision
-    assert set(gui.widget.schedule.columns) >= {"alpha", "bravo", "charlie"}
+    assert set(gui.widget.tasks.columns) >= {"alpha", "bravo", "charlie"}
 
 
 def test_requests_are_recorded_not_sent(gui: Gui) -> None:

@@ -63,7 +63,7 @@ def test_planned_skills_of_two_robots_can_start_together(gui: Gui) -> None:
     gui.click_row("alpha", True, 0)
     gui.click_row("bravo", True, 0, Qt.ControlModifier)
     # "Send" sends both robots up to their selected skill (one team send); "move" acts on
-    # one robot's plan.
+    # one robot's task.
     assert gui.enabled() == {"delete", "barrier", "synchronize"}
 
 
@@ -130,7 +130,7 @@ def test_read_only_window_enables_nothing(mission: Mission, library: Library) ->
         harness.feed.add("alpha")
         harness.click_row("alpha", True, 0)
         assert harness.enabled() == set()
-        column = harness.widget.schedule.columns["alpha"]
+        column = harness.widget.tasks.columns["alpha"]
         assert not any(button.isEnabled() for button in column.buttons.values())
         assert not column.add_button.isEnabled()
         harness.widget.do_robot("alpha", R.SYNC_ALL)
@@ -141,7 +141,7 @@ def test_read_only_window_enables_nothing(mission: Mission, library: Library) ->
 
 def test_robot_buttons_follow_the_robot(gui: Gui) -> None:
     feed = gui.feed
-    column = gui.widget.schedule.columns["alpha"]
+    column = gui.widget.tasks.columns["alpha"]
 
     def enabled() -> set[RobotAction]:
         gui.widget.repaints.show_statuses_now()  # the 5 Hz header repaint, now
@@ -178,7 +178,7 @@ def test_robot_legality_is_recomputed_only_for_touched_robots(gui: Gui) -> None:
 
 
 def test_the_lost_link_policy_is_chosen_among_the_robots_skills(gui: Gui) -> None:
-    column = gui.widget.schedule.columns["alpha"]
+    column = gui.widget.tasks.columns["alpha"]
     assert column.policy_button.isEnabled()
     offered: list[list[str]] = []
 
@@ -195,7 +195,7 @@ def test_the_lost_link_policy_is_chosen_among_the_robots_skills(gui: Gui) -> Non
     QTest.mouseClick(column.policy_button, Qt.LeftButton)
     assert offered == [["move", "noop", "scan", "wait"]]
     [request] = gui.backend.requests
-    assert request.operation == "set_robot_options"
+    assert request.operation == "set_lost_link_policy"
     assert request.args == ("alpha", LostLinkPolicy(LostLinkKind.SAFE_SKILL, 45.0, "wait"))
     assert "run wait after 45 s" in request.what
     column.ask_policy = lambda *_: None  # the operator cancels

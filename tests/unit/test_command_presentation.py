@@ -15,7 +15,7 @@ import pytest
 from python_qt_binding.QtCore import Qt
 
 from rosmc_rqt_command.core import presentation as p
-from rosmc_rqt_command.qt.schedule_model import STATUS, TAG
+from rosmc_rqt_command.qt.task_model import STATUS, TAG
 from rosmc_server.core import AgentStatus, Library, Mission, SkillStatus
 from tests.unit.test_command_harness import Gui, open_gui
 

@@ -48,7 +48,7 @@ def test_mypy_refuses_a_wrong_call_and_accepts_a_right_one(tmp_path: Path) -> No
         tmp_path,
         """
         ask(lambda c: c.delete_skills, "delete", 3)(42)
-        ask(lambda c: c.retry, "retry", 3)("a", "b")
+        ask(lambda c: c.retry_skill, "retry", 3)("a", "b")
         ask(lambda c: c.no_such_method, "?", 3)()
         """,
     )

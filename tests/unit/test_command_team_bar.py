@@ -1,7 +1,7 @@
 """The command GUI with 20 robots on a 1600x1000 screen, driven with the mouse.
 
 The real widget (offscreen Qt) follows a real 20-robot mission through a real mirror
-(the unit harness). The operator scrolls the schedule sideways with the scroll bar, makes
+(the unit harness). The operator scrolls the task panel sideways with the scroll bar, makes
 the columns compact, and narrows the team by name, by ticking robots in the robot list
 and by status; the test checks which columns are on screen after each click.
 """
@@ -51,11 +51,11 @@ def test_every_robot_is_reachable_by_scrolling_at_a_readable_width(
     first = on_screen(gui.widget)
     assert first[0] == "drone_1" and len(first) < len(staged.robots)
     seen = list(first)
-    bar = gui.widget.schedule.horizontalScrollBar()
+    bar = gui.widget.tasks.horizontalScrollBar()
     while bar.value() < bar.maximum():
         before = bar.value()
         step_right(gui.widget)
-        assert bar.value() > before, "a click on the scroll bar moves the schedule"
+        assert bar.value() > before, "a click on the scroll bar moves the task panel"
         seen += [agent for agent in on_screen(gui.widget) if agent not in seen]
     assert seen == list(staged.robots)
     assert all(c.width() >= COLUMN_WIDTH for c in columns(gui.widget).values())

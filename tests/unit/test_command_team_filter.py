@@ -1,4 +1,4 @@
-"""Which robots the schedule shows: the Qt-free filter over a real mission's view.
+"""Which robots the task panel shows: the Qt-free filter over a real mission's view.
 
 A real mission with the 20-robot team feeds a :class:`MissionView` through a real mirror
 (as the GUI's bridge does); the filter then picks robots by name, by the robot list and by

@@ -92,7 +92,7 @@ def test_every_module_has_a_layer() -> None:
         ("rosmc_rviz_markers/core/geometry.py", "core"),
         ("rosmc_rviz_markers/ros/node.py", "app"),
         ("rosmc_rqt_command/ros_bridge.py", "app"),
-        ("rosmc_rqt_command/schedule_model.py", "app"),
+        ("rosmc_rqt_command/task_model.py", "app"),
         # any folder named core is the core layer, existing or not, at any depth
         ("rosmc_rqt_command/core/view.py", "core"),
         ("rosmc_rqt_command/core/rules/legal.py", "core"),
@@ -346,9 +346,9 @@ def _scan_source(root: Path, relative: str, source: str) -> list[str]:
         ("rosmc_server/cli/x.py", "from ..conversions import event_from_msg"),
         ("rosmc_server/cli/x.py", "from ..ros.server_node import ServerNode"),
         # GUI models and widgets: no rospy, no messages, not even the client
-        ("rosmc_rqt_command/schedule_model.py", "import rospy"),
-        ("rosmc_rqt_command/schedule_model.py", "from rosmc.msg import Selection"),
-        ("rosmc_rqt_command/schedule_model.py", "from rosmc_server.ros.client import X"),
+        ("rosmc_rqt_command/task_model.py", "import rospy"),
+        ("rosmc_rqt_command/task_model.py", "from rosmc.msg import Selection"),
+        ("rosmc_rqt_command/task_model.py", "from rosmc_server.ros.client import X"),
         ("rosmc_rqt_command/plugin.py", "from rosmc.msg import Selection"),
         ("rosmc_rqt_command/standalone.py", "from rosmc_server.ros import operator_services"),
         ("rosmc_rqt_command/widgets/plugin.py", "import rospy"),
@@ -398,8 +398,8 @@ def test_scanner_catches_a_layer_break(fake_repo: Path, relative: str, source: s
         ),
         ("rosmc_rqt_command/plugin.py", "from rosmc_server.ros.client import init_node"),
         ("rosmc_rqt_command/standalone.py", "import rospy\nfrom rosmc_server.ros.client import X"),
-        ("rosmc_rqt_command/schedule_model.py", "from python_qt_binding import QtCore"),
-        ("rosmc_rqt_command/schedule_model.py", "from rosmc_server.core import MissionState"),
+        ("rosmc_rqt_command/task_model.py", "from python_qt_binding import QtCore"),
+        ("rosmc_rqt_command/task_model.py", "from rosmc_server.core import MissionState"),
         (
             "rosmc_rqt_command/core/x.py",
             "if TYPE_CHECKING:\n    from rosmc_server.ros.client import MissionClient",
@@ -430,6 +430,6 @@ def test_ros_adapter_naming() -> None:
     assert is_ros_adapter("rosmc_rqt_command/ros_bridge.py")
     assert is_ros_adapter("rosmc_rqt_command/node.py")
     assert not is_ros_adapter("rosmc_rqt_command/plugin.py")
-    assert not is_ros_adapter("rosmc_rqt_command/widgets/schedule.py")
+    assert not is_ros_adapter("rosmc_rqt_command/widgets/tasks.py")
     assert not is_ros_adapter("rosmc_rviz_markers/core/geometry.py")
     assert not is_ros_adapter("rosmc_server/core/mission.py")

@@ -1,4 +1,4 @@
-"""The radio map (core/radio_map.py): readings, prediction, last link, the plan-end warning."""
+"""The radio map (core/radio_map.py): readings, prediction, last link, the task-end warning."""
 
 from __future__ import annotations
 
@@ -73,7 +73,7 @@ def test_a_plan_ending_out_of_coverage_warns_only_under_a_policy_that_leaves_it_
     radio = RadioMap(prediction=model())
     out = [skill("out", S.RUNNING, target=Pose(17.0, 0.0))]
     warning = coverage_warning(out, radio, "on link loss: continue", RETURN)
-    assert warning.startswith("the plan ends out of coverage at (17.0, 0.0) (predicted ")
+    assert warning.startswith("the task ends out of coverage at (17.0, 0.0) (predicted ")
     assert coverage_warning(out, radio, "on link loss: hold after 60 s", None)
     returning = RETURN.describe() + " (library default)"
     assert coverage_warning(out, radio, returning, None) == ""

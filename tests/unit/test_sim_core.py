@@ -1,4 +1,4 @@
-"""The simulation core: planner, batteries, coverage, discovery, scoring, handling, tasks.
+"""The simulation core: planner, batteries, coverage, discovery, scoring, handling, skill runs.
 
 Runs headless pybullet (DIRECT) worlds; no ROS.
 """
@@ -25,8 +25,8 @@ from rosmc_sim.core.sim import (
     Robot,
     Simulation,
 )
-from rosmc_sim.core.skills_registry import TASKS, task_for
-from rosmc_sim.core.tasks import TaskFailed, TaskResult, TaskRunner
+from rosmc_sim.core.skill_runs import RunResult, SkillFailed, SkillRunner
+from rosmc_sim.core.skills_registry import SIM_SKILLS, sim_skill_for
 from rosmc_sim.core.world import World
 
 REPO = Path(__file__).resolve().parents[2]
@@ -70,12 +70,12 @@ def mars() -> Iterator[Simulation]:
     world.close()
 
 
-def runner(sim: Simulation, robot: str, skill: str, **params: Any) -> TaskRunner:
-    kind = task_for(skill, sim.robots[robot].kind)
-    return TaskRunner(sim, sim.robots[robot], kind.function, params, kind.needs_power)
+def runner(sim: Simulation, robot: str, skill: str, **params: Any) -> SkillRunner:
+    kind = sim_skill_for(skill, sim.robots[robot].kind)
+    return SkillRunner(sim, sim.robots[robot], kind.function, params, kind.needs_power)
 
 
-def finish(sim: Simulation, *runners: TaskRunner, limit: float = 1000.0) -> list[TaskResult]:
+def finish(sim: Simulation, *runners: SkillRunner, limit: float = 1000.0) -> list[RunResult]:
     """Step until every runner has a result."""
     end = sim.time + limit
     while any(r.result is None for r in runners):
@@ -86,7 +86,7 @@ def finish(sim: Simulation, *runners: TaskRunner, limit: float = 1000.0) -> list
     return [r.result for r in runners if r.result is not None]
 
 
-def run(sim: Simulation, robot: str, skill: str, **params: Any) -> TaskResult:
+def run(sim: Simulation, robot: str, skill: str, **params: Any) -> RunResult:
     return finish(sim, runner(sim, robot, skill, **params))[0]
 
 
@@ -135,12 +135,12 @@ def test_planner_refuses_unreachable_targets(goal: tuple[float, float], reason: 
 def test_rover_drives_around_the_boulder(sim: Simulation) -> None:
     rover, boulder = sim.robots["sci"], sim.scenario.obstacles[0]
     put(rover, 4.0, 0.0)
-    task = runner(sim, "sci", "navigate_to", target=Pose(16.0, 0.0))
+    running = runner(sim, "sci", "navigate_to", target=Pose(16.0, 0.0))
     closest = math.inf
-    while task.update() is None:
+    while running.update() is None:
         sim.step(DT)
         closest = min(closest, obstacle_distance(boulder, rover.x, rover.y))
-    assert task.result == TaskResult(True, "arrived at (16.0, 0.0)")
+    assert running.result == RunResult(True, "arrived at (16.0, 0.0)")
     assert closest > 0.5
     assert (rover.x, rover.y) == (16.0, 0.0)
 
@@ -167,11 +167,11 @@ def test_moving_drains_more_than_idling(sim: Simulation) -> None:
     assert moved > 5 * idled
 
 
-def test_an_empty_battery_stops_the_task_and_the_robot(sim: Simulation) -> None:
+def test_an_empty_battery_stops_the_run_and_the_robot(sim: Simulation) -> None:
     rover = sim.robots["sci"]
     rover.battery = 0.0005
     result = run(sim, "sci", "navigate_to", target=Pose(3.5, -25.0))
-    assert result == TaskResult(False, "battery empty")
+    assert result == RunResult(False, "battery empty")
     y = rover.y
     sim.step(1.0)
     assert rover.battery == 0.0 and rover.y == y and not rover.path
@@ -179,7 +179,7 @@ def test_an_empty_battery_stops_the_task_and_the_robot(sim: Simulation) -> None:
 
 def test_recharge_at_the_lander_even_when_empty(sim: Simulation) -> None:
     rover = sim.robots["sci"]
-    assert run(sim, "sci", "return_to_lander") == TaskResult(True, "at the lander")
+    assert run(sim, "sci", "return_to_lander") == RunResult(True, "at the lander")
     rover.battery = 0.0
     start = sim.time
     result = run(sim, "sci", "recharge", level=0.5)
@@ -190,7 +190,7 @@ def test_recharge_at_the_lander_even_when_empty(sim: Simulation) -> None:
 
 def test_recharge_away_from_the_lander_fails(sim: Simulation) -> None:
     put(sim.robots["sci"], 15.0, -15.0)
-    assert run(sim, "sci", "recharge") == TaskResult(False, "not at the lander: return to it first")
+    assert run(sim, "sci", "recharge") == RunResult(False, "not at the lander: return to it first")
 
 
 # -- coverage and line of sight ----------------------------------------------------------
@@ -236,20 +236,20 @@ def test_a_deployed_wifi_box_extends_coverage(sim: Simulation) -> None:
 def test_fly_over_discovers_the_regions_in_its_area(mars: Simulation) -> None:
     assert run(mars, "drone", "take_off", altitude=8.0).success
     result = run(mars, "drone", "fly_over", area=AREA_A, altitude=8.0, spacing=4.0)
-    assert result == TaskResult(True, "found RSS A")
+    assert result == RunResult(True, "found RSS A")
     assert [n for n, r in mars.regions.items() if r.discovered] == ["RSS A"]
     assert any("drone discovered RSS A" in line for line in mars.events)
 
 
 def test_explore_finds_nothing_where_nothing_is(sim: Simulation) -> None:
     area = [{"x": -12, "y": -12}, {"x": -4, "y": -12}, {"x": -4, "y": -4}]
-    assert run(sim, "sci", "explore", area=area) == TaskResult(True, "found no region")
+    assert run(sim, "sci", "explore", area=area) == RunResult(True, "found no region")
 
 
 def test_the_drone_must_take_off_first(sim: Simulation) -> None:
     for skill, params in (("navigate_to", {"target": Pose(5, 5)}), ("fly_over", {"area": AREA_A})):
         result = run(sim, "drone", skill, **params)
-        assert result == TaskResult(False, "the drone must take off first")
+        assert result == RunResult(False, "the drone must take off first")
 
 
 # -- scoring -------------------------------------------------------------------------
@@ -257,8 +257,8 @@ def identify_and_deliver(sim: Simulation, *robots: str) -> float:
     discover(sim)
     put(sim.robots["sci"], 12.0, 6.0)
     put(sim.robots["arm"], 16.0, 6.0)
-    tasks = [runner(sim, r, "identify_stones", position=Pose(14, 8), mode="quick") for r in robots]
-    assert all(result.success for result in finish(sim, *tasks))
+    runs = [runner(sim, r, "identify_stones", position=Pose(14, 8), mode="quick") for r in robots]
+    assert all(result.success for result in finish(sim, *runs))
     assert run(sim, "arm", "pick_stone", position=Pose(14, 8)).success
     assert run(sim, "arm", "deposit_at_lander").success
     return sim.score
@@ -309,94 +309,94 @@ def test_pick_and_deposit_a_stone(sim: Simulation) -> None:
 
 
 def test_no_stone_there(sim: Simulation) -> None:
-    assert run(sim, "arm", "pick_stone", position=Pose(14, 8)) == TaskResult(
+    assert run(sim, "arm", "pick_stone", position=Pose(14, 8)) == RunResult(
         False, "no discovered region at (14.0, 8.0): explore first"
     )
     discover(sim)
     for stone in sim.stones.values():
         stone.delivered = True
-    assert run(sim, "arm", "pick_stone", position=Pose(14, 8)) == TaskResult(
+    assert run(sim, "arm", "pick_stone", position=Pose(14, 8)) == RunResult(
         False, "no stone left at rss"
     )
 
 
 def test_the_gripper_already_full(sim: Simulation) -> None:
     discover(sim)
-    assert run(sim, "arm", "pick_box", box="wifi_box") == TaskResult(True, "holding wifi_box")
+    assert run(sim, "arm", "pick_box", box="wifi_box") == RunResult(True, "holding wifi_box")
     result = run(sim, "arm", "pick_stone", position=Pose(14, 8))
-    assert result == TaskResult(False, "the gripper already holds wifi_box")
+    assert result == RunResult(False, "the gripper already holds wifi_box")
     assert run(sim, "arm", "pick_box", box="wifi_box").text == "the gripper already holds wifi_box"
 
 
 def test_carry_and_deploy_a_wifi_box(sim: Simulation) -> None:
     arm, box = sim.robots["arm"], sim.boxes["wifi_box"]
     assert run(sim, "arm", "pick_box", box="wifi_box").success
-    task = runner(sim, "arm", "place_box", target=Pose(0.0, -15.0))
+    running = runner(sim, "arm", "place_box", target=Pose(0.0, -15.0))
     for _ in range(50):
-        task.update()
+        running.update()
         sim.step(DT)
     assert (box.x, box.y) == (arm.x, arm.y) and box.carried_by == "arm"
-    assert finish(sim, task)[0] == TaskResult(True, "wifi_box deployed")
+    assert finish(sim, running)[0] == RunResult(True, "wifi_box deployed")
     assert box.deployed and box.z == pytest.approx(0.25) and not arm.carrying
     assert math.dist((box.x, box.y), (0.0, -15.0)) < 1.5
     assert any("deployed wifi_box" in line for line in sim.events)
 
 
 def test_only_the_manipulator_handles_things(sim: Simulation) -> None:
-    with pytest.raises(TaskFailed, match="a science rover cannot pick_box"):
-        task_for("pick_box", "science_rover")
-    with pytest.raises(TaskFailed, match="a science rover cannot take_off"):
-        task_for("take_off", "science_rover")
-    with pytest.raises(TaskFailed, match="unknown skill 'dance'"):
-        task_for("dance", "drone")
-    assert set(TASKS) >= {"navigate_to", "pick_stone", "fly_over"}
+    with pytest.raises(SkillFailed, match="a science rover cannot pick_box"):
+        sim_skill_for("pick_box", "science_rover")
+    with pytest.raises(SkillFailed, match="a science rover cannot take_off"):
+        sim_skill_for("take_off", "science_rover")
+    with pytest.raises(SkillFailed, match="unknown skill 'dance'"):
+        sim_skill_for("dance", "drone")
+    assert set(SIM_SKILLS) >= {"navigate_to", "pick_stone", "fly_over"}
 
 
-# -- task runner -----------------------------------------------------------------------
+# -- running runner -----------------------------------------------------------------------
 def test_pause_holds_the_robot_and_resume_goes_on(sim: Simulation) -> None:
     rover = sim.robots["sci"]
-    task = runner(sim, "sci", "navigate_to", target=Pose(3.5, -20.0))
+    running = runner(sim, "sci", "navigate_to", target=Pose(3.5, -20.0))
     for _ in range(30):
-        task.update()
+        running.update()
         sim.step(DT)
-    task.pause()
+    running.pause()
     held = (rover.x, rover.y)
     for _ in range(30):
-        assert task.update() is None
+        assert running.update() is None
         sim.step(DT)
     assert (rover.x, rover.y) == held and rover.y < -3.5
-    task.resume()
-    assert finish(sim, task)[0].success and (rover.x, rover.y) == (3.5, -20.0)
+    running.resume()
+    assert finish(sim, running)[0].success and (rover.x, rover.y) == (3.5, -20.0)
 
 
 def test_timed_work_does_not_elapse_while_paused(sim: Simulation) -> None:
     discover(sim)
     put(sim.robots["sci"], 12.0, 6.0)
-    task = runner(sim, "sci", "identify_stones", position=Pose(14, 8), mode="quick")
+    running = runner(sim, "sci", "identify_stones", position=Pose(14, 8), mode="quick")
     start = sim.time
     for _ in range(20):
-        task.update()
+        running.update()
         sim.step(DT)
-    task.pause()
+    running.pause()
     for _ in range(200):
-        task.update()
+        running.update()
         sim.step(DT)
-    task.resume()
-    assert finish(sim, task)[0].success
+    running.resume()
+    assert finish(sim, running)[0].success
     assert sim.time - start >= 10.0 + 20.0 - DT
 
 
 def test_cancel_stops_the_robot_for_good(sim: Simulation) -> None:
     rover = sim.robots["sci"]
-    task = runner(sim, "sci", "navigate_to", target=Pose(3.5, -20.0))
+    running = runner(sim, "sci", "navigate_to", target=Pose(3.5, -20.0))
     for _ in range(20):
-        task.update()
+        running.update()
         sim.step(DT)
-    task.cancel()
-    assert task.result == TaskResult(False, "cancelled")
+    running.cancel()
+    assert running.result == RunResult(False, "cancelled")
     where = (rover.x, rover.y)
     sim.step(1.0)
-    assert (rover.x, rover.y) == where and task.update() == TaskResult(False, "cancelled")
+    assert (rover.x, rover.y) == where and running.update() == RunResult(False, "cancelled")
 
 
 @pytest.mark.parametrize(
@@ -408,13 +408,13 @@ def test_cancel_stops_the_robot_for_good(sim: Simulation) -> None:
         ("identify_stones", {"position": Pose(14, 8), "mode": "slow"}, "mode must be one of"),
     ],
 )
-def test_malformed_parameters_fail_the_task(
+def test_malformed_parameters_fail_the_run(
     sim: Simulation, skill: str, params: dict[str, Any], reason: str
 ) -> None:
     discover(sim)
     robot = "drone" if skill == "take_off" else "sci"
     put(sim.robots["sci"], 12.0, 6.0)
-    task = runner(sim, robot, skill, **params)
-    result = finish(sim, task)[0]
+    running = runner(sim, robot, skill, **params)
+    result = finish(sim, running)[0]
     assert not result.success and reason in result.text
-    assert task.update() == result  # stays failed (it used to turn into a success)
+    assert running.update() == result  # stays failed (it used to turn into a success)

@@ -30,7 +30,7 @@ def transfers(state: MissionState) -> dict[str, list[Transfer]]:
 def test_every_robot_in_one_event_and_one_upload_per_robot(mission: Mission) -> None:
     alpha, bravo, barrier = barrier_plan(mission)
     revision = mission.revision
-    event = mission.synchronize_team()  # every robot with planned skills, whole plans
+    event = mission.synchronize_team()  # every robot with planned skills, whole tasks
     assert (event.revision, event.kind, event.agent) == (revision + 1, EventKind.SYNC_REQUESTED, "")
     assert [p.skill.id for p in event.change.put_skills] == alpha + bravo
     assert transfers(mission.state)["charlie"] == []

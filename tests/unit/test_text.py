@@ -24,7 +24,7 @@ from rosmc_server.text import (
     format_event,
     format_library,
     format_markers,
-    format_schedule,
+    format_tasks,
     format_value,
     library_to_json,
     mission_to_json,
@@ -45,8 +45,8 @@ def planned(mission: Mission, drv: Any) -> Mission:
     return mission
 
 
-def test_schedule_has_sections_marks_and_tags(planned: Mission) -> None:
-    text = format_schedule(planned.state, "Plan")
+def test_tasks_has_sections_marks_and_tags(planned: Mission) -> None:
+    text = format_tasks(planned.state, "Plan")
     lines = text.splitlines()
     assert lines[0] == f"=== Plan (revision {planned.revision}) ==="
     alpha = lines.index("  alpha")
@@ -57,28 +57,28 @@ def test_schedule_has_sections_marks_and_tags(planned: Mission) -> None:
     assert lines[lines.index("  charlie") + 1].endswith("blueprint (empty)")
 
 
-def test_schedule_without_title_names_revision_and_library(planned: Mission) -> None:
-    first = format_schedule(planned.state).splitlines()[0]
+def test_tasks_without_title_names_revision_and_library(planned: Mission) -> None:
+    first = format_tasks(planned.state).splitlines()[0]
     assert first == f"mission at revision {planned.revision} (library unit_team)"
 
 
-def test_schedule_shows_uploading(mission: Mission, drv: Any) -> None:
+def test_tasks_shows_uploading(mission: Mission, drv: Any) -> None:
     drv.add("alpha")
     mission.synchronize("alpha")
-    assert "uploading" in format_schedule(mission.state)
+    assert "uploading" in format_tasks(mission.state)
 
 
-def test_schedule_with_statuses_adds_one_line_per_robot(planned: Mission) -> None:
+def test_tasks_with_statuses_adds_one_line_per_robot(planned: Mission) -> None:
     status = AgentStatus("alpha", link="up", last_heard=0.25, battery=0.5, executor_state="run")
-    lines = format_schedule(planned.state, statuses={"alpha": status}).splitlines()
+    lines = format_tasks(planned.state, statuses={"alpha": status}).splitlines()
     assert lines[lines.index("  alpha") + 1] == (
         "    link up (heard 0.2 s ago), battery 50%, executor run"
     )
     assert lines[lines.index("  bravo") + 1] == "    link unknown"
 
 
-def test_verbose_schedule_lists_parameters(planned: Mission) -> None:
-    text = format_schedule(planned.state, verbose=True)
+def test_verbose_tasks_lists_parameters(planned: Mission) -> None:
+    text = format_tasks(planned.state, verbose=True)
     assert "point=@Spot" in text
     assert "seconds=3" in text
     assert "speed=1.5" in text

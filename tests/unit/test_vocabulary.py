@@ -25,7 +25,7 @@ from rosmc_server.core.vocabulary import (
     number,
     rgb,
 )
-from rosmc_server.text import format_agent_status, format_schedule
+from rosmc_server.text import format_agent_status, format_tasks
 from rosmc_sim.core import world
 
 
@@ -51,7 +51,7 @@ def test_rosmc_marks_a_running_skill_with_the_vocabulary(mission: Mission, drv: 
     first = drv.add("alpha", "move", label="go")
     drv.sync("alpha")
     drv.run(first)
-    line = next(x for x in format_schedule(mission.state).splitlines() if first in x)
+    line = next(x for x in format_tasks(mission.state).splitlines() if first in x)
     assert line.strip().startswith(STATUS_MARKS[SkillStatus.RUNNING])
 
 

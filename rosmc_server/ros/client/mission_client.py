@@ -159,36 +159,30 @@ class MissionClient(ClientBase):
             ).revision
         )
 
-    def reorder(
+    def reorder_skills(
         self,
         agent: str,
-        order: Sequence[str],
+        order: Sequence[str] = (),
         *,
+        moves: Sequence[tuple[str, int]] = (),
         base_revision: int | None = None,
         retry_on_conflict: bool = False,
     ) -> Result:
-        """Give ``agent``'s editable blueprint a new order (a permutation of its ids)."""
-        return Result(
-            self._mutate(
-                "reorder_skills", base_revision, retry_on_conflict, agent=agent, order=list(order)
-            ).revision
-        )
+        """Give ``agent``'s editable blueprint a new order, as ``order`` or as ``moves``.
 
-    def move_skills(
-        self,
-        agent: str,
-        moves: Sequence[tuple[str, int]],
-        *,
-        base_revision: int | None = None,
-        retry_on_conflict: bool = False,
-    ) -> Result:
-        """Move skills within ``agent``'s editable blueprint: (skill id, index once moved)
-        pairs, applied one after the other; the request's size is the moves', not the task's.
+        ``order`` is the whole new order (a permutation of its ids); ``moves`` are
+        (skill id, index once moved) pairs, applied one after the other, so the request's
+        size is the moves', not the task's. The server refuses a request with both.
         """
         wire_moves = moves_to_msgs([SkillMove(skill_id, index) for skill_id, index in moves])
         return Result(
             self._mutate(
-                "reorder_skills", base_revision, retry_on_conflict, agent=agent, moves=wire_moves
+                "reorder_skills",
+                base_revision,
+                retry_on_conflict,
+                agent=agent,
+                order=list(order),
+                moves=wire_moves,
             ).revision
         )
 
@@ -248,7 +242,7 @@ class MissionClient(ClientBase):
         raise_for(response, response.revision)
         return ControlSent(response.revision, tuple(response.agents), response.note)
 
-    def set_robot_options(self, agent: str, policy: LostLinkPolicy) -> Result:
+    def set_lost_link_policy(self, agent: str, policy: LostLinkPolicy) -> Result:
         """Set ``agent``'s lost-link policy (what it does when it stops hearing the ground).
 
         The safe skill's parameters are checked against the library here and on the
@@ -261,19 +255,19 @@ class MissionClient(ClientBase):
             self._parameters(agent, policy.skill, policy.params, {}) if policy.skill else []
         )
         response = self._caller.call(
-            "set_robot_options", agent=agent, **policy_to_request(policy, parameters)
+            "set_lost_link_policy", agent=agent, **policy_to_request(policy, parameters)
         )
         raise_for(response, response.revision)
         return Result(response.revision)
 
-    def retry(
+    def retry_skill(
         self, skill_id: str, *, base_revision: int | None = None, retry_on_conflict: bool = False
     ) -> SkillRetried:
         """Retry a FAILURE: a fresh synchronized instance follows it."""
         response = self._mutate("retry_skill", base_revision, retry_on_conflict, skill_id=skill_id)
         return SkillRetried(response.revision, response.new_skill_id)
 
-    def skip(
+    def skip_skill(
         self, skill_id: str, *, base_revision: int | None = None, retry_on_conflict: bool = False
     ) -> Result:
         """Skip a FAILURE: the robot continues after it."""
@@ -305,7 +299,7 @@ class MissionClient(ClientBase):
             ).revision
         )
 
-    def add_marker(
+    def add_task_marker(
         self,
         marker: TaskMarker,
         *,
@@ -318,7 +312,7 @@ class MissionClient(ClientBase):
         )
         return MarkerAdded(response.revision, response.name)
 
-    def move_marker(
+    def move_task_marker(
         self,
         name: str,
         pose: Pose,
@@ -338,7 +332,7 @@ class MissionClient(ClientBase):
         )
         return Result(response.revision)
 
-    def rename_marker(
+    def rename_task_marker(
         self,
         name: str,
         new_name: str,
@@ -352,7 +346,7 @@ class MissionClient(ClientBase):
         )
         return Result(response.revision)
 
-    def delete_marker(
+    def delete_task_marker(
         self, name: str, *, base_revision: int | None = None, retry_on_conflict: bool = False
     ) -> Result:
         """Delete a task marker that no skill is bound to."""
@@ -360,7 +354,7 @@ class MissionClient(ClientBase):
             self._mutate("delete_task_marker", base_revision, retry_on_conflict, name=name).revision
         )
 
-    def undo(
+    def undo_edit(
         self,
         revision: int = 0,
         *,

@@ -80,7 +80,7 @@ class BarrierAdded(Result):
 
 @dataclass(frozen=True)
 class MarkerAdded(Result):
-    """``add_marker`` succeeded; ``name`` is the marker's (possibly generated) name."""
+    """``add_task_marker`` succeeded; ``name`` is the marker's (possibly generated) name."""
 
     name: str
 

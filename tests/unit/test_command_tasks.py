@@ -1,4 +1,4 @@
-"""The schedule: rows change only where an update touched them; the selection survives.
+"""The task panel: rows change only where an update touched them; the selection survives.
 
 Each model's change signals are recorded while a real mission changes one thing at a
 time; only the rows of that change may be reported, in the column of that robot.
@@ -14,7 +14,7 @@ import pytest
 from python_qt_binding.QtCore import Qt
 from python_qt_binding.QtTest import QTest
 
-from rosmc_rqt_command.qt.schedule_model import STATUS, SectionModel
+from rosmc_rqt_command.qt.task_model import STATUS, TaskModel
 from rosmc_server.core import AgentStatus, Library, Mission, SkillStatus
 from tests.unit.test_command_harness import Gui, open_gui
 
@@ -28,18 +28,18 @@ def gui(mission: Mission, library: Library) -> Iterator[Gui]:
 
 
 class Signals:
-    """Every row change each model of the schedule reports."""
+    """Every row change each model of the task panel reports."""
 
     def __init__(self, gui: Gui) -> None:
         self.seen: list[tuple[str, str, int, int]] = []
-        for agent, column in gui.widget.schedule.columns.items():
+        for agent, column in gui.widget.tasks.columns.items():
             for name, model in (
                 ("synced", column.synced_model),
                 ("blueprint", column.blueprint_model),
             ):
                 self._watch(f"{agent}/{name}", model)
 
-    def _watch(self, key: str, model: SectionModel) -> None:
+    def _watch(self, key: str, model: TaskModel) -> None:
         def record(kind: str) -> Any:
             def slot(first: Any, last: Any, *_rest: Any) -> None:
                 if kind == "changed":
@@ -109,7 +109,7 @@ def test_robot_reports_repaint_headers_not_rows(gui: Gui) -> None:
     signals = Signals(gui)
     gui.feed.statuses(AgentStatus("alpha", link="up", last_heard=0.2, battery=0.8))
     assert signals.take() == []
-    label = gui.widget.schedule.columns["alpha"].status_label
+    label = gui.widget.tasks.columns["alpha"].status_label
     _wait(lambda: "battery 80%" in label.text())
 
 
@@ -137,22 +137,22 @@ def test_selection_follows_skills_across_updates(gui: Gui) -> None:
     feed = gui.feed
     ids = [feed.add("alpha", "move") for _ in range(3)]
     gui.click_row("alpha", True, 1)
-    assert gui.widget.schedule.selected_ids == [ids[1]]
+    assert gui.widget.tasks.selected_ids == [ids[1]]
     feed("reorder", "alpha", [ids[1], ids[0], ids[2]])  # the selected skill moves up
-    assert gui.widget.schedule.selected_ids == [ids[1]]
+    assert gui.widget.tasks.selected_ids == [ids[1]]
     assert _selected_rows(gui, "alpha", True) == [0]
     feed.add("alpha", "scan")  # another row arrives
     feed("edit_skill", ids[1], label="renamed")  # the selected skill itself changes
     assert _selected_rows(gui, "alpha", True) == [0]
     feed.sync("alpha", ids[1])  # it moves to the robot's table
-    assert gui.widget.schedule.selected_ids == [ids[1]]
+    assert gui.widget.tasks.selected_ids == [ids[1]]
     assert _selected_rows(gui, "alpha", False) == [0]
     assert _selected_rows(gui, "alpha", True) == []
     assert gui.widget.parameters.skill is not None
     assert gui.widget.parameters.skill.id == ids[1]
     assert gui.widget.parameters.skill.label == "renamed"
     feed("delete_skills", [ids[0]])  # another robot's change leaves it alone
-    assert gui.widget.schedule.selected_ids == [ids[1]]
+    assert gui.widget.tasks.selected_ids == [ids[1]]
 
 
 def test_ctrl_click_selects_across_columns_and_a_plain_click_lets_go(gui: Gui) -> None:
@@ -164,12 +164,12 @@ def test_ctrl_click_selects_across_columns_and_a_plain_click_lets_go(gui: Gui) -
     gui.click_row("alpha", True, 1, Qt.ControlModifier)
     gui.click_row("bravo", True, 0, Qt.ControlModifier)
     gui.click_row("charlie", True, 0, Qt.ControlModifier)
-    assert gui.widget.schedule.selected_ids == [a[0], a[1], b, c]
+    assert gui.widget.tasks.selected_ids == [a[0], a[1], b, c]
     assert gui.widget.parameters.title.text() == "<i>4 skills selected.</i>"
     feed("edit_skill", b, label="kept")  # a live update keeps the whole selection
-    assert gui.widget.schedule.selected_ids == [a[0], a[1], b, c]
+    assert gui.widget.tasks.selected_ids == [a[0], a[1], b, c]
     gui.click_row("bravo", True, 0)
-    assert gui.widget.schedule.selected_ids == [b]
+    assert gui.widget.tasks.selected_ids == [b]
     assert _selected_rows(gui, "alpha", True) == []
     # The selection goes to rviz with the markers it uses.
     assert gui.backend.selections[-1] == ([b], [])
@@ -179,7 +179,7 @@ def test_a_selected_skill_that_is_deleted_leaves_the_selection(gui: Gui) -> None
     skill = gui.feed.add("alpha", "move")
     gui.click_row("alpha", True, 0)
     gui.feed("delete_skills", [skill])
-    assert gui.widget.schedule.selected_ids in ([], [skill])
+    assert gui.widget.tasks.selected_ids in ([], [skill])
     assert gui.ids("alpha", True) == []
     assert gui.widget.parameters.skill is None
 

@@ -11,10 +11,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, TypeVar
 
 from .sim import LEVEL_COLLABORATIVE, LEVEL_SCIENCE, Robot, Simulation
-from .tasks import Steps, TaskFailed, _drive, _pose, _work, free_stop
+from .skill_runs import SkillFailed, Steps, _drive, _pose, _work, free_stop
+
+T = TypeVar("T")
 
 IDENTIFY_SECONDS = {"quick": 10.0, "standard": 20.0, "detailed": 40.0}
 HANDLING_SECONDS = 8.0
@@ -24,19 +26,19 @@ REACH = 1.5  # how close the arm must be to what it handles
 def identify_stones(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps:
     """Image the stones of the region at a position (both rovers together: best score)."""
     if robot.kind == "drone":
-        raise TaskFailed("the drone has no cameras for identification")
+        raise SkillFailed("the drone has no cameras for identification")
     x, y, _ = _pose(params, "position")
     reach = float(params.get("radius", 2.0))
     region = sim.region_at(x, y, margin=reach)
     if region is None:
-        raise TaskFailed(f"no discovered region at ({x:.1f}, {y:.1f}): explore first")
+        raise SkillFailed(f"no discovered region at ({x:.1f}, {y:.1f}): explore first")
     away = robot.distance_to(x, y) - reach - region.spec.radius
     if away > 0:
-        raise TaskFailed(f"too far from {region.spec.name}: {away:.1f} m away")
+        raise SkillFailed(f"too far from {region.spec.name}: {away:.1f} m away")
     start = sim.time
     seconds = IDENTIFY_SECONDS.get(str(params.get("mode", "standard")))
     if seconds is None:
-        raise TaskFailed(f"mode must be one of {', '.join(IDENTIFY_SECONDS)}")
+        raise SkillFailed(f"mode must be one of {', '.join(IDENTIFY_SECONDS)}")
     region.sessions[robot.kind] = (start, None)
     try:
         yield from _work(sim, robot, seconds, f"identifying stones at {region.spec.name}")
@@ -70,19 +72,19 @@ def pick_stone(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Step
     """Drive to the best stone near a position and pick it up."""
     _require_arm(robot)
     if robot.carrying:
-        raise TaskFailed(f"the gripper already holds {robot.carrying}")
+        raise SkillFailed(f"the gripper already holds {robot.carrying}")
     x, y, _ = _pose(params, "position")
     reach = float(params.get("radius", 2.0))
     region = sim.region_at(x, y, margin=reach)
     if region is None:
-        raise TaskFailed(f"no discovered region at ({x:.1f}, {y:.1f}): explore first")
+        raise SkillFailed(f"no discovered region at ({x:.1f}, {y:.1f}): explore first")
     stones = [
         s
         for s in sim.stones.values()
         if s.region == region.spec.name and not s.carried_by and not s.delivered
     ]
     if not stones:
-        raise TaskFailed(f"no stone left at {region.spec.name}")
+        raise SkillFailed(f"no stone left at {region.spec.name}")
     stone = max(stones, key=lambda s: (s.level, -math.hypot(s.x - x, s.y - y)))
     yield from _approach(sim, robot, stone.x, stone.y, f"approaching {stone.name}")
     yield from _work(sim, robot, HANDLING_SECONDS, f"picking {stone.name}")
@@ -94,10 +96,7 @@ def pick_stone(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Step
 
 def deposit_at_lander(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps:
     """Bring the carried stone to the lander's sample box."""
-    _require_arm(robot)
-    stone = sim.stones.get(robot.carrying)
-    if stone is None:
-        raise TaskFailed("not carrying a stone")
+    stone = _carried(robot, sim.stones, "a stone")
     yield from _approach(
         sim, robot, 0.0, 0.0, "driving to the lander", reach=sim.scenario.charge_radius - 0.5
     )
@@ -115,11 +114,11 @@ def pick_box(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps:
     _require_arm(robot)
     box = sim.boxes.get(str(params["box"]))
     if box is None:
-        raise TaskFailed(f"there is no box {params['box']!r}")
+        raise SkillFailed(f"there is no box {params['box']!r}")
     if robot.carrying:
-        raise TaskFailed(f"the gripper already holds {robot.carrying}")
+        raise SkillFailed(f"the gripper already holds {robot.carrying}")
     if box.carried_by:
-        raise TaskFailed(f"{box.spec.name} is carried by {box.carried_by}")
+        raise SkillFailed(f"{box.spec.name} is carried by {box.carried_by}")
     yield from _approach(sim, robot, box.x, box.y, f"approaching {box.spec.name}", reach=3.0)
     yield from _work(sim, robot, HANDLING_SECONDS, f"picking {box.spec.name}")
     box.carried_by, box.deployed, robot.carrying = robot.name, False, box.spec.name
@@ -128,10 +127,7 @@ def pick_box(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps:
 
 def place_box(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps:
     """Drive to a pose and deploy the carried box there."""
-    _require_arm(robot)
-    box = sim.boxes.get(robot.carrying)
-    if box is None:
-        raise TaskFailed("not carrying a box")
+    box = _carried(robot, sim.boxes, "a box")
     x, y, _ = _pose(params, "target")
     yield from _drive(sim, robot, x, y, robot.spec.speed, f"carrying {box.spec.name}")
     yield from _work(sim, robot, HANDLING_SECONDS, f"deploying {box.spec.name}")
@@ -143,7 +139,16 @@ def place_box(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps
 
 def _require_arm(robot: Robot) -> None:
     if robot.kind != "manipulator_rover":
-        raise TaskFailed(f"{robot.name} has no arm")
+        raise SkillFailed(f"{robot.name} has no arm")
+
+
+def _carried(robot: Robot, things: Mapping[str, T], what: str) -> T:
+    """The one of ``things`` the robot's arm holds; SkillFailed if it holds none of them."""
+    _require_arm(robot)
+    thing = things.get(robot.carrying)
+    if thing is None:
+        raise SkillFailed(f"not carrying {what}")
+    return thing
 
 
 def _approach(

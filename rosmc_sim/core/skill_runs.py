@@ -1,12 +1,12 @@
-"""What the simulated robots can do: one task per skill, stepped with the simulation.
+"""What the simulated robots can do: each skill's run, stepped with the simulation.
 
-A *robot task* here is the simulated controllers' run of one skill (``rosmc/RobotTask``
-asks for it), not the mission's *task* of an agent (its skills in order).
+A *skill run* is the simulated controllers' run of one skill (``rosmc/SkillRun`` asks
+for it); a robot's *task* is its skills in order, which this module never sees.
 
-Each task is a generator that sets the robot moving or working and yields
+Each skill function is a generator that sets the robot moving or working and yields
 progress text while it waits for the world to catch up; it returns a closing
-text on success and raises :class:`TaskFailed` with the reason on failure.
-:class:`TaskRunner` steps it, pauses it (the robot holds still and resumes
+text on success and raises :class:`SkillFailed` with the reason on failure.
+:class:`SkillRunner` steps it, pauses it (the robot holds still and resumes
 the same path), cancels it, and fails it when the battery runs empty.
 """
 
@@ -21,39 +21,39 @@ from .planner import NoPath
 from .sim import Robot, Simulation
 
 Steps = Generator[str, None, str]
-TaskFunction = Callable[[Simulation, Robot, Mapping[str, Any]], Steps]
+SkillFunction = Callable[[Simulation, Robot, Mapping[str, Any]], Steps]
 
 
-class TaskFailed(Exception):
-    """A task cannot go on; the message is the reason the operator reads."""
+class SkillFailed(Exception):
+    """A skill run cannot go on; the message is the reason the operator reads."""
 
 
 @dataclass(frozen=True)
-class TaskResult:
-    """How a task ended."""
+class RunResult:
+    """How a skill run ended."""
 
     success: bool
     text: str
 
 
-class TaskRunner:
-    """Runs one task of one robot."""
+class SkillRunner:
+    """Runs one skill of one robot."""
 
     def __init__(
         self,
         sim: Simulation,
         robot: Robot,
-        task: TaskFunction,
+        function: SkillFunction,
         params: Mapping[str, Any],
         needs_power: bool = True,
     ) -> None:
         self._sim = sim
         self._needs_power = needs_power
         self._robot = robot
-        self._steps = task(sim, robot, params)
+        self._steps = function(sim, robot, params)
         self.progress = ""
         self.paused = False
-        self.result: TaskResult | None = None
+        self.result: RunResult | None = None
         self._saved: tuple[list[tuple[float, float]], float | None, str, float | None] = (
             [],
             None,
@@ -61,8 +61,8 @@ class TaskRunner:
             None,
         )
 
-    def update(self) -> TaskResult | None:
-        """Advance the task by one simulation step; the result once finished."""
+    def update(self) -> RunResult | None:
+        """Advance the run by one simulation step; the result once finished."""
         if self.result is not None or self.paused:
             return self.result
         if self._needs_power and self._robot.battery <= 0.0:
@@ -71,7 +71,7 @@ class TaskRunner:
             self.progress = next(self._steps)
         except StopIteration as done:
             return self._end(True, str(done.value or ""))
-        except (TaskFailed, NoPath) as failure:
+        except (SkillFailed, NoPath) as failure:
             return self._end(False, str(failure))
         except KeyError as missing:
             return self._end(False, f"missing parameter {missing}")
@@ -80,7 +80,7 @@ class TaskRunner:
         return None
 
     def pause(self) -> None:
-        """Hold still; the task resumes where it was."""
+        """Hold still; the run resumes where it was."""
         if not self.paused and self.result is None:
             self.paused = True
             robot = self._robot
@@ -101,12 +101,12 @@ class TaskRunner:
         if self.result is None:
             self._end(False, "cancelled")
 
-    def _end(self, success: bool, text: str) -> TaskResult:
-        self._steps.close()  # an interrupted task cleans up (e.g. an identification session)
+    def _end(self, success: bool, text: str) -> RunResult:
+        self._steps.close()  # an interrupted run cleans up (e.g. an identification session)
         self._sim.halt(self._robot)
         self._robot.activity = "idle"
         self._robot.charging_to = None
-        self.result = TaskResult(success, text)
+        self.result = RunResult(success, text)
         return self.result
 
 
@@ -114,9 +114,9 @@ class TaskRunner:
 def _drive(sim: Simulation, robot: Robot, x: float, y: float, speed: float, what: str) -> Steps:
     """Move to (x, y) along a planned path, yielding the distance left."""
     if robot.kind == "drone" and not robot.flying:
-        raise TaskFailed("the drone must take off first")
+        raise SkillFailed("the drone must take off first")
     if robot.kind != "drone" and robot.z > 0.05:
-        raise TaskFailed("the rover cannot move from here")
+        raise SkillFailed("the rover cannot move from here")
     sim.go(robot, sim.plan(robot, x, y), speed)
     while robot.path:
         left = math.hypot(robot.path[-1][0] - robot.x, robot.path[-1][1] - robot.y)
@@ -149,7 +149,7 @@ def _pose(params: Mapping[str, Any], name: str) -> tuple[float, float, float]:
 def _area(params: Mapping[str, Any]) -> list[tuple[float, float]]:
     corners = [(float(p["x"]), float(p["y"])) for p in params["area"]]
     if len(corners) < 3:
-        raise TaskFailed("an area needs at least three corners")
+        raise SkillFailed("an area needs at least three corners")
     return corners
 
 
@@ -208,7 +208,7 @@ def fly_over(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps:
     """Cover an area in lanes, discovering the regions in it."""
     area = _area(params)
     if not robot.flying:
-        raise TaskFailed("the drone must take off first")
+        raise SkillFailed("the drone must take off first")
     yield from _climb(sim, robot, float(params.get("altitude", robot.z)))
     found: list[str] = []
     lanes = _sweep(area, float(params.get("spacing", 4.0)))
@@ -240,7 +240,7 @@ def return_to_lander(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -
     """Go back to the lander (the drone lands on it)."""
     if robot.kind == "drone":
         if not robot.flying:
-            raise TaskFailed("the drone must take off first")
+            raise SkillFailed("the drone must take off first")
         yield from _drive(sim, robot, 0.0, 0.0, robot.spec.speed, "returning")
         yield from land(sim, robot, params)
         return "landed on the lander"
@@ -259,7 +259,7 @@ def return_to_lander(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -
 def recharge(sim: Simulation, robot: Robot, params: Mapping[str, Any]) -> Steps:
     """Charge at the lander up to a battery level."""
     if not sim.at_lander(robot):
-        raise TaskFailed("not at the lander: return to it first")
+        raise SkillFailed("not at the lander: return to it first")
     level = min(1.0, max(0.0, float(params.get("level", 1.0))))  # above 1 would never end
     robot.charging_to = level
     while robot.battery < level - 1e-6:

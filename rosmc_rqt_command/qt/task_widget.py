@@ -1,4 +1,4 @@
-"""The schedule panel: one :class:`AgentColumn` per robot, side by side, scrolling sideways.
+"""The task panel: one :class:`AgentColumn` per robot, side by side, scrolling sideways.
 
 Owns the selection across columns: a plain click selects in one table only; Ctrl or
 Shift keep what other columns have selected (a barrier spans robots). The selection is
@@ -35,8 +35,8 @@ LATER_COLUMNS = 4
 LATER_MS = 10
 
 
-class ScheduleWidget(QScrollArea):  # type: ignore[misc]
-    """Every robot's schedule; emits the selection and the operator's requests."""
+class TaskWidget(QScrollArea):  # type: ignore[misc]
+    """Every robot's task; emits the selection and the operator's requests."""
 
     selection_changed = Signal(list)  # selected skill ids
     context_menu_requested = Signal(object, QPoint)  # table, global position

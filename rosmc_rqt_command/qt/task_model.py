@@ -1,10 +1,10 @@
-"""One section (synchronized or blueprint) of one robot's schedule, as a Qt table model.
+"""One section (synchronized or blueprint) of one robot's task, as a Qt table model.
 
-:meth:`SectionModel.set_rows` takes the section's new skills and changes only the rows that
+:meth:`TaskModel.set_rows` takes the section's new skills and changes only the rows that
 differ (same ids: ``dataChanged`` for the changed rows; otherwise the differing middle is
 removed and inserted), so views keep their scroll position and unchanged rows their
 selection. The blueprint model also accepts drops: a drag of its own rows asks for a new
-order through :attr:`SectionModel.reorder_requested` instead of moving anything itself;
+order through :attr:`TaskModel.reorder_requested` instead of moving anything itself;
 the server's answer moves the rows.
 """
 
@@ -29,7 +29,7 @@ TAG, NUMBER, SKILL, STATUS, PARAMS = range(5)
 HEADERS = ("", "#", "Skill", "Status", "Details")
 
 
-class SectionModel(QAbstractTableModel):  # type: ignore[misc]
+class TaskModel(QAbstractTableModel):  # type: ignore[misc]
     """The rows of one robot's synchronized section or blueprint.
 
     Args:
