@@ -199,7 +199,8 @@ class GroundLink:
             return
         # The robot is back after a silence. Its stalled connections would resume only
         # at TCP's next retransmission, which backs off to minutes: connect afresh.
-        reconnect_in_background(link.listeners, f"the ground hears {sender} again")
+        how = "its return beacon" if returning else "a beacon after a silence"
+        reconnect_in_background(link.listeners, f"the ground hears {sender} again ({how})")
         with self._host.locked():
             link.outbox.contact_returned(self._clock())
             self._transmit(link)
