@@ -165,6 +165,10 @@ class Outbox(Generic[Payload]):
         The backoff grew while nothing could arrive; keeping it would hold the commands
         back for up to ``max_retry`` after contact returned.
         """
+        self._resend_all(now)
+
+    def _resend_all(self, now: float) -> None:
+        """Make every unacknowledged command due at ``now``, backing off from the start."""
         for item in self._pending:
             item.backoff = 0
             item.next_send = min(item.next_send, now)
@@ -175,8 +179,18 @@ class Outbox(Generic[Payload]):
         Acknowledgements are per command (not cumulative): each carries the
         robot's answer to that command, and a robot answers a retransmitted
         command with the answer it gave the first time.
+
+        They are taken in order, as the robot gave them: an answer that arrives while
+        an earlier command is still unanswered (its answer was lost, say in a
+        reconnection of the link's topics) is early. It is not taken (None): the
+        earlier commands and this one are due again at once, and the robot answers
+        them again, in order. Taken early, it would be applied before the answer it
+        depends on (an upload confirmed only after the uploads before it).
         """
         self.heard(now)
+        if self.early(seq):
+            self._resend_all(now)
+            return None
         for item in self._pending:
             if item.seq == seq and seq > 0:
                 self._pending.remove(item)
@@ -184,6 +198,10 @@ class Outbox(Generic[Payload]):
                     self.round_trip_sample(now - item.first_sent)
                 return item
         return None
+
+    def early(self, seq: int) -> bool:
+        """Whether an answer to ``seq`` is early: a command numbered before it is unanswered."""
+        return seq > 0 and any(0 < item.seq < seq for item in self._pending)
 
     def round_trip_sample(self, seconds: float) -> None:
         """One measured round trip (a command's ack, or an echoed heartbeat); smoothed."""

@@ -199,7 +199,8 @@ class GroundLink:
             return
         # The robot is back after a silence. Its stalled connections would resume only
         # at TCP's next retransmission, which backs off to minutes: connect afresh.
-        reconnect_in_background(link.listeners, f"the ground hears {sender} again")
+        how = "its return beacon" if returning else "a beacon after a silence"
+        reconnect_in_background(link.listeners, f"the ground hears {sender} again ({how})")
         with self._host.locked():
             link.outbox.contact_returned(self._clock())
             self._transmit(link)
@@ -219,9 +220,12 @@ class GroundLink:
     def _on_ack(self, agent: str, msg: wire.RobotAck) -> None:
         link = self._links[agent]
         link.newest_stamp = max(link.newest_stamp, msg.stamp.to_sec())
+        if link.outbox.early(msg.seq):
+            # An earlier answer was lost: the outbox has the robot answer them all again.
+            _log.info("link %s: answer to command %d came before an earlier one", agent, msg.seq)
         item = link.outbox.acknowledge(msg.seq, self._clock())
         if item is None:
-            return  # the answer to a retransmission already processed
+            return  # early, or the answer to a retransmission already processed
         self._record(wire.CommandRecord.DELIVERED, item, msg.result)
         if msg.result != wire.RobotAck.ACCEPTED:
             link.last_error = msg.error or "; ".join(msg.rejection_reasons)

@@ -522,10 +522,10 @@ class RosmcSystem:
         if "server" in self.processes:
             stop_process(self.processes["server"])
 
-    def log_tails(self, lines: int = 30) -> str:
-        """The end of every process's log."""
+    def log_tails(self, lines: int = 30, names: Sequence[str] = ()) -> str:
+        """The end of the log of every process (or of those in ``names``)."""
         out = []
-        for name in self.processes:
+        for name in names or list(self.processes):
             try:
                 text = self.log(name).read_text(errors="replace").splitlines()
             except OSError:

@@ -145,7 +145,11 @@ def test_work_sent_to_a_robot_out_of_contact_arrives_once_in_order_after_the_cut
     time.sleep(max(0.0, cut + OUT_OF_CONTACT - time.time()))
     restored = time.time()
     lab.restore(["r3"])
-    op("wait_status", sent, "SUCCESS", 60.0, timeout=70.0)
+    try:
+        op("wait_status", sent, "SUCCESS", 60.0, timeout=70.0)
+    except AssertionError:
+        print(team.log_tails(80, ["server", "r3"]))  # what the link did after the restore
+        raise
     assert team.stop("server") == 0  # the module's last test: its journal is complete
 
     records = [

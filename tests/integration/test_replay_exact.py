@@ -190,6 +190,8 @@ def _session(
     step(lambda: client.move_task_marker("RSS A", Pose(6.0, 2.0)))
     time.sleep(0.6)  # the robots move on: TF and agent states are journaled meanwhile
     robot.announce()
+    # A robot answers its commands in order: the library's policy first (no revision).
+    robot.ack(robot.wait_command(wire.RobotCommand.SET_OPTIONS))
     step(lambda: client.synchronize("drone", take_off))
     upload = robot.wait_command(wire.RobotCommand.UPLOAD)
     step(lambda: robot.ack(upload))

@@ -115,6 +115,27 @@ def test_what_waited_leaves_in_order_exactly_once_when_the_robot_is_heard() -> N
     assert outbox.pending() == () and outbox.report(now + 30).waiting == 0
 
 
+def test_answers_to_held_commands_are_taken_in_order_when_the_first_one_is_lost() -> None:
+    # The radio returns: the three held uploads leave together and the robot executes and
+    # answers each. The first answer is lost (the ground was reconnecting its topics).
+    # Taking the second before the first confirmed an upload before the one it follows,
+    # and it stayed "uploading" for good.
+    outbox = lost_outbox()
+    now = 10.0  # out of contact
+    for skill in ("a", "b", "c"):
+        queue(outbox, command(CommandKind.UPLOAD, (skill,)), now)
+    outbox.heard(now + 60.0)
+    first, second, third = outbox.due(now + 60.0)
+    assert [first.seq, second.seq, third.seq] == [1, 2, 3]
+    later = now + 60.1  # the answer to 1 never came; those to 2 and 3 do
+    assert outbox.acknowledge(second.seq, later) is None, "an answer before an earlier one"
+    assert outbox.acknowledge(third.seq, later) is None
+    assert [i.seq for i in outbox.due(later)] == [1, 2, 3], "all asked again at once"
+    taken = [outbox.acknowledge(seq, later + 0.1) for seq in (1, 2, 3)]  # answered again
+    assert [(item.payload.skills[0].id if item else None) for item in taken] == ["a", "b", "c"]
+    assert outbox.pending() == ()
+
+
 def test_a_take_back_cancels_what_a_waiting_send_would_have_brought() -> None:
     outbox = lost_outbox()
     queue(outbox, command(CommandKind.UPLOAD, ("a", "b", "c")), 10.0)
