@@ -71,7 +71,7 @@ def canonical_moves(
     before = 0  # staying skills before the next moved one, in the new order
     counted = 0  # regions below this one are summed in ``unmoved_before``
     unmoved_before = 0
-    for skill_id, number in zip(order, region):
+    for skill_id, number in zip(order, region, strict=True):
         if number < 0:
             before += 1
             continue
