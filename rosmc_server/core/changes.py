@@ -69,8 +69,7 @@ def _new_move(skill_id: str, index: int) -> SkillMove:
 
 
 _new_object = object.__new__
-_set_skill_id = SkillMove.skill_id.__set__  # type: ignore[attr-defined]
-_set_index = SkillMove.index.__set__  # type: ignore[attr-defined]
+_set_skill_id, _set_index = (getattr(SkillMove, name).__set__ for name in SkillMove.__slots__)
 
 
 @dataclass(frozen=True)
