@@ -91,7 +91,8 @@ def test_an_unused_optional_module_is_kept_out_of_the_program(
     # As genpy does with numpy: an optional import, handled when it fails.
     (tmp_path / "entry_optional_extra.py").write_text("LOADED = True\n", encoding="utf-8")
     body = (
-        "try:\n    import entry_optional_extra\nexcept ImportError:\n    entry_optional_extra = None\n"
+        "try:\n    import entry_optional_extra\n"
+        "except ImportError:\n    entry_optional_extra = None\n"
         "\ndef main():\n    return 0 if entry_optional_extra is None else 5\n"
     )
     try:
