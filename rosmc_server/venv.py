@@ -84,7 +84,7 @@ def run_entry_point(module: str, unused: tuple[str, ...] = ()) -> int:
     kept out (their import raises ImportError, which such a dependency handles).
     """
     for name in unused:
-        sys.modules.setdefault(name, None)  # type: ignore[assignment]
+        sys.modules.setdefault(name, None)  # type: ignore[arg-type]
     use_project_venv()
     try:
         main = cast(Callable[[], int], importlib.import_module(module).main)
