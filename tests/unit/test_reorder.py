@@ -193,3 +193,22 @@ def test_a_whole_new_order_is_planned_once_not_decoded_again(
     state.apply(proposal.change)
     assert scanned(state)["A"] == new
     assert decoded == []
+
+
+def test_the_collector_is_paused_for_a_reorder_and_restored_after() -> None:
+    import gc
+
+    from rosmc_server.core.collector import collector_paused
+
+    assert gc.isenabled()
+    with pytest.raises(RuntimeError), collector_paused():
+        assert not gc.isenabled()
+        raise RuntimeError("a refused reorder")
+    assert gc.isenabled()
+    gc.disable()
+    try:
+        with collector_paused():
+            assert not gc.isenabled()
+        assert not gc.isenabled()  # off before: off after
+    finally:
+        gc.enable()
