@@ -75,12 +75,16 @@ def _package_path() -> list[str]:
     return list(getattr(rosmc_server, "__path__", []))
 
 
-def run_entry_point(module: str) -> int:
+def run_entry_point(module: str, unused: tuple[str, ...] = ()) -> int:
     """Run ``module.main()`` with the project's venv; a missing dependency ends in one sentence.
 
     What a ``scripts/`` entry script calls. A module of this project that is missing is a
-    broken install and raises as usual.
+    broken install and raises as usual. ``unused`` names optional modules that a
+    dependency imports when they are installed but this program never needs: they are
+    kept out (their import raises ImportError, which such a dependency handles).
     """
+    for name in unused:
+        sys.modules.setdefault(name, None)  # type: ignore[arg-type]
     use_project_venv()
     try:
         main = cast(Callable[[], int], importlib.import_module(module).main)

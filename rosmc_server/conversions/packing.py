@@ -48,7 +48,8 @@ _POSE_HEAD = _PARAM_NUMBERS.pack(ParamType.POSE, False, 0, 0.0) + _EMPTY + _EMPT
 _STRING_HEAD = _PARAM_NUMBERS.pack(ParamType.STRING, False, 0, 0.0)
 
 
-def _string(text: str) -> bytes:
+def string_bytes(text: str) -> bytes:
+    """The wire bytes of a ROS ``string``."""
     if not text:
         return _EMPTY
     data = text.encode("utf-8")
@@ -69,13 +70,13 @@ def _param_body(value: Value) -> bytes:
         return _PARAM_NUMBERS.pack(ParamType.INT, False, value, 0.0) + _NO_TEXT_NO_POSE
     if kind is str:
         assert isinstance(value, str)
-        return _STRING_HEAD + _string(value) + _EMPTY + _NO_POSE
+        return _STRING_HEAD + string_bytes(value) + _EMPTY + _NO_POSE
     ptype = value_type(value)
     return b"".join(
         (
             _PARAM_NUMBERS.pack(ptype, value if ptype is ParamType.BOOL else False, 0, 0.0),
             _EMPTY,
-            _string(json.dumps(value, separators=(",", ":")))
+            string_bytes(json.dumps(value, separators=(",", ":")))
             if ptype in (ParamType.LIST, ParamType.DICT)
             else _EMPTY,
             _NO_POSE,
@@ -95,17 +96,17 @@ def skill_bytes(skill: SkillInstance, names: dict[str, bytes] | None = None) -> 
         names = {}
     bindings = skill.bindings
     parts = [
-        _string(skill.id),
-        names.get(skill.agent) or names.setdefault(skill.agent, _string(skill.agent)),
-        names.get(skill.skill) or names.setdefault(skill.skill, _string(skill.skill)),
-        _string(skill.label),
+        string_bytes(skill.id),
+        names.get(skill.agent) or names.setdefault(skill.agent, string_bytes(skill.agent)),
+        names.get(skill.skill) or names.setdefault(skill.skill, string_bytes(skill.skill)),
+        string_bytes(skill.label),
         _COUNT.pack(len(skill.params)),
     ]
     for name, value in skill.params.items():
         parts += (
-            names.get(name) or names.setdefault(name, _string(name)),
+            names.get(name) or names.setdefault(name, string_bytes(name)),
             _param_body(value),
-            _string(bindings[name]) if name in bindings else _EMPTY,
+            string_bytes(bindings[name]) if name in bindings else _EMPTY,
         )
     parts += (
         _SKILL_NUMBERS.pack(
@@ -116,7 +117,7 @@ def skill_bytes(skill: SkillInstance, names: dict[str, bytes] | None = None) -> 
             skill.timeout,
             skill.max_retries,
         ),
-        _string(skill.status_text),
+        string_bytes(skill.status_text),
         _TIMES.pack(skill.started, skill.finished),
     )
     return b"".join(parts)
@@ -170,8 +171,8 @@ class PackedGetMissionResponse(srv.GetMissionResponse):  # type: ignore[misc]
     def serialize(self, buff: Any) -> None:
         """Write the message's wire bytes to ``buff``: the packed mission, alert and epoch."""
         self.mission.serialize(buff)
-        buff.write(_string(self.journal_alert))
-        buff.write(_string(self.epoch))
+        buff.write(string_bytes(self.journal_alert))
+        buff.write(string_bytes(self.epoch))
 
 
 @dataclass(frozen=True)
@@ -219,14 +220,14 @@ class SnapshotPacker:
         with self._lock:
             previous, prepared = self._tasks, self._prepared
         tasks: dict[str, _PackedTask] = {}
-        parts = [_string(content.library), _COUNT.pack(len(content.tasks))]
+        parts = [string_bytes(content.library), _COUNT.pack(len(content.tasks))]
         for agent, task in content.tasks.items():
             sources = [packed for packed in (previous.get(agent), prepared.get(agent)) if packed]
             packed = next((p for p in sources if _same_instances(p.skills, task)), None)
             if packed is None:
                 packed = self._pack_task(task, sources)
             tasks[agent] = packed
-            parts += (_string(agent), _COUNT.pack(len(task)))
+            parts += (string_bytes(agent), _COUNT.pack(len(task)))
             parts += packed.parts
         agent_of = _agents_of_members(content).__getitem__
         parts.append(_array(barrier_to_msg(b, agent_of) for b in content.barriers.values()))

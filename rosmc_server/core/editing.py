@@ -157,7 +157,9 @@ def plan_reorder(state: MissionState, agent: str, order: Sequence[str]) -> Propo
             f"the new order must list each of {agent}'s {len(editable)} editable blueprint "
             f"skills exactly once (got {len(order)} ids)"
         )
-    return _reordered(state, agent, moves_between(editable, order, start))
+    moves = moves_between(editable, order, start)
+    state.expect_moves(agent, moves, start, order)
+    return _reordered(state, agent, moves)
 
 
 def plan_move_skills(state: MissionState, agent: str, moves: Sequence[SkillMove]) -> Proposal:

@@ -15,6 +15,7 @@ from dataclasses import replace
 
 from . import barriers, editing, execution, markers, team
 from .changes import Change, EventKind, MissionEvent, Proposal, SkillMove
+from .collector import collector_paused
 from .errors import RuleViolation, StaleRevision
 from .library import Library
 from .model import SkillStatus, TaskMarker, Transfer
@@ -132,14 +133,16 @@ class Mission:
     ) -> MissionEvent:
         """Give an agent's editable blueprint a new order."""
         self._check_revision(base_revision)
-        return self._commit(editing.plan_reorder(self.state, agent, order))
+        with collector_paused():
+            return self._commit(editing.plan_reorder(self.state, agent, order))
 
     def move_skills(
         self, agent: str, moves: Sequence[SkillMove], *, base_revision: int | None = None
     ) -> MissionEvent:
         """Move skills within an agent's editable blueprint, one after the other."""
         self._check_revision(base_revision)
-        return self._commit(editing.plan_move_skills(self.state, agent, moves))
+        with collector_paused():
+            return self._commit(editing.plan_move_skills(self.state, agent, moves))
 
     # -- synchronization and execution ------------------------------------------
     def synchronize(

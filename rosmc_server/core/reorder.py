@@ -50,35 +50,38 @@ def canonical_moves(
         tail -= 1
     current, order, offset = current[head:tail], order[head:tail], offset + head
     position = {skill_id: index for index, skill_id in enumerate(order)}
-    targets = [position[skill_id] for skill_id in current]
+    targets = list(map(position.__getitem__, current))
     staying = _longest_increasing(targets)
-    # The region of a moved skill: how many staying skills are before it now.
-    region: dict[str, int] = {}
+    # Per place in the new order: the region of the skill moved there (how many staying
+    # skills are before it now), or -1 where a staying skill is. Lists, not dicts: the
+    # loops below index them by place.
+    region = [-1] * len(order)
     passed = 0
-    for skill_id, target in zip(current, targets, strict=True):
-        if target in staying:
+    for target in targets:
+        if staying[target]:
             passed += 1
         else:
-            region[skill_id] = passed
+            region[target] = passed
     waiting = [0] * (passed + 1)  # per region, the moved skills not moved yet
-    for number in region.values():
-        waiting[number] += 1
+    for number in region:
+        if number >= 0:
+            waiting[number] += 1
     moves: list[tuple[str, int]] = []
+    append = moves.append
     before = 0  # staying skills before the next moved one, in the new order
     counted = 0  # regions below this one are summed in ``unmoved_before``
     unmoved_before = 0
-    for index, skill_id in enumerate(order):
-        if index in staying:
+    for skill_id, number in zip(order, region, strict=True):
+        if number < 0:
             before += 1
             continue
-        number = region[skill_id]
         waiting[number] -= 1
         if number < counted:
             unmoved_before -= 1
         while counted < before:
             unmoved_before += waiting[counted]
             counted += 1
-        moves.append((skill_id, offset + len(moves) + before + unmoved_before))
+        append((skill_id, offset + len(moves) + before + unmoved_before))
     return moves
 
 
@@ -138,8 +141,9 @@ def play_one_by_one(current: Sequence[str], moves: Sequence[Move], offset: int =
     return result
 
 
-def _longest_increasing(values: Sequence[int]) -> set[int]:
-    """The values of a longest increasing run (subsequence) of ``values``."""
+def _longest_increasing(values: Sequence[int]) -> bytearray:
+    """Flags, by value, of the values of a longest increasing run (subsequence) of
+    ``values``, a permutation of ``range(len(values))``."""
     tails: list[int] = []  # the smallest last value of an increasing run of each length
     ends: list[int] = []  # where in ``values`` that run ends
     previous: list[int] = []
@@ -152,9 +156,9 @@ def _longest_increasing(values: Sequence[int]) -> set[int]:
             tails[length] = value
             ends[length] = index
         previous.append(ends[length - 1] if length else -1)
-    run: set[int] = set()
+    run = bytearray(len(values))
     index = ends[-1] if ends else -1
     while index >= 0:
-        run.add(values[index])
+        run[values[index]] = 1
         index = previous[index]
     return run

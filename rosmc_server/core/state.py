@@ -232,6 +232,15 @@ class MissionState:
         self._played = (moves, agent, played)
         return played
 
+    def expect_moves(
+        self, agent: str, moves: Sequence[SkillMove], start: int, order: Sequence[str]
+    ) -> None:
+        """Note that ``moves`` give ``agent``'s task from ``start`` on in ``order`` (the
+        planner of a whole new order knows it), so that :meth:`order_after_moves` need
+        not decode them. Nothing changes."""
+        if len(moves) >= BULK_MOVES:
+            self._played = (moves, agent, (start, list(order)))
+
     def _order_after_moves(
         self, agent: str, moves: Sequence[SkillMove]
     ) -> tuple[int, list[str]] | None:

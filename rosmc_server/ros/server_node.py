@@ -71,12 +71,12 @@ import rospy
 from .. import interface
 from ..conversions import (
     event_from_msg,
-    event_to_msg,
     library_to_msg,
     mission_from_msg,
     mission_to_msg,
     time_to_msg,
 )
+from ..conversions.event_packing import packed_event
 from ..conversions.packing import PackedMission, SnapshotPacker
 from ..core import (
     Library,
@@ -201,8 +201,8 @@ class MissionServer:
 
     def _record(self, event: MissionEvent) -> None:
         state = self.mission.state
-        msg = event_to_msg(event, lambda skill_id: state.locate(skill_id)[0])
-        msg.epoch = self.epoch
+        # Bytes made once for the journal and the topic (a whole reorder is 10,000 moves).
+        msg = packed_event(event, lambda skill_id: state.locate(skill_id)[0], self.epoch)
         stamp_ns = time.time_ns()
         try:
             self._journal.append_event(msg, stamp_ns)

@@ -14,11 +14,9 @@ the document and serializes the new skills before it takes the server's lock.
 
 from __future__ import annotations
 
-import contextlib
 import gc
 import logging
 import time
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -26,6 +24,7 @@ import rosmc.srv as srv
 
 from ..conversions.packing import PackedGetMissionResponse
 from ..core import InvalidRequest, MissionEvent, MissionFileError, load_mission, parse_mission
+from ..core.collector import collector_paused
 from ..core.persistence import MissionDumper, write_document
 from ..core.validation import check_file_path
 from .server_host import ServerHost
@@ -132,15 +131,3 @@ class WholeMissionServices:
         # full collection (tens of milliseconds at 10,000 skills).
         gc.freeze()
         return event
-
-
-@contextlib.contextmanager
-def collector_paused() -> Iterator[None]:
-    """Run the body without cyclic garbage collection (several passes over a new mission)."""
-    was_enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if was_enabled:
-            gc.enable()

@@ -164,3 +164,51 @@ def test_a_whole_random_order_is_decoded_not_played_move_by_move() -> None:
     assert state.order_after_moves("A", moves) == (0, new)
     state.apply(Change(order_agent="A", moves=moves))
     assert scanned(state)["A"] == new
+
+
+def test_a_whole_new_order_is_planned_once_not_decoded_again(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # The planner knows the new order: checking, undo history and apply all take it.
+    import random
+
+    from rosmc_server.core import state as state_module
+    from rosmc_server.core.editing import plan_reorder
+    from tests.unit.test_change_indexes import state_of
+
+    ids = [f"a{n}" for n in range(400)]
+    state = state_of({"A": ids, "B": ["b0"]}, [])
+    decoded: list[int] = []
+    real = state_module.play_moves
+
+    def counting(*args: Any) -> Any:
+        decoded.append(len(args[1]))
+        return real(*args)
+
+    monkeypatch.setattr(state_module, "play_moves", counting)
+    new = random.Random(3).sample(ids, len(ids))
+    proposal = plan_reorder(state, "A", new)
+    assert len(proposal.change.moves) >= BULK_MOVES
+    assert state.members_after_moves("A", proposal.change.moves) == []
+    state.apply(proposal.change)
+    assert scanned(state)["A"] == new
+    assert decoded == []
+
+
+def test_the_collector_is_paused_for_a_reorder_and_restored_after() -> None:
+    import gc
+
+    from rosmc_server.core.collector import collector_paused
+
+    assert gc.isenabled()
+    with pytest.raises(RuntimeError), collector_paused():
+        assert not gc.isenabled()
+        raise RuntimeError("a refused reorder")
+    assert gc.isenabled()
+    gc.disable()
+    try:
+        with collector_paused():
+            assert not gc.isenabled()
+        assert not gc.isenabled()  # off before: off after
+    finally:
+        gc.enable()

@@ -83,3 +83,23 @@ def test_a_missing_module_of_the_project_itself_is_not_hidden(
     module = _entry_module(tmp_path, monkeypatch, "entry_broken", "import rosmc_not_here\n")
     with pytest.raises(ModuleNotFoundError, match="rosmc_not_here"):
         venv.run_entry_point(module)
+
+
+def test_an_unused_optional_module_is_kept_out_of_the_program(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # As genpy does with numpy: an optional import, handled when it fails.
+    (tmp_path / "entry_optional_extra.py").write_text("LOADED = True\n", encoding="utf-8")
+    body = (
+        "try:\n    import entry_optional_extra\n"
+        "except ImportError:\n    entry_optional_extra = None\n"
+        "\ndef main():\n    return 0 if entry_optional_extra is None else 5\n"
+    )
+    try:
+        module = _entry_module(tmp_path, monkeypatch, "entry_lean", body)
+        assert venv.run_entry_point(module, unused=("entry_optional_extra",)) == 0
+        sys.modules.pop(module)
+        sys.modules.pop("entry_optional_extra")
+        assert venv.run_entry_point(module) == 5  # installed and not kept out: imported
+    finally:
+        sys.modules.pop("entry_optional_extra", None)
