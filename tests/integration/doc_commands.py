@@ -313,6 +313,13 @@ DOC_COMMANDS: dict[str, Evidence] = {
     "colcon build --base-paths /path/to/rosmc --cmake-args -DPYTHON_EXECUTABLE=/usr/bin/python3": (
         Evidence(COLCON, ('"--base-paths",', '"--cmake-args",'))
     ),
+    # docs/writing-skills.md: the example robot, started by the guide's own command
+    "PYTHONPATH=$PWD:$PYTHONPATH rosrun rosmc mission_executor __ns:=sweeper1 _agent:=sweeper1 "
+    "_skills:=lab_skills:skill_types _library:=sweeper_lab.yaml": Evidence(
+        "tests/integration/test_writing_skills_example.py::"
+        "test_the_guide_example_robot_runs_its_skill",
+        ('blocks("bash")[0]', '["bash", "-c", command]'),
+    ),
     "rostest rosmc server.test": Evidence(*ROSTEST),
     "rostest rosmc executor.test": Evidence(*RUN_TESTS),
     "rostest rosmc sim.test": Evidence(*RUN_TESTS),
