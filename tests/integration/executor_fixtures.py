@@ -28,6 +28,7 @@ from io import BytesIO
 from pathlib import Path
 from typing import Any
 
+import rosgraph
 import rosmc.msg as wire
 import rosmc.srv as srv
 import rospy
@@ -521,6 +522,23 @@ class RosmcSystem:
             stop_process(process)
         if "server" in self.processes:
             stop_process(self.processes["server"])
+        self._forget_private_params()
+
+    def _forget_private_params(self) -> None:
+        """Delete the private parameters this system's nodes were started with.
+
+        They outlive the nodes on the session's master, and a later node of the same name
+        started without one (another module's server, with the default library) would
+        read this system's value.
+        """
+        master = rosgraph.Master("/rosmc_tests", master_uri=self.env["ROS_MASTER_URI"])
+        for name in self.processes:
+            node = {"server": "/rosmc/mission_server", "emulator": "/rosmc/link_emulator"}.get(
+                name, f"/{name}/mission_executor"
+            )
+            with contextlib.suppress(rosgraph.MasterError, OSError):
+                if master.hasParam(node):
+                    master.deleteParam(node)
 
     def log_tails(self, lines: int = 30, names: Sequence[str] = ()) -> str:
         """The end of the log of every process (or of those in ``names``)."""
