@@ -27,11 +27,15 @@ the profile.
 from __future__ import annotations
 
 import contextlib
+import faulthandler
 import os
 import signal
 import socket
 import subprocess
+import sys
+import threading
 import time
+import traceback
 import xmlrpc.client
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
@@ -47,6 +51,10 @@ T = TypeVar("T")
 LOOPBACK = "127.0.0.1"
 MASTER_START_TIMEOUT = 60.0
 STOP_TIMEOUT = 30.0
+# After the last test, the interpreter must exit within this time: a thread still running
+# (a worker stuck in a call, a timer that re-arms itself) would otherwise hold the run open
+# until CI's own limit. Its stack is printed, and the run ends with a failure.
+EXIT_GRACE = 120.0
 HYPOTHESIS_PROFILES = MappingProxyType(
     {
         "quick": settings(max_examples=100, deadline=None, print_blob=True),
@@ -69,6 +77,27 @@ def pytest_configure(config: pytest.Config) -> None:
     for profile, chosen in HYPOTHESIS_PROFILES.items():
         settings.register_profile(profile, chosen)
     settings.load_profile(name)
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    """Name every thread that would keep the interpreter from exiting, with its stack.
+
+    Such a thread is a leak of the code under test (a mission client not closed, a timer
+    chain): it is reported here, and if the process still runs ``EXIT_GRACE`` seconds later
+    every stack is dumped and the process exits with status 1.
+    """
+    frames = sys._current_frames()
+    lingering = [
+        thread
+        for thread in threading.enumerate()
+        if thread is not threading.main_thread() and not thread.daemon and thread.is_alive()
+    ]
+    for thread in lingering:
+        stack = (
+            "".join(traceback.format_stack(frames[thread.ident])) if thread.ident in frames else ""
+        )
+        sys.stderr.write(f"\nthread still running after the tests: {thread.name}\n{stack}")
+    faulthandler.dump_traceback_later(EXIT_GRACE, exit=True)
 
 
 def wait_until(
