@@ -64,6 +64,23 @@ def init_test_node(name: str = "executor_tests") -> None:
         rospy.init_node(name, anonymous=True, disable_signals=True)
 
 
+def stop_action_server(server: Any) -> None:
+    """Stop an ``actionlib.SimpleActionServer`` started by a test, its thread included.
+
+    Its execute thread is not a daemon and runs until rospy shuts down, which a test
+    process never asks for: left alone it would keep the interpreter from exiting.
+    """
+    server.action_server.stop()
+    if server.execute_thread is None:
+        return
+    with server.terminate_mutex:
+        server.need_to_terminate = True
+    with server.execute_condition:
+        server.execute_condition.notify_all()
+    server.execute_thread.join(timeout=30.0)
+    assert not server.execute_thread.is_alive(), "the action server's thread did not stop"
+
+
 @dataclass
 class EventLog:
     """``/rosmc/mission_events`` as received here, with the local receive time."""

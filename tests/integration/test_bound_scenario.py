@@ -41,6 +41,10 @@ class Spectrometer:
         )
         self.server.start()
 
+    def close(self) -> None:
+        """Withdraw the action server (its thread would outlive the tests)."""
+        stop_action_server(self.server)
+
     def _expose(self, goal: Any) -> None:
         with self._lock:
             self.goals.append(goal.goal)
@@ -67,6 +71,7 @@ def lab_team(ros_master: Any, tmp_path: Path) -> Iterator[tuple[Team, Operator, 
         if operator is not None:
             operator.close()
         team.close()
+        spectrometer.close()
 
 
 def test_a_bound_skill_runs_in_the_simulated_team_after_a_simulated_one(

@@ -83,6 +83,12 @@ class Lab:
         with self.lock:
             self.looks.append(msg)
 
+    def stop(self) -> None:
+        """Withdraw the interfaces (the action server's thread would outlive the tests)."""
+        stop_action_server(self.counter)
+        self.service.shutdown()
+        self.subscriber.unregister()
+
     def clear(self) -> None:
         """Forget what earlier tests asked."""
         with self.lock:
@@ -93,12 +99,13 @@ class Lab:
 
 
 @pytest.fixture(scope="module")
-def lab(ros_master: RosMaster) -> Lab:
+def lab(ros_master: RosMaster) -> Iterator[Lab]:
     """The lab's interfaces, advertised once for the module (the master outlives it)."""
     init_test_node()
     lab = Lab()
     lab.start()
-    return lab
+    yield lab
+    lab.stop()
 
 
 @pytest.fixture
