@@ -234,7 +234,9 @@ class MarkerNode:
                 return
             statuses = self.mirror.agent_statuses
             names = set(touched.markers)
-            agents = set(touched.agents)
+            # Agents touched under a previous library may be unknown to this one (the server
+            # restarted with another library): they have nothing left to draw.
+            agents = set(touched.agents) & set(scene.agents())
             if touched.everything or touched.markers or touched.icons:
                 names |= scene.relayout(state, self._block_labels(scene, statuses, state))
             if touched.everything:
