@@ -20,6 +20,7 @@ import pytest
 import rospy
 
 from rosmc_server.core import Pose, SkillStatus
+from tests.integration.executor_fixtures import stop_action_server
 from tests.integration.scenario_fixtures import Operator, Team, TeamSettings
 
 pytestmark = pytest.mark.integration

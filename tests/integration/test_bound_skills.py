@@ -27,7 +27,13 @@ from std_srvs.srv import SetBool, SetBoolRequest, SetBoolResponse
 
 from rosmc_server.core import Pose, SkillStatus
 from tests.conftest import RosMaster, wait_until
-from tests.integration.executor_fixtures import REPO_ROOT, Operator, RosmcSystem, init_test_node
+from tests.integration.executor_fixtures import (
+    REPO_ROOT,
+    Operator,
+    RosmcSystem,
+    init_test_node,
+    stop_action_server,
+)
 
 pytestmark = pytest.mark.integration
 
