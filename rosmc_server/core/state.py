@@ -10,14 +10,13 @@ from __future__ import annotations
 import bisect
 import operator
 from collections.abc import Iterable, Iterator, Sequence
-from dataclasses import replace
 from fractions import Fraction
 
 from .changes import Change, SkillMove, moves_between
 from .content import MissionContent as MissionContent
 from .content import Sections as Sections
 from .errors import NotFound
-from .model import Barrier, SkillInstance, SkillStatus, TaskMarker, Transfer
+from .model import Barrier, SkillInstance, SkillStatus, TaskMarker, Transfer, skill_with
 from .pair_index import PairIndex
 from .reorder import play_moves
 from .validation import excerpt
@@ -323,7 +322,10 @@ class MissionState:
     def _put_skill(self, index: int, skill: SkillInstance) -> None:
         task = self._content.tasks[skill.agent]
         if skill.id in self._agent_of:
-            _, current = self.locate(skill.id)
+            # Most puts replace the skill at the place they name (a synchronize of
+            # thousands): only a stale place needs the binary search.
+            fits = 0 <= index < len(task) and task[index].id == skill.id
+            current = index if fits else self.locate(skill.id)[1]
             self._unbind(task[current])
             task[current] = skill
             self._note_transfer(skill)
@@ -475,4 +477,4 @@ class MissionState:
 
 def with_status(skill: SkillInstance, status: SkillStatus, **changes: object) -> SkillInstance:
     """A copy of ``skill`` with a new status (and any other field changes)."""
-    return replace(skill, status=status, **changes)  # type: ignore[arg-type]
+    return skill_with(skill, status=status, **changes)
