@@ -175,6 +175,10 @@ class MissionState:
         barrier_id = self._barrier_of.get(skill_id)
         return None if barrier_id is None else self._content.barriers[barrier_id]
 
+    def members_of(self, agent: str) -> tuple[str, ...]:
+        """``agent``'s barrier members, in task order."""
+        return tuple(self._member_ids.get(agent, ()))
+
     def members_around(self, skill_id: str) -> tuple[str | None, str | None]:
         """The barrier members just before and just after a skill on its agent's task.
 
