@@ -40,6 +40,8 @@ class PackedCommand(wire.RobotCommand):  # type: ignore[misc]
     unsynchronize cancels part of an upload not sent yet); the bytes follow it.
     """
 
+    skills: list[SkillInstance]  # the genpy slot, holding core skills
+
     def __init__(self, **fields: Any) -> None:
         super().__init__(**fields)
         self._skill_bytes: tuple[list[SkillInstance], bytes] | None = None

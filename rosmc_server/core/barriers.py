@@ -98,9 +98,8 @@ def check_moves(state: MissionState, agent: str, moves: Sequence[SkillMove]) -> 
     member's barrier is on any new cycle, so the search starts from those only.
     """
     moved = {move.skill_id for move in moves}
-    members = state.members_of(agent)
-    if len(members) < len(moved):  # a whole new order moves thousands, of a few members
-        moved = {skill_id for skill_id in members if skill_id in moved}
+    if len(state.members_of(agent)) < len(moved):  # a whole new order moves thousands
+        moved &= set(state.members_of(agent))
     starts = {b.id for b in map(state.barrier_of, moved) if b is not None}
     if not starts:
         return

@@ -22,7 +22,6 @@ import bisect
 from collections.abc import Sequence
 from typing import Protocol
 
-
 NOT_A_PERMUTATION = "the new order is not a permutation of the current one"
 
 
