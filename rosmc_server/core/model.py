@@ -165,8 +165,9 @@ class SkillInstance:
     _set_started,
     _set_finished,
 ) = (getattr(SkillInstance, name).__set__ for name in SkillInstance.__slots__)
+skill_id_of = operator.attrgetter("id")  # a skill's id, in C (for map over thousands)
 _fields_of = operator.attrgetter(*SkillInstance.__slots__)
-_FIELD_PLACE = {name: place for place, name in enumerate(SkillInstance.__slots__)}
+_FIELD_PLACE = MappingProxyType({name: at for at, name in enumerate(SkillInstance.__slots__)})
 
 
 def skill_with(skill: SkillInstance, /, **changes: Any) -> SkillInstance:

@@ -8,7 +8,6 @@ that can be journaled and replayed.
 from __future__ import annotations
 
 import bisect
-import operator
 from collections.abc import Iterable, Iterator, Sequence
 from fractions import Fraction
 
@@ -16,7 +15,15 @@ from .changes import Change, SkillMove, moves_between
 from .content import MissionContent as MissionContent
 from .content import Sections as Sections
 from .errors import NotFound
-from .model import Barrier, SkillInstance, SkillStatus, TaskMarker, Transfer, skill_with
+from .model import (
+    Barrier,
+    SkillInstance,
+    SkillStatus,
+    TaskMarker,
+    Transfer,
+    skill_id_of,
+    skill_with,
+)
 from .pair_index import PairIndex
 from .reorder import play_moves
 from .validation import excerpt
@@ -27,7 +34,7 @@ _KEY_SPACING = 1 << 32
 # From this many moves on, a reorder is decoded in one pass over the stretch it touches
 # (see :mod:`.reorder`) instead of shifting the task once per move.
 BULK_MOVES = 16
-_skill_id = operator.attrgetter("id")
+_skill_id = skill_id_of
 
 
 class MissionState:
@@ -206,7 +213,7 @@ class MissionState:
             task_keys, member_keys = self._keys[agent], self._member_keys.get(agent, [])
             first = bisect.bisect_left(member_keys, task_keys[start])
             last = bisect.bisect_right(member_keys, task_keys[start + len(ids) - 1])
-            inside = [skill_id for skill_id in ids if skill_id in self._barrier_of]
+            inside = list(filter(self._barrier_of.__contains__, ids))
             return [*members[:first], *inside, *members[last:]]
         keys: list[int | Fraction] = list(self._keys[agent])
         moved: dict[str, int | Fraction] = {}
@@ -381,7 +388,8 @@ class MissionState:
         start, ids = played
         end = start + len(ids)
         task, keys, key_of = self._content.tasks[agent], self._keys[agent], self._key_of
-        by_id = {skill.id: skill for skill in task[start:end]}
+        stretch = task[start:end]
+        by_id = dict(zip(map(_skill_id, stretch), stretch, strict=True))  # in C, all at once
         task[start:end] = map(by_id.__getitem__, ids)
         low = keys[start - 1] if start else 0
         high = keys[end] if end < len(keys) else low + _KEY_SPACING * (len(ids) + 1)
