@@ -12,7 +12,6 @@ from __future__ import annotations
 import random
 
 import genpy
-import pytest
 import rosmc.msg as wire
 
 from rosmc_server.conversions import barrier_to_msg, skill_to_msg
@@ -22,20 +21,14 @@ from rosmc_server.conversions.command_packing import (
     command_msg,
 )
 from rosmc_server.conversions.packing import serialized
-from rosmc_server.core import Barrier, Library
+from rosmc_server.core import Barrier
 from rosmc_server.core.commands import CommandKind, CommandSpec
 from rosmc_server.core.library import library_from_dict
 from rosmc_server.core.link import Outbox
 from rosmc_server.core.waiting import collapse
+from tests.ros.test_event_packing import ALPHABET
 from tests.unit.conftest import TEST_LIBRARY
 from tests.unit.random_missions import random_content, text
-
-ALPHABET = ["a", "Z", "0", "-", "_", " ", "é", "ß", "→", "火", "\u2028", '"']
-
-
-@pytest.fixture(scope="module")
-def library() -> Library:
-    return library_from_dict(TEST_LIBRARY)
 
 
 def test_the_packed_writer_is_in_use() -> None:
@@ -59,7 +52,8 @@ def genpy_command(spec: CommandSpec) -> wire.RobotCommand:
     )
 
 
-def random_specs(library: Library, count: int, seed: int) -> list[CommandSpec]:
+def random_specs(count: int, seed: int) -> list[CommandSpec]:
+    library = library_from_dict(TEST_LIBRARY)
     rng = random.Random(seed)
     skills = [s for task in random_content(library, 600, seed=seed).tasks.values() for s in task]
     ids = [skill.id for skill in skills]
@@ -79,9 +73,9 @@ def random_specs(library: Library, count: int, seed: int) -> list[CommandSpec]:
     return specs
 
 
-def test_every_command_packs_as_genpy_serializes_it(library: Library) -> None:
+def test_every_command_packs_as_genpy_serializes_it() -> None:
     rng = random.Random(3)
-    for number, spec in enumerate(random_specs(library, 150, seed=17)):
+    for number, spec in enumerate(random_specs(150, seed=17)):
         packed, expected = command_msg(spec, agent_of), genpy_command(spec)
         assert isinstance(packed, PackedCommand)
         for _ in range(2):  # a retransmission is numbered and stamped anew
@@ -93,10 +87,8 @@ def test_every_command_packs_as_genpy_serializes_it(library: Library) -> None:
         assert [s.id for s in packed.skills] == list(s.id for s in spec.skills)
 
 
-def test_an_upload_shortened_by_an_unsynchronize_sends_the_skills_it_kept(
-    library: Library,
-) -> None:
-    skills = random_content(library, 60, seed=4).tasks["alpha"]
+def test_an_upload_shortened_by_an_unsynchronize_sends_the_skills_it_kept() -> None:
+    skills = random_content(library_from_dict(TEST_LIBRARY), 60, seed=4).tasks["alpha"]
     upload = CommandSpec("alpha", CommandKind.UPLOAD, tuple(skills))
     outbox: Outbox[wire.RobotCommand] = Outbox()
     queued = command_msg(upload, agent_of)
