@@ -8,6 +8,7 @@ A:[x1, y1], B:[y2, x2] with barriers {x1, x2} and {y1, y2}.
 
 from __future__ import annotations
 
+import operator
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 
@@ -97,7 +98,9 @@ def check_moves(state: MissionState, agent: str, moves: Sequence[SkillMove]) -> 
     Moving a skill that is in no barrier never changes the barriers' order; a moved
     member's barrier is on any new cycle, so the search starts from those only.
     """
-    moved = {move.skill_id for move in moves}
+    moved = set(map(operator.attrgetter("skill_id"), moves))
+    if len(state.members_of(agent)) < len(moved):  # a whole new order moves thousands
+        moved &= set(state.members_of(agent))
     starts = {b.id for b in map(state.barrier_of, moved) if b is not None}
     if not starts:
         return

@@ -122,7 +122,8 @@ class Proposal:
 def moves_between(
     current: Sequence[str], order: Sequence[str], offset: int = 0
 ) -> tuple[SkillMove, ...]:
-    """The fewest moves that turn ``current`` into ``order`` (a permutation of it).
+    """The fewest moves that turn ``current`` into ``order`` (a permutation of it, else
+    ValueError).
 
     Skills of a longest run already in the right relative order stay; each other
     skill, taken in its new order, moves to just after its new predecessor, so

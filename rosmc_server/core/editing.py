@@ -14,7 +14,7 @@ from .barriers import barrier_without, check_moves
 from .changes import Change, EventKind, PlacedSkill, Proposal, SkillMove, moves_between
 from .errors import InvalidRequest, RuleViolation
 from .library import Library, SkillSpec
-from .model import SkillInstance, TaskMarker
+from .model import SkillInstance, TaskMarker, skill_id_of
 from .params import ParamType, Value
 from .state import MissionState
 from .validation import (
@@ -151,13 +151,14 @@ def plan_reorder(state: MissionState, agent: str, order: Sequence[str]) -> Propo
     """
     task = state.task(agent)
     start = state.sections(agent).editable_start
-    editable = [skill.id for skill in task[start:]]
-    if len(order) != len(editable) or set(order) != set(editable):
+    editable = list(map(skill_id_of, task[start:]))
+    try:  # checks that ``order`` is a permutation of ``editable`` as it goes
+        moves = moves_between(editable, order, start)
+    except ValueError:
         raise InvalidRequest(
             f"the new order must list each of {agent}'s {len(editable)} editable blueprint "
             f"skills exactly once (got {len(order)} ids)"
-        )
-    moves = moves_between(editable, order, start)
+        ) from None
     state.expect_moves(agent, moves, start, order)
     return _reordered(state, agent, moves)
 

@@ -22,7 +22,7 @@ from .legality import (
     unsync_refusal,
     unsync_start,
 )
-from .model import Resolution, SkillInstance, SkillStatus, Transfer
+from .model import Resolution, SkillInstance, SkillStatus, Transfer, skill_with
 from .state import MissionState
 from .validation import clip_status_text, excerpt
 
@@ -54,7 +54,7 @@ def plan_synchronize(state: MissionState, agent: str, upto_id: str | None) -> Pr
     editable = task[sections.editable_start : end]
     start = sections.editable_start
     puts = tuple(
-        PlacedSkill(start + offset, replace(skill, transfer=Transfer.UPLOADING))
+        PlacedSkill(start + offset, skill_with(skill, transfer=Transfer.UPLOADING))
         for offset, skill in enumerate(editable)
     )
     return Proposal(
@@ -72,7 +72,7 @@ def plan_confirm_sync(state: MissionState, agent: str, skill_ids: Sequence[str])
     puts = _placed(
         state,
         [
-            replace(s, status=S.IDLE_SYNCHRONIZED, transfer=Transfer.NONE)
+            skill_with(s, status=S.IDLE_SYNCHRONIZED, transfer=Transfer.NONE)
             for s in uploading[: len(skill_ids)]
         ],
     )
@@ -92,7 +92,9 @@ def plan_decline_sync(
     _require_run(uploading, skill_ids, agent, "uploads", from_front=False)
     declined = uploading[len(uploading) - len(skill_ids) :]
     text = reason.strip() or "declined by the robot"
-    puts = _placed(state, [replace(s, transfer=Transfer.NONE, status_text=text) for s in declined])
+    puts = _placed(
+        state, [skill_with(s, transfer=Transfer.NONE, status_text=text) for s in declined]
+    )
     return Proposal(
         EventKind.SYNC_DECLINED,
         agent,
@@ -115,7 +117,9 @@ def plan_cancel_uploads(state: MissionState, agent: str, from_id: str | None = N
     if from_id in ids:
         uploading = uploading[ids.index(from_id) :]
     text = "upload cancelled by the operator"
-    puts = _placed(state, [replace(s, transfer=Transfer.NONE, status_text=text) for s in uploading])
+    puts = _placed(
+        state, [skill_with(s, transfer=Transfer.NONE, status_text=text) for s in uploading]
+    )
     return Proposal(
         EventKind.UPLOAD_CANCELLED,
         agent,
@@ -139,7 +143,7 @@ def plan_request_unsync(state: MissionState, agent: str, from_id: str | None) ->
     start = unsync_start(view) if index is None else index
     pulled = synced[start:]
     puts = tuple(
-        PlacedSkill(start + offset, replace(skill, transfer=Transfer.REMOVING))
+        PlacedSkill(start + offset, skill_with(skill, transfer=Transfer.REMOVING))
         for offset, skill in enumerate(pulled)
     )
     return Proposal(
@@ -158,8 +162,10 @@ def plan_confirm_unsync(state: MissionState, agent: str, removed_ids: Sequence[s
     _require_run(removing, removed_ids, agent, "removals", from_front=False, allow_empty=True)
     kept = removing[: len(removing) - len(removed_ids)]
     removed = removing[len(kept) :]
-    updated = [replace(s, transfer=Transfer.NONE) for s in kept]
-    updated += [replace(s, status=S.IDLE, transfer=Transfer.NONE, status_text="") for s in removed]
+    updated = [skill_with(s, transfer=Transfer.NONE) for s in kept]
+    updated += [
+        skill_with(s, status=S.IDLE, transfer=Transfer.NONE, status_text="") for s in removed
+    ]
     summary = f"{agent} gave back {_ids(removed) or 'nothing'}"
     if kept:
         summary += f"; kept {_ids(kept)}, which had started"
@@ -251,7 +257,7 @@ def plan_stop(state: MissionState, agent: str) -> Proposal:
     """The active skill of ``agent`` goes back to IDLE_SYNCHRONIZED (restarts next time)."""
     for index, skill in enumerate(state.task(agent)):
         if skill.status.is_active:
-            new = replace(skill, status=S.IDLE_SYNCHRONIZED, status_text="stopped", started=0.0)
+            new = skill_with(skill, status=S.IDLE_SYNCHRONIZED, status_text="stopped", started=0.0)
             return Proposal(
                 EventKind.SKILL_STOPPED,
                 agent,

@@ -7,9 +7,11 @@ they change, which keeps every change explicit and easy to journal.
 from __future__ import annotations
 
 import enum
+import operator
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
+from typing import Any
 
 from .params import MarkerType, Pose, Value
 
@@ -163,6 +165,27 @@ class SkillInstance:
     _set_started,
     _set_finished,
 ) = (getattr(SkillInstance, name).__set__ for name in SkillInstance.__slots__)
+skill_id_of = operator.attrgetter("id")  # a skill's id, in C (for map over thousands)
+_fields_of = operator.attrgetter(*SkillInstance.__slots__)
+_FIELD_PLACE = MappingProxyType({name: at for at, name in enumerate(SkillInstance.__slots__)})
+
+
+def skill_with(skill: SkillInstance, /, **changes: Any) -> SkillInstance:
+    """A copy of ``skill`` with ``changes``: ``dataclasses.replace`` for skills, faster.
+
+    A synchronize of thousands of skills copies each with a new transfer state;
+    ``replace`` spends about 3 µs a copy walking the dataclass fields, this about 1.3.
+    A field name the skill does not have raises TypeError, as ``replace`` does.
+    """
+    values = list(_fields_of(skill))
+    for name, value in changes.items():
+        place = _FIELD_PLACE.get(name)
+        if place is None:
+            raise TypeError(f"a skill instance has no field {name!r}")
+        values[place] = value
+    made = SkillInstance.assemble(*values)
+    _set_bindings(made, values[_FIELD_PLACE["bindings"]])  # as given, even an empty dict
+    return made
 
 
 @dataclass(frozen=True)

@@ -22,6 +22,8 @@ import bisect
 from collections.abc import Sequence
 from typing import Protocol
 
+NOT_A_PERMUTATION = "the new order is not a permutation of the current one"
+
 
 class Move(Protocol):
     """A skill and its index once moved (what :class:`.changes.SkillMove` holds)."""
@@ -38,11 +40,14 @@ def canonical_moves(
 ) -> list[tuple[str, int]]:
     """The fewest moves, as (skill id, index) pairs, that turn ``current`` into ``order``.
 
-    ``order`` is a permutation of ``current``; indexes are ``offset`` plus the index in
-    the sequence (``current`` is a task's stretch starting at ``offset``). Skills that
-    keep their place at either end take no part. Cost: ``n log n`` for the longest run
-    (in C, through :mod:`bisect`), ``n`` for the rest.
+    ``current`` holds distinct ids; ``order`` must be a permutation of it, else
+    ValueError (checked on the way, without sets of both). Indexes are ``offset`` plus
+    the index in the sequence (``current`` is a task's stretch starting at ``offset``).
+    Skills that keep their place at either end take no part. Cost: ``n log n`` for the
+    longest run (in C, through :mod:`bisect`), ``n`` for the rest.
     """
+    if len(current) != len(order):
+        raise ValueError(NOT_A_PERMUTATION)
     pairs = zip(current, order, strict=True)
     head = next((i for i, (was, now) in enumerate(pairs) if was != now), len(order))
     tail = len(order)
@@ -50,7 +55,12 @@ def canonical_moves(
         tail -= 1
     current, order, offset = current[head:tail], order[head:tail], offset + head
     position = {skill_id: index for index, skill_id in enumerate(order)}
-    targets = list(map(position.__getitem__, current))
+    try:
+        targets = list(map(position.__getitem__, current))
+    except KeyError:  # an id of ``current`` is missing from ``order``
+        raise ValueError(NOT_A_PERMUTATION) from None
+    if len(position) != len(order):  # ``order`` names an id twice
+        raise ValueError(NOT_A_PERMUTATION)
     staying = _longest_increasing(targets)
     # Per place in the new order: the region of the skill moved there (how many staying
     # skills are before it now), or -1 where a staying skill is. Lists, not dicts: the

@@ -8,16 +8,22 @@ that can be journaled and replayed.
 from __future__ import annotations
 
 import bisect
-import operator
 from collections.abc import Iterable, Iterator, Sequence
-from dataclasses import replace
 from fractions import Fraction
 
 from .changes import Change, SkillMove, moves_between
 from .content import MissionContent as MissionContent
 from .content import Sections as Sections
 from .errors import NotFound
-from .model import Barrier, SkillInstance, SkillStatus, TaskMarker, Transfer
+from .model import (
+    Barrier,
+    SkillInstance,
+    SkillStatus,
+    TaskMarker,
+    Transfer,
+    skill_id_of,
+    skill_with,
+)
 from .pair_index import PairIndex
 from .reorder import play_moves
 from .validation import excerpt
@@ -28,7 +34,7 @@ _KEY_SPACING = 1 << 32
 # From this many moves on, a reorder is decoded in one pass over the stretch it touches
 # (see :mod:`.reorder`) instead of shifting the task once per move.
 BULK_MOVES = 16
-_skill_id = operator.attrgetter("id")
+_skill_id = skill_id_of
 
 
 class MissionState:
@@ -176,6 +182,10 @@ class MissionState:
         barrier_id = self._barrier_of.get(skill_id)
         return None if barrier_id is None else self._content.barriers[barrier_id]
 
+    def members_of(self, agent: str) -> tuple[str, ...]:
+        """``agent``'s barrier members, in task order."""
+        return tuple(self._member_ids.get(agent, ()))
+
     def members_around(self, skill_id: str) -> tuple[str | None, str | None]:
         """The barrier members just before and just after a skill on its agent's task.
 
@@ -203,7 +213,7 @@ class MissionState:
             task_keys, member_keys = self._keys[agent], self._member_keys.get(agent, [])
             first = bisect.bisect_left(member_keys, task_keys[start])
             last = bisect.bisect_right(member_keys, task_keys[start + len(ids) - 1])
-            inside = [skill_id for skill_id in ids if skill_id in self._barrier_of]
+            inside = list(filter(self._barrier_of.__contains__, ids))
             return [*members[:first], *inside, *members[last:]]
         keys: list[int | Fraction] = list(self._keys[agent])
         moved: dict[str, int | Fraction] = {}
@@ -323,7 +333,10 @@ class MissionState:
     def _put_skill(self, index: int, skill: SkillInstance) -> None:
         task = self._content.tasks[skill.agent]
         if skill.id in self._agent_of:
-            _, current = self.locate(skill.id)
+            # Most puts replace the skill at the place they name (a synchronize of
+            # thousands): only a stale place needs the binary search.
+            fits = 0 <= index < len(task) and task[index].id == skill.id
+            current = index if fits else self.locate(skill.id)[1]
             self._unbind(task[current])
             task[current] = skill
             self._note_transfer(skill)
@@ -375,7 +388,8 @@ class MissionState:
         start, ids = played
         end = start + len(ids)
         task, keys, key_of = self._content.tasks[agent], self._keys[agent], self._key_of
-        by_id = {skill.id: skill for skill in task[start:end]}
+        stretch = task[start:end]
+        by_id = dict(zip(map(_skill_id, stretch), stretch, strict=True))  # in C, all at once
         task[start:end] = map(by_id.__getitem__, ids)
         low = keys[start - 1] if start else 0
         high = keys[end] if end < len(keys) else low + _KEY_SPACING * (len(ids) + 1)
@@ -475,4 +489,4 @@ class MissionState:
 
 def with_status(skill: SkillInstance, status: SkillStatus, **changes: object) -> SkillInstance:
     """A copy of ``skill`` with a new status (and any other field changes)."""
-    return replace(skill, status=status, **changes)  # type: ignore[arg-type]
+    return skill_with(skill, status=status, **changes)

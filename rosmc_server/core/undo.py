@@ -25,7 +25,7 @@ from .changes import (
     moves_between,
 )
 from .errors import InvalidRequest, NotFound, RuleViolation
-from .model import Barrier, SkillInstance, TaskMarker
+from .model import Barrier, SkillInstance, TaskMarker, skill_id_of
 from .state import BULK_MOVES, MissionState
 
 # The event kind of an edit's inverse (an edit of either kind can be undone).
@@ -113,7 +113,7 @@ class UndoHistory:
             if played is not None:
                 start, after = played
                 task = state.task(change.order_agent)[start : start + len(after)]
-                before = tuple(skill.id for skill in task)
+                before = tuple(map(skill_id_of, task))
                 self._stretch = Stretch(change.order_agent, start, before, tuple(after))
                 return Change(order_agent=change.order_agent)
         return inverse_change(state, change)

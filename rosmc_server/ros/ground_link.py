@@ -29,7 +29,8 @@ from collections.abc import Callable, Iterable
 import rosmc.msg as wire
 import rospy
 
-from ..conversions import barrier_to_msg, skill_to_msg, time_to_msg
+from ..conversions import time_to_msg
+from ..conversions.command_packing import command_msg
 from ..core import Mission, RosmcError, SkillStatus, StorageFull, Transfer
 from ..core.commands import CommandKind, CommandSpec, queued_barriers
 from ..core.link import (
@@ -126,14 +127,7 @@ class GroundLink:
         if spec.kind in (CommandKind.UPLOAD, CommandKind.BARRIERS, CommandKind.SYNC_STATE):
             link.barriers_sent = spec.barriers
         state = self._mission.state
-        msg = wire.RobotCommand(
-            agent=spec.agent,
-            type=int(spec.kind),
-            skills=[skill_to_msg(s) for s in spec.skills],
-            skill_ids=list(spec.skill_ids),
-            barriers=[barrier_to_msg(b, lambda s: state.locate(s)[0]) for b in spec.barriers],
-            argument=spec.argument,
-        )
+        msg = command_msg(spec, lambda skill_id: state.locate(skill_id)[0])
         now = self._clock()
         collapsed = collapse(link.outbox, msg)
         for withdrawn in collapsed.withdrawn:

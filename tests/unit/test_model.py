@@ -11,10 +11,12 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rosmc_server.core import Library, Pose, SkillInstance
+from rosmc_server.core.model import skill_with
 from tests.unit.random_missions import random_content
 
 
@@ -47,3 +49,29 @@ def test_an_assembled_skill_is_the_skill_the_constructor_builds(
         for made in task:
             fields = [getattr(made, f.name) for f in dataclasses.fields(made)]
             same_object(SkillInstance.assemble(*fields), SkillInstance(*fields))
+
+
+@settings(max_examples=20, deadline=None)
+@given(
+    st.integers(0, 2**32 - 1), st.sampled_from([f.name for f in dataclasses.fields(SkillInstance)])
+)
+def test_a_skill_with_a_change_is_the_skill_replace_gives(
+    library: Library, seed: int, name: str
+) -> None:
+    content = random_content(library, 20, seed=seed)
+    other = random_content(library, 20, seed=seed + 1)
+    donors = [skill for task in other.tasks.values() for skill in task]
+    for task in content.tasks.values():
+        for number, made in enumerate(task):
+            value = getattr(donors[number % len(donors)], name)
+            changed = skill_with(made, **{name: value})
+            same_object(changed, dataclasses.replace(made, **{name: value}))
+            assert getattr(changed, name) is value  # as given, not a copy or a stand-in
+            assert fields_of(made) == fields_of(dataclasses.replace(made))  # untouched
+
+
+def test_a_skill_with_an_unknown_field_is_refused() -> None:
+    skill = SkillInstance("s1", "robot", "wait", "wait", {})
+    with pytest.raises(TypeError, match="no field 'colour'"):
+        skill_with(skill, colour="red")
+    assert skill_with(skill, bindings={}).bindings == {}

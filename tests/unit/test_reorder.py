@@ -212,3 +212,20 @@ def test_the_collector_is_paused_for_a_reorder_and_restored_after() -> None:
         assert not gc.isenabled()  # off before: off after
     finally:
         gc.enable()
+
+
+@given(st.permutations(range(12)), st.integers(0, 11), st.integers(0, 11), st.sampled_from("dfm"))
+def test_an_order_that_is_no_permutation_is_refused(
+    order: list[int], at: int, other: int, fault: str
+) -> None:
+    current = [f"s{n}" for n in range(12)]
+    new = [current[n] for n in order]
+    moves_between(current, new, 3)  # a permutation: accepted
+    if fault == "d":  # one id twice, another missing
+        new[at] = new[other] if at != other else "ghost"
+    elif fault == "f":  # an id from elsewhere
+        new[at] = "ghost"
+    else:  # one id short
+        del new[at]
+    with pytest.raises(ValueError):
+        moves_between(current, new, 3)
