@@ -18,8 +18,10 @@ missing package and the two ways to install it, instead of a traceback.
 
 from __future__ import annotations
 
+import faulthandler
 import importlib
 import os
+import signal
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -78,6 +80,8 @@ def _package_path() -> list[str]:
 def run_entry_point(module: str, unused: tuple[str, ...] = ()) -> int:
     """Run ``module.main()`` with the project's venv; a missing dependency ends in one sentence.
 
+    ``SIGUSR1`` makes the process print every thread's stack (to diagnose a stuck node).
+
     What a ``scripts/`` entry script calls. A module of this project that is missing is a
     broken install and raises as usual. ``unused`` names optional modules that a
     dependency imports when they are installed but this program never needs: they are
@@ -85,6 +89,9 @@ def run_entry_point(module: str, unused: tuple[str, ...] = ()) -> int:
     """
     for name in unused:
         sys.modules.setdefault(name, None)  # type: ignore[arg-type]
+    # `kill -USR1 <pid>` prints every thread's stack to the node's stderr (its log): what a
+    # node that stopped answering is doing, without stopping it.
+    faulthandler.register(signal.SIGUSR1, all_threads=True)
     use_project_venv()
     try:
         main = cast(Callable[[], int], importlib.import_module(module).main)

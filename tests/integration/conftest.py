@@ -11,6 +11,8 @@ from typing import TYPE_CHECKING
 
 import pytest
 
+from tests.integration.failures import FAILED_CALL
+
 if TYPE_CHECKING:
     from tests.integration.workspaces import CatkinWorkspace
 
@@ -40,6 +42,15 @@ WORKSPACE_VARIABLES = (
     "COLCON_PREFIX_PATH",
     "AMENT_PREFIX_PATH",
 )
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]) -> object:
+    """Note on the test whether its body failed (a fixture then gathers what explains it)."""
+    report = yield
+    if call.when == "call":
+        item.stash[FAILED_CALL] = bool(getattr(report, "failed", False))
+    return report
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:

@@ -183,6 +183,13 @@ class Team:
         with contextlib.suppress(KeyError):
             rospy.delete_param(USE_SIM_TIME)
 
+    def dump_stacks(self) -> None:
+        """Have every live process print its threads' stacks into its log (SIGUSR1)."""
+        for process in self.processes.values():
+            if process.poll() is None:
+                _signal(process, signal.SIGUSR1)
+        time.sleep(1.0)  # the dumps are written by the processes themselves
+
     def log_tails(self, lines: int = 25) -> str:
         """The end of every process's log, for failure messages."""
         out = []

@@ -40,6 +40,7 @@ from rosmc_server.recording import read_journal
 from rosmc_server.ros.client import ControlCommand
 from rosmc_sim.ros.demo_operator import WIFI_SPOT_ADAPTED
 from tests.conftest import wait_until
+from tests.integration.failures import body_failed
 from tests.integration.scenario_fixtures import Operator, Team, TeamSettings
 
 pytestmark = pytest.mark.integration
@@ -226,11 +227,18 @@ def module_operator(team: Team) -> Iterator[Operator]:
 
 
 @pytest.fixture
-def op(module_operator: Operator, team: Team) -> Iterator[Operator]:
-    """The operator, on an empty mission; every process must outlive the test."""
+def op(module_operator: Operator, team: Team, request: pytest.FixtureRequest) -> Iterator[Operator]:
+    """The operator, on an empty mission; every process must outlive the test.
+
+    After a failed test every process prints its threads' stacks, and the logs' ends are
+    shown with the failure (a robot that stopped answering says where it stands).
+    """
     module_operator.new_mission()
     module_operator.timings.clear()
     yield module_operator
+    if body_failed(request):
+        team.dump_stacks()
+        print(team.log_tails(lines=200))
     assert not team.dead(), f"{team.dead()} died:\n{team.log_tails()}"
 
 
