@@ -26,7 +26,7 @@ from typing import Any
 
 import yaml
 
-from .documents import load_yaml
+from .documents import read_yaml
 from .errors import MissionFileError
 from .mission_text import JSON_ENCODER, digest_line, yaml_reads_alike
 
@@ -76,8 +76,9 @@ def read_document(text: str, source: str) -> Any:
         data = _read_around(text, source, runs)
         if data is not None:
             return data
-    data = load_yaml(text)
-    refuse_alias_bombs(data, len(text), source)
+    data, shared = read_yaml(text)
+    if shared:  # without aliases, the data holds fewer values than the text has characters
+        refuse_alias_bombs(data, len(text), source)
     return data
 
 
@@ -140,12 +141,13 @@ def _read_around(text: str, source: str, runs: list[_Run]) -> Any:
         done = run.end
     pieces.append(text[done:])
     try:
-        data = load_yaml("".join(pieces))
+        data, shared = read_yaml("".join(pieces))
     except yaml.YAMLError:
         return None  # the error as the document itself shows it, from the caller
     if data is None:
         return None
-    refuse_alias_bombs(data, len(text), source, weights)
+    if shared:
+        refuse_alias_bombs(data, len(text), source, weights)
     return data if _put_back(data, f"{token}:", [run.items for run in runs]) else None
 
 
