@@ -22,6 +22,7 @@ from .library import Library, ParameterSpec, SkillSpec
 from .mission_text import MISSION_VERSION
 from .model import Barrier, Resolution, SkillInstance, SkillStatus, TaskMarker, Transfer
 from .params import MarkerType, Pose, QuickCheck, Value, quick_checker
+from .plain_skills import read_plain
 from .state import MissionContent
 from .validation import (
     MAX_ATTEMPT,
@@ -54,6 +55,7 @@ _KEYS = _REQUIRED | _OPTIONAL
 _STATUS: Mapping[str, SkillStatus] = SkillStatus.__members__
 _TRANSFER: Mapping[str, Transfer] = Transfer.__members__
 _RESOLUTION: Mapping[str, Resolution] = Resolution.__members__
+_BLUEPRINT = {(SkillStatus.IDLE, Transfer.NONE, Resolution.NONE)}
 
 
 def mission_from_dict(
@@ -267,6 +269,14 @@ def _read_tasks(
         if agent not in tasks:
             reader.fail(f"tasks.{agent}", "names no dynamic agent of the library")
         task = tasks[agent]
+        plain = read_plain(entries, agent, skills.spec, skills.params)
+        if plain is not None and seen.isdisjoint(s.id for s in plain):
+            ids = {s.id for s in plain}
+            if len(ids) == len(plain):  # else read one by one, to name the id given twice
+                seen |= ids
+                task += plain
+                _check_sections(reader, task, f"tasks.{agent}")
+                continue
         for i, entry in enumerate(reader.items(entries, f"tasks.{agent}")):
             skill = skills.quick(entry, agent)
             if skill is None:
@@ -320,6 +330,8 @@ def _check_sections(reader: DocumentReader, task: list[SkillInstance], key: str)
     A robot runs its skills in order, so a skill that has started follows only
     settled ones (SUCCESS, or a FAILURE that was retried or skipped).
     """
+    if {(s.status, s.transfer, s.resolution) for s in task} <= _BLUEPRINT:
+        return  # a blueprint, nothing uploading: in order whatever the order
     rank_seen = 0
     unsettled = ""
     for i, skill in enumerate(task):
