@@ -59,9 +59,13 @@ _BLUEPRINT = {(SkillStatus.IDLE, Transfer.NONE, Resolution.NONE)}
 
 
 def mission_from_dict(
-    data: object, library: Library, source: str = "<mission>"
+    data: object, library: Library, source: str = "<mission>", *, consume: bool = False
 ) -> tuple[MissionContent, int]:
-    """Build and check a mission from plain data."""
+    """Build and check a mission from plain data.
+
+    With ``consume``, each task's entries are emptied once read, so that the data and
+    the mission built from it are not both held whole (for data nobody else holds).
+    """
     reader = DocumentReader(source, MissionFileError)
     if isinstance(data, dict) and "rosmc_mission" in data:
         _check_version(reader, data["rosmc_mission"])  # before anything a new version may change
@@ -78,7 +82,7 @@ def mission_from_dict(
     if isinstance(revision, bool) or not isinstance(revision, int) or revision < 0:
         reader.fail("revision", f"must be a whole number >= 0, got {revision!r}")
     markers = _read_markers(reader, top.get("markers", []))
-    tasks = _read_tasks(reader, top["tasks"], library, markers)
+    tasks = _read_tasks(reader, top["tasks"], library, markers, consume)
     barriers = _read_barriers(reader, top.get("barriers", []), tasks)
     return MissionContent(library.name, tasks, barriers, markers), revision
 
@@ -256,6 +260,7 @@ def _read_tasks(
     raw: object,
     library: Library,
     markers: Mapping[str, TaskMarker],
+    consume: bool,
 ) -> dict[str, list[SkillInstance]]:
     body = reader.mapping(raw, "tasks", set(), None)
     tasks: dict[str, list[SkillInstance]] = {agent: [] for agent in library.dynamic_agents}
@@ -276,6 +281,8 @@ def _read_tasks(
                 seen |= ids
                 task += plain
                 _check_sections(reader, task, f"tasks.{agent}")
+                if consume:
+                    entries.clear()
                 continue
         for i, entry in enumerate(reader.items(entries, f"tasks.{agent}")):
             skill = skills.quick(entry, agent)
@@ -286,6 +293,8 @@ def _read_tasks(
             seen.add(skill.id)
             task.append(skill)
         _check_sections(reader, task, f"tasks.{agent}")
+        if consume:
+            entries.clear()
     return tasks
 
 
