@@ -102,17 +102,6 @@ class PerfBench(ServerClient):
         load = self.p("load_mission", calls, base_revision=0, path="bench.yaml")
         return {"get_mission": got, "save": save, "load": load}
 
-
-def client_get(env: dict[str, str], repo: Path, calls: int) -> Any:
-    """GetMission as the client code of ``repo`` reads it (see ``_client_get.py``)."""
-    child_env = dict(env, PYTHONPATH=os.pathsep.join([str(repo), env.get("PYTHONPATH", "")]))
-    script = Path(__file__).resolve().parent / "_client_get.py"
-    argv = [sys.executable, str(script), str(repo), skill_id(0, 4), "radius", str(calls)]
-    done = subprocess.run(argv, env=child_env, capture_output=True, text=True, timeout=600)
-    if done.returncode != 0:
-        return {"error": done.stderr[-2000:]}
-    return json.loads(done.stdout.strip().splitlines()[-1])
-
     def per_change(self) -> dict[str, Any]:
         """add, edit, delete, sync p50/p95."""
         pv = self.wire.ParameterValue
@@ -141,6 +130,17 @@ def client_get(env: dict[str, str], repo: Path, calls: int) -> Any:
             )
             self.call("unsynchronize", base_revision=self.rev, agent=agent)
         return {name: percentiles(values) for name, values in times.items()}
+
+
+def client_get(env: dict[str, str], repo: Path, calls: int) -> Any:
+    """GetMission as the client code of ``repo`` reads it (see ``_client_get.py``)."""
+    child_env = dict(env, PYTHONPATH=os.pathsep.join([str(repo), env.get("PYTHONPATH", "")]))
+    script = Path(__file__).resolve().parent / "_client_get.py"
+    argv = [sys.executable, str(script), str(repo), skill_id(0, 4), "radius", str(calls)]
+    done = subprocess.run(argv, env=child_env, capture_output=True, text=True, timeout=600)
+    if done.returncode != 0:
+        return {"error": done.stderr[-2000:]}
+    return json.loads(done.stdout.strip().splitlines()[-1])
 
 
 def run(env: dict[str, str], work: Path, repo: Path, per_agent: int, samples: int) -> Any:
