@@ -4,10 +4,12 @@
 random tasks of entries in the writer's usual form, some of them wrong in one field (an id,
 a label, a skill name, a status, a parameter), it either declines or gives the very skills
 the entry-by-entry reader gives, and it takes the usual case: a blueprint written by ROSMC.
+A reader told to consume its data (a load's own) empties each task once read, and no other.
 """
 
 from __future__ import annotations
 
+import copy
 from dataclasses import replace
 from typing import Any
 
@@ -23,10 +25,11 @@ from rosmc_server.core import (
     SkillStatus,
     Transfer,
     dump_mission,
+    mission_to_dict,
     parse_mission,
 )
 from rosmc_server.core.documents import DocumentReader
-from rosmc_server.core.mission_reader import _TaskReader
+from rosmc_server.core.mission_reader import _TaskReader, mission_from_dict
 from rosmc_server.core.model import NO_BINDINGS
 from rosmc_server.core.plain_skills import PLAIN_FORM, read_plain
 from tests.unit.random_missions import random_content
@@ -147,3 +150,15 @@ def test_a_blueprint_written_by_rosmc_is_read_a_column_at_a_time(library: Librar
     assert all(len(task) > 10 for task in blueprint.values())
     assert all(task is not None for task in read.values())
     assert parse_mission(text, library, "x")[0].tasks == blueprint
+
+
+def test_consumed_data_is_emptied_task_by_task_and_other_data_is_left_alone(
+    library: Library,
+) -> None:
+    content = random_content(library, 300, seed=6)
+    data = mission_to_dict(content, 1)
+    kept = copy.deepcopy(data)
+    assert mission_from_dict(data, library, "x") == (content, 1)
+    assert data == kept
+    assert mission_from_dict(data, library, "x", consume=True) == (content, 1)
+    assert [len(entries) for entries in data["tasks"].values()] == [0, 0, 0]
