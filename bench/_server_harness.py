@@ -320,7 +320,8 @@ class ServerClient:
         import rospy
 
         from rosmc_server import interface
-        from rosmc_server.conversions.unpacking import UnpackedGetMission
+        from rosmc_server.conversions.task_memory import TaskMemory
+        from rosmc_server.conversions.unpacking import remembering_get_mission
 
         self.wire, self.rospy = wire, rospy
         self.proxies: dict[str, Any] = {}
@@ -329,9 +330,12 @@ class ServerClient:
             self.proxies[operation] = rospy.ServiceProxy(
                 interface.service_name(operation), getattr(srv, type_name), persistent=True
             )
-        # GetMission as the project's client reads it: straight into core objects.
+        # GetMission as the project's client reads it: straight into core objects, the
+        # skills of records unchanged since its last answer taken from that answer.
         self.proxies["get_mission_core"] = rospy.ServiceProxy(
-            interface.service_name("get_mission"), UnpackedGetMission, persistent=True
+            interface.service_name("get_mission"),
+            remembering_get_mission(TaskMemory()),
+            persistent=True,
         )
         self.events: list[Any] = []
         self._lock = threading.Lock()

@@ -11,8 +11,11 @@ commit with this checkout's ``build`` and ``.venv`` linked in), it starts a real
   (``sparse``), with none (``absent``: the mission's barriers are deleted first) and with
   a barrier on every second skill (``dense``: a mission of its own): two skills near the
   tasks' start, so a search along the barriers after them would walk every one;
-* ``get_mission`` (as the project's client reads it), ``save`` (to a file),
+* ``get_mission`` (as this checkout's client reads it), ``save`` (to a file),
   ``load`` (of the saved file);
+* ``get_mission_own_client``: GetMission as each checkout's own client reads it, in a
+  process of its own (``_client_get.py``): the first call, with nothing changed, and
+  after an edit of one skill;
 * ``add``, ``edit``, ``delete``, ``sync`` p50/p95 (``sync``: the first skill of a
   blueprint, then taken back); ``sync_3000`` / ``unsync_3000``: the first 3,000 skills
   of a blueprint uploaded, then taken back (a cancelled upload: no robot runs);
@@ -27,7 +30,10 @@ Run from the repository root (one size takes about a minute per checkout)::
 from __future__ import annotations
 
 import argparse
+import json
+import os
 import random
+import subprocess
 import sys
 import tempfile
 import time
@@ -148,6 +154,17 @@ class PerfBench(ServerClient):
         return {f"{name}_{skills}": percentiles(values) for name, values in times.items()}
 
 
+def client_get(env: dict[str, str], repo: Path, calls: int) -> Any:
+    """GetMission as the client code of ``repo`` reads it (see ``_client_get.py``)."""
+    child_env = dict(env, PYTHONPATH=os.pathsep.join([str(repo), env.get("PYTHONPATH", "")]))
+    script = Path(__file__).resolve().parent / "_client_get.py"
+    argv = [sys.executable, str(script), str(repo), skill_id(0, 4), "radius", str(calls)]
+    done = subprocess.run(argv, env=child_env, capture_output=True, text=True, timeout=600)
+    if done.returncode != 0:
+        return {"error": done.stderr[-2000:]}
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
 def run(env: dict[str, str], work: Path, repo: Path, per_agent: int, samples: int) -> Any:
     """Every figure of one size against the server of ``repo``."""
     work.mkdir(parents=True, exist_ok=True)
@@ -169,6 +186,8 @@ def run(env: dict[str, str], work: Path, repo: Path, per_agent: int, samples: in
                 result["peak_rss_after_load_mib"] = server.peak_rss_mib()
                 result["add_barrier_sparse"] = bench.add_barrier_near_start(samples // 4)
                 result.update(bench.whole(5))
+                result["get_mission_own_client"] = client_get(env, repo, 5)
+                bench.rev = bench.call("get_mission").mission.revision  # it edited a skill
                 result["reorder_random"] = bench.reorder_random(3)
                 result["per_change"] = bench.per_change()
                 for number in barrier_positions(per_agent, barriers):

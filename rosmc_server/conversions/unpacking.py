@@ -38,6 +38,7 @@ from ..core import (
     Transfer,
 )
 from .mission import mission_from_msg
+from .task_memory import TaskMemory
 from .values import json_param, param_type
 
 # The rosmc/Mission definition the reader follows (with its nested types).
@@ -69,6 +70,7 @@ class UnpackedGetMissionResponse(srv.GetMissionResponse):  # type: ignore[misc]
     mission: Any
     content: MissionContent
     revision: int
+    memory: TaskMemory | None = None  # see remembering_get_mission
 
     def deserialize(self, data: bytes) -> UnpackedGetMissionResponse:
         """Read the answer's wire bytes (rospy calls this); genpy.DeserializationError if
@@ -79,7 +81,7 @@ class UnpackedGetMissionResponse(srv.GetMissionResponse):  # type: ignore[misc]
             self.mission = wire.Mission()  # as documented: not kept twice
             return self
         with _reading():
-            self.content, self.revision, end = _read_mission(data, 0)
+            self.content, self.revision, end = _read_mission(data, 0, self.memory)
             self.journal_alert, end = _text(data, end)
             self.epoch, end = _text(data, end)
         if end != len(data):
@@ -94,6 +96,15 @@ class UnpackedGetMission:
     _md5sum = srv.GetMission._md5sum
     _request_class = srv.GetMissionRequest
     _response_class = UnpackedGetMissionResponse
+
+
+def remembering_get_mission(memory: TaskMemory) -> type:
+    """:class:`UnpackedGetMission` whose answers reuse the skills of unchanged records read
+    before into ``memory`` (one memory per client: see :mod:`.task_memory`)."""
+    response = type(
+        "RememberingGetMissionResponse", (UnpackedGetMissionResponse,), {"memory": memory}
+    )
+    return type("RememberingGetMission", (UnpackedGetMission,), {"_response_class": response})
 
 
 def mission_from_bytes(data: bytes, start: int = 0) -> tuple[MissionContent, int, int]:
@@ -123,15 +134,21 @@ def _reading() -> Iterator[None]:
             gc.enable()
 
 
-def _read_mission(data: bytes, pos: int) -> tuple[MissionContent, int, int]:
+def _read_mission(
+    data: bytes, pos: int, memory: TaskMemory | None = None
+) -> tuple[MissionContent, int, int]:
     revision = _HEADER.unpack_from(data, pos)[0]
     library, pos = _text(data, pos + _HEADER.size)
     (count,) = _COUNT(data, pos)
     pos += 4
     tasks: dict[str, list[SkillInstance]] = {}
+    fresh: dict[str, Any] = {}
     for _ in range(count):
         agent, pos = _text(data, pos)
-        tasks[agent], pos = _read_skills(data, pos)
+        if memory is None:
+            tasks[agent], pos = _read_skills(data, pos)
+        else:
+            tasks[agent], pos = memory.read_task(agent, data, pos, read_records, fresh)
     barriers: dict[str, Barrier] = {}
     (count,) = _COUNT(data, pos)
     pos += 4
@@ -148,21 +165,33 @@ def _read_mission(data: bytes, pos: int) -> tuple[MissionContent, int, int]:
         markers[marker.name] = marker
     if pos > len(data):
         raise genpy.DeserializationError("the bytes end inside the mission")
+    if memory is not None:
+        memory.remember(fresh)
     return MissionContent(library, tasks, barriers, markers), revision, pos
 
 
 def _read_skills(data: bytes, pos: int) -> tuple[list[SkillInstance], int]:
-    """The ``rosmc/Skill[]`` at ``pos`` as core skills, and where it ends.
+    """The ``rosmc/Skill[]`` at ``pos`` as core skills, and where it ends."""
+    skills: list[SkillInstance] = []
+    end = read_records(data, pos + 4, _COUNT(data, pos)[0], skills, None)
+    return skills, end
+
+
+def read_records(
+    data: bytes, pos: int, count: int, skills: list[SkillInstance], starts: list[int] | None
+) -> int:
+    """Read ``count`` ``rosmc/Skill`` records from ``pos`` onto ``skills`` (and where each
+    starts onto ``starts``); return where the last ends.
 
     The hot loop of a snapshot: its strings are read inline, not through :func:`_text`
     (a call per string would cost a fifth more). A string read past the end of ``data``
     comes out short; the caller checks where the mission ends.
     """
-    count = _COUNT(data, pos)[0]
-    pos += 4
-    skills: list[SkillInstance] = []
     append = skills.append
+    mark = starts.append if starts is not None else None
     for _ in range(count):
+        if mark is not None:
+            mark(pos)
         size = _COUNT(data, pos)[0]
         pos += 4
         skill_id = data[pos : pos + size].decode("utf-8", "rosmsg")
@@ -216,7 +245,7 @@ def _read_skills(data: bytes, pos: int) -> tuple[list[SkillInstance], int]:
                 finished,
             )
         )
-    return skills, pos
+    return pos
 
 
 def _read_params(data: bytes, pos: int) -> tuple[dict[str, Any], dict[str, str], int]:

@@ -26,12 +26,12 @@ from typing import Any
 
 import yaml
 
-from .documents import load_yaml
+from .documents import read_yaml
 from .errors import MissionFileError
 from .mission_text import JSON_ENCODER, digest_line, yaml_reads_alike
 
-# One entry of a block sequence, written as a one-line flow mapping.
-_FLOW_ENTRY = re.compile(r"^( *)- (\{.*\})$", re.MULTILINE)
+# Consecutive entries of a block sequence at one indentation, each a one-line flow mapping.
+_FLOW_RUN = re.compile(r"^( *)- \{.*\}$(?:\n\1- \{.*\}$)*", re.MULTILINE)
 # The digest a document ends with (see mission_text.digest_line).
 _DIGEST = re.compile(r"^# sha256 of the text above: [0-9a-f]{64}\n\Z", re.MULTILINE)
 
@@ -76,8 +76,9 @@ def read_document(text: str, source: str) -> Any:
         data = _read_around(text, source, runs)
         if data is not None:
             return data
-    data = load_yaml(text)
-    refuse_alias_bombs(data, len(text), source)
+    data, shared = read_yaml(text)
+    if shared:  # without aliases, the data holds fewer values than the text has characters
+        refuse_alias_bombs(data, len(text), source)
     return data
 
 
@@ -90,17 +91,46 @@ def _digest_matches(text: str) -> bool:
 def _checked_runs(text: str) -> list[_Run]:
     """The runs of lines that each hold one JSON mapping, read line by line."""
     runs: list[_Run] = []
-    for match in _FLOW_ENTRY.finditer(text):
-        data = _scan_line(match.group(2))
-        if data is None:
-            continue
+    for match in _FLOW_RUN.finditer(text):
         indent = match.group(1)
-        if runs and runs[-1].end + 1 == match.start() and runs[-1].indent == indent:
-            runs[-1].end = match.end()
+        skip = len(indent) + 2  # the indentation and "- "
+        lines = [line[skip:] for line in match.group().split("\n")]
+        items = _read_lines(lines)
+        if items is not None:
+            runs.append(_Run(match.start(), match.end(), indent, lines, items))
         else:
-            runs.append(_Run(match.start(), match.end(), indent))
-        runs[-1].lines.append(match.group(2))
-        runs[-1].items.append(data)
+            runs += _line_by_line(match.start(), indent, lines)
+    return runs
+
+
+def _read_lines(lines: list[str]) -> list[dict[str, Any]] | None:
+    """The mapping each line holds, or None if one does not hold exactly one."""
+    scan = _SCAN
+    try:
+        read = [scan(line, 0) for line in lines]
+    except (StopIteration, ValueError, RecursionError):
+        return None
+    items = [data for data, _ in read]
+    if [end for _, end in read] != list(map(len, lines)) or set(map(type, items)) != {dict}:
+        return None
+    return items
+
+
+def _line_by_line(start: int, indent: str, lines: list[str]) -> list[_Run]:
+    """The runs of ``lines`` (the first starting at ``start``) read one line at a time."""
+    runs: list[_Run] = []
+    at = start
+    for line in lines:
+        end = at + len(indent) + 2 + len(line)
+        data = _scan_line(line)
+        if data is not None:
+            if runs and runs[-1].end + 1 == at:
+                runs[-1].end = end
+            else:
+                runs.append(_Run(at, end, indent))
+            runs[-1].lines.append(line)
+            runs[-1].items.append(data)
+        at = end + 1
     return runs
 
 
@@ -140,12 +170,13 @@ def _read_around(text: str, source: str, runs: list[_Run]) -> Any:
         done = run.end
     pieces.append(text[done:])
     try:
-        data = load_yaml("".join(pieces))
+        data, shared = read_yaml("".join(pieces))
     except yaml.YAMLError:
         return None  # the error as the document itself shows it, from the caller
     if data is None:
         return None
-    refuse_alias_bombs(data, len(text), source, weights)
+    if shared:
+        refuse_alias_bombs(data, len(text), source, weights)
     return data if _put_back(data, f"{token}:", [run.items for run in runs]) else None
 
 

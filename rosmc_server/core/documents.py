@@ -14,6 +14,7 @@ from typing import Any, NoReturn
 import yaml
 
 from .errors import RosmcError
+from .plain_yaml import load_plain
 from .validation import excerpt, finite_float
 
 # libyaml's C loader and dumper when present: the same safe subset (plain data only,
@@ -33,6 +34,16 @@ def load_yaml(text: str) -> Any:
     A document nested more than MAX_NESTING levels deep raises YAMLError without
     being parsed: deep enough nesting crashes libyaml (and recursion limits Python's).
     """
+    return read_yaml(text)[0]
+
+
+def read_yaml(text: str) -> tuple[Any, bool]:
+    """Parse YAML text as :func:`load_yaml` does; also say whether the data may share
+    values through aliases (only then can it expand beyond the text).
+
+    Plain data is built from the parser's events (see :mod:`.plain_yaml`), anything
+    else by PyYAML's safe loader, as before.
+    """
     depth = deepest = 0
     for match in _BRACKETS.finditer(text):
         depth += 1 if match.group() in "[{" else -1
@@ -40,7 +51,10 @@ def load_yaml(text: str) -> Any:
     indent = max((len(m.group(1)) for m in _INDENT.finditer(text)), default=0)
     if deepest > MAX_NESTING or indent > 2 * MAX_NESTING:
         raise yaml.YAMLError(f"the document is nested more than {MAX_NESTING} levels deep")
-    return yaml.load(text, Loader=_UniqueKeyLoader)  # nosec: a safe loader
+    plain, data, aliased = load_plain(text, _UniqueKeyLoader)
+    if plain:
+        return data, aliased
+    return yaml.load(text, Loader=_UniqueKeyLoader), True  # nosec: a safe loader
 
 
 class DuplicateKeyError(yaml.MarkedYAMLError):

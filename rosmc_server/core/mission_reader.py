@@ -22,6 +22,7 @@ from .library import Library, ParameterSpec, SkillSpec
 from .mission_text import MISSION_VERSION
 from .model import Barrier, Resolution, SkillInstance, SkillStatus, TaskMarker, Transfer
 from .params import MarkerType, Pose, QuickCheck, Value, quick_checker
+from .plain_skills import read_plain
 from .state import MissionContent
 from .validation import (
     MAX_ATTEMPT,
@@ -54,12 +55,17 @@ _KEYS = _REQUIRED | _OPTIONAL
 _STATUS: Mapping[str, SkillStatus] = SkillStatus.__members__
 _TRANSFER: Mapping[str, Transfer] = Transfer.__members__
 _RESOLUTION: Mapping[str, Resolution] = Resolution.__members__
+_BLUEPRINT = {(SkillStatus.IDLE, Transfer.NONE, Resolution.NONE)}
 
 
 def mission_from_dict(
-    data: object, library: Library, source: str = "<mission>"
+    data: object, library: Library, source: str = "<mission>", *, consume: bool = False
 ) -> tuple[MissionContent, int]:
-    """Build and check a mission from plain data."""
+    """Build and check a mission from plain data.
+
+    With ``consume``, each task's entries are emptied once read, so that the data and
+    the mission built from it are not both held whole (for data nobody else holds).
+    """
     reader = DocumentReader(source, MissionFileError)
     if isinstance(data, dict) and "rosmc_mission" in data:
         _check_version(reader, data["rosmc_mission"])  # before anything a new version may change
@@ -76,7 +82,7 @@ def mission_from_dict(
     if isinstance(revision, bool) or not isinstance(revision, int) or revision < 0:
         reader.fail("revision", f"must be a whole number >= 0, got {revision!r}")
     markers = _read_markers(reader, top.get("markers", []))
-    tasks = _read_tasks(reader, top["tasks"], library, markers)
+    tasks = _read_tasks(reader, top["tasks"], library, markers, consume)
     barriers = _read_barriers(reader, top.get("barriers", []), tasks)
     return MissionContent(library.name, tasks, barriers, markers), revision
 
@@ -254,6 +260,7 @@ def _read_tasks(
     raw: object,
     library: Library,
     markers: Mapping[str, TaskMarker],
+    consume: bool,
 ) -> dict[str, list[SkillInstance]]:
     body = reader.mapping(raw, "tasks", set(), None)
     tasks: dict[str, list[SkillInstance]] = {agent: [] for agent in library.dynamic_agents}
@@ -267,6 +274,16 @@ def _read_tasks(
         if agent not in tasks:
             reader.fail(f"tasks.{agent}", "names no dynamic agent of the library")
         task = tasks[agent]
+        plain = read_plain(entries, agent, skills.spec, skills.params)
+        if plain is not None and seen.isdisjoint(s.id for s in plain):
+            ids = {s.id for s in plain}
+            if len(ids) == len(plain):  # else read one by one, to name the id given twice
+                seen |= ids
+                task += plain
+                _check_sections(reader, task, f"tasks.{agent}")
+                if consume:
+                    entries.clear()
+                continue
         for i, entry in enumerate(reader.items(entries, f"tasks.{agent}")):
             skill = skills.quick(entry, agent)
             if skill is None:
@@ -276,6 +293,8 @@ def _read_tasks(
             seen.add(skill.id)
             task.append(skill)
         _check_sections(reader, task, f"tasks.{agent}")
+        if consume:
+            entries.clear()
     return tasks
 
 
@@ -320,6 +339,8 @@ def _check_sections(reader: DocumentReader, task: list[SkillInstance], key: str)
     A robot runs its skills in order, so a skill that has started follows only
     settled ones (SUCCESS, or a FAILURE that was retried or skipped).
     """
+    if {(s.status, s.transfer, s.resolution) for s in task} <= _BLUEPRINT:
+        return  # a blueprint, nothing uploading: in order whatever the order
     rank_seen = 0
     unsettled = ""
     for i, skill in enumerate(task):

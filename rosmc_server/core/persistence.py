@@ -86,4 +86,4 @@ def parse_mission(text: str, library: Library, source: str) -> tuple[MissionCont
         ) from error
     except yaml.YAMLError as error:
         raise MissionFileError(f"{source}: not valid YAML ({yaml_problem(error)})") from error
-    return mission_from_dict(data, library, source)
+    return mission_from_dict(data, library, source, consume=True)

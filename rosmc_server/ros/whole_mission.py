@@ -120,6 +120,9 @@ class WholeMissionServices:
             lambda m: m.load(content, source, base_revision=req.base_revision)
         )
         assert event is not None
+        # The lines of the replaced skills cannot serve the next save; kept, they would
+        # keep those skills alive beside the new mission.
+        self._dumper = MissionDumper()
         _log.info(
             "loaded %d skills from %s: read and checked in %.0f ms, serialized in %.0f ms, "
             "applied and journaled in %.0f ms",

@@ -23,7 +23,8 @@ from rosmc.msg import ErrorCode
 from rospy.exceptions import TransportException
 
 from ... import interface
-from ...conversions.unpacking import UnpackedGetMission
+from ...conversions.task_memory import TaskMemory
+from ...conversions.unpacking import remembering_get_mission
 from ...core import (
     InvalidRequest,
     NotFound,
@@ -45,8 +46,6 @@ _ERRORS: Mapping[int, type[RosmcError]] = {
     ErrorCode.INTERNAL: RosmcError,
     ErrorCode.FORBIDDEN: NotPermitted,
 }
-# Services whose answers are read straight into core objects rather than genpy messages.
-_ANSWERED_AS: Mapping[str, Any] = {"get_mission": UnpackedGetMission}
 # rospy's ServiceException texts when the server's handler (not the connection) failed.
 _HANDLER_FAILURES = ("service cannot process request", "error processing request")
 
@@ -69,6 +68,9 @@ class ServiceCaller:
         self.prefix = prefix
         self._proxies: dict[str, rospy.ServiceProxy] = {}
         self._lock = threading.RLock()
+        # GetMission answers are read straight into core objects, not genpy messages,
+        # reusing the skills of records unchanged since the last answer.
+        self._answered_as = {"get_mission": remembering_get_mission(TaskMemory())}
 
     def close(self) -> None:
         """Close every persistent connection (they reopen on the next call)."""
@@ -120,7 +122,9 @@ class ServiceCaller:
             if time.monotonic() >= deadline or rospy.is_shutdown():
                 raise ServerUnavailable(self._not_reachable(name))
             time.sleep(0.1)
-        service_class = _ANSWERED_AS.get(operation) or getattr(srv, interface.SERVICES[operation])
+        service_class = self._answered_as.get(operation) or getattr(
+            srv, interface.SERVICES[operation]
+        )
         proxy = rospy.ServiceProxy(name, service_class, persistent=True)
         self._proxies[operation] = proxy
         return proxy
