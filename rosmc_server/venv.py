@@ -18,8 +18,10 @@ missing package and the two ways to install it, instead of a traceback.
 
 from __future__ import annotations
 
+import contextlib
 import faulthandler
 import importlib
+import io
 import os
 import signal
 import sys
@@ -91,7 +93,8 @@ def run_entry_point(module: str, unused: tuple[str, ...] = ()) -> int:
         sys.modules.setdefault(name, None)  # type: ignore[arg-type]
     # `kill -USR1 <pid>` prints every thread's stack to the node's stderr (its log): what a
     # node that stopped answering is doing, without stopping it.
-    faulthandler.register(signal.SIGUSR1, all_threads=True)
+    with contextlib.suppress(io.UnsupportedOperation, ValueError):  # stderr is no file
+        faulthandler.register(signal.SIGUSR1, all_threads=True)
     use_project_venv()
     try:
         main = cast(Callable[[], int], importlib.import_module(module).main)

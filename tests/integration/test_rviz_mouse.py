@@ -44,6 +44,7 @@ OPEN_GROUND = (-7.0, -7.0)  # between the grid's lines (every 10 m), nothing abo
 POSE_AT = (-6.0, -9.0)
 DRONE_AT = (0.0, 0.0)  # resting on the lander, inside the lander's clickable shell
 STEPS = 12  # mouse positions per drag
+SETTLE = 2.0  # seconds a dragged marker must hold still to count as put down
 
 
 @dataclass
@@ -150,10 +151,23 @@ def test_publish_point_on_open_ground_creates_a_marker_there(
 
 
 def _moved(client: MissionClient, name: str, before: Pose) -> Callable[[], TaskMarker | None]:
+    """The marker once it moved from ``before`` and then held still for a second.
+
+    A loaded machine may deliver the drag in bursts, and the markers node commits the
+    pose each time the mouse rests: the first change can be part of the way.
+    """
+    seen: list[tuple[float, tuple[float, float, float]]] = []
+
     def check() -> TaskMarker | None:
         marker = mission_markers(client)[name]
-        same = (marker.pose.x, marker.pose.y, marker.pose.yaw) == (before.x, before.y, before.yaw)
-        return None if same else marker
+        pose = (marker.pose.x, marker.pose.y, marker.pose.yaw)
+        if pose == (before.x, before.y, before.yaw):
+            return None
+        now = time.monotonic()
+        if not seen or seen[-1][1] != pose:
+            seen.append((now, pose))
+            return None
+        return marker if now - seen[-1][0] >= SETTLE else None
 
     return check
 
