@@ -75,15 +75,18 @@ def measured_cells(radio: RadioMap, now: float) -> list[Cell]:
     return cells
 
 
-def last_links(radio: RadioMap, now: float) -> list[LastLink]:
+def last_links(
+    radio: RadioMap, now: float, in_contact: frozenset[str] = frozenset()
+) -> list[LastLink]:
     """Each robot's last position with a link, labelled ``<robot> last link: -72 dBm 26 s
-    ago``."""
+    ago`` unless the robot is ``in_contact`` (its link is up): then it stands at its mark and
+    its status line says so, and a label there would only cover that line."""
     return [
         LastLink(
             agent,
             reading.x,
             reading.y,
-            f"{agent} last link: {reading_text(reading, now)}",
+            "" if agent in in_contact else f"{agent} last link: {reading_text(reading, now)}",
             now - reading.stamp > OLD_AFTER,
         )
         for agent, reading in sorted(radio.last_link.items())

@@ -46,6 +46,7 @@ class CoverageLayer:
         self._lock = threading.Lock()
         self._radio = RadioMap()
         self._now = 0.0
+        self._in_contact: frozenset[str] = frozenset()  # robots whose link is up
         self._next = 0.0
         self._publisher = rospy.Publisher(
             prefixed(COVERAGE_MARKERS_TOPIC, ns), MarkerArray, queue_size=2, latch=True
@@ -62,6 +63,9 @@ class CoverageLayer:
     def _on_states(self, msg: wire.AgentStates) -> None:
         with self._lock:
             self._now = max(self._now, msg.stamp.to_sec())
+            self._in_contact = frozenset(
+                state.agent for state in msg.agents if state.link.state == wire.LinkState.UP
+            )
             for state in msg.agents:
                 telemetry = state.telemetry
                 if telemetry.frame_id or not telemetry.stamp.is_zero():
@@ -80,7 +84,7 @@ class CoverageLayer:
         with self._lock:
             model = model_cells(self._radio)
             measured = measured_cells(self._radio, self._now)
-            marks = last_links(self._radio, self._now)
+            marks = last_links(self._radio, self._now, self._in_contact)
         out = MarkerArray()
         # Under the site's pick ground (its top at z = 0) and every interactive marker: rviz
         # picks the nearest surface, so shading above them would take the operator's clicks
@@ -123,6 +127,9 @@ def _last_link(index: int, mark: LastLink) -> list[Marker]:
     pole.scale.z = POLE_HEIGHT
     pole.color = ColorRGBA(0.1, 0.4, 1.0, alpha)
     label = _marker("last_link_label", index, Marker.TEXT_VIEW_FACING)
+    if not mark.label:  # rviz flags an empty text as an error: take the label away instead
+        label.action = Marker.DELETE
+        return [pole, label]
     label.pose.position = Point(mark.x, mark.y, POLE_HEIGHT + 0.4)
     label.scale.z = 0.5
     label.color = ColorRGBA(1.0, 1.0, 1.0, alpha)
