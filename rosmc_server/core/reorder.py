@@ -20,25 +20,16 @@ from __future__ import annotations
 
 import bisect
 from collections.abc import Sequence
-from typing import Protocol
+
+from .moves import SkillMove, move_columns
 
 NOT_A_PERMUTATION = "the new order is not a permutation of the current one"
 
 
-class Move(Protocol):
-    """A skill and its index once moved (what :class:`.changes.SkillMove` holds)."""
-
-    @property
-    def skill_id(self) -> str: ...
-
-    @property
-    def index(self) -> int: ...
-
-
 def canonical_moves(
     current: Sequence[str], order: Sequence[str], offset: int = 0
-) -> list[tuple[str, int]]:
-    """The fewest moves, as (skill id, index) pairs, that turn ``current`` into ``order``.
+) -> tuple[list[str], list[int]]:
+    """The fewest moves, as their ids and indexes, that turn ``current`` into ``order``.
 
     ``current`` holds distinct ids; ``order`` must be a permutation of it, else
     ValueError (checked on the way, without sets of both). Indexes are ``offset`` plus
@@ -76,8 +67,9 @@ def canonical_moves(
     for number in region:
         if number >= 0:
             waiting[number] += 1
-    moves: list[tuple[str, int]] = []
-    append = moves.append
+    ids: list[str] = []
+    indexes: list[int] = []
+    add_id, add_index = ids.append, indexes.append
     before = 0  # staying skills before the next moved one, in the new order
     counted = 0  # regions below this one are summed in ``unmoved_before``
     unmoved_before = 0
@@ -91,18 +83,21 @@ def canonical_moves(
         while counted < before:
             unmoved_before += waiting[counted]
             counted += 1
-        append((skill_id, offset + len(moves) + before + unmoved_before))
-    return moves
+        add_index(offset + len(ids) + before + unmoved_before)
+        add_id(skill_id)
+    return ids, indexes
 
 
-def play_moves(current: Sequence[str], moves: Sequence[Move], offset: int = 0) -> list[str] | None:
+def play_moves(
+    current: Sequence[str], moves: Sequence[SkillMove], offset: int = 0
+) -> list[str] | None:
     """``current`` after ``moves`` (played one after the other), or None if not canonical.
 
     ``current`` is a task's stretch starting at index ``offset`` that holds every moved
     skill and every index moved to. Canonical moves (see the module's docstring) are
     decoded in one pass; for others the answer is None, never a wrong order.
     """
-    moved = [move.skill_id for move in moves]
+    moved, indexes = move_columns(moves)
     moved_set = set(moved)
     if len(moved_set) != len(moved):
         return None
@@ -120,18 +115,18 @@ def play_moves(current: Sequence[str], moves: Sequence[Move], offset: int = 0) -
         waiting[number] += 1
     chains: dict[int, list[str]] = {}  # staying skills before a run of moved ones -> the run
     before = unmoved_before = 0
-    for done, move in enumerate(moves):
-        number = region[move.skill_id]
+    for done, (skill_id, index) in enumerate(zip(moved, indexes, strict=True)):
+        number = region[skill_id]
         waiting[number] -= 1
         if number < before:
             unmoved_before -= 1
-        wanted = move.index - offset - done
+        wanted = index - offset - done
         while before + unmoved_before < wanted and before < len(staying):
             unmoved_before += waiting[before]
             before += 1
         if before + unmoved_before != wanted:
             return None
-        chains.setdefault(before, []).append(move.skill_id)
+        chains.setdefault(before, []).append(skill_id)
     result: list[str] = []
     start = 0
     for at, run in chains.items():  # in increasing ``at``: ``before`` never decreases
@@ -142,7 +137,9 @@ def play_moves(current: Sequence[str], moves: Sequence[Move], offset: int = 0) -
     return result
 
 
-def play_one_by_one(current: Sequence[str], moves: Sequence[Move], offset: int = 0) -> list[str]:
+def play_one_by_one(
+    current: Sequence[str], moves: Sequence[SkillMove], offset: int = 0
+) -> list[str]:
     """``current`` after ``moves``, each played as the definition says (the simple way)."""
     result = list(current)
     for move in moves:

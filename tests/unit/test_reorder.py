@@ -172,7 +172,7 @@ def test_a_whole_new_order_is_planned_once_not_decoded_again(
     # The planner knows the new order: checking, undo history and apply all take it.
     import random
 
-    from rosmc_server.core import state as state_module
+    from rosmc_server.core import task_order as state_module
     from rosmc_server.core.editing import plan_reorder
     from tests.unit.test_change_indexes import state_of
 
