@@ -20,10 +20,12 @@ from __future__ import annotations
 
 import bisect
 from collections.abc import Sequence
+from itertools import compress
 
 from .moves import SkillMove, move_columns
 
 NOT_A_PERMUTATION = "the new order is not a permutation of the current one"
+_IS_REGION = (-1).__lt__  # a region number, not the -1 of a staying skill
 
 
 def canonical_moves(
@@ -45,7 +47,7 @@ def canonical_moves(
     while tail > head and current[tail - 1] == order[tail - 1]:
         tail -= 1
     current, order, offset = current[head:tail], order[head:tail], offset + head
-    position = {skill_id: index for index, skill_id in enumerate(order)}
+    position = dict(zip(order, range(len(order))))
     try:
         targets = list(map(position.__getitem__, current))
     except KeyError:  # an id of ``current`` is missing from ``order``
@@ -54,37 +56,33 @@ def canonical_moves(
         raise ValueError(NOT_A_PERMUTATION)
     staying = _longest_increasing(targets)
     # Per place in the new order: the region of the skill moved there (how many staying
-    # skills are before it now), or -1 where a staying skill is. Lists, not dicts: the
-    # loops below index them by place.
+    # skills are before it now), or -1 where a staying skill is; per region, how many
+    # moved skills wait there. Lists, not dicts: the loops index them by place.
     region = [-1] * len(order)
+    waiting = [0] * (staying.count(1) + 1)
     passed = 0
     for target in targets:
         if staying[target]:
             passed += 1
         else:
             region[target] = passed
-    waiting = [0] * (passed + 1)  # per region, the moved skills not moved yet
-    for number in region:
-        if number >= 0:
-            waiting[number] += 1
-    ids: list[str] = []
+            waiting[passed] += 1
+    ids = list(compress(order, map(_IS_REGION, region)))
     indexes: list[int] = []
-    add_id, add_index = ids.append, indexes.append
+    add = indexes.append
+    moved = offset  # ``offset`` + the skills moved so far (all before the next one)
     before = 0  # staying skills before the next moved one, in the new order
-    counted = 0  # regions below this one are summed in ``unmoved_before``
-    unmoved_before = 0
-    for skill_id, number in zip(order, region, strict=True):
+    unmoved_before = 0  # moved skills not moved yet in the regions below ``before``
+    for number in region:
         if number < 0:
+            unmoved_before += waiting[before]
             before += 1
-            continue
-        waiting[number] -= 1
-        if number < counted:
-            unmoved_before -= 1
-        while counted < before:
-            unmoved_before += waiting[counted]
-            counted += 1
-        add_index(offset + len(ids) + before + unmoved_before)
-        add_id(skill_id)
+        else:
+            waiting[number] -= 1
+            if number < before:
+                unmoved_before -= 1
+            add(moved + before + unmoved_before)
+            moved += 1
     return ids, indexes
 
 
