@@ -7,6 +7,9 @@ breaks: a skill id holds none) and ``move_indexes`` (``uint32[]``), genpy writes
 reads each field in one call, and a reader splits the ids in one call, straight into
 the core's :class:`~rosmc_server.core.moves.MoveList`. Recordings made before these
 fields existed carry their moves in ``moves``, which is still read.
+
+A whole new order in a ``ReorderSkills`` request travels the same way: its ``order``
+may be one string of the ids joined by line breaks.
 """
 
 from __future__ import annotations
@@ -46,3 +49,20 @@ def moves_from_fields(msg: Any) -> Sequence[SkillMove] | None:
             f"an event names {len(ids)} moved skills but gives {len(indexes)} indexes"
         )
     return MoveList(ids, indexes)
+
+
+def order_to_field(order: Sequence[str]) -> list[str]:
+    """``order`` as a ``ReorderSkills`` request's ``order``: its ids joined by line
+    breaks in one string (as is if it has fewer than two ids or an id holds a break)."""
+    joined = SEPARATOR.join(order)
+    if len(order) < 2 or joined.count(SEPARATOR) != len(order) - 1:
+        return list(order)
+    return [joined]
+
+
+def order_from_field(order: Sequence[str]) -> Sequence[str]:
+    """A ``ReorderSkills`` request's ``order`` as the ids it names (see
+    :func:`order_to_field`); the core then checks them as any other order."""
+    if len(order) == 1 and SEPARATOR in order[0]:
+        return order[0].split(SEPARATOR)
+    return order

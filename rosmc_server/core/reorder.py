@@ -47,7 +47,7 @@ def canonical_moves(
     while tail > head and current[tail - 1] == order[tail - 1]:
         tail -= 1
     current, order, offset = current[head:tail], order[head:tail], offset + head
-    position = dict(zip(order, range(len(order))))
+    position = dict(zip(order, range(len(order)), strict=True))
     try:
         targets = list(map(position.__getitem__, current))
     except KeyError:  # an id of ``current`` is missing from ``order``
