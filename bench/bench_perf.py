@@ -6,7 +6,10 @@ commit with this checkout's ``build`` and ``.venv`` linked in), it starts a real
 ``mission_server`` on a private rosmaster and loads a generated mission, then times:
 
 * ``reorder_random``: a ``ReorderSkills`` request with the blueprint's whole order,
-  shuffled at random (barrier members keep their relative order, so no deadlock);
+  shuffled at random (barrier members keep their relative order, so no deadlock), one
+  id per ``order`` element; ``reorder_random_lines``: the same with ``order`` as one
+  string of lines, as the project's client sends it (only for ``this`` checkout: an
+  older server reads that as one id);
 * ``add_barrier`` with no other barrier near, in a mission with ten barriers
   (``sparse``), with none (``absent``: the mission's barriers are deleted first) and with
   a barrier on every second skill (``dense``: a mission of its own): two skills near the
@@ -48,6 +51,7 @@ from _server_harness import REPO, Server, ServerClient, figures_printed, percent
 
 AGENTS = 2
 SYNC_PREFIX = 3000  # skills per synchronize in the figure of a large one
+REORDERS = 7  # whole random new orders per figure
 
 
 class PerfBench(ServerClient):
@@ -68,8 +72,9 @@ class PerfBench(ServerClient):
             times.append(self.timed(operation, **fields)[0])
         return percentiles(times)
 
-    def reorder_random(self, calls: int) -> dict[str, float]:
-        """Whole random new orders of robot 0's blueprint, members in their order."""
+    def reorder_random(self, calls: int, lines: bool = False) -> dict[str, float]:
+        """Whole random new orders of robot 0's blueprint, members in their order (with
+        ``lines``, ``order`` is one string of the ids joined by line breaks)."""
         times = []
         for _ in range(calls):
             task = next(
@@ -82,8 +87,9 @@ class PerfBench(ServerClient):
             kept = [s.id for s in task.skills if s.id in members]
             for index, member in zip(at, kept, strict=True):
                 order[index] = member
+            sent = ["\n".join(order)] if lines else order
             elapsed, _ = self.timed(
-                "reorder_skills", base_revision=self.rev, agent=agent_name(0), order=order
+                "reorder_skills", base_revision=self.rev, agent=agent_name(0), order=sent
             )
             times.append(elapsed)
         return percentiles(times)
@@ -188,7 +194,9 @@ def run(env: dict[str, str], work: Path, repo: Path, per_agent: int, samples: in
                 result.update(bench.whole(5))
                 result["get_mission_own_client"] = client_get(env, repo, 5)
                 bench.rev = bench.call("get_mission").mission.revision  # it edited a skill
-                result["reorder_random"] = bench.reorder_random(3)
+                result["reorder_random"] = bench.reorder_random(REORDERS)
+                if repo == REPO:
+                    result["reorder_random_lines"] = bench.reorder_random(REORDERS, lines=True)
                 result["per_change"] = bench.per_change()
                 for number in barrier_positions(per_agent, barriers):
                     barrier = f"barrier-{number:05d}"

@@ -17,6 +17,8 @@ from dataclasses import dataclass, field
 
 from rosmc_server.core import AgentStatus, Barrier, MissionState, SkillInstance, TaskMarker
 from rosmc_server.core.legality import TaskView
+from rosmc_server.core.moves import move_columns
+from rosmc_server.core.reorder import play_moves
 from rosmc_server.core.updates import (
     AgentStatusChanged,
     BarrierPut,
@@ -132,7 +134,7 @@ def delta_agent(delta: SkillDelta) -> str:
 def delta_ids(delta: SkillDelta) -> tuple[str, ...]:
     """The skills ``delta`` added, changed, removed or moved."""
     if isinstance(delta, SkillsMoved):
-        return tuple(move.skill_id for move in delta.moves)
+        return tuple(move_columns(delta.moves)[0])
     return (delta.new.id,) if isinstance(delta, SkillChanged) else (delta.skill.id,)
 
 
@@ -145,6 +147,13 @@ def apply_delta(task: list[SkillInstance], delta: SkillDelta) -> None:
     elif isinstance(delta, SkillRemoved):
         del task[delta.index]
     else:
+        # A whole new order is thousands of moves: decoded in one pass, not played one
+        # by one (each a search and a shift of the task).
+        order = play_moves([skill.id for skill in task], delta.moves)
+        if order is not None:
+            by_id = {skill.id: skill for skill in task}
+            task[:] = [by_id[skill_id] for skill_id in order]
+            return
         for move in delta.moves:
             at = next(i for i, skill in enumerate(task) if skill.id == move.skill_id)
             task.insert(move.index, task.pop(at))

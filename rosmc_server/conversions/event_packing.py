@@ -1,16 +1,16 @@
 """Mission events as ROS 1 wire bytes, written once for the journal and the topic.
 
-Part of :mod:`rosmc_server.conversions`. A whole-order reorder of 10,000 skills is an
-event of 10,000 moves: as genpy messages it costs 10,000 ``rosmc/SkillMove`` objects, and
-genpy serializes them twice (the journal's record, then the topic's publish), each time
-in a Python loop; a synchronize of thousands of skills puts as many ``rosmc/Skill``s.
-:class:`PackedEvent` is a ``rosmc/MissionEvent`` whose ``serialize`` writes bytes made
-once, with the moves and the skills put written straight from the core's (skills through
-:func:`~.packing.skill_bytes`); every other field is an ordinary genpy field (small).
+Part of :mod:`rosmc_server.conversions`. A synchronize of thousands of skills puts as
+many ``rosmc/Skill``s: as genpy messages they cost an object tree each, and genpy
+serializes them twice (the journal's record, then the topic's publish), each time in a
+Python loop. :class:`PackedEvent` is a ``rosmc/MissionEvent`` whose ``serialize``
+writes bytes made once, with the skills put written straight from the core's (through
+:func:`~.packing.skill_bytes`); every other field is an ordinary genpy field (a
+reorder's moves are two packed fields, see :mod:`.move_fields`).
 
 Used only while ``rosmc/MissionEvent`` is the definition it was written for (its
-md5sum: ``moves`` and ``epoch`` are its last fields); otherwise :func:`packed_event`
-gives the plain genpy message. A test checks the bytes against genpy's for random events.
+md5sum: ``put_skills`` follows the summary); otherwise :func:`packed_event` gives the
+plain genpy message. A test checks the bytes against genpy's for random events.
 """
 
 from __future__ import annotations
@@ -23,12 +23,12 @@ from typing import Any
 import rosmc.msg as wire
 
 from ..core import MissionEvent
-from ..core.changes import PlacedSkill, SkillMove
+from ..core.changes import PlacedSkill
 from .mission import event_to_msg
 from .packing import serialized, skill_bytes, string_bytes
 
 # The rosmc/MissionEvent definition PackedEvent writes (with its nested types).
-PACKED_EVENT_MD5 = "ac4d4b26a525e4fbf93a677c9f22c326"
+PACKED_EVENT_MD5 = "b1445743a23e64ee6c9f7a4b412cdf11"
 
 _COUNT = struct.Struct("<I")
 _PUT_SKILLS_AT = 8 + 8 + 1  # revision, stamp and kind come before the agent and summary
@@ -37,32 +37,21 @@ _PUT_SKILLS_AT = 8 + 8 + 1  # revision, stamp and kind come before the agent and
 class PackedEvent(wire.MissionEvent):  # type: ignore[misc]
     """A ``rosmc/MissionEvent`` that serializes as bytes made once, at construction.
 
-    ``put_skills`` and ``moves`` stay empty as fields: the core's are in
-    ``core_put_skills`` and ``core_moves`` and in the bytes. The other fields are set as
-    usual (and must not change afterwards).
+    ``put_skills`` stays empty as a field: the core's are in ``core_put_skills`` and in
+    the bytes. The other fields are set as usual (and must not change afterwards).
     """
 
     def __init__(self, event: MissionEvent, agent_of: Callable[[str], str], epoch: str) -> None:
         change = event.change
-        bare = replace(change, moves=(), put_skills=())
-        plain = event_to_msg(replace(event, change=bare), agent_of)
+        plain = event_to_msg(replace(event, change=replace(change, put_skills=())), agent_of)
         plain.epoch = epoch
         super().__init__(**{name: getattr(plain, name) for name in plain.__slots__})
-        self.core_moves: Sequence[SkillMove] = change.moves
         self.core_put_skills: Sequence[PlacedSkill] = change.put_skills
-        # genpy's bytes with no skills put and no moves: the skills' count (0) follows the
-        # summary; the moves' count (0) and the epoch end them.
+        # genpy's bytes with no skills put: the skills' count (0) follows the summary.
         head = serialized(plain)
         put_at = _PUT_SKILLS_AT + len(string_bytes(plain.agent)) + len(string_bytes(plain.summary))
-        tail = len(string_bytes(epoch))
         self.data = b"".join(
-            (
-                head[:put_at],
-                placed_skills_bytes(change.put_skills),
-                head[put_at + 4 : -tail - 4],
-                moves_bytes(change.moves),
-                head[-tail:],
-            )
+            (head[:put_at], placed_skills_bytes(change.put_skills), head[put_at + 4 :])
         )
 
     def serialize(self, buff: Any) -> None:
@@ -95,15 +84,4 @@ def placed_skills_bytes(placed: Sequence[PlacedSkill]) -> bytes:
     parts = [pack(len(placed))]
     for item in placed:
         parts += (pack(item.index), skill_bytes(item.skill, names))
-    return b"".join(parts)
-
-
-def moves_bytes(moves: Sequence[SkillMove]) -> bytes:
-    """The wire bytes of a ``rosmc/SkillMove[]`` of ``moves``."""
-    pack = _COUNT.pack
-    parts = [pack(len(moves))]
-    append = parts.append
-    for move in moves:
-        skill_id = move.skill_id.encode("utf-8")
-        append(pack(len(skill_id)) + skill_id + pack(move.index))
     return b"".join(parts)

@@ -28,6 +28,7 @@ from ..core import (
     Transfer,
 )
 from ..core.changes import SkillMove
+from .move_fields import moves_from_fields, moves_to_fields
 from .values import (
     enum_from_number,
     param_from_msg,
@@ -155,7 +156,7 @@ def mission_from_msg(msg: wire.Mission) -> tuple[MissionContent, int]:
 def event_to_msg(event: MissionEvent, agent_of: Callable[[str], str]) -> wire.MissionEvent:
     """An event as ``rosmc/MissionEvent`` (a replacement travels without content)."""
     change = event.change
-    return wire.MissionEvent(
+    msg = wire.MissionEvent(
         revision=event.revision,
         stamp=time_to_msg(event.stamp),
         kind=int(event.kind),
@@ -171,8 +172,13 @@ def event_to_msg(event: MissionEvent, agent_of: Callable[[str], str]) -> wire.Mi
         removed_barrier_ids=list(change.removed_barrier_ids),
         put_markers=[marker_to_msg(m) for m in change.put_markers],
         removed_marker_names=list(change.removed_marker_names),
-        moves=moves_to_msgs(change.moves),
     )
+    fields = moves_to_fields(change.moves)
+    if fields is None:
+        msg.moves, msg.move_indexes = moves_to_msgs(change.moves), ()
+    else:
+        msg.move_ids, msg.move_indexes = fields
+    return msg
 
 
 def moves_to_msgs(moves: Sequence[SkillMove]) -> list[wire.SkillMove]:
@@ -189,7 +195,8 @@ def event_from_msg(msg: wire.MissionEvent) -> MissionEvent:
     """``rosmc/MissionEvent`` as a core event (a replacement has no content).
 
     An event recorded before reorders carried moves has no ``moves`` field and
-    gives the whole new order in ``blueprint_order``; the core applies either.
+    gives the whole new order in ``blueprint_order``; the core applies either. One
+    recorded before the packed move fields carries its moves in ``moves``.
     """
     change = Change(
         put_skills=tuple(PlacedSkill(p.index, skill_from_msg(p.skill)) for p in msg.put_skills),
@@ -200,7 +207,7 @@ def event_from_msg(msg: wire.MissionEvent) -> MissionEvent:
         removed_barrier_ids=tuple(msg.removed_barrier_ids),
         put_markers=tuple(marker_from_msg(m) for m in msg.put_markers),
         removed_marker_names=tuple(msg.removed_marker_names),
-        moves=moves_from_msgs(getattr(msg, "moves", ())),
+        moves=moves_from_fields(msg) or moves_from_msgs(getattr(msg, "moves", ())),
     )
     return MissionEvent(
         msg.revision,

@@ -8,7 +8,6 @@ A:[x1, y1], B:[y2, x2] with barriers {x1, x2} and {y1, y2}.
 
 from __future__ import annotations
 
-import operator
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 
@@ -19,6 +18,7 @@ from .deadlock import find_deadlock as find_deadlock
 from .errors import InvalidRequest, RuleViolation
 from .legality import member_refusal, staying_refusal
 from .model import Barrier, SkillInstance, SkillStatus
+from .moves import move_columns
 from .state import MissionState
 
 
@@ -98,15 +98,16 @@ def check_moves(state: MissionState, agent: str, moves: Sequence[SkillMove]) -> 
     Moving a skill that is in no barrier never changes the barriers' order; a moved
     member's barrier is on any new cycle, so the search starts from those only.
     """
-    moved = set(map(operator.attrgetter("skill_id"), moves))
-    if len(state.members_of(agent)) < len(moved):  # a whole new order moves thousands
-        moved &= set(state.members_of(agent))
+    ids = move_columns(moves)[0]
+    members = state.members_of(agent)
+    # A whole new order moves thousands of skills and a few members: look at those.
+    moved = set(members).intersection(ids) if len(members) < len(ids) else set(ids)
     starts = {b.id for b in map(state.barrier_of, moved) if b is not None}
     if not starts:
         return
     graph = _BarrierGraph(state)
-    members = state.members_after_moves(agent, moves)
-    graph.next_member.update(zip(members, [*members[1:], None], strict=True))
+    after = state.members_after_moves(agent, moves)
+    graph.next_member.update(zip(after, [*after[1:], None], strict=True))
     for start in sorted(starts):
         _refuse_cycle(graph.cycle_through(start))
 

@@ -11,10 +11,10 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 
 from .barriers import barrier_without, check_moves
-from .changes import Change, EventKind, PlacedSkill, Proposal, SkillMove, moves_between
+from .changes import Change, EventKind, PlacedSkill, Proposal, SkillMove
 from .errors import InvalidRequest, RuleViolation
 from .library import Library, SkillSpec
-from .model import SkillInstance, TaskMarker, skill_id_of
+from .model import SkillInstance, TaskMarker
 from .params import ParamType, Value
 from .state import MissionState
 from .validation import (
@@ -151,15 +151,13 @@ def plan_reorder(state: MissionState, agent: str, order: Sequence[str]) -> Propo
     """
     task = state.task(agent)
     start = state.sections(agent).editable_start
-    editable = list(map(skill_id_of, task[start:]))
-    try:  # checks that ``order`` is a permutation of ``editable`` as it goes
-        moves = moves_between(editable, order, start)
+    try:  # checks that ``order`` is a permutation of the editable ids as it goes
+        moves = state.plan_order(agent, start, order)
     except ValueError:
         raise InvalidRequest(
-            f"the new order must list each of {agent}'s {len(editable)} editable blueprint "
-            f"skills exactly once (got {len(order)} ids)"
+            f"the new order must list each of {agent}'s {len(task) - start} editable "
+            f"blueprint skills exactly once (got {len(order)} ids)"
         ) from None
-    state.expect_moves(agent, moves, start, order)
     return _reordered(state, agent, moves)
 
 
@@ -183,7 +181,7 @@ def plan_move_skills(state: MissionState, agent: str, moves: Sequence[SkillMove]
     return _reordered(state, agent, tuple(moves))
 
 
-def _reordered(state: MissionState, agent: str, moves: tuple[SkillMove, ...]) -> Proposal:
+def _reordered(state: MissionState, agent: str, moves: Sequence[SkillMove]) -> Proposal:
     check_moves(state, agent, moves)
     shown = ", ".join(f"'{move.skill_id}' to {move.index}" for move in moves[:3])
     more = f" and {len(moves) - 3} more" if len(moves) > 3 else ""

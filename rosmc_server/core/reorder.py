@@ -20,25 +20,18 @@ from __future__ import annotations
 
 import bisect
 from collections.abc import Sequence
-from typing import Protocol
+from itertools import compress
+
+from .moves import SkillMove, move_columns
 
 NOT_A_PERMUTATION = "the new order is not a permutation of the current one"
-
-
-class Move(Protocol):
-    """A skill and its index once moved (what :class:`.changes.SkillMove` holds)."""
-
-    @property
-    def skill_id(self) -> str: ...
-
-    @property
-    def index(self) -> int: ...
+_IS_REGION = (-1).__lt__  # a region number, not the -1 of a staying skill
 
 
 def canonical_moves(
     current: Sequence[str], order: Sequence[str], offset: int = 0
-) -> list[tuple[str, int]]:
-    """The fewest moves, as (skill id, index) pairs, that turn ``current`` into ``order``.
+) -> tuple[list[str], list[int]]:
+    """The fewest moves, as their ids and indexes, that turn ``current`` into ``order``.
 
     ``current`` holds distinct ids; ``order`` must be a permutation of it, else
     ValueError (checked on the way, without sets of both). Indexes are ``offset`` plus
@@ -54,7 +47,7 @@ def canonical_moves(
     while tail > head and current[tail - 1] == order[tail - 1]:
         tail -= 1
     current, order, offset = current[head:tail], order[head:tail], offset + head
-    position = {skill_id: index for index, skill_id in enumerate(order)}
+    position = dict(zip(order, range(len(order)), strict=True))
     try:
         targets = list(map(position.__getitem__, current))
     except KeyError:  # an id of ``current`` is missing from ``order``
@@ -63,46 +56,46 @@ def canonical_moves(
         raise ValueError(NOT_A_PERMUTATION)
     staying = _longest_increasing(targets)
     # Per place in the new order: the region of the skill moved there (how many staying
-    # skills are before it now), or -1 where a staying skill is. Lists, not dicts: the
-    # loops below index them by place.
+    # skills are before it now), or -1 where a staying skill is; per region, how many
+    # moved skills wait there. Lists, not dicts: the loops index them by place.
     region = [-1] * len(order)
+    waiting = [0] * (staying.count(1) + 1)
     passed = 0
     for target in targets:
         if staying[target]:
             passed += 1
         else:
             region[target] = passed
-    waiting = [0] * (passed + 1)  # per region, the moved skills not moved yet
-    for number in region:
-        if number >= 0:
-            waiting[number] += 1
-    moves: list[tuple[str, int]] = []
-    append = moves.append
+            waiting[passed] += 1
+    ids = list(compress(order, map(_IS_REGION, region)))
+    indexes: list[int] = []
+    add = indexes.append
+    moved = offset  # ``offset`` + the skills moved so far (all before the next one)
     before = 0  # staying skills before the next moved one, in the new order
-    counted = 0  # regions below this one are summed in ``unmoved_before``
-    unmoved_before = 0
-    for skill_id, number in zip(order, region, strict=True):
+    unmoved_before = 0  # moved skills not moved yet in the regions below ``before``
+    for number in region:
         if number < 0:
+            unmoved_before += waiting[before]
             before += 1
-            continue
-        waiting[number] -= 1
-        if number < counted:
-            unmoved_before -= 1
-        while counted < before:
-            unmoved_before += waiting[counted]
-            counted += 1
-        append((skill_id, offset + len(moves) + before + unmoved_before))
-    return moves
+        else:
+            waiting[number] -= 1
+            if number < before:
+                unmoved_before -= 1
+            add(moved + before + unmoved_before)
+            moved += 1
+    return ids, indexes
 
 
-def play_moves(current: Sequence[str], moves: Sequence[Move], offset: int = 0) -> list[str] | None:
+def play_moves(
+    current: Sequence[str], moves: Sequence[SkillMove], offset: int = 0
+) -> list[str] | None:
     """``current`` after ``moves`` (played one after the other), or None if not canonical.
 
     ``current`` is a task's stretch starting at index ``offset`` that holds every moved
     skill and every index moved to. Canonical moves (see the module's docstring) are
     decoded in one pass; for others the answer is None, never a wrong order.
     """
-    moved = [move.skill_id for move in moves]
+    moved, indexes = move_columns(moves)
     moved_set = set(moved)
     if len(moved_set) != len(moved):
         return None
@@ -120,18 +113,18 @@ def play_moves(current: Sequence[str], moves: Sequence[Move], offset: int = 0) -
         waiting[number] += 1
     chains: dict[int, list[str]] = {}  # staying skills before a run of moved ones -> the run
     before = unmoved_before = 0
-    for done, move in enumerate(moves):
-        number = region[move.skill_id]
+    for done, (skill_id, index) in enumerate(zip(moved, indexes, strict=True)):
+        number = region[skill_id]
         waiting[number] -= 1
         if number < before:
             unmoved_before -= 1
-        wanted = move.index - offset - done
+        wanted = index - offset - done
         while before + unmoved_before < wanted and before < len(staying):
             unmoved_before += waiting[before]
             before += 1
         if before + unmoved_before != wanted:
             return None
-        chains.setdefault(before, []).append(move.skill_id)
+        chains.setdefault(before, []).append(skill_id)
     result: list[str] = []
     start = 0
     for at, run in chains.items():  # in increasing ``at``: ``before`` never decreases
@@ -142,7 +135,9 @@ def play_moves(current: Sequence[str], moves: Sequence[Move], offset: int = 0) -
     return result
 
 
-def play_one_by_one(current: Sequence[str], moves: Sequence[Move], offset: int = 0) -> list[str]:
+def play_one_by_one(
+    current: Sequence[str], moves: Sequence[SkillMove], offset: int = 0
+) -> list[str]:
     """``current`` after ``moves``, each played as the definition says (the simple way)."""
     result = list(current)
     for move in moves:

@@ -7,9 +7,7 @@ that can be journaled and replayed.
 
 from __future__ import annotations
 
-import bisect
-from collections.abc import Iterable, Iterator, Sequence
-from fractions import Fraction
+from collections.abc import Iterator, Sequence
 
 from .changes import Change, SkillMove, moves_between
 from .content import MissionContent as MissionContent
@@ -24,46 +22,32 @@ from .model import (
     skill_id_of,
     skill_with,
 )
-from .pair_index import PairIndex
-from .reorder import play_moves
+from .task_order import BULK_MOVES as BULK_MOVES
+from .task_order import KEY_SPACING, TaskOrder
 from .validation import excerpt
 
-# Spacing of the position keys given to a task's skills: room for 32 insertions at one
-# place before the task's keys are spread again.
-_KEY_SPACING = 1 << 32
-# From this many moves on, a reorder is decoded in one pass over the stretch it touches
-# (see :mod:`.reorder`) instead of shifting the task once per move.
-BULK_MOVES = 16
 _skill_id = skill_id_of
 
 
-class MissionState:
+class MissionState(TaskOrder):
     """Mission content plus lookup indexes; mutated only by :meth:`apply`.
 
     Every skill has a position key: the keys of a task increase along it, so a
     skill's index is a binary search away and the order of any two skills is a
     comparison. The barrier members of each task are kept sorted by key too, so
-    the deadlock check looks at barrier members only. A change updates these
-    indexes where it touched the task: its cost does not grow with the mission.
+    the deadlock check looks at barrier members only (see :class:`.TaskOrder`). A
+    change updates these indexes where it touched the task: its cost does not grow
+    with the mission.
     """
 
     def __init__(self, content: MissionContent, revision: int = 0) -> None:
+        super().__init__()
         self.revision = revision
         # Own copies: the state changes its content in place, and neither the
         # caller's content nor an event's replacement may change with it.
         self._content = content.copy()
-        self._agent_of: dict[str, str] = {}
-        self._barrier_of: dict[str, str] = {}
         self._bound: dict[str, set[str]] = {}
-        self._key_of: dict[str, int] = {}
-        self._keys: dict[str, list[int]] = {}  # per agent, parallel to its task
-        self._member_keys: dict[str, list[int]] = {}  # per agent, its barrier members' keys
-        self._member_ids: dict[str, list[str]] = {}  # ... and their ids, in task order
         self._in_transfer: dict[str, set[str]] = {}  # per agent, skills awaiting the robot
-        self._pairs = PairIndex()  # barrier members by pair of agents they join
-        # The last moves decoded and what they gave: planning, the undo history and
-        # applying a reorder each ask for it within one commit (cleared by every change).
-        self._played: tuple[Sequence[SkillMove], str, tuple[int, list[str]] | None] | None = None
         self._reindex()
 
     # -- queries ---------------------------------------------------------
@@ -115,34 +99,6 @@ class MissionState:
         """Whether a skill with this id exists."""
         return skill_id in self._agent_of
 
-    def locate(self, skill_id: str) -> tuple[str, int]:
-        """The agent and index of a skill; NotFound if there is none."""
-        agent = self._agent_of.get(skill_id)
-        if agent is None:
-            raise NotFound(f"there is no skill {excerpt(skill_id)}")
-        return agent, bisect.bisect_left(self._keys[agent], self._key_of[skill_id])
-
-    def order_key(self, skill_id: str) -> int:
-        """A number that grows along the skill's task: compares two skills of one task."""
-        return self._key_of[skill_id]
-
-    def partner_agents(self, agent: str) -> Iterable[str]:
-        """The agents whose tasks share (or shared) a barrier with ``agent``'s."""
-        return self._pairs.partners(agent)
-
-    def first_shared_after(self, skill_id: str, other: str) -> str | None:
-        """The first barrier member after ``skill_id`` on its task that shares a barrier
-        with ``other``'s task (a binary search; see :mod:`.pair_index`)."""
-        agent = self.agent_of(skill_id)
-        return self._pairs.first_after(agent, other, self._key_of[skill_id])
-
-    def agent_of(self, skill_id: str) -> str:
-        """The agent whose task holds the skill; NotFound if there is none."""
-        agent = self._agent_of.get(skill_id)
-        if agent is None:
-            raise NotFound(f"there is no skill {excerpt(skill_id)}")
-        return agent
-
     def skill(self, skill_id: str) -> SkillInstance:
         """The skill with this id; NotFound if there is none."""
         agent, index = self.locate(skill_id)
@@ -182,98 +138,6 @@ class MissionState:
         barrier_id = self._barrier_of.get(skill_id)
         return None if barrier_id is None else self._content.barriers[barrier_id]
 
-    def members_of(self, agent: str) -> tuple[str, ...]:
-        """``agent``'s barrier members, in task order."""
-        return tuple(self._member_ids.get(agent, ()))
-
-    def members_around(self, skill_id: str) -> tuple[str | None, str | None]:
-        """The barrier members just before and just after a skill on its agent's task.
-
-        The skill itself, if a member, is neither. None where there is no such member.
-        """
-        agent = self.agent_of(skill_id)
-        keys, ids = self._member_keys.get(agent, []), self._member_ids.get(agent, [])
-        key = self._key_of[skill_id]
-        at = bisect.bisect_left(keys, key)
-        before = ids[at - 1] if at else None
-        if at < len(keys) and keys[at] == key:
-            at += 1
-        return before, ids[at] if at < len(ids) else None
-
-    def members_after_moves(self, agent: str, moves: Sequence[SkillMove]) -> list[str]:
-        """``agent``'s barrier members in task order as they would be after ``moves``.
-
-        Nothing changes: many moves are decoded at once (:meth:`order_after_moves`), a
-        few are played on a copy of the task's keys.
-        """
-        members = self._member_ids.get(agent, [])
-        played = self.order_after_moves(agent, moves) if len(moves) >= BULK_MOVES else None
-        if played is not None:
-            start, ids = played
-            task_keys, member_keys = self._keys[agent], self._member_keys.get(agent, [])
-            first = bisect.bisect_left(member_keys, task_keys[start])
-            last = bisect.bisect_right(member_keys, task_keys[start + len(ids) - 1])
-            inside = list(filter(self._barrier_of.__contains__, ids))
-            return [*members[:first], *inside, *members[last:]]
-        keys: list[int | Fraction] = list(self._keys[agent])
-        moved: dict[str, int | Fraction] = {}
-        for move in moves:
-            key = moved.get(move.skill_id, self._key_of[move.skill_id])
-            keys.pop(bisect.bisect_left(keys, key))
-            index = min(max(move.index, 0), len(keys))
-            # An exact key between the neighbours: a copy never needs spreading out.
-            low = keys[index - 1] if index else (keys[0] - 2 if keys else 0)
-            high = keys[index] if index < len(keys) else low + 2
-            moved[move.skill_id] = Fraction(low + high, 2)
-            keys.insert(index, moved[move.skill_id])
-        return sorted(members, key=lambda skill_id: moved.get(skill_id, self._key_of[skill_id]))
-
-    def order_after_moves(
-        self, agent: str, moves: Sequence[SkillMove]
-    ) -> tuple[int, list[str]] | None:
-        """Where the stretch of ``agent``'s task that ``moves`` touch starts, and its ids
-        after them; None unless the moves are canonical (see :func:`.reorder.play_moves`).
-
-        Costs the stretch, once: nothing changes.
-        """
-        if self._played is not None and self._played[0] is moves and self._played[1] == agent:
-            return self._played[2]
-        played = self._order_after_moves(agent, moves)
-        self._played = (moves, agent, played)
-        return played
-
-    def expect_moves(
-        self, agent: str, moves: Sequence[SkillMove], start: int, order: Sequence[str]
-    ) -> None:
-        """Note that ``moves`` give ``agent``'s task from ``start`` on in ``order`` (the
-        planner of a whole new order knows it), so that :meth:`order_after_moves` need
-        not decode them. Nothing changes."""
-        if len(moves) >= BULK_MOVES:
-            self._played = (moves, agent, (start, list(order)))
-
-    def _order_after_moves(
-        self, agent: str, moves: Sequence[SkillMove]
-    ) -> tuple[int, list[str]] | None:
-        keys, key_of = self._keys[agent], self._key_of
-        ids = [move.skill_id for move in moves]
-        if set(map(self._agent_of.get, ids)) != {agent}:
-            return None
-        moved_keys = list(map(key_of.__getitem__, ids))
-        targets = [move.index for move in moves]
-        start = min(bisect.bisect_left(keys, min(moved_keys)), *targets)
-        end = max(bisect.bisect_left(keys, max(moved_keys)), *targets) + 1
-        if start < 0 or end > len(keys):
-            return None
-        stretch = list(map(_skill_id, self._content.tasks[agent][start:end]))
-        order = play_moves(stretch, moves, start)
-        return None if order is None else (start, order)
-
-    def moves_for_order(self, agent: str, order: Sequence[str]) -> tuple[SkillMove, ...]:
-        """The moves that give the last ``len(order)`` skills of ``agent``'s task ``order``."""
-        task = self.task(agent)
-        start = len(task) - len(order)
-        return moves_between([skill.id for skill in task[start:]], order, start)
-
     def marker(self, name: str) -> TaskMarker:
         """The task marker called ``name``; NotFound if there is none."""
         try:
@@ -293,6 +157,12 @@ class MissionState:
             for agent, index in map(self.locate, self._bound.get(marker_name, ()))
         )
         return [self._content.tasks[self.agents[rank]][index] for rank, index in places]
+
+    def moves_for_order(self, agent: str, order: Sequence[str]) -> Sequence[SkillMove]:
+        """The moves that give the last ``len(order)`` skills of ``agent``'s task ``order``."""
+        task = self.task(agent)
+        start = len(task) - len(order)
+        return moves_between([skill.id for skill in task[start:]], order, start)
 
     # -- the one way to change -------------------------------------------
     def apply(self, change: Change) -> None:
@@ -348,7 +218,7 @@ class MissionState:
         task, keys = self._content.tasks[agent], self._keys[agent]
         index = min(max(index, 0), len(task))
         low = keys[index - 1] if index else 0
-        high = keys[index] if index < len(keys) else low + 2 * _KEY_SPACING
+        high = keys[index] if index < len(keys) else low + 2 * KEY_SPACING
         if high - low < 2:  # no key left between the neighbours: spread the task's keys
             self._spread_keys(agent)
             low = keys[index - 1] if index else 0
@@ -384,34 +254,8 @@ class MissionState:
         if played is None:
             for move in moves:
                 self._move_skill(move.skill_id, move.index)
-            return
-        start, ids = played
-        end = start + len(ids)
-        task, keys, key_of = self._content.tasks[agent], self._keys[agent], self._key_of
-        stretch = task[start:end]
-        by_id = dict(zip(map(_skill_id, stretch), stretch, strict=True))  # in C, all at once
-        task[start:end] = map(by_id.__getitem__, ids)
-        low = keys[start - 1] if start else 0
-        high = keys[end] if end < len(keys) else low + _KEY_SPACING * (len(ids) + 1)
-        step = (high - low) // (len(ids) + 1)
-        if step < 2:
-            self._spread_keys(agent)
         else:
-            keys[start:end] = range(low + step, low + step * (len(ids) + 1), step)
-            key_of.update(zip(ids, keys[start:end], strict=True))
-        members = self._member_ids.get(agent)
-        if members:
-            members.sort(key=key_of.__getitem__)
-            self._member_keys[agent] = [key_of[skill_id] for skill_id in members]
-            self._pairs.rekey(agent, key_of.__getitem__)
-
-    def _spread_keys(self, agent: str) -> None:
-        """Give ``agent``'s skills evenly spaced keys again (same order)."""
-        task, keys = self._content.tasks[agent], self._keys[agent]
-        keys[:] = range(_KEY_SPACING, _KEY_SPACING * (len(task) + 1), _KEY_SPACING)
-        self._key_of.update(zip(map(_skill_id, task), keys, strict=True))
-        self._member_keys[agent] = [self._key_of[i] for i in self._member_ids.get(agent, [])]
-        self._pairs.rekey(agent, self._key_of.__getitem__)
+            self._reorder_stretch(agent, *played)
 
     def _drop_barrier(self, barrier_id: str) -> None:
         old = self._content.barriers.pop(barrier_id, None)
@@ -419,33 +263,6 @@ class MissionState:
             for skill_id in old.skill_ids:
                 self._remove_member(skill_id)
                 self._barrier_of.pop(skill_id, None)
-
-    def _add_member(self, skill_id: str) -> None:
-        agent = self._agent_of.get(skill_id)
-        if agent is None:
-            return  # a barrier naming a skill that is not there (only a bad snapshot does)
-        keys = self._member_keys.setdefault(agent, [])
-        ids = self._member_ids.setdefault(agent, [])
-        key = self._key_of[skill_id]
-        at = bisect.bisect_left(keys, key)
-        if at == len(keys) or keys[at] != key:
-            keys.insert(at, key)
-            ids.insert(at, skill_id)
-        barrier = self._content.barriers.get(self._barrier_of.get(skill_id, ""))
-        if barrier is not None:
-            partners = (self._agent_of.get(member) for member in barrier.skill_ids)
-            self._pairs.add(skill_id, agent, key, [a for a in partners if a is not None])
-
-    def _remove_member(self, skill_id: str) -> None:
-        agent = self._agent_of.get(skill_id)
-        if agent is None:
-            return
-        self._pairs.remove(skill_id, self._key_of[skill_id])
-        keys = self._member_keys.get(agent, [])
-        at = bisect.bisect_left(keys, self._key_of[skill_id])
-        if at < len(keys) and keys[at] == self._key_of[skill_id]:
-            del keys[at]
-            del self._member_ids[agent][at]
 
     def _note_transfer(self, skill: SkillInstance) -> None:
         waiting = self._in_transfer.setdefault(skill.agent, set())

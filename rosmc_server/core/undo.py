@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import collections
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
 from .barriers import check_moves, find_deadlock
@@ -226,8 +227,8 @@ def inverse_change(before: MissionState, change: Change) -> Change:
 
 
 def _inverse_moves(
-    before: MissionState, agent: str, moves: tuple[SkillMove, ...]
-) -> tuple[SkillMove, ...]:
+    before: MissionState, agent: str, moves: Sequence[SkillMove]
+) -> Sequence[SkillMove]:
     """Moves that undo ``moves`` (applied one after the other), last one first.
 
     A few moves: only the moved skills' indexes are followed, so the cost is the moves',

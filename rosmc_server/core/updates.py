@@ -9,7 +9,7 @@ update only what an event touched.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from .agent_status import AgentStatus
@@ -82,7 +82,7 @@ class SkillsMoved:
     """
 
     agent: str
-    moves: tuple[SkillMove, ...]
+    moves: Sequence[SkillMove]
 
 
 @dataclass(frozen=True)

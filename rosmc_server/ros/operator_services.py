@@ -30,6 +30,7 @@ from ..conversions import (
     policy_from_request,
     pose_from_msg,
 )
+from ..conversions.move_fields import order_from_field
 from ..core import (
     InvalidRequest,
     LibraryError,
@@ -218,7 +219,8 @@ class OperatorServices:
                 raise InvalidRequest("give either a new order or moves, not both")
             moves = moves_from_msgs(req.moves)
             return self._apply(lambda m: m.move_skills(agent, moves, base_revision=base))
-        return self._apply(lambda m: m.reorder(agent, req.order, base_revision=base))
+        order = order_from_field(req.order)
+        return self._apply(lambda m: m.reorder(agent, order, base_revision=base))
 
     # -- synchronization and execution ---------------------------------------------
     def _synchronize(self, req: Any, resp: Any) -> MissionEvent:

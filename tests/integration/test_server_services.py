@@ -23,6 +23,7 @@ import rosmc.msg as wire
 import yaml
 
 from rosmc_server import interface
+from rosmc_server.conversions import event_from_msg
 from rosmc_server.core.link import status_digest
 
 pytest.register_assert_rewrite("tests.integration.server_fixtures")
@@ -395,6 +396,12 @@ def test_reorder_skills_applies_the_permutation(scene: Scene) -> None:
     assert skill_ids(c.mission(), "drone") == [scene.d3, scene.d1, scene.d2]
 
 
+def test_a_whole_order_may_travel_as_one_string_of_lines(scene: Scene) -> None:
+    c = scene.client
+    do(c, "reorder_skills", agent="drone", order=[f"{scene.d2}\n{scene.d3}\n{scene.d1}"])
+    assert skill_ids(c.mission(), "drone") == [scene.d2, scene.d3, scene.d1]
+
+
 def test_reorders_travel_as_moves(scene: Scene, events: Any) -> None:
     """A whole new order and a list of moves both publish only the moves."""
     c, recorder = scene.client, events()
@@ -409,8 +416,8 @@ def test_reorders_travel_as_moves(scene: Scene, events: Any) -> None:
     ):
         event = by_revision[revision]
         assert event.kind == wire.MissionEvent.SKILLS_REORDERED and event.order_agent == "drone"
-        assert not event.blueprint_order
-        assert [(m.skill_id, m.index) for m in event.moves] == moves
+        assert not event.blueprint_order and not event.moves  # packed in move_ids/_indexes
+        assert [(m.skill_id, m.index) for m in event_from_msg(event).change.moves] == moves
 
 
 REORDER_REJECTIONS: list[Case] = [
@@ -422,6 +429,13 @@ REORDER_REJECTIONS: list[Case] = [
     ("long", lambda s: {"agent": "drone", "order": [s.d1, s.d2, s.d3, s.d3]}, E.INVALID),
     ("repeated", lambda s: {"agent": "drone", "order": [s.d1, s.d1, s.d2]}, E.INVALID),
     ("unknown-id", lambda s: {"agent": "drone", "order": [s.d1, s.d2, "x"]}, E.INVALID),
+    ("lines-short", lambda s: {"agent": "drone", "order": [f"{s.d1}\n{s.d2}"]}, E.INVALID),
+    (
+        "lines-repeated",
+        lambda s: {"agent": "drone", "order": [f"{s.d1}\n{s.d1}\n{s.d2}"]},
+        E.INVALID,
+    ),
+    ("lines-blank", lambda s: {"agent": "drone", "order": [f"{s.d1}\n\n{s.d2}"]}, E.INVALID),
     ("other-agents-ids", lambda s: {"agent": "drone", "order": [s.d1, s.d2, s.s1]}, E.INVALID),
     (
         "stale-revision",

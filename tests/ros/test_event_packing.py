@@ -20,6 +20,7 @@ from rosmc_server.conversions.event_packing import (
     PackedEvent,
     packed_event,
 )
+from rosmc_server.conversions.move_fields import order_from_field, order_to_field
 from rosmc_server.conversions.packing import serialized
 from rosmc_server.core import Barrier, EventKind, Library, MissionEvent
 from rosmc_server.core.changes import Change, PlacedSkill, SkillMove
@@ -99,6 +100,26 @@ def test_a_whole_reorder_event_carries_every_move_in_order(library: Library) -> 
     event = MissionEvent(9, EventKind.SKILLS_REORDERED, "robot", "reordered", 3.5, change)
     packed = packed_event(event, str, "epoch-1")
     read = wire.MissionEvent().deserialize(serialized(packed))
-    assert [(m.skill_id, m.index) for m in read.moves] == [(m.skill_id, m.index) for m in moves]
+    assert not read.moves and read.move_ids.count("\n") == len(moves) - 1
+    assert list(event_from_msg(read).change.moves) == list(moves)
     assert read.order_agent == "robot" and read.epoch == "epoch-1"
     assert "packed" in str(packed)
+
+
+def test_moves_whose_ids_hold_a_line_break_travel_as_messages() -> None:
+    # Only an id that never passed the id check can hold one; it must not split in two.
+    moves = (SkillMove("a\nb", 3), SkillMove("c", 4))
+    event = MissionEvent(
+        2, EventKind.SKILLS_REORDERED, "r", "s", 1.0, Change(order_agent="r", moves=moves)
+    )
+    read = wire.MissionEvent().deserialize(serialized(packed_event(event, str, "e")))
+    assert [(m.skill_id, m.index) for m in read.moves] == [("a\nb", 3), ("c", 4)]
+    assert not read.move_indexes and event_from_msg(read).change.moves == moves
+
+
+def test_a_whole_order_travels_as_lines_and_reads_back() -> None:
+    order = [f"robot-s{n:05d}" for n in range(1000)]
+    assert order_to_field(order) == ["\n".join(order)]
+    assert order_from_field(order_to_field(order)) == order
+    for plain in ([], ["one"], ["a\nb", "c"]):  # too short to join, or an id with a break
+        assert order_to_field(plain) == plain and order_from_field(plain) == plain

@@ -4,7 +4,9 @@ A real core mission is journaled the way the server journals it; the recording's
 history and a resume (latest snapshot, then every event through ``Mission.replay``)
 must give the order the mission had at every revision. A journal written before
 ``MissionEvent`` had ``moves`` (its recorded definition lacks the field, and its
-reorders list the agent's whole blueprint) must still read, replay and resume.
+reorders list the agent's whole blueprint), and one written before the packed
+``move_ids`` / ``move_indexes`` (its moves are ``SkillMove`` messages), must still
+read, replay and resume.
 No ROS master.
 """
 
@@ -24,6 +26,7 @@ from rosmc_server.conversions import (  # noqa: E402
     event_to_msg,
     mission_from_msg,
     mission_to_msg,
+    moves_to_msgs,
 )
 from rosmc_server.core import (  # noqa: E402
     Change,
@@ -97,7 +100,8 @@ def test_reorders_journaled_as_moves_replay_to_the_order_of_every_revision(
             except RuleViolation:
                 continue  # a deadlock, refused
             msg = event_to_msg(event, mission.state.agent_of)
-            assert not msg.blueprint_order and len(msg.moves) == len(event.change.moves)
+            assert not msg.blueprint_order and not msg.moves
+            assert len(msg.move_indexes) == len(event.change.moves)
             writer.append_event(msg, T0 + event.revision)
             live[event.revision] = mission.state.content()
     assert len(live) > 15
@@ -108,24 +112,44 @@ def test_reorders_journaled_as_moves_replay_to_the_order_of_every_revision(
     assert resumed(path).state.content() == mission.state.content()
 
 
-def old_mission_event_definition() -> bytes:
-    """``rosmc/MissionEvent`` as journals recorded it before reorders carried moves."""
+PACKED_MOVES = ("string move_ids", "uint32[] move_indexes")
+
+
+def old_mission_event_definition(moves_as_messages: bool = False) -> bytes:
+    """``rosmc/MissionEvent`` as journals recorded it before the packed move fields, and
+    (unless ``moves_as_messages``) before reorders carried moves at all."""
+    dropped = PACKED_MOVES if moves_as_messages else ("SkillMove[]", *PACKED_MOVES)
     main, *sections = str(wire.MissionEvent._full_text).split(SECTION)
-    main = "\n".join(line for line in main.split("\n") if not line.startswith("SkillMove[]"))
-    kept = [s for s in sections if not s.startswith("MSG: rosmc/SkillMove")]
+    main = "\n".join(line for line in main.split("\n") if not line.startswith(dropped))
+    kept = [s for s in sections if moves_as_messages or not s.startswith("MSG: rosmc/SkillMove")]
     return SECTION.join([main, *kept]).encode()
 
 
 def old_event_bytes(event: MissionEvent, mission: Mission) -> bytes:
-    """The event serialized without the ``moves`` field (an empty array is its last 4 bytes)."""
+    """The event serialized without ``moves`` and the packed move fields: with an empty
+    epoch, its last 16 bytes are four empty fields (moves, epoch, move ids, move indexes),
+    of which the old definition has one."""
     msg = event_to_msg(event, mission.state.agent_of)
-    assert not msg.moves
+    assert not msg.moves and not msg.move_indexes and not msg.epoch
     data = serialize(msg)
-    assert data.endswith(b"\0\0\0\0")
-    return data[:-4]
+    assert data.endswith(b"\0" * 16)
+    return data[:-12]
 
 
-def write_old_journal(path: Path, snapshot: Any, events: list[bytes]) -> None:
+def moves_as_messages_bytes(event: MissionEvent, mission: Mission) -> bytes:
+    """The event serialized as journals did before the packed move fields: its moves as
+    ``SkillMove`` messages, and without the two packed fields (empty: the last 8 bytes)."""
+    msg = event_to_msg(event, mission.state.agent_of)
+    msg.moves = moves_to_msgs(event.change.moves)
+    msg.move_ids, msg.move_indexes = "", ()
+    data = serialize(msg)
+    assert data.endswith(b"\0" * 8)
+    return data[:-8]
+
+
+def write_old_journal(
+    path: Path, snapshot: Any, events: list[bytes], moves_as_messages: bool = False
+) -> None:
     with path.open("wb") as file:
         writer = McapWriter(file)
         writer.start(profile="ros1", library="rosmc before moves")
@@ -133,7 +157,7 @@ def write_old_journal(path: Path, snapshot: Any, events: list[bytes]) -> None:
             "rosmc/Mission", "ros1msg", str(wire.Mission._full_text).encode()
         )
         event_schema = writer.register_schema(
-            "rosmc/MissionEvent", "ros1msg", old_mission_event_definition()
+            "rosmc/MissionEvent", "ros1msg", old_mission_event_definition(moves_as_messages)
         )
         snapshots = writer.register_channel(MISSION_TOPIC, "ros1", mission_schema)
         changes = writer.register_channel(EVENTS_TOPIC, "ros1", event_schema)
@@ -175,4 +199,30 @@ def test_an_old_journal_whose_reorders_list_the_whole_order_still_replays(
     assert orders(final) == orders(mission.state.content())
     drone = orders(history.at_revision(old_reorder.revision).content())["drone"]
     assert drone[2:] == new_order
+    assert resumed(path).state.content() == mission.state.content()
+
+
+def test_a_journal_whose_moves_are_messages_still_replays(tmp_path: Path) -> None:
+    mission = team_mission()
+    snapshot = mission_to_msg(mission.state.content(), mission.revision, 0.0)
+    blueprint = [s.id for s in mission.state.task("drone")[2:]]
+    reorder = mission.reorder("drone", blueprint[5:] + blueprint[:5])
+    moved = mission.move_skills("drone", [SkillMove(blueprint[0], 2)])
+    after = mission.add_skill("drone", "land", index=3)
+    path = tmp_path / "messages.mcap"
+    events = [moves_as_messages_bytes(event, mission) for event in (reorder, moved, after)]
+    write_old_journal(path, snapshot, events, moves_as_messages=True)
+
+    result = read_journal(path)
+    assert any("recorded definition of rosmc/MissionEvent" in w for w in result.warnings)
+    read = [event_from_msg(record.message) for record in result.records[1:]]
+    assert [list(e.change.moves) for e in read] == [
+        list(e.change.moves) for e in (reorder, moved, after)
+    ]
+    assert read[0].change.moves and read[1].change.moves == (SkillMove(blueprint[0], 2),)
+    history = MissionHistory.from_journal(path)
+    assert not history.problems
+    assert orders(history.at_revision(reorder.revision).content())["drone"][2:] == (
+        blueprint[5:] + blueprint[:5]
+    )
     assert resumed(path).state.content() == mission.state.content()

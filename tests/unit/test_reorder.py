@@ -10,6 +10,7 @@ which decode many moves at once, must agree with the definition too.
 from __future__ import annotations
 
 import itertools
+from collections.abc import Sequence
 from typing import Any
 
 import pytest
@@ -19,6 +20,7 @@ from hypothesis import strategies as st
 from rosmc_server.core import Change, MissionState, RuleViolation
 from rosmc_server.core.barriers import check_moves, check_new_barrier, find_deadlock
 from rosmc_server.core.changes import SkillMove, moves_between
+from rosmc_server.core.moves import MoveList
 from rosmc_server.core.reorder import play_moves, play_one_by_one
 from rosmc_server.core.state import BULK_MOVES
 from rosmc_server.core.undo import inverse_change
@@ -172,7 +174,7 @@ def test_a_whole_new_order_is_planned_once_not_decoded_again(
     # The planner knows the new order: checking, undo history and apply all take it.
     import random
 
-    from rosmc_server.core import state as state_module
+    from rosmc_server.core import task_order as state_module
     from rosmc_server.core.editing import plan_reorder
     from tests.unit.test_change_indexes import state_of
 
@@ -229,3 +231,32 @@ def test_an_order_that_is_no_permutation_is_refused(
         del new[at]
     with pytest.raises(ValueError):
         moves_between(current, new, 3)
+
+
+@SETTINGS
+@given(reorders())
+def test_a_move_list_reads_as_the_moves_it_holds(reorder: tuple[list[str], list[str], int]) -> None:
+    # The planner's two lists stand for SkillMove objects wherever moves are read.
+    current, order, offset = reorder
+    moves = moves_between(current, order, offset)
+    ids, indexes = columns(moves)
+    objects = tuple(
+        SkillMove(skill_id, index) for skill_id, index in zip(ids, indexes, strict=True)
+    )
+    assert moves == objects and objects == moves and list(moves) == list(objects)
+    assert len(moves) == len(objects) and hash(moves) == hash(moves_between(current, order, offset))
+    assert all(moves[k] == objects[k] for k in range(len(objects)))
+    assert moves[1:] == objects[1:] and play_one_by_one(current, moves, offset) == order
+    assert moves != objects[:-1] or not objects
+    if objects:
+        assert moves != (*objects[:-1], SkillMove(objects[-1].skill_id, objects[-1].index + 1))
+
+
+def columns(moves: Sequence[SkillMove]) -> tuple[Sequence[str], Sequence[int]]:
+    assert isinstance(moves, MoveList)
+    return moves.ids, moves.indexes
+
+
+def test_a_move_list_needs_an_index_per_id() -> None:
+    with pytest.raises(ValueError):
+        MoveList(["a", "b"], [1])

@@ -6,6 +6,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from ...conversions import marker_to_msg, moves_to_msgs, policy_to_request, pose_to_msg
+from ...conversions.move_fields import order_to_field
 from ...core import (
     InvalidRequest,
     LostLinkPolicy,
@@ -181,7 +182,7 @@ class MissionClient(ClientBase):
                 base_revision,
                 retry_on_conflict,
                 agent=agent,
-                order=list(order),
+                order=order_to_field(order),
                 moves=wire_moves,
             ).revision
         )
