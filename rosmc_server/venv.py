@@ -30,6 +30,7 @@ from pathlib import Path
 from typing import cast
 
 VENV_VARIABLE = "ROSMC_VENV"
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a program Ctrl-C stopped
 OWN_PACKAGE_PREFIX = "rosmc"
 # Import names whose PyPI name differs (requirements.txt has the PyPI names).
 PYPI_NAMES = {"mcap_ros1": "mcap-ros1-support", "yaml": "PyYAML"}
@@ -82,7 +83,8 @@ def _package_path() -> list[str]:
 def run_entry_point(module: str, unused: tuple[str, ...] = ()) -> int:
     """Run ``module.main()`` with the project's venv; a missing dependency ends in one sentence.
 
-    ``SIGUSR1`` makes the process print every thread's stack (to diagnose a stuck node).
+    ``SIGUSR1`` makes the process print every thread's stack (to diagnose a stuck node);
+    Ctrl-C while the program is still importing ends it quietly with status 130.
 
     What a ``scripts/`` entry script calls. A module of this project that is missing is a
     broken install and raises as usual. ``unused`` names optional modules that a
@@ -105,6 +107,8 @@ def run_entry_point(module: str, unused: tuple[str, ...] = ()) -> int:
             raise
         print(missing_dependency_message(top, Path(sys.argv[0]).name), file=sys.stderr)
         return 1
+    except KeyboardInterrupt:  # Ctrl-C before the program took it over (while importing)
+        return EXIT_INTERRUPTED
 
 
 def missing_dependency_message(name: str, program: str) -> str:

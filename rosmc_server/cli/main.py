@@ -7,13 +7,14 @@ import os
 import sys
 from collections.abc import Callable, Sequence
 
+from .. import venv
 from .parser import build_parser
 
 EXIT_OK = 0
 EXIT_REFUSED = 1
 EXIT_USAGE = 2
 EXIT_UNREACHABLE = 3
-EXIT_INTERRUPTED = 130
+EXIT_INTERRUPTED = venv.EXIT_INTERRUPTED
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -61,6 +61,15 @@ def test_an_entry_point_runs_main_and_returns_its_status(
     assert venv.run_entry_point(module) == 3
 
 
+def test_ctrl_c_while_the_program_imports_ends_it_quietly_with_130(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    body = "raise KeyboardInterrupt  # as if Ctrl-C came during the imports\n"
+    module = _entry_module(tmp_path, monkeypatch, "entry_interrupted", body)
+    assert venv.run_entry_point(module) == 130
+    assert capsys.readouterr().err == "", "no traceback"
+
+
 def test_a_missing_dependency_ends_in_one_sentence_naming_both_routes(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
