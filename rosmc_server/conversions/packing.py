@@ -84,42 +84,61 @@ def _param_body(value: Value) -> bytes:
     )
 
 
-def skill_bytes(skill: SkillInstance, names: dict[str, bytes] | None = None) -> bytes:
+def skill_bytes(
+    skill: SkillInstance,
+    names: dict[str, bytes] | None = None,
+    shared: dict[int, tuple[Any, Any, bytes]] | None = None,
+) -> bytes:
     """The ROS 1 wire bytes of ``skill_to_msg(skill)``.
 
     ``names`` keeps the encoded agent, skill and parameter names between calls (a library
-    has few of them); pass the same dict to every call.
+    has few of them); pass the same dict to every call. ``shared`` keeps the bytes of
+    each parameters dict written, for skills that share one (a loaded mission's alike
+    parameters, see :mod:`~rosmc_server.core.shared_params`): pass one dict to the calls
+    for one mission.
     """
     if wire.Skill._md5sum != PACKED_SKILL_MD5:  # the definition changed: go through genpy
         return serialized(skill_to_msg(skill))
     if names is None:
         names = {}
-    bindings = skill.bindings
-    parts = [
-        string_bytes(skill.id),
-        names.get(skill.agent) or names.setdefault(skill.agent, string_bytes(skill.agent)),
-        names.get(skill.skill) or names.setdefault(skill.skill, string_bytes(skill.skill)),
-        string_bytes(skill.label),
-        _COUNT.pack(len(skill.params)),
-    ]
-    for name, value in skill.params.items():
+    params, bindings = skill.params, skill.bindings
+    found = shared.get(id(params)) if shared is not None else None
+    if found is not None and found[0] is params and found[1] is bindings:
+        block = found[2]
+    else:
+        block = _params_bytes(params, bindings, names)
+        if shared is not None:
+            shared[id(params)] = (params, bindings, block)  # kept alive: ids stay theirs
+    return b"".join(
+        (
+            string_bytes(skill.id),
+            names.get(skill.agent) or names.setdefault(skill.agent, string_bytes(skill.agent)),
+            names.get(skill.skill) or names.setdefault(skill.skill, string_bytes(skill.skill)),
+            string_bytes(skill.label),
+            block,
+            _SKILL_NUMBERS.pack(
+                skill.status,
+                skill.transfer,
+                skill.resolution,
+                skill.attempt,
+                skill.timeout,
+                skill.max_retries,
+            ),
+            string_bytes(skill.status_text),
+            _TIMES.pack(skill.started, skill.finished),
+        )
+    )
+
+
+def _params_bytes(params: Any, bindings: Any, names: dict[str, bytes]) -> bytes:
+    """The ``rosmc/ParameterValue[]`` of a skill's parameters and marker bindings."""
+    parts = [_COUNT.pack(len(params))]
+    for name, value in params.items():
         parts += (
             names.get(name) or names.setdefault(name, string_bytes(name)),
             _param_body(value),
             string_bytes(bindings[name]) if name in bindings else _EMPTY,
         )
-    parts += (
-        _SKILL_NUMBERS.pack(
-            skill.status,
-            skill.transfer,
-            skill.resolution,
-            skill.attempt,
-            skill.timeout,
-            skill.max_retries,
-        ),
-        string_bytes(skill.status_text),
-        _TIMES.pack(skill.started, skill.finished),
-    )
     return b"".join(parts)
 
 
@@ -207,9 +226,10 @@ class SnapshotPacker:
         Kept until the next call (a snapshot built meanwhile of the old mission does not
         drop them).
         """
-        names = self._names
+        names: dict[str, bytes] = self._names
+        shared: dict[int, tuple[Any, Any, bytes]] = {}  # alike parameters written once
         ready = {
-            agent: _PackedTask(list(task), [skill_bytes(skill, names) for skill in task])
+            agent: _PackedTask(list(task), [skill_bytes(skill, names, shared) for skill in task])
             for agent, task in content.tasks.items()
         }
         with self._lock:

@@ -29,7 +29,6 @@ from ..core import (
     InvalidRequest,
     MarkerType,
     MissionContent,
-    ParamType,
     Pose,
     Resolution,
     SkillInstance,
@@ -38,24 +37,23 @@ from ..core import (
     Transfer,
 )
 from .mission import mission_from_msg
+from .param_unpacking import read_params
 from .task_memory import TaskMemory
-from .values import json_param, param_type
 
 # The rosmc/Mission definition the reader follows (with its nested types).
 UNPACKED_MISSION_MD5 = "afb150ec3f57bc7466152152c338c587"
 
 _COUNT = struct.Struct("<I").unpack_from
 _HEADER = struct.Struct("<Q2I")  # revision, stamp
-_PARAM_NUMBERS = struct.Struct("<2Bqd").unpack_from  # type, bool_value, int_value, float_value
 _POSE = struct.Struct("<6d").unpack_from
 _SKILL_NUMBERS = struct.Struct("<3BIdI").unpack_from  # status ... max_retries
-# The usual forms in one read each: a skill's tail with an empty status_text (status ...
-# max_retries, status_text's length, started, finished) and a parameter with empty
-# string_value and json_value (type ... float_value, both lengths, pose, marker's length).
-# Each is at most as long as the field run it starts, so valid bytes never end inside it.
+# The usual form in one read: a skill's tail with an empty status_text (status ...
+# max_retries, status_text's length, started, finished). It is at most as long as the
+# field run it starts, so valid bytes never end inside it.
 _SKILL_TAIL = struct.Struct("<3BIdII2d").unpack_from
-_PARAM_FIXED = struct.Struct("<2BqdII6dI").unpack_from
 _TIMES = struct.Struct("<2d").unpack_from  # started, finished
+_SHARED_MOST = 4096  # parameter blocks kept for sharing per call (bounds their memory)
+_SHARE_TRIES = 64  # records in a row with parameters not read before, then sharing stops
 _MARKER_TYPE = struct.Struct("<B").unpack_from
 
 
@@ -186,9 +184,21 @@ def read_records(
     The hot loop of a snapshot: its strings are read inline, not through :func:`_text`
     (a call per string would cost a fifth more). A string read past the end of ``data``
     comes out short; the caller checks where the mission ends.
+
+    Records of one task share their agent, and skills of one kind often carry the same
+    parameters (the library's defaults): a record whose agent bytes are the last ones
+    read, or whose parameter bytes (as long as its kind's last) equal bytes read before,
+    takes those values, shared rather than read again. The encoding delimits itself, so
+    bytes equal to a whole earlier field are that field; skills are immutable, so
+    sharing is safe. After many records in a row with new parameters the call stops
+    looking (looking would cost more than it saves).
     """
     append = skills.append
     mark = starts.append if starts is not None else None
+    agent_raw, agent = b"", ""
+    block_size: dict[str, int] = {}  # by skill name
+    shared: dict[bytes, tuple[dict[str, Any], dict[str, str]]] = {}  # by parameter bytes
+    tries = _SHARE_TRIES  # records left to look for shared parameters in, unless one is found
     for _ in range(count):
         if mark is not None:
             mark(pos)
@@ -198,7 +208,9 @@ def read_records(
         pos += size
         size = _COUNT(data, pos)[0]
         pos += 4
-        agent = data[pos : pos + size].decode("utf-8", "rosmsg")
+        if size != len(agent_raw) or not data.startswith(agent_raw, pos):
+            agent_raw = data[pos : pos + size]
+            agent = agent_raw.decode("utf-8", "rosmsg")
         pos += size
         size = _COUNT(data, pos)[0]
         pos += 4
@@ -208,7 +220,25 @@ def read_records(
         pos += 4
         label = data[pos : pos + size].decode("utf-8", "rosmsg")
         pos += size
-        params, bindings, pos = _read_params(data, pos)
+        if not tries:  # the parameters were all new lately: reading them is cheaper
+            params, bindings, pos = read_params(data, pos)
+        else:
+            size = block_size.get(name, 0)  # the length of this kind's last parameters
+            block = data[pos : pos + size]
+            found = shared.get(block)
+            if found is not None:
+                params, bindings = found
+                pos += size
+                tries = _SHARE_TRIES
+            else:
+                start = pos
+                params, bindings, pos = read_params(data, pos)
+                tries -= 1
+                if pos - start != size:
+                    block_size[name] = pos - start
+                    block = data[start:pos]
+                if len(shared) < _SHARED_MOST:  # read before with another kind's length
+                    params, bindings = shared.setdefault(block, (params, bindings))
         numbers = _SKILL_TAIL(data, pos)  # status ... max_retries, len(status_text), times
         if numbers[6]:  # a status text: its bytes stand between the numbers and the times
             numbers = _SKILL_NUMBERS(data, pos)
@@ -246,80 +276,6 @@ def read_records(
             )
         )
     return pos
-
-
-def _read_params(data: bytes, pos: int) -> tuple[dict[str, Any], dict[str, str], int]:
-    """The ``rosmc/ParameterValue[]`` at ``pos``: values, marker bindings, where it ends."""
-    count = _COUNT(data, pos)[0]
-    pos += 4
-    params: dict[str, Any] = {}
-    bindings: dict[str, str] = {}
-    for _ in range(count):
-        size = _COUNT(data, pos)[0]
-        pos += 4
-        name = data[pos : pos + size].decode("utf-8", "rosmsg")
-        pos += size
-        # type, bool, int, float, len(string_value), len(json_value), pose, len(marker)
-        fixed = _PARAM_FIXED(data, pos)
-        type_number = fixed[0]
-        if type_number in _FIXED_TYPES and not (fixed[4] or fixed[5]) and name:
-            if type_number == _FLOAT:  # the usual forms, read at once
-                params[name] = fixed[3]
-            elif type_number == _POSE_TYPE:
-                params[name] = _assemble_pose(*fixed[6:12])
-            elif type_number == _INT:
-                params[name] = fixed[2]
-            else:
-                params[name] = bool(fixed[1])
-            pos += 78
-            size = fixed[12]
-        elif type_number == _STRING and name and not _COUNT(data, pos + 22 + fixed[4])[0]:
-            # Text (its length where the fixed form has string_value's) and no JSON: the
-            # text, then the unused JSON, pose and the marker's length.
-            end = pos + 22 + fixed[4]
-            params[name] = data[pos + 22 : end].decode("utf-8", "rosmsg")
-            pos = end + 56
-            size = _COUNT(data, pos - 4)[0]
-        else:
-            params[name], pos = _read_param_value(data, pos, name)
-            size = _COUNT(data, pos)[0]
-            pos += 4
-        if size:  # a bound marker
-            bindings[name] = data[pos : pos + size].decode("utf-8", "rosmsg")
-            pos += size
-    return params, bindings, pos
-
-
-def _read_param_value(data: bytes, pos: int, name: str) -> tuple[Any, int]:
-    """The value of the parameter whose fields start at ``pos``, and where its marker starts.
-
-    Any form: text, JSON, or numbers beside non-empty text fields (which are ignored).
-    """
-    type_number, bool_value, int_value, float_value = _PARAM_NUMBERS(data, pos)
-    pos += 18
-    size = _COUNT(data, pos)[0]  # string_value
-    text = data[pos + 4 : pos + 4 + size].decode("utf-8", "rosmsg") if size else ""
-    pos += 4 + size
-    size = _COUNT(data, pos)[0]  # json_value
-    json_text = data[pos + 4 : pos + 4 + size].decode("utf-8", "rosmsg") if size else ""
-    pos += 4 + size
-    ptype = _PARAM_TYPES.get(type_number) if name else None
-    value: Any
-    if ptype is ParamType.FLOAT:
-        value = float_value
-    elif ptype is ParamType.POSE:
-        value = _assemble_pose(*_POSE(data, pos))
-    elif ptype is ParamType.INT:
-        value = int_value
-    elif ptype is ParamType.STRING:
-        value = text
-    elif ptype is ParamType.BOOL:
-        value = bool(bool_value)
-    else:  # LIST, DICT, or InvalidRequest for a nameless or unknown parameter
-        if pos > len(data):  # the JSON text was cut short: malformed, not invalid
-            raise genpy.DeserializationError("the bytes end inside a parameter")
-        value = json_param(name, param_type(name, type_number), json_text)
-    return value, pos + 48
 
 
 def _read_marker(data: bytes, pos: int) -> tuple[TaskMarker, int]:
@@ -375,11 +331,6 @@ _STATUS: Mapping[int, SkillStatus] = {int(s): s for s in SkillStatus}
 _TRANSFER: Mapping[int, Transfer] = {int(t): t for t in Transfer}
 _RESOLUTION: Mapping[int, Resolution] = {int(r): r for r in Resolution}
 _MARKER_TYPES: Mapping[int, MarkerType] = {int(m): m for m in MarkerType}
-_PARAM_TYPES: Mapping[int, ParamType] = {int(t): t for t in ParamType}
-_FLOAT, _POSE_TYPE, _INT = int(ParamType.FLOAT), int(ParamType.POSE), int(ParamType.INT)
-_STRING = int(ParamType.STRING)
-_FIXED_TYPES = frozenset({_FLOAT, _POSE_TYPE, _INT, int(ParamType.BOOL)})  # no text, no JSON
 _assemble_skill = SkillInstance.assemble
-_assemble_pose = Pose.assemble
 _SKILL_ENUMS = (_STATUS, _TRANSFER, _RESOLUTION)
 _SKILL_ENUM_NAMES = ("status", "transfer", "resolution")

@@ -52,8 +52,12 @@ class _Run:
     start: int
     end: int
     indent: str
-    lines: list[str] = field(default_factory=list)
     items: list[dict[str, Any]] = field(default_factory=list)
+
+    def lines(self, text: str) -> list[str]:
+        """Each line of the run in ``text`` without its indentation and ``- ``."""
+        skip = len(self.indent) + 2
+        return [line[skip:] for line in text[self.start : self.end].split("\n")]
 
 
 def read_document(text: str, source: str) -> Any:
@@ -69,9 +73,10 @@ def read_document(text: str, source: str) -> Any:
         yaml.YAMLError: What :func:`~.documents.load_yaml` raises for the text.
         MissionFileError: YAML aliases expand the document beyond reason.
     """
+    as_written = _digest_matches(text)  # first: its copies of the text go before the entries come
     runs = _checked_runs(text)
-    if not _digest_matches(text):
-        runs = [run for run in runs if _written_alike(run.lines, run.items)]
+    if not as_written:
+        runs = [run for run in runs if _written_alike(run.lines(text), run.items)]
     if runs:
         data = _read_around(text, source, runs)
         if data is not None:
@@ -92,26 +97,39 @@ def _checked_runs(text: str) -> list[_Run]:
     """The runs of lines that each hold one JSON mapping, read line by line."""
     runs: list[_Run] = []
     for match in _FLOW_RUN.finditer(text):
-        indent = match.group(1)
-        skip = len(indent) + 2  # the indentation and "- "
-        lines = [line[skip:] for line in match.group().split("\n")]
-        items = _read_lines(lines)
+        run = _Run(match.start(), match.end(), match.group(1))
+        items = _read_lines(text, run)
         if items is not None:
-            runs.append(_Run(match.start(), match.end(), indent, lines, items))
+            run.items = items
+            runs.append(run)
         else:
-            runs += _line_by_line(match.start(), indent, lines)
+            runs += _line_by_line(run.start, run.indent, run.lines(text))
     return runs
 
 
-def _read_lines(lines: list[str]) -> list[dict[str, Any]] | None:
-    """The mapping each line holds, or None if one does not hold exactly one."""
-    scan = _SCAN
+def _read_lines(text: str, run: _Run) -> list[dict[str, Any]] | None:
+    """The mapping each line of ``run`` holds, or None if one does not hold exactly one.
+
+    Each line is scanned where it stands in ``text`` (no copy of the run or its lines). A
+    value that ends anywhere but at its line's end (before it, or on a later line: lines
+    end with ``}``, after which JSON takes no value) declines the run, as a scan of the
+    line alone would.
+    """
+    scan, find, end = _SCAN, text.find, run.end
+    skip = len(run.indent) + 2  # the indentation and "- "
+    items: list[dict[str, Any]] = []
+    append = items.append
+    at = run.start
     try:
-        read = [scan(line, 0) for line in lines]
+        while at < end:
+            stop = find("\n", at, end)
+            stop = end if stop < 0 else stop
+            item, after = scan(text, at + skip)
+            if after != stop or type(item) is not dict:
+                return None
+            append(item)
+            at = stop + 1
     except (StopIteration, ValueError, RecursionError):
-        return None
-    items = [data for data, _ in read]
-    if [end for _, end in read] != list(map(len, lines)) or set(map(type, items)) != {dict}:
         return None
     return items
 
@@ -128,7 +146,6 @@ def _line_by_line(start: int, indent: str, lines: list[str]) -> list[_Run]:
                 runs[-1].end = end
             else:
                 runs.append(_Run(at, end, indent))
-            runs[-1].lines.append(line)
             runs[-1].items.append(data)
         at = end + 1
     return runs

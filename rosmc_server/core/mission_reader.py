@@ -23,6 +23,7 @@ from .mission_text import MISSION_VERSION
 from .model import Barrier, Resolution, SkillInstance, SkillStatus, TaskMarker, Transfer
 from .params import MarkerType, Pose, QuickCheck, Value, quick_checker
 from .plain_skills import read_plain
+from .shared_params import SharedParams
 from .state import MissionContent
 from .validation import (
     MAX_ATTEMPT,
@@ -270,11 +271,12 @@ def _read_tasks(
     except RosmcError as error:
         reader.fail("tasks", str(error))
     seen: set[str] = set()
+    shared = SharedParams(skills.params)  # alike parameters checked once, one dict for all
     for agent, entries in body.items():
         if agent not in tasks:
             reader.fail(f"tasks.{agent}", "names no dynamic agent of the library")
         task = tasks[agent]
-        plain = read_plain(entries, agent, skills.spec, skills.params)
+        plain = read_plain(entries, agent, skills.spec, shared)
         if plain is not None and seen.isdisjoint(s.id for s in plain):
             ids = {s.id for s in plain}
             if len(ids) == len(plain):  # else read one by one, to name the id given twice

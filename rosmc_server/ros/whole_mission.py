@@ -99,6 +99,10 @@ class WholeMissionServices:
             raise InvalidRequest("give exactly one of a path and a document to load")
         library = self._server.library
         started = time.perf_counter()
+        # The save cache's lines are of the skills a load replaces: dropped before the
+        # document is read, they are not held beside it (a failed load only costs the next
+        # save its cache).
+        self._dumper = MissionDumper()
         with collector_paused():  # the new mission is acyclic: nothing for it to find
             if req.path:
                 mission_dir = self._server.config.mission_dir
@@ -120,9 +124,7 @@ class WholeMissionServices:
             lambda m: m.load(content, source, base_revision=req.base_revision)
         )
         assert event is not None
-        # The lines of the replaced skills cannot serve the next save; kept, they would
-        # keep those skills alive beside the new mission.
-        self._dumper = MissionDumper()
+        self._dumper = MissionDumper()  # again: a save meanwhile filled it with the old skills
         _log.info(
             "loaded %d skills from %s: read and checked in %.0f ms, serialized in %.0f ms, "
             "applied and journaled in %.0f ms",

@@ -66,9 +66,9 @@ def count_packed(monkeypatch: pytest.MonkeyPatch) -> list[str]:
     packed: list[str] = []
     real = packing.skill_bytes
 
-    def counting(skill: Any, names: Any = None) -> bytes:
+    def counting(skill: Any, names: Any = None, shared: Any = None) -> bytes:
         packed.append(skill.id)
-        return real(skill, names)
+        return real(skill, names, shared)
 
     monkeypatch.setattr(packing, "skill_bytes", counting)
     return packed
@@ -137,3 +137,19 @@ def test_skills_shifted_far_keep_their_bytes(
     assert task[2].id in packed
     assert len(packed) <= 1 + packing._FEW_MISSES
     assert snapshot.body == SnapshotPacker().body(changed)
+
+
+def test_skills_sharing_parameters_pack_as_genpy_serializes_them(library: Library) -> None:
+    # A loaded mission's alike parameters are one dict; the bytes written for it serve
+    # every skill holding that very dict (and bindings), no other.
+    content = random_content(library, 400, seed=25)
+    task = content.tasks["alpha"]
+    shared = task[0].params
+    for index in range(1, len(task), 3):
+        task[index] = replace(task[index], params=shared)  # the very dict
+    for index in range(2, len(task), 7):
+        task[index] = replace(task[index], params=dict(shared))  # equal, another dict
+    task[4] = replace(task[4], params=shared, bindings={name: "rock_1" for name in shared})
+    packer = SnapshotPacker()
+    packer.prepare(content)
+    assert serialized(packer.pack(content, 9, 0.0)) == serialized(mission_to_msg(content, 9, 0.0))

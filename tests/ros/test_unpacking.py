@@ -10,6 +10,7 @@ hold fail with the sentence ``mission_from_msg`` gives.
 
 from __future__ import annotations
 
+import random
 import struct
 
 import genpy
@@ -195,3 +196,39 @@ def test_text_parameters_in_any_form_read_as_the_conversion_reads_them(
     read, _, end = mission_from_bytes(data)
     assert (read, 3) == genpy_read(data)
     assert end == len(data)
+
+
+def test_repeated_parameters_read_as_genpy_reads_them_and_are_shared() -> None:
+    # Parameter blocks that repeat, differ only at their end, differ in count or binding,
+    # and runs of blocks never seen before (beta's longer than the reader keeps looking),
+    # in a random order of two skill names.
+    rng = random.Random(36)
+    pose = Pose(1.0, 2.0, 0.0, 0.0, 0.0, 0.5)
+    pool: list[tuple[dict[str, object], dict[str, str]]] = [
+        ({"target": pose, "speed": 0.8}, {}),
+        ({"target": pose, "speed": 0.9}, {}),
+        ({"target": pose}, {}),
+        ({"target": pose, "speed": 0.8}, {"target": "rock_1"}),
+        ({"target": pose, "speed": 0.8, "mode": "quick"}, {}),
+    ]
+
+    def task(agent: str, new_run: int) -> list[SkillInstance]:
+        skills = []
+        for number in range(600):
+            params, bindings = rng.choice(pool)
+            if 200 <= number < 200 + new_run:
+                params = {"target": pose, "speed": float(number)}
+            name = rng.choice(["move", "drive"])
+            skills.append(SkillInstance(f"{agent}{number}", agent, name, "x", params, bindings))
+        return skills
+
+    tasks = {"alpha": task("alpha", 40), "beta": task("beta", 100)}
+    content = MissionContent("lib", tasks, {}, {})
+    data = serialized(mission_to_msg(content, 8, 0.0))
+    read, revision, _ = mission_from_bytes(data)
+    assert (read, revision) == genpy_read(data)
+    assert read == content
+    alpha = read.tasks["alpha"]
+    # One dict per distinct block of parameters and binding, however often it comes.
+    assert len({id(skill.params) for skill in alpha[300:]}) == len(pool)
+    assert len({id(skill.agent) for skill in alpha}) == 1

@@ -199,6 +199,14 @@ def test_lines_that_only_look_like_the_writers_read_as_yaml_does(row: str) -> No
     assert read_document(document, "x") == expected
 
 
+@pytest.mark.parametrize("row", ['- {"a": {"b": 1}\n  }', '- {"a": 1, "b": {}\n  , "c": 2}'])
+def test_a_flow_mapping_ending_on_a_later_line_reads_as_yaml_does(row: str) -> None:
+    # Each line is scanned where it stands in the text: a value must end at its line's end.
+    document = f'items:\n{row}\n- {{"b": 2.5}}\n'
+    for text in (document, document + digest_line(document)):
+        assert read_document(text, "x") == load_yaml(text)
+
+
 def test_flow_lines_inside_other_yaml_stay_what_yaml_makes_of_them() -> None:
     inner = '  - {"id": "a", "n": 1.5}\n'
     documents = [
