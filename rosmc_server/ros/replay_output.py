@@ -17,10 +17,14 @@ heard (its first telemetry).
 from __future__ import annotations
 
 import copy
+import logging
+import threading
+import time
 from collections.abc import Callable
 from typing import Any
 
 import genpy
+import rosgraph
 import rosmc.msg as wire
 import rospy
 from tf2_msgs.msg import TFMessage
@@ -29,6 +33,8 @@ from visualization_msgs.msg import Marker, MarkerArray
 from .. import interface
 from ..recording.channels import LATCHED_TOPICS
 from ..recording.playback import Playlist, StampShift
+
+_log = logging.getLogger(__name__)
 
 TYPES: dict[str, Any] = {
     interface.MISSION_TOPIC: wire.Mission,
@@ -101,6 +107,37 @@ class ReplayOutput:
         self._standing = standing or {}  # first telemetry by robot: see first_telemetry
         self._stand = False  # robots not heard yet are shown where first heard (once paused)
         self._shown: set[str] = set()  # topics of CURRENT_AT_START published so far
+
+    def wait_for_subscribers(self, timeout: float, stop: threading.Event) -> None:
+        """Wait (up to ``timeout`` s, or until ``stop``) until every node that the master lists
+        as a subscriber of a replayed topic is connected, so none misses the first messages.
+
+        A subscriber connects only after the master told it of this new publisher: on a busy
+        machine that takes longer than any fixed pause.
+        """
+        wanted = self._subscriber_counts()
+        deadline = time.monotonic() + timeout
+        while not all(
+            self._publishers[topic].get_num_connections() >= count
+            for topic, count in wanted.items()
+        ):
+            if stop.wait(0.02) or time.monotonic() > deadline:
+                return
+
+    def _subscriber_counts(self) -> dict[str, int]:
+        """Per replayed topic, how many other nodes subscribe to it (the master's list)."""
+        names = {publisher.resolved_name: topic for topic, publisher in self._publishers.items()}
+        try:
+            _, subscriptions, _ = rosgraph.Master(rospy.get_name()).getSystemState()
+        except (OSError, rosgraph.MasterException) as error:
+            _log.debug("cannot ask the master for subscribers (%s)", error)
+            return {}
+        own = rospy.get_name()
+        return {
+            names[name]: len([node for node in nodes if node != own])
+            for name, nodes in subscriptions
+            if name in names
+        }
 
     def publish(self, topic: str, msg: Any) -> None:
         """Publish one recorded message on its topic (TF with the current stamp shift)."""

@@ -67,7 +67,9 @@ QUIET = 0.05
 MAX_DELAY = 0.25
 """Longest a burst of events goes without a new snapshot."""
 WARM_UP = 0.5
-"""Seconds for subscribers to connect before the first message."""
+"""Seconds for subscribers to appear before the first message."""
+CONNECT_TIMEOUT = 5.0
+"""Longest the replay then waits for the subscribers it knows of to connect."""
 LINGER = 1.0
 """Seconds the last messages get to reach their subscribers before the node leaves."""
 SEEK_ANSWER = 10.0
@@ -249,6 +251,9 @@ class RecordingReplayer:
         with self._handled:
             self._playing = True
         if self._stop.wait(WARM_UP):
+            return self._current
+        self._out().wait_for_subscribers(CONNECT_TIMEOUT, self._stop)
+        if self._stop.is_set():
             return self._current
         self._clock.start()
         playlist, seen, index = self._playlist, -1, 0
