@@ -97,7 +97,10 @@ def pytest_unconfigure(config: pytest.Config) -> None:
             "".join(traceback.format_stack(frames[thread.ident])) if thread.ident in frames else ""
         )
         sys.stderr.write(f"\nthread still running after the tests: {thread.name}\n{stack}")
-    faulthandler.dump_traceback_later(EXIT_GRACE, exit=True)
+    if not os.environ.get("PYTEST_XDIST_WORKER"):
+        # A pytest-xdist worker stays up after its last test until the whole run ends, so
+        # only the process that runs the session itself is held to the grace period.
+        faulthandler.dump_traceback_later(EXIT_GRACE, exit=True)
 
 
 def wait_until(
