@@ -4,7 +4,7 @@
 #   make setup   Debian packages, .venv (pinned PyPI packages), messages built into build/
 #   make demo    setup, then the demo mission (scripts/rosmc_demo); DEMO_ARGS=... passes options;
 #                GUI=1 also opens rviz and the command GUI on it
-#   make test    setup, lint, then pytest over tests/ in PYTEST_WORKERS (3) processes;
+#   make test    setup, lint, then pytest over tests/ in PYTEST_WORKERS (2) processes;
 #                PYTEST_ARGS=... passes options
 #   make test-thorough  the same with the thorough hypothesis profile (nightly: many examples)
 #   make test-busy      make test with two CPU-bound processes beside it (tools/beside_busy.py)
@@ -115,9 +115,10 @@ test-busy: setup
 
 # pytest's own exit codes pass through: 5 (no test collected) fails the target.
 # PYTEST_WORKERS processes share the test files (pytest-xdist, a file stays on one worker:
-# module fixtures start once). Most tests wait on ROS processes: on two cores, two workers
-# keep the CPUs 60 % busy, three keep them busier. PYTEST_WORKERS=0 runs in this process.
-PYTEST_WORKERS ?= 3
+# module fixtures start once). Most tests wait on ROS processes, so two workers halve the
+# time even on two cores; three were faster still but made the sim scenarios' timing
+# flaky there. PYTEST_WORKERS=0 runs everything in this process.
+PYTEST_WORKERS ?= 2
 pytest: setup
 	$(IN_ENV) python -m pytest $(if $(filter-out 0,$(PYTEST_WORKERS)),-n $(PYTEST_WORKERS) --dist loadfile) $(PYTEST_ARGS)
 
