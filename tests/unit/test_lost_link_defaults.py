@@ -166,6 +166,23 @@ def test_the_robot_returns_to_where_it_was_a_margin_before_the_last_contact(
     assert ret.ctx is not None and ret.ctx.params["target"] == back
 
 
+def test_a_robot_that_hears_the_ground_rarely_still_returns_a_margin_before_the_last_contact(
+    rover: Rover,
+) -> None:
+    """Contacts seconds apart (a poor radio, a fast sim) do not send it back to the start."""
+    rover.set_policy(RETURN)  # heard here, at x = 0
+    for x in range(1, 20):  # driving out at 1 m/s; the robot ticks, the ground is silent
+        rover.pose = Pose(float(x), 5.0)
+        rover.run_for(1.0)
+    rover.engine.report_acknowledged(0)  # heard once more, at x = 19
+    back = Pose(19.0 - LINK_MARGIN, 5.0)
+    assert rover.engine.lost_link.last_link_pose == back
+    rover.pose = Pose(30.0, 5.0)
+    rover.run_for(61.0)
+    ret = Timed.instances[-1]
+    assert ret.ctx is not None and ret.ctx.params["target"] == back
+
+
 def test_without_a_known_position_the_robot_holds(rover: Rover) -> None:
     rover.pose = None
     rover.set_policy(RETURN)

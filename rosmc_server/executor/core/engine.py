@@ -164,6 +164,7 @@ class Engine:
         now = self.clock()
         self._apply_progress()
         idle = self.idle
+        self.lost_link.observe(now)
         if self.lost_link.due(now, idle):
             self.lost_link.trigger(now, idle, self.pause)
             self.outputs.changed()

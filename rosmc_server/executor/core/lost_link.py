@@ -4,11 +4,14 @@ The policy itself (:class:`~rosmc_server.core.policy.LostLinkPolicy`) is the cor
 shared with the server and the operators' tools; this module only runs it.
 
 Where the robot is comes from a :data:`PoseSource` that the robot's integration gives
-the executor (the simulator's robots read their odometry): the guard asks it each time
-the ground is heard, so ``return_to_link`` knows where the robot last had a link. It
-returns to where it was :data:`LINK_MARGIN` seconds before the last contact: a link is
-known lost only some time after it went, so the very last contact can lie beyond the
-edge of coverage.
+the executor (the simulator's robots read their odometry): the guard samples it as the
+engine ticks (every :data:`POSE_SAMPLE_PERIOD` s) and when the ground is heard, so
+``return_to_link`` knows where the robot last had a link. It returns to where it was
+:data:`LINK_MARGIN` seconds before the last contact: a link is known lost only some time
+after it went, so the very last contact can lie beyond the edge of coverage. The poses
+come from the robot's own steady sampling, not only from the moments the ground was
+heard: over a poor radio those are seconds apart, and a sim running many times faster
+than real time hears the ground once per many simulated seconds.
 """
 
 from __future__ import annotations
@@ -25,6 +28,8 @@ from .skills import SkillBehavior, SkillContext, SkillType
 _log = logging.getLogger(__name__)
 LINK_MARGIN = 10.0
 """Seconds before the last ground contact where the robot returns to."""
+POSE_SAMPLE_PERIOD = 0.5
+"""Seconds between the poses the guard remembers while the robot works."""
 
 PoseSource = Callable[[], Pose | None]
 """Where the robot is now in the mission's map frame (None while it does not know)."""
@@ -71,7 +76,8 @@ class LostLinkGuard:
         self.is_default = False
         self.note = ""
         self.contingency: SkillBehavior | None = None
-        self._trail: deque[tuple[float, Pose]] = deque()  # contacts within the margin
+        self._recent: deque[tuple[float, Pose]] = deque()  # poses within the margin
+        self._link_pose: Pose | None = None
         self._pose_source = pose_source
         self._last_contact = clock()
         self._idle_since: float | None = None
@@ -98,24 +104,37 @@ class LostLinkGuard:
     def contact(self) -> bool:
         """The ground was heard; True if that ends a triggered policy (the note changed)."""
         now = self._last_contact = self.clock()
-        pose = self._pose_source()
-        if pose is not None:
-            self._trail.append((now, pose))
-            while len(self._trail) > 1 and self._trail[1][0] <= now - LINK_MARGIN:
-                self._trail.popleft()
+        self._sample(now)
+        if self._recent:
+            self._link_pose = self._recent[0][1]
         if not self._triggered:
             return False
         self._triggered = False
         self.note += "; ground contact is back"
         return True
 
+    def observe(self, now: float) -> None:
+        """Remember where the robot is, at most every :data:`POSE_SAMPLE_PERIOD` s."""
+        if not self._recent or now - self._recent[-1][0] >= POSE_SAMPLE_PERIOD:
+            self._sample(now)
+
+    def _sample(self, now: float) -> None:
+        """Add the pose now; keep the newest pose at least the margin old, and all after."""
+        pose = self._pose_source()
+        if pose is None:
+            return
+        recent = self._recent
+        recent.append((now, pose))
+        while len(recent) > 1 and recent[1][0] <= now - LINK_MARGIN:
+            recent.popleft()
+
     @property
     def last_link_pose(self) -> Pose | None:
         """Where the robot returns to: its pose :data:`LINK_MARGIN` s before the last contact.
 
-        The oldest pose heard if it has not been in contact that long; None if none is known.
+        The oldest pose known then if it had not been sampled that long; None if none is known.
         """
-        return self._trail[0][1] if self._trail else None
+        return self._link_pose
 
     def due(self, now: float, idle: bool) -> bool:
         """Whether the policy acts now (``idle``: the robot has nothing left to do).
