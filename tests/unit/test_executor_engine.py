@@ -209,10 +209,10 @@ class Robot:
         return self.skill(skill_id).status
 
     def skill(self, skill_id: str) -> SkillInstance:
-        return next(s for s in self.engine.queue if s.id == skill_id)
+        return next(s for s in self.engine.ledger.queue if s.id == skill_id)
 
     def ids(self) -> list[str]:
-        return [s.id for s in self.engine.queue]
+        return [s.id for s in self.engine.ledger.queue]
 
     def run_for(self, seconds: float, step: float = 0.1) -> None:
         """Advance the clock in steps, ticking the engine."""
@@ -238,7 +238,7 @@ def test_upload_holds_the_skills_and_answers_with_the_queue_hash(robot: Robot) -
     assert ack.result is AckResult.ACCEPTED
     assert ack.accepted_ids == ("a", "b") and ack.rejected_ids == ()
     assert ack.queue_hash == queue_hash(["a", "b"]) == robot.engine.queue_hash()
-    assert [(s.status, s.transfer) for s in robot.engine.queue] == [
+    assert [(s.status, s.transfer) for s in robot.engine.ledger.queue] == [
         (S.IDLE_SYNCHRONIZED, Transfer.NONE)
     ] * 2
     assert robot.out.reports == []  # holding a skill is no status change to report
@@ -306,12 +306,12 @@ def test_a_duplicate_command_gets_the_same_answer_and_runs_once(robot: Robot) ->
     again = robot.engine.handle_command(Command(1, K.UPLOAD, skills=(make_skill("c"),)))
     assert again == first
     assert robot.ids() == ["a", "b"]
-    assert robot.engine.last_command_seq == 2
+    assert robot.engine.commands.last_seq == 2
 
 
 def test_an_early_command_waits_for_the_missing_one(robot: Robot) -> None:
     assert robot.engine.handle_command(Command(2, K.START)) is None
-    assert robot.engine.mode is Mode.STOPPED and robot.engine.last_command_seq == 0
+    assert robot.engine.mode is Mode.STOPPED and robot.engine.commands.last_seq == 0
     assert robot.engine.handle_command(Command(1, K.UPLOAD, skills=(make_skill("a"),))) is not None
     assert robot.engine.handle_command(Command(2, K.START)) is not None
     assert robot.status("a") is S.RUNNING
@@ -320,7 +320,7 @@ def test_an_early_command_waits_for_the_missing_one(robot: Robot) -> None:
 def test_a_duplicate_older_than_the_kept_answers_is_answered_plainly(robot: Robot) -> None:
     for seq in range(1, KEPT_ACKS + 3):
         robot.engine.handle_command(Command(seq, K.PAUSE))
-    assert len(robot.engine.acks) == KEPT_ACKS
+    assert len(robot.engine.commands.acks) == KEPT_ACKS
     ack = robot.engine.handle_command(Command(1, K.PAUSE))
     assert ack is not None and ack.seq == 1 and ack.error == "already executed"
 
@@ -364,7 +364,7 @@ def test_start_runs_the_queue_in_order_with_numbered_reports(robot: Robot) -> No
         (3, "b", S.RUNNING),
         (4, "b", S.SUCCESS),
     ]
-    assert robot.engine.unacked == robot.out.reports
+    assert robot.engine.ledger.unacked == robot.out.reports
     assert robot.engine.state_name() == "idle"
 
 
@@ -373,9 +373,9 @@ def test_acknowledged_reports_are_forgotten(robot: Robot) -> None:
     robot.send(K.START)
     robot.run_for(1.0)
     robot.engine.report_acknowledged(1)
-    assert [r.seq for r in robot.engine.unacked] == [2]
+    assert [r.seq for r in robot.engine.ledger.unacked] == [2]
     robot.engine.report_acknowledged(5)
-    assert robot.engine.unacked == []
+    assert robot.engine.ledger.unacked == []
 
 
 def test_an_upload_to_a_started_idle_robot_runs_at_once(robot: Robot) -> None:
@@ -1093,7 +1093,7 @@ def test_report_acks_keep_the_link_alive(robot: Robot) -> None:
     robot.send(K.START)
     for _ in range(10):
         robot.run_for(1.0)
-        robot.engine.report_acknowledged(robot.engine.last_report_seq)
+        robot.engine.report_acknowledged(robot.engine.ledger.last_report_seq)
     assert robot.status("a") is S.RUNNING
 
 
@@ -1161,7 +1161,7 @@ def restart(robot: Robot, path: Path, agent: str = "r1") -> tuple[Robot, list[st
     save_state(robot.engine, path)
     fresh = Robot(agent, robot.clock)
     interrupted = load_state(fresh.engine, path)
-    fresh.seq = fresh.engine.last_command_seq
+    fresh.seq = fresh.engine.commands.last_seq
     return fresh, interrupted
 
 
@@ -1184,16 +1184,17 @@ def test_state_round_trip_keeps_queue_reports_answers_barriers_and_policy(
     fresh, interrupted = restart(robot, path)
     engine = fresh.engine
     assert interrupted == ["g"]
-    assert [s.id for s in engine.queue] == ["p", "g", "c"]
-    assert engine.queue[0] == robot.engine.queue[0]  # status, resolution, texts, stamps
-    assert engine.queue[1].params["target"] == Pose(1.0, 2.0, 0.5, yaw=1.5)
-    assert engine.queue[1].timeout == 9.0 and engine.queue[2].max_retries == 3
-    assert engine.queue[2] == robot.engine.queue[2]
+    assert [s.id for s in engine.ledger.queue] == ["p", "g", "c"]
+    # status, resolution, texts, stamps
+    assert engine.ledger.queue[0] == robot.engine.ledger.queue[0]
+    assert engine.ledger.queue[1].params["target"] == Pose(1.0, 2.0, 0.5, yaw=1.5)
+    assert engine.ledger.queue[1].timeout == 9.0 and engine.ledger.queue[2].max_retries == 3
+    assert engine.ledger.queue[2] == robot.engine.ledger.queue[2]
     assert engine.lost_link.policy == robot.engine.lost_link.policy
     assert engine.board.barriers == robot.engine.board.barriers
     assert engine.board.may_start(barrier_of(("c", "r1"), ("y", "r2")), 0.0)  # RELEASED kept
-    assert engine.last_command_seq == robot.engine.last_command_seq
-    assert engine.acks == robot.engine.acks
+    assert engine.commands.last_seq == robot.engine.commands.last_seq
+    assert engine.commands.acks == robot.engine.commands.acks
     assert engine.mode is Mode.STOPPED  # a restarted robot waits for the operator
 
 
@@ -1212,7 +1213,7 @@ def test_the_interrupted_skill_returns_to_idle_synchronized(robot: Robot, tmp_pa
     )
     assert fresh.status("a") is S.SUCCESS
     # The unacknowledged reports survive, and numbering goes on after them.
-    assert [r.seq for r in fresh.engine.unacked] == [1, 2, 3, 4]
+    assert [r.seq for r in fresh.engine.ledger.unacked] == [1, 2, 3, 4]
     assert fresh.out.reports[-1].seq == 4 and fresh.out.reports[-1].skill_id == "b"
     assert fresh.engine.state_name() == "stopped"
     fresh.send(K.START)
@@ -1301,7 +1302,7 @@ def test_peer_readiness_is_not_restored_after_a_restart(tmp_path: Path) -> None:
     team.deliver()
     fresh = Robot("r1", team.clock)
     load_state(fresh.engine, tmp_path / "r1.json")
-    fresh.seq = fresh.engine.last_command_seq
+    fresh.seq = fresh.engine.commands.last_seq
     team.robots["r1"] = fresh
     team._delivered["r1"] = 0
     fresh.send(K.START)

@@ -18,6 +18,7 @@ from rosmc_server.core.protocol import Ack, AckResult, BarrierInfo, Command
 
 from . import queueing
 from .barriers import BarrierBoard
+from .ledger import SkillLedger
 from .lost_link import LostLinkGuard, pose_parameter
 from .skills import SkillType
 
@@ -25,7 +26,9 @@ from .skills import SkillType
 class CommandTarget(Protocol):
     """What the ground's commands change on a robot: the engine's public surface."""
 
-    queue: list[SkillInstance]
+    @property
+    def ledger(self) -> SkillLedger:
+        """The robot's skills in order (and its reports)."""
 
     @property
     def agent(self) -> str:
@@ -95,8 +98,8 @@ def ack(engine: CommandTarget, seq: int, **fields: object) -> Ack:
 
 
 def _upload(engine: CommandTarget, cmd: Command) -> Ack:
-    answer = queueing.upload(engine.queue, cmd.skills, functools.partial(why_not, engine))
-    engine.queue = answer.queue
+    answer = queueing.upload(engine.ledger.queue, cmd.skills, functools.partial(why_not, engine))
+    engine.ledger.queue = answer.queue
     engine.board.replace(cmd.barriers)
     engine.advance()
     return _answer(engine, cmd.seq, answer, error=next(iter(answer.reasons), ""))
@@ -124,14 +127,14 @@ def why_not(engine: CommandTarget, skill: SkillInstance) -> str:
 
 
 def _unsync(engine: CommandTarget, cmd: Command) -> Ack:
-    answer = queueing.unsync(engine.queue, cmd.skill_ids, engine.active_skill_id)
-    engine.queue = answer.queue
+    answer = queueing.unsync(engine.ledger.queue, cmd.skill_ids, engine.active_skill_id)
+    engine.ledger.queue = answer.queue
     return _answer(engine, cmd.seq, answer)
 
 
 def _start(engine: CommandTarget, cmd: Command) -> Ack:
     engine.start()
-    holding = queueing.holding(engine.queue)
+    holding = queueing.holding(engine.ledger.queue)
     note = f"holding after the failure of '{holding.id}': retry or skip it" if holding else ""
     return ack(engine, cmd.seq, error=note)
 
@@ -149,7 +152,7 @@ def _stop(engine: CommandTarget, cmd: Command) -> Ack:
 def _retry(engine: CommandTarget, cmd: Command) -> Ack:
     if not cmd.skill_ids or not cmd.skills:
         return ack(engine, cmd.seq, error="a retry names the failed skill and its new instance")
-    answer = queueing.retry(engine.queue, cmd.skill_ids[0], cmd.skills[0])
+    answer = queueing.retry(engine.ledger.queue, cmd.skill_ids[0], cmd.skills[0])
     if answer.accepted:
         engine.board.member_retried(cmd.skill_ids[0], cmd.skills[0].id)
     return _queue_changed(engine, cmd.seq, answer)
@@ -158,11 +161,11 @@ def _retry(engine: CommandTarget, cmd: Command) -> Ack:
 def _skip(engine: CommandTarget, cmd: Command) -> Ack:
     if not cmd.skill_ids:
         return ack(engine, cmd.seq, error="a skip names the failed skill")
-    return _queue_changed(engine, cmd.seq, queueing.skip(engine.queue, cmd.skill_ids[0]))
+    return _queue_changed(engine, cmd.seq, queueing.skip(engine.ledger.queue, cmd.skill_ids[0]))
 
 
 def _queue_changed(engine: CommandTarget, seq: int, answer: queueing.Answer) -> Ack:
-    engine.queue = answer.queue
+    engine.ledger.queue = answer.queue
     engine.advance()
     return _answer(engine, seq, answer, error=next(iter(answer.reasons), ""))
 
@@ -201,5 +204,5 @@ def _sync_state(engine: CommandTarget, cmd: Command) -> Ack:
     return _queue_changed(
         engine,
         cmd.seq,
-        queueing.adopt(engine.queue, cmd.skills, functools.partial(why_not, engine)),
+        queueing.adopt(engine.ledger.queue, cmd.skills, functools.partial(why_not, engine)),
     )

@@ -3,7 +3,7 @@
 It reacts to numbered ground commands (executing each once, answering
 duplicates with the stored answer), to peers' barrier signals, and to time
 (:meth:`Engine.tick`: skill progress, timeouts, retries, lost-link policy).
-Every status change becomes a numbered :class:`Report` kept until the ground
+Every status change becomes a numbered report (:mod:`.ledger`) kept until the ground
 acknowledges it, so an outage delays reports but never loses or reorders them.
 The engine is single-threaded; the ROS adapter serializes calls with a lock.
 Skills may report progress from threads of their own: that is queued and
@@ -13,20 +13,18 @@ applied by the next :meth:`Engine.tick`.
 from __future__ import annotations
 
 import logging
-from collections import OrderedDict, deque
+from collections import deque
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Protocol
 
-from rosmc_server.core import SkillInstance, SkillStatus
+from rosmc_server.core import SkillStatus
 from rosmc_server.core.control import ExecutorState
-from rosmc_server.core.link import queue_hash, status_digest
 from rosmc_server.core.protocol import (
     Ack,
     BarrierInfo,
     Command,
     Mode,
-    Report,
     Signal,
     SignalKind,
     Snapshot,
@@ -35,26 +33,24 @@ from rosmc_server.core.protocol import (
 from . import commanding, queueing
 from .barrier_wait import ANNOUNCE_PERIOD, Announcements, BarrierWaits
 from .barriers import BarrierBoard
+from .ledger import KEPT_ACKS, CommandLog, ReportOutputs, SkillLedger
 from .lost_link import LostLinkGuard, PoseSource, no_pose
 from .skills import Outcome, SkillBehavior, SkillContext, SkillType
 
 _log = logging.getLogger(__name__)
 S = SkillStatus
-KEPT_ACKS = 256
 __all__ = ["ANNOUNCE_PERIOD", "KEPT_ACKS", "Engine", "EngineOutputs", "Mode"]
 
 
-class EngineOutputs(Protocol):
-    """Where the engine's messages go (the ROS adapter publishes them)."""
+class EngineOutputs(ReportOutputs, Protocol):
+    """Where the engine's messages go (the ROS adapter publishes them).
 
-    def report(self, report: Report) -> None:
-        """A new status report (also kept in ``Engine.unacked`` until acknowledged)."""
+    Status reports (also kept in ``Engine.ledger.unacked`` until acknowledged) and state
+    changes to persist, as :class:`~.ledger.ReportOutputs`; and barrier signals.
+    """
 
     def signal(self, signal: Signal) -> None:
         """A barrier signal for the peers."""
-
-    def changed(self) -> None:
-        """The engine's state changed and should be persisted."""
 
 
 @dataclass
@@ -91,12 +87,9 @@ class Engine:
         self.skill_types = dict(skill_types)
         self.clock = clock
         self.outputs = outputs
-        self.queue: list[SkillInstance] = []
+        self.ledger = SkillLedger(clock, outputs)
         self.mode = Mode.STOPPED
-        self.last_command_seq = 0
-        self.last_report_seq = 0
-        self.unacked: list[Report] = []
-        self.acks: OrderedDict[int, Ack] = OrderedDict()
+        self.commands = CommandLog()
         self.board = BarrierBoard(agent)
         self.waits = BarrierWaits(agent, self.board, clock, outputs.signal)
         self.lost_link = LostLinkGuard(agent, clock, self.skill_types, pose_source)
@@ -119,16 +112,10 @@ class Engine:
 
     def _numbered(self, seq: int, answer: Callable[[], Ack]) -> Ack | None:
         self.ground_contact()
-        if seq <= self.last_command_seq:
-            return self.acks.get(seq) or self._ack(seq, error="already executed")
-        if seq != self.last_command_seq + 1:
-            return None  # an earlier command is missing; the ground resends in order
-        ack = answer()
-        self.last_command_seq = seq
-        self.acks[seq] = ack
-        while len(self.acks) > KEPT_ACKS:
-            self.acks.popitem(last=False)
-        self.outputs.changed()
+        done = self.commands.last_seq
+        ack = self.commands.answer(seq, answer, lambda: self._ack(seq, error="already executed"))
+        if self.commands.last_seq != done:
+            self.outputs.changed()  # a command ran
         return ack
 
     def _execute(self, cmd: Command) -> Ack:
@@ -148,9 +135,7 @@ class Engine:
     def report_acknowledged(self, seq: int) -> None:
         """The ground has every report up to ``seq``."""
         self.ground_contact()
-        before = len(self.unacked)
-        self.unacked = [r for r in self.unacked if r.seq > seq]
-        if len(self.unacked) != before:
+        if self.ledger.acknowledged(seq):
             self.outputs.changed()
 
     def ground_contact(self) -> None:
@@ -174,9 +159,9 @@ class Engine:
         active = self._active
         if active is None:
             return
-        if active.behavior is not None and self._status(active.skill_id) is S.RUNNING:
+        if active.behavior is not None and self.ledger.status(active.skill_id) is S.RUNNING:
             self._update_running(active, now)
-        elif self._status(active.skill_id) is S.SYNCWAITING:
+        elif self.ledger.status(active.skill_id) is S.SYNCWAITING:
             if active.deadline and now >= active.deadline and self.waits.may_give_up(active.told):
                 self._give_up_waiting(active)
             elif self.waits.reannounce_due(active.told):
@@ -191,7 +176,7 @@ class Engine:
         self._apply_progress()  # what the skill said before it finished
         if outcome is None and active.deadline and now >= active.deadline:
             active.behavior.cancel()
-            skill = self._find(active.skill_id)
+            skill = self.ledger.find(active.skill_id)
             outcome = Outcome.failed(
                 f"timed out after {skill.timeout:g} s" if skill else "timed out"
             )
@@ -207,7 +192,7 @@ class Engine:
         """
         if self._active is not None or self.lost_link.contingency is not None:
             return False
-        upcoming = queueing.upcoming(self.queue)
+        upcoming = queueing.upcoming(self.ledger.queue)
         return upcoming is None or upcoming.status is S.FAILURE or self.mode is not Mode.STARTED
 
     @property
@@ -219,7 +204,7 @@ class Engine:
         """Execute: a paused skill resumes (or waits at its barrier again), else the next starts."""
         self.mode = Mode.STARTED
         active = self._active
-        if active is not None and self._status(active.skill_id) is S.PAUSED:
+        if active is not None and self.ledger.status(active.skill_id) is S.PAUSED:
             self._resume_active(active)
         self.advance()
 
@@ -236,15 +221,15 @@ class Engine:
         if active is None or active.behavior is not None or active.barrier is None:
             return
         active.barrier = self.board.barrier_of(active.skill_id)
-        if active.barrier is not None and self._status(active.skill_id) is S.SYNCWAITING:
-            self._set(active.skill_id, S.SYNCWAITING, text=self._waiting_text(active.barrier))
+        if active.barrier is not None and self.ledger.status(active.skill_id) is S.SYNCWAITING:
+            self.ledger.set(active.skill_id, S.SYNCWAITING, text=self.waits.text(active.barrier))
         self._try_release(active)
 
     def advance(self) -> None:
         """Start the next skill if the robot may execute and nothing is active."""
         if self.mode is not Mode.STARTED or self._active is not None or self.lost_link.contingency:
             return
-        upcoming = queueing.upcoming(self.queue)
+        upcoming = queueing.upcoming(self.ledger.queue)
         if upcoming is None or upcoming.status is S.FAILURE:
             return  # finished, or holding after a failure
         active = _Active(upcoming.id, barrier=self.board.barrier_of(upcoming.id))
@@ -254,7 +239,7 @@ class Engine:
             return
         if upcoming.timeout > 0:  # the timeout bounds the wait too: partners may never come
             active.deadline = self.clock() + upcoming.timeout
-        self._set(upcoming.id, S.SYNCWAITING, text=self._waiting_text(active.barrier))
+        self.ledger.set(upcoming.id, S.SYNCWAITING, text=self.waits.text(active.barrier))
         self._announce_wait(active)
         self._try_release(active)
 
@@ -276,14 +261,11 @@ class Engine:
         until the operator retries (the fresh instance takes this one's place in the
         barrier) or skips (the barrier goes on without it).
         """
-        skill = self._find(active.skill_id)
+        skill = self.ledger.find(active.skill_id)
         assert skill is not None and active.barrier is not None
         text = self.waits.give_up(skill.id, active.barrier, active.told, skill.timeout)
         self._active = None
-        self._set(skill.id, S.FAILURE, text=text, finished=self.clock())
-
-    def _waiting_text(self, barrier: BarrierInfo) -> str:
-        return self.waits.text(barrier)
+        self.ledger.set(skill.id, S.FAILURE, text=text, finished=self.clock())
 
     def _announce_wait(self, active: _Active) -> None:
         if active.barrier is not None:
@@ -294,7 +276,7 @@ class Engine:
             self.waits.announce(active.skill_id, active.barrier, active.told, kind)
 
     def _run(self, active: _Active) -> None:
-        skill = self._find(active.skill_id)
+        skill = self.ledger.find(active.skill_id)
         assert skill is not None
         kind = self.skill_types[skill.skill]
         behavior = kind.create()
@@ -311,18 +293,18 @@ class Engine:
         active.deadline = now + skill.timeout if skill.timeout > 0 else 0.0
         started = now if active.retries_used == 0 else skill.started
         text = f"retry {active.retries_used} of {skill.max_retries}" if active.retries_used else ""
-        self._set(skill.id, S.RUNNING, text=text, started=started, attempt=ctx.attempt)
+        self.ledger.set(skill.id, S.RUNNING, text=text, started=started, attempt=ctx.attempt)
         try:
             behavior.start(ctx)
         except Exception as error:  # a skill that cannot start fails cleanly
             self._finish(active, Outcome.failed(f"could not start: {error}"))
 
     def _finish(self, active: _Active, outcome: Outcome) -> None:
-        skill = self._find(active.skill_id)
+        skill = self.ledger.find(active.skill_id)
         assert skill is not None
         if outcome.success:
             self._active = None
-            self._set(skill.id, S.SUCCESS, text=outcome.reason, finished=self.clock())
+            self.ledger.set(skill.id, S.SUCCESS, text=outcome.reason, finished=self.clock())
             self.advance()
             return
         if active.retries_used < skill.max_retries:
@@ -331,19 +313,19 @@ class Engine:
             self._run(active)
             return
         self._active = None
-        self._set(skill.id, S.FAILURE, text=outcome.reason, finished=self.clock())
+        self.ledger.set(skill.id, S.FAILURE, text=outcome.reason, finished=self.clock())
 
     def _apply_progress(self) -> None:
         while self._progress_box:
             self._progress(*self._progress_box.popleft())
 
     def _progress(self, skill_id: str, text: str) -> None:
-        skill = self._find(skill_id)
+        skill = self.ledger.find(skill_id)
         active = self._active
         if skill is None or active is None or active.skill_id != skill_id:
             return
         if skill.status is S.RUNNING and text != skill.status_text:
-            self._set(skill_id, S.RUNNING, text=text)
+            self.ledger.set(skill_id, S.RUNNING, text=text)
 
     def pause(self, why: str) -> None:
         """Hold the robot: the active skill pauses (or leaves its barrier wait)."""
@@ -351,7 +333,7 @@ class Engine:
         active = self._active
         if active is None:
             return
-        status = self._status(active.skill_id)
+        status = self.ledger.status(active.skill_id)
         if status is S.RUNNING and active.behavior is not None:
             active.behavior.pause()
         elif status is S.SYNCWAITING:
@@ -360,18 +342,19 @@ class Engine:
             return
         active.paused_at = self.clock()
         active.paused_from = status
-        self._set(active.skill_id, S.PAUSED, text=why)
+        self.ledger.set(active.skill_id, S.PAUSED, text=why)
 
     def _resume_active(self, active: _Active) -> None:
         if active.deadline:  # time spent paused counts against no timeout, running or waiting
             active.deadline += self.clock() - active.paused_at
         if active.paused_from is S.RUNNING and active.behavior is not None:
             active.behavior.resume()
-            self._set(active.skill_id, S.RUNNING, text="")
+            self.ledger.set(active.skill_id, S.RUNNING, text="")
         else:
             if active.barrier is not None:
                 # Back to waiting at the barrier, not to PAUSED (and not straight to running).
-                self._set(active.skill_id, S.SYNCWAITING, text=self._waiting_text(active.barrier))
+                waiting = self.waits.text(active.barrier)
+                self.ledger.set(active.skill_id, S.SYNCWAITING, text=waiting)
                 self._announce_wait(active)
             self._try_release(active)  # runs it if its barrier went away meanwhile
         active.paused_from = None
@@ -382,74 +365,12 @@ class Engine:
         if active.barrier is not None and active.behavior is None:
             self._announce(active, SignalKind.WITHDRAWN)
         self._active = None
-        self._set(active.skill_id, S.IDLE_SYNCHRONIZED, text=why, started=0.0)
+        self.ledger.set(active.skill_id, S.IDLE_SYNCHRONIZED, text=why, started=0.0)
 
-    # -- state helpers -----------------------------------------------------------------
-    def _find(self, skill_id: str) -> SkillInstance | None:
-        return next((s for s in self.queue if s.id == skill_id), None)
-
-    def _status(self, skill_id: str) -> SkillStatus | None:
-        skill = self._find(skill_id)
-        return None if skill is None else skill.status
-
-    def _replace(self, skill: SkillInstance) -> None:
-        self.queue = [skill if s.id == skill.id else s for s in self.queue]
-
-    def _set(
-        self,
-        skill_id: str,
-        status: SkillStatus,
-        text: str | None = None,
-        started: float | None = None,
-        finished: float | None = None,
-        attempt: int | None = None,
-    ) -> None:
-        """Change a skill's status and emit the report."""
-        old = self._find(skill_id)
-        assert old is not None
-        new = replace(
-            old,
-            status=status,
-            status_text=old.status_text if text is None else text,
-            started=old.started if started is None else started,
-            finished=old.finished if finished is None else finished,
-            attempt=old.attempt if attempt is None else attempt,
-        )
-        if new == old:
-            return
-        self._replace(new)
-        self.last_report_seq += 1
-        report = Report(
-            self.last_report_seq,
-            self.clock(),
-            new.id,
-            new.status,
-            new.attempt,
-            new.status_text,
-            new.started,
-            new.finished,
-        )
-        self.unacked.append(report)
-        self.outputs.report(report)
-        self.outputs.changed()
-
-    def interrupted_by_restart(self) -> list[str]:
-        """After loading a saved state: skills that were active go back to IDLE_SYNCHRONIZED."""
-        interrupted = [s.id for s in self.queue if s.status.is_active]
-        for skill_id in interrupted:
-            self._set(skill_id, S.IDLE_SYNCHRONIZED, text="interrupted by an executor restart",
-                      started=0.0)  # fmt: skip
-            barrier = self.board.barrier_of(skill_id)
-            if barrier is not None:  # peers may still count this robot as ready
-                now = self.clock()
-                self.outputs.signal(
-                    Signal(self.agent, barrier.id, skill_id, SignalKind.WITHDRAWN, now)
-                )
-        return interrupted
-
+    # -- state ------------------------------------------------------------------------
     def queue_hash(self) -> str:
         """Hash of the ids this robot holds, in order (the ground computes the same)."""
-        return queue_hash(s.id for s in self.queue)
+        return self.ledger.queue_hash()
 
     def state_name(self) -> str:
         """A one-word state for operators (an :class:`ExecutorState`'s word)."""
@@ -461,7 +382,7 @@ class Engine:
             return ExecutorState.CONTINGENCY
         if self.mode is not Mode.STARTED:
             return ExecutorState(self.mode.value)
-        if queueing.holding(self.queue):
+        if queueing.holding(self.ledger.queue):
             return ExecutorState.HOLDING
         active = self._active
         if active is None:
@@ -476,14 +397,14 @@ class Engine:
             waiting = self.waits.summary(active.barrier)
         return Snapshot(
             self.clock(),
-            self.last_command_seq,
-            self.last_report_seq,
+            self.commands.last_seq,
+            self.ledger.last_report_seq,
             self.queue_hash(),
-            tuple(self.queue) if full else (),
+            tuple(self.ledger.queue) if full else (),
             self.state_name(),
             active.skill_id if active else "",
             waiting,
             self.lost_link.describe(),
             full,
-            status_digest((s.id, int(s.status)) for s in self.queue),
+            self.ledger.status_digest(),
         )

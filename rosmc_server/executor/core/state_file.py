@@ -22,7 +22,15 @@ from rosmc_server.core import (
     SkillStatus,
     Transfer,
 )
-from rosmc_server.core.protocol import Ack, AckResult, BarrierInfo, Mode, Report
+from rosmc_server.core.protocol import (
+    Ack,
+    AckResult,
+    BarrierInfo,
+    Mode,
+    Report,
+    Signal,
+    SignalKind,
+)
 
 from .engine import Engine
 
@@ -35,11 +43,11 @@ def save_state(engine: Engine, path: Path) -> None:
         "rosmc_executor": STATE_VERSION,
         "agent": engine.agent,
         "mode": engine.mode.value,
-        "last_command_seq": engine.last_command_seq,
-        "last_report_seq": engine.last_report_seq,
-        "queue": [_skill_out(s) for s in engine.queue],
-        "unacked": [_report_out(r) for r in engine.unacked],
-        "acks": [_ack_out(a) for a in engine.acks.values()],
+        "last_command_seq": engine.commands.last_seq,
+        "last_report_seq": engine.ledger.last_report_seq,
+        "queue": [_skill_out(s) for s in engine.ledger.queue],
+        "unacked": [_report_out(r) for r in engine.ledger.unacked],
+        "acks": [_ack_out(a) for a in engine.commands.acks.values()],
         "barriers": [
             {"id": b.id, "members": [list(m) for m in b.members]}
             for b in engine.board.barriers.values()
@@ -68,12 +76,12 @@ def load_state(engine: Engine, path: Path) -> list[str]:
         raise ValueError(f"{path}: not an executor state file of version {STATE_VERSION}")
     if data.get("agent") != engine.agent:
         raise ValueError(f"{path}: holds the state of {data.get('agent')!r}, not {engine.agent!r}")
-    engine.queue = [_skill_in(s, engine.agent) for s in data["queue"]]
-    engine.last_command_seq = int(data["last_command_seq"])
-    engine.last_report_seq = int(data["last_report_seq"])
-    engine.unacked = [_report_in(r) for r in data["unacked"]]
+    engine.ledger.queue = [_skill_in(s, engine.agent) for s in data["queue"]]
+    engine.commands.last_seq = int(data["last_command_seq"])
+    engine.ledger.last_report_seq = int(data["last_report_seq"])
+    engine.ledger.unacked = [_report_in(r) for r in data["unacked"]]
     for ack in data["acks"]:
-        engine.acks[int(ack["seq"])] = _ack_in(ack)
+        engine.commands.acks[int(ack["seq"])] = _ack_in(ack)
     engine.board.replace(
         tuple(
             BarrierInfo(b["id"], tuple((str(m[0]), str(m[1])) for m in b["members"]))
@@ -92,7 +100,23 @@ def load_state(engine: Engine, path: Path) -> list[str]:
     engine.lost_link.is_default = data.get("policy_default") is True
     mode = Mode(data["mode"])
     engine.mode = Mode.STOPPED if mode is Mode.STARTED else mode
-    return engine.interrupted_by_restart()
+    return _interrupted_by_restart(engine)
+
+
+WITHDRAWN = SignalKind.WITHDRAWN
+
+
+def _interrupted_by_restart(engine: Engine) -> list[str]:
+    """Skills that were active go back to IDLE_SYNCHRONIZED; their barrier partners are told."""
+    interrupted = [s.id for s in engine.ledger.queue if s.status.is_active]
+    for skill_id in interrupted:
+        why = "interrupted by an executor restart"
+        engine.ledger.set(skill_id, SkillStatus.IDLE_SYNCHRONIZED, text=why, started=0.0)
+        barrier = engine.board.barrier_of(skill_id)
+        if barrier is not None:  # peers may still count this robot as ready
+            now = engine.clock()
+            engine.outputs.signal(Signal(engine.agent, barrier.id, skill_id, WITHDRAWN, now))
+    return interrupted
 
 
 def _skill_out(skill: SkillInstance) -> dict[str, Any]:

@@ -138,7 +138,7 @@ class ExecutorNode:
                 _log.info(
                     "%s: restored %d queued skills from %s (interrupted: %s)",
                     agent,
-                    len(self.engine.queue),
+                    len(self.engine.ledger.queue),
                     state_file,
                     ", ".join(interrupted) or "none",
                 )
@@ -262,7 +262,7 @@ class ExecutorNode:
                     _log.exception("%s: executor tick failed", self.agent)
                 if now >= next_retry:
                     next_retry = now + report_retry
-                    for report in self.engine.unacked:
+                    for report in self.engine.ledger.unacked:
                         self._report_pub.publish(report_to_msg(self.agent, report))
                 if now >= next_snapshot:
                     snapshot = self._snapshot_msg(now)
