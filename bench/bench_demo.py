@@ -9,6 +9,8 @@ once per real-time factor, 5 and 20 by default, and reports per run:
 * ``achieved_factor``: their ratio;
 * ``process_wall_s``: the whole ``rosmc_demo`` run, with start-up and shutdown;
 * ``score``, ``stones``, ``operator_changes``, ``revision``: the summary's figures;
+* ``journal_bytes``: the size of the mission journal the run wrote (every accepted change
+  and robot report, with the snapshots);
 * ``exit_code``: 0 if the mission completed.
 
 Run from the repository root::
@@ -82,10 +84,12 @@ def run_demo(factor: float, timeout: float) -> dict[str, Any]:
             text = output.decode(errors="replace") if isinstance(output, bytes) else output
             result = subprocess.CompletedProcess(argv, -9, text, f"killed after {timeout + 120} s")
         wall = time.monotonic() - started
+        journal_bytes = sum(f.stat().st_size for f in Path(journal_dir).rglob("*") if f.is_file())
     figures: dict[str, Any] = {"real_time_factor": factor, **parse_summary(result.stdout)}
     sim, mission_wall = figures["mission_sim_s"], figures["mission_wall_s"]
     figures["achieved_factor"] = round(sim / mission_wall, 2) if sim and mission_wall else None
     figures["process_wall_s"] = round(wall, 1)
+    figures["journal_bytes"] = journal_bytes
     figures["exit_code"] = result.returncode
     if result.returncode != 0:
         figures["output_tail"] = (result.stdout + result.stderr)[-2000:]

@@ -41,6 +41,7 @@ from rosmc_server.executor.core import (
     SkillType,
 )
 from rosmc_server.executor.core.engine import ANNOUNCE_PERIOD, KEPT_ACKS, Mode
+from rosmc_server.executor.core.progress import PROGRESS_PERIOD
 from rosmc_server.executor.core.state_file import load_state, save_state
 
 S = SkillStatus
@@ -396,6 +397,17 @@ def test_progress_is_reported_as_running_text(robot: Robot) -> None:
         (S.RUNNING, "step 2 of 2"),
         (S.SUCCESS, ""),
     ]
+
+
+def test_progress_said_on_every_step_reaches_the_ground_once_a_period(robot: Robot) -> None:
+    """Each text is a report over the radio: a chatty skill is paced, its last text kept."""
+    robot.upload(make_skill("c", "count", params={"steps": 50, "period": 0.1}))
+    robot.send(K.START)
+    robot.run_for(6.0)
+    texts = [r.status_text for r in robot.out.reports if r.status is S.RUNNING and r.status_text]
+    assert 5 <= len(texts) <= 1 + 5.0 / PROGRESS_PERIOD, texts
+    assert texts[0] == "step 1 of 50" and texts[-1] == "step 50 of 50"
+    assert robot.status("c") is S.SUCCESS
 
 
 def test_progress_from_a_skill_thread_waits_for_the_next_tick(robot: Robot) -> None:

@@ -12,8 +12,8 @@ applied by the next :meth:`Engine.tick`.
 
 from __future__ import annotations
 
+import functools
 import logging
-from collections import deque
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Protocol
@@ -35,6 +35,7 @@ from .barrier_wait import ANNOUNCE_PERIOD, Announcements, BarrierWaits
 from .barriers import BarrierBoard
 from .ledger import KEPT_ACKS, CommandLog, ReportOutputs, SkillLedger
 from .lost_link import LostLinkGuard, PoseSource, no_pose
+from .progress import ProgressBox
 from .skills import Outcome, SkillBehavior, SkillContext, SkillType
 
 _log = logging.getLogger(__name__)
@@ -82,6 +83,7 @@ class Engine:
         clock: Callable[[], float],
         outputs: EngineOutputs,
         pose_source: PoseSource = no_pose,
+        pace_clock: Callable[[], float] | None = None,
     ) -> None:
         self.agent = agent
         self.skill_types = dict(skill_types)
@@ -94,8 +96,8 @@ class Engine:
         self.waits = BarrierWaits(agent, self.board, clock, outputs.signal)
         self.lost_link = LostLinkGuard(agent, clock, self.skill_types, pose_source)
         self._active: _Active | None = None
-        # Progress texts from skill threads, applied by tick() (deque appends are atomic).
-        self._progress_box: deque[tuple[str, str]] = deque()
+        # Progress texts from skill threads, applied by tick() at most once a period.
+        self._progress_box = ProgressBox(pace_clock or clock)
 
     # -- ground commands -----------------------------------------------------------
     def handle_command(self, cmd: Command) -> Ack | None:
@@ -173,7 +175,8 @@ class Engine:
             outcome = active.behavior.update(now)
         except Exception as error:  # a broken skill implementation fails the skill
             outcome = Outcome.failed(f"skill crashed: {type(error).__name__}: {error}")
-        self._apply_progress()  # what the skill said before it finished
+        if outcome is not None:
+            self._apply_progress(flush=True)  # what the skill said before it finished
         if outcome is None and active.deadline and now >= active.deadline:
             active.behavior.cancel()
             skill = self.ledger.find(active.skill_id)
@@ -287,7 +290,7 @@ class Engine:
             skill.params,
             skill.attempt + (1 if active.retries_used else 0),  # one more than the last run
             self.clock,
-            lambda text: self._progress_box.append((skill.id, text)),
+            functools.partial(self._progress_box.put, skill.id),
         )
         active.behavior = behavior
         active.deadline = now + skill.timeout if skill.timeout > 0 else 0.0
@@ -315,9 +318,10 @@ class Engine:
         self._active = None
         self.ledger.set(skill.id, S.FAILURE, text=outcome.reason, finished=self.clock())
 
-    def _apply_progress(self) -> None:
-        while self._progress_box:
-            self._progress(*self._progress_box.popleft())
+    def _apply_progress(self, flush: bool = False) -> None:
+        taken = self._progress_box.take(flush)
+        if taken is not None:
+            self._progress(*taken)
 
     def _progress(self, skill_id: str, text: str) -> None:
         skill = self.ledger.find(skill_id)

@@ -128,7 +128,9 @@ class ExecutorNode:
         self._barrier_pub = rospy.Publisher(
             interface.BARRIER_TOPIC, wire.BarrierSignal, queue_size=100
         )
-        self.engine = Engine(agent, skill_types, rospy.get_time, self, pose_source)
+        self.engine = Engine(
+            agent, skill_types, rospy.get_time, self, pose_source, pace_clock=time.monotonic
+        )
         if state_file is not None and state_file.exists():
             try:
                 interrupted = load_state(self.engine, state_file)
