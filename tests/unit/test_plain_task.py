@@ -132,7 +132,8 @@ def test_any_digested_lines_read_as_yaml_reads_them(items: list[dict[str, Any]])
     ],
 )
 def test_lines_whose_parameters_are_not_one_mapping_read_as_yaml_does(line: str) -> None:
-    text = digested([line, '{"id": "b", "skill": "wait", "label": "m", "params": {}, "status": "IDLE"}'])
+    other = '{"id": "b", "skill": "wait", "label": "m", "params": {}, "status": "IDLE"}'
+    text = digested([line, other])
     data = read_document(text, "x", plain_tasks=True)
     assert expanded(data) == yaml.load(text, Loader=yaml.CSafeLoader)
 
