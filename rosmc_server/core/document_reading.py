@@ -29,11 +29,21 @@ import yaml
 from .documents import read_yaml
 from .errors import MissionFileError
 from .mission_text import JSON_ENCODER, digest_line, yaml_reads_alike
+from .plain_skills import PlainTask
 
 # Consecutive entries of a block sequence at one indentation, each a one-line flow mapping.
 _FLOW_RUN = re.compile(r"^( *)- \{.*\}$(?:\n\1- \{.*\}$)*", re.MULTILINE)
 # The digest a document ends with (see mission_text.digest_line).
 _DIGEST = re.compile(r"^# sha256 of the text above: [0-9a-f]{64}\n\Z", re.MULTILINE)
+# A flow line of a skill in the plain form (plain_skills.PLAIN_FORM) whose strings hold no
+# escape (nor a control character, which JSON refuses): each string is its text, and the
+# parameters are the text between their key and the status (scanned apart).
+_TEXT = r'"([^"\\\x00-\x1f]*)"'
+_PLAIN_LINE = re.compile(
+    rf'^ *- \{{"id": {_TEXT}, "skill": {_TEXT}, "label": {_TEXT}, "params": (\{{.*\}}), '
+    rf'"status": {_TEXT}\}}$',
+    re.MULTILINE,
+)
 
 
 def _refuse_constant(name: str) -> None:
@@ -53,6 +63,7 @@ class _Run:
     end: int
     indent: str
     items: list[dict[str, Any]] = field(default_factory=list)
+    plain: PlainTask | None = None  # the entries as text (then ``items`` is empty)
 
     def lines(self, text: str) -> list[str]:
         """Each line of the run in ``text`` without its indentation and ``- ``."""
@@ -60,7 +71,7 @@ class _Run:
         return [line[skip:] for line in text[self.start : self.end].split("\n")]
 
 
-def read_document(text: str, source: str) -> Any:
+def read_document(text: str, source: str, *, plain_tasks: bool = False) -> Any:
     """Parse a mission document as YAML does, reading flow-line entries with ``json``.
 
     Each run of consecutive flow lines (at one indentation) that is exactly what
@@ -69,12 +80,16 @@ def read_document(text: str, source: str) -> Any:
     by its run's entries. If a placeholder is missing or stands where no list item could,
     the whole text is parsed as YAML instead.
 
+    With ``plain_tasks``, a task (``tasks.<agent>``) of a document as its writer wrote it
+    whose entries are all one run of lines in the plain form comes as a
+    :class:`~.plain_skills.PlainTask` (its fields as text) instead of a list of mappings.
+
     Raises:
         yaml.YAMLError: What :func:`~.documents.load_yaml` raises for the text.
         MissionFileError: YAML aliases expand the document beyond reason.
     """
     as_written = _digest_matches(text)  # first: its copies of the text go before the entries come
-    runs = _checked_runs(text)
+    runs = _checked_runs(text, plain_tasks and as_written)
     if not as_written:
         runs = [run for run in runs if _written_alike(run.lines(text), run.items)]
     if runs:
@@ -93,11 +108,16 @@ def _digest_matches(text: str) -> bool:
     return digest is not None and digest_line(text[: digest.start()]) == digest.group()
 
 
-def _checked_runs(text: str) -> list[_Run]:
-    """The runs of lines that each hold one JSON mapping, read line by line."""
+def _checked_runs(text: str, plain: bool) -> list[_Run]:
+    """The runs of lines that each hold one JSON mapping, read line by line (with
+    ``plain``, a run of skills in the plain form is read as text, see :func:`_plain_task`)."""
     runs: list[_Run] = []
     for match in _FLOW_RUN.finditer(text):
         run = _Run(match.start(), match.end(), match.group(1))
+        run.plain = _plain_task(text, run) if plain else None
+        if run.plain is not None:
+            runs.append(run)
+            continue
         items = _read_lines(text, run)
         if items is not None:
             run.items = items
@@ -132,6 +152,28 @@ def _read_lines(text: str, run: _Run) -> list[dict[str, Any]] | None:
     except (StopIteration, ValueError, RecursionError):
         return None
     return items
+
+
+def _plain_task(text: str, run: _Run) -> PlainTask | None:
+    """The entries of ``run`` as text if each line is a skill in the plain form, else None.
+
+    Each parameters text (each distinct one once) must be exactly one JSON mapping; the
+    line is then exactly the mapping of its fields (JSON reads a value alone as it reads
+    it inside the line), so no line is read whole.
+    """
+    rows = _PLAIN_LINE.findall(text, run.start, run.end)
+    if len(rows) != text.count("\n", run.start, run.end) + 1:
+        return None
+    params: dict[str, Any] = {}
+    try:
+        for params_text in {row[3] for row in rows}:
+            value, end = _SCAN(params_text, 0)
+            if end != len(params_text) or type(value) is not dict:
+                return None
+            params[params_text] = value
+    except (StopIteration, ValueError, RecursionError):
+        return None
+    return PlainTask(rows, params)
 
 
 def _line_by_line(start: int, indent: str, lines: list[str]) -> list[_Run]:
@@ -194,7 +236,31 @@ def _read_around(text: str, source: str, runs: list[_Run]) -> Any:
         return None
     if shared:
         refuse_alias_bombs(data, len(text), source, weights)
-    return data if _put_back(data, f"{token}:", [run.items for run in runs]) else None
+    found = _place_plain_tasks(data, f"{token}:", runs)
+    entries = [  # a plain run placed needs none; one that is not is put back as mappings
+        run.plain.entries() if run.plain is not None and n not in found else run.items
+        for n, run in enumerate(runs)
+    ]
+    return data if _put_back(data, f"{token}:", entries, found) else None
+
+
+def _place_plain_tasks(data: Any, prefix: str, runs: list[_Run]) -> set[int]:
+    """Put each plain run that is a whole task where the task stands; the numbers placed."""
+    tasks = data.get("tasks") if isinstance(data, dict) else None
+    placed: set[int] = set()
+    if not isinstance(tasks, dict):
+        return placed
+    for agent, entries in tasks.items():
+        if type(entries) is not list or len(entries) != 1 or not isinstance(entries[0], str):
+            continue
+        number = entries[0].removeprefix(prefix)
+        if number == entries[0] or not number.isdigit() or int(number) >= len(runs):
+            continue
+        plain = runs[int(number)].plain
+        if plain is not None and int(number) not in placed:  # an aliased task: put back
+            tasks[agent] = plain
+            placed.add(int(number))
+    return placed
 
 
 def refuse_alias_bombs(
@@ -224,12 +290,12 @@ def refuse_alias_bombs(
             pending.extend(item)
 
 
-def _put_back(data: Any, prefix: str, runs: list[list[dict[str, Any]]]) -> bool:
-    """Replace each placeholder item of a list by its run; whether each was found once.
+def _put_back(data: Any, prefix: str, runs: list[list[dict[str, Any]]], found: set[int]) -> bool:
+    """Replace each placeholder item of a list by its run; whether each was found once
+    (those in ``found`` were placed before).
 
     A placeholder anywhere but as a list item (a key, a mapping value) counts as missing.
     """
-    found: set[int] = set()
     pending, seen = [data], set()
     while pending:
         item = pending.pop()

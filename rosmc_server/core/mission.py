@@ -11,16 +11,16 @@ from __future__ import annotations
 import secrets
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import replace
 
 from . import barriers, editing, execution, markers, team
 from .changes import Change, EventKind, MissionEvent, Proposal, SkillMove
 from .collector import collector_paused
 from .errors import RuleViolation, StaleRevision
 from .library import Library
-from .model import SkillStatus, TaskMarker, Transfer
+from .model import SkillStatus, TaskMarker
 from .params import Pose
 from .reconcile import Reconciliation, RobotSkill, plan_reconcile
+from .replacing import loaded_tasks, require_robots_idle
 from .site_guard import SiteGuard
 from .state import MissionContent, MissionState
 from .undo import UndoHistory
@@ -319,22 +319,7 @@ class Mission:
         """
         self._check_revision(base_revision)
         self._require_robots_idle("load a mission")
-        tasks = {
-            agent: [
-                s
-                if (s.status is SkillStatus.IDLE and s.transfer is Transfer.NONE)
-                or s.status.is_final
-                else replace(
-                    s,
-                    status=SkillStatus.IDLE,
-                    transfer=Transfer.NONE,
-                    status_text="",
-                    started=0.0,
-                )
-                for s in task
-            ]
-            for agent, task in content.tasks.items()
-        }
+        tasks = loaded_tasks(content.tasks)
         loaded = MissionContent(
             content.library, tasks, dict(content.barriers), dict(content.markers)
         )
@@ -405,16 +390,4 @@ class Mission:
         raise RuleViolation("could not find a free id; the id factory keeps repeating itself")
 
     def _require_robots_idle(self, action: str) -> None:
-        held = _HELD_BY_ROBOT
-        for skill in self.state.skills():
-            if skill.status in held or skill.transfer is not Transfer.NONE:
-                raise RuleViolation(
-                    f"cannot {action} while {skill.agent} holds unfinished skill '{skill.id}'; "
-                    "unsynchronize or stop it first"
-                )
-
-
-# What a robot holds: a synchronized skill not finished (waiting, running or paused too).
-_HELD_BY_ROBOT = frozenset({SkillStatus.IDLE_SYNCHRONIZED}) | frozenset(
-    status for status in SkillStatus if status.is_active
-)
+        require_robots_idle(self.state.content().tasks.values(), action)

@@ -77,7 +77,7 @@ def parse_mission(text: str, library: Library, source: str) -> tuple[MissionCont
     """Parse and check a mission document; return its content and revision."""
     check_encodable(text, f"the mission document {source}")
     try:
-        data = read_document(text, source)
+        data = read_document(text, source, plain_tasks=True)
     except DuplicateKeyError as error:
         raise MissionFileError(f"{source}: not valid YAML ({yaml_problem(error)})") from error
     except yaml.constructor.ConstructorError as error:

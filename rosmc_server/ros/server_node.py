@@ -206,7 +206,6 @@ class MissionServer:
         stamp_ns = time.time_ns()
         try:
             self._journal.append_event(msg, stamp_ns)
-            self._marks.record(event.revision)  # the journal's high-water mark, kept apart
             if event.kind is EventKind.MISSION_REPLACED:
                 # The new mission is only in the snapshot: it must be durable now. Its
                 # skills were serialized ahead (prepare_snapshot), off the lock.
@@ -215,6 +214,9 @@ class MissionServer:
                 )
                 self._snapshot = snapshot
                 self._journal.append_snapshot(snapshot, stamp_ns)
+            # The journal's high-water mark, kept apart; a replacement counts only with its
+            # snapshot (a journal ending in the event alone leaves it out on resume).
+            self._marks.record(event.revision)
         except Exception:
             _log.critical("cannot write the journal; shutting down to protect the mission")
             self.failed = self._stopping = True  # a supervisor restarts it: exit status 1
