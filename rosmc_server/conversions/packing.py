@@ -226,6 +226,11 @@ class SnapshotPacker:
         with self._lock:
             self._prepared = prepared
 
+    def forget(self) -> None:
+        """Drop the last snapshot's bytes (the next one serializes every skill afresh)."""
+        with self._lock:
+            self._last = PackedBody(b"", {})
+
     def body(self, content: MissionContent) -> bytes:
         """The wire bytes of a ``rosmc/Mission`` of ``content`` after its revision and stamp."""
         with self._lock:

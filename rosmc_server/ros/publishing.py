@@ -118,17 +118,24 @@ class SnapshotPublisher(rospy.SubscribeListener):  # type: ignore[misc]
                 broadcast = self._urgent or self._broadcast_changes
                 self._dirty_since, self._urgent = None, False
             started = time.monotonic()
-            try:
-                with self._sending:
-                    snapshot = self._build()
-                    if broadcast:
-                        self._publisher.publish(snapshot)
-                if self._on_built is not None:
-                    self._on_built(snapshot)
-            except Exception:  # keep building later snapshots whatever happened
-                _log.exception("could not build or publish the mission snapshot")
+            self._build_and_publish(broadcast)
             self._published = time.monotonic()
             self._cost = self._published - started
+
+    def _build_and_publish(self, broadcast: bool) -> None:
+        """Build the snapshot, publish it if ``broadcast``, hand it to ``on_built``.
+
+        Not kept afterwards (megabytes): the next one is built from the mission.
+        """
+        try:
+            with self._sending:
+                snapshot = self._build()
+                if broadcast:
+                    self._publisher.publish(snapshot)
+            if self._on_built is not None:
+                self._on_built(snapshot)
+        except Exception:  # keep building later snapshots whatever happened
+            _log.exception("could not build or publish the mission snapshot")
 
     def _wait_for_pause(self) -> None:
         """Wait (lock held) until changes pause or the burst is old enough."""
