@@ -268,8 +268,11 @@ class MissionServer:
         """Let the snapshot's bytes go while a load reads its document (megabytes each).
 
         A snapshot asked for before the load ends, or after a load that failed, is then
-        serialized afresh.
+        serialized afresh. Kept while the publisher has one to build (after a change just
+        before, such as the previous load): it would serialize the mission again.
         """
+        if not self._snapshots.idle:
+            return
         with self._building:
             self._snapshot = None
             self._packer.forget()
