@@ -25,6 +25,7 @@ import io
 import os
 import signal
 import sys
+import types
 from collections.abc import Callable
 from pathlib import Path
 from typing import cast
@@ -80,7 +81,36 @@ def _package_path() -> list[str]:
     return list(getattr(rosmc_server, "__path__", []))
 
 
-def run_entry_point(module: str, unused: tuple[str, ...] = ()) -> int:
+def defer_functions(module: str, names: tuple[str, ...]) -> None:
+    """Stand in for ``module`` with its functions ``names``, each importing it when called.
+
+    For a dependency's module that is costly to import and that its importers only take
+    functions from (``from module import name``), rarely calling them: the module is then
+    imported at the first call, not at start. Does nothing if ``module`` is imported already.
+    """
+    if module in sys.modules:
+        return
+    stand_in = types.ModuleType(module, f"Stands in for {module} until it is needed.")
+
+    def real() -> types.ModuleType:
+        if sys.modules.get(module) is stand_in:
+            del sys.modules[module]
+        return importlib.import_module(module)
+
+    for name in names:
+
+        def call(*args: object, _name: str = name, **kwargs: object) -> object:
+            return getattr(real(), _name)(*args, **kwargs)
+
+        setattr(stand_in, name, call)
+    sys.modules[module] = stand_in
+
+
+def run_entry_point(
+    module: str,
+    unused: tuple[str, ...] = (),
+    deferred: dict[str, tuple[str, ...]] | None = None,
+) -> int:
     """Run ``module.main()`` with the project's venv; a missing dependency ends in one sentence.
 
     ``SIGUSR1`` makes the process print every thread's stack (to diagnose a stuck node);
@@ -90,9 +120,13 @@ def run_entry_point(module: str, unused: tuple[str, ...] = ()) -> int:
     broken install and raises as usual. ``unused`` names optional modules that a
     dependency imports when they are installed but this program never needs: they are
     kept out (their import raises ImportError, which such a dependency handles).
+    ``deferred`` maps a dependency's modules to the functions taken from them, imported
+    only when one is called (see :func:`defer_functions`).
     """
     for name in unused:
         sys.modules.setdefault(name, None)  # type: ignore[arg-type]
+    for name, functions in (deferred or {}).items():
+        defer_functions(name, functions)
     # `kill -USR1 <pid>` prints every thread's stack to the node's stderr (its log): what a
     # node that stopped answering is doing, without stopping it.
     with contextlib.suppress(io.UnsupportedOperation, ValueError):  # stderr is no file

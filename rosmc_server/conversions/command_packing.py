@@ -68,9 +68,11 @@ class PackedCommand(wire.RobotCommand):  # type: ignore[misc]
         if cached is not None and _same(cached[0], skills):
             return cached[1]
         names: dict[str, bytes] = {}
-        data = b"".join(
-            [len(skills).to_bytes(4, "little"), *(skill_bytes(s, names) for s in skills)]
-        )
+        out = io.BytesIO()  # each skill's bytes written as made: not all of them, then joined
+        out.write(len(skills).to_bytes(4, "little"))
+        for skill in skills:
+            out.write(skill_bytes(skill, names))
+        data = out.getvalue()
         self._skill_bytes = (list(skills), data)
         return data
 

@@ -20,8 +20,8 @@ import json
 import operator
 import struct
 import threading
+from array import array
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import genpy
@@ -29,6 +29,7 @@ import rosmc.msg as wire
 import rosmc.srv as srv
 
 from ..core import MissionContent, ParamType, Pose, SkillInstance, Value
+from .body_writer import BodyWriter, PackedBody, PackedTask
 from .mission import barrier_to_msg, marker_to_msg, skill_to_msg
 from .values import time_to_msg, value_type
 
@@ -194,116 +195,162 @@ class PackedGetMissionResponse(srv.GetMissionResponse):  # type: ignore[misc]
         buff.write(string_bytes(self.epoch))
 
 
-@dataclass(frozen=True)
-class _PackedTask:
-    """An agent's task as packed: its skills and the bytes of each, in order."""
-
-    skills: list[SkillInstance]
-    parts: list[bytes]
-
-
 class SnapshotPacker:
     """Builds packed mission snapshots, serializing only the skills changed since the last.
 
     Skill instances are frozen and replaced by a new instance on every change, so an
     instance still in the mission has the bytes it had last time: a task that holds the
     very instances of last time is reused whole (checked in C, position by position), and
-    a changed task reuses the bytes of each skill still there. :meth:`prepare` serializes
-    a mission ahead (one about to be loaded, outside the server's lock). Safe to call from
-    several threads at once.
+    a changed task reuses the bytes of each skill still there. Those bytes are kept once,
+    in the last snapshot's body. :meth:`prepare` serializes a mission ahead (one about to
+    be loaded, outside the server's lock): its first snapshot is then the prepared body
+    itself. Safe to call from several threads at once.
     """
 
     def __init__(self) -> None:
-        self._tasks: dict[str, _PackedTask] = {}  # the last snapshot's, by agent
-        self._prepared: dict[str, _PackedTask] = {}  # the last prepare's, by agent
+        self._last = PackedBody(b"", {})  # the last snapshot's
+        self._prepared = PackedBody(b"", {})  # the last prepare's
         self._names: dict[str, bytes] = {}  # agent, skill and parameter names, encoded
         self._lock = threading.Lock()
 
     def prepare(self, content: MissionContent) -> None:
-        """Serialize the skills of ``content`` now, so that the next snapshot holding them
-        is quick.
+        """Serialize ``content`` now, so that the next snapshot holding its skills is quick.
 
-        Kept until the next call (a snapshot built meanwhile of the old mission does not
-        drop them).
+        Kept until a snapshot takes it over (a snapshot built meanwhile of the old mission
+        does not drop it) or the next call.
         """
-        names: dict[str, bytes] = self._names
-        shared: dict[int, tuple[Any, Any, bytes]] = {}  # alike parameters written once
-        ready = {
-            agent: _PackedTask(list(task), [skill_bytes(skill, names, shared) for skill in task])
-            for agent, task in content.tasks.items()
-        }
         with self._lock:
-            self._prepared = ready
+            self._prepared = PackedBody(b"", {})  # the previous one is not kept beside the new one
+        shared: dict[int, tuple[Any, Any, bytes]] = {}  # alike parameters written once
+        prepared = self._build(content, {}, {}, shared)
+        with self._lock:
+            self._prepared = prepared
+
+    def forget(self) -> None:
+        """Drop the last snapshot's bytes (the next one serializes every skill afresh)."""
+        with self._lock:
+            self._last = PackedBody(b"", {})
 
     def body(self, content: MissionContent) -> bytes:
         """The wire bytes of a ``rosmc/Mission`` of ``content`` after its revision and stamp."""
         with self._lock:
-            previous, prepared = self._tasks, self._prepared
-        tasks: dict[str, _PackedTask] = {}
-        parts = [string_bytes(content.library), _COUNT.pack(len(content.tasks))]
-        for agent, task in content.tasks.items():
-            sources = [packed for packed in (previous.get(agent), prepared.get(agent)) if packed]
-            packed = next((p for p in sources if _same_instances(p.skills, task)), None)
-            if packed is None:
-                packed = self._pack_task(task, sources)
-            tasks[agent] = packed
-            parts += (string_bytes(agent), _COUNT.pack(len(task)))
-            parts += packed.parts
-        agent_of = _agents_of_members(content).__getitem__
-        parts.append(_array(barrier_to_msg(b, agent_of) for b in content.barriers.values()))
-        parts.append(_array(marker_to_msg(m) for m in content.markers.values()))
+            previous, prepared = self._last, self._prepared
+        if _is_prepared(content, prepared):
+            built = prepared  # a loaded mission's first snapshot: the bytes made ahead
+        else:
+            built = self._build(content, previous.tasks, prepared.tasks, None)
         with self._lock:
-            self._tasks = tasks
-            taken = [agent for agent, packed in prepared.items() if tasks.get(agent) is packed]
+            self._last = built
+            taken = [a for a, p in built.tasks.items() if p.data is prepared.data]
+            taken += built.taken
             if taken and self._prepared is prepared:
                 # A task this snapshot took over lives on in it; the others wait (a snapshot
                 # of the old mission may come first).
-                self._prepared = {a: p for a, p in prepared.items() if a not in taken}
-        return b"".join(parts)
+                rest = {a: p for a, p in prepared.tasks.items() if a not in taken}
+                self._prepared = PackedBody(prepared.data if rest else b"", rest)
+        return built.data
 
     def pack(self, content: MissionContent, revision: int, stamp: float) -> PackedMission:
         """A packed snapshot of ``content`` at ``revision``."""
         return PackedMission(revision, time_to_msg(stamp), self.body(content))
 
-    def _pack_task(self, task: Sequence[SkillInstance], sources: list[_PackedTask]) -> _PackedTask:
-        """``task`` packed, reusing the bytes of each skill ``sources`` hold (packed before).
+    def _build(
+        self,
+        content: MissionContent,
+        previous: dict[str, PackedTask],
+        prepared: dict[str, PackedTask],
+        shared: dict[int, tuple[Any, Any, bytes]] | None,
+    ) -> PackedBody:
+        """The body of ``content``, reusing the bytes of skills packed before."""
+        writer = BodyWriter()
+        writer.write(_head(content))
+        placed: list[tuple[str, list[SkillInstance], int, array[int]]] = []
+        taken: list[str] = []  # tasks taken whole from ``prepared``
+        for agent, task in content.tasks.items():
+            writer.write(_task_head(agent, task))
+            start = writer.tell()
+            sources = [p for p in (previous.get(agent), prepared.get(agent)) if p is not None]
+            whole = next((p for p in sources if _same_instances(p.skills, task)), None)
+            if whole is not None:
+                writer.reuse(whole.data, *whole.span(0, len(task)))
+                placed.append((agent, whole.skills, start, whole.ends))
+                if whole is prepared.get(agent):
+                    taken.append(agent)
+            else:
+                ends = self._pack_task(task, sources, writer, shared)
+                placed.append((agent, list(task), start, ends))
+        writer.write(_tail(content))
+        data = writer.value()
+        tasks = {a: PackedTask(skills, data, start, ends) for a, skills, start, ends in placed}
+        return PackedBody(data, tasks, tuple(taken))
+
+    def _pack_task(
+        self,
+        task: Sequence[SkillInstance],
+        sources: list[PackedTask],
+        writer: BodyWriter,
+        shared: dict[int, tuple[Any, Any, bytes]] | None,
+    ) -> array[int]:
+        """Write ``task``, reusing the bytes of each skill ``sources`` hold (packed before);
+        return where each skill's bytes end.
 
         A skill is looked for where it was, or one place off (one inserted, deleted or
         moved before it); only a task that changed in more than a few places (a range
         deleted, many moves) looks skills up by identity.
         """
-        nearest = sources[0] if sources else _PackedTask([], [])
-        misses = 0
-        moved: dict[int, tuple[SkillInstance, bytes]] | None = None
-        parts: list[bytes] = []
-        for index, skill in enumerate(task):
-            if index < len(nearest.skills) and nearest.skills[index] is skill:  # most stay put
-                parts.append(nearest.parts[index])
-                continue
-            part = _near(sources, index, skill)
-            if part is None:
+        start = writer.tell()
+        ends: array[int] = array("Q")
+        misses, index, count = 0, 0, len(task)
+        moved: dict[int, tuple[SkillInstance, PackedTask, int]] | None = None
+        while index < count:
+            skill = task[index]
+            found = _near(sources, index, skill)
+            if found is None:
                 misses += 1
                 if moved is None and misses > _FEW_MISSES:
                     moved = {
-                        id(s): (s, data)
+                        id(s): (s, source, at)
                         for source in sources
-                        for s, data in zip(source.skills, source.parts, strict=True)
+                        for at, s in enumerate(source.skills)
                     }
                 entry = moved.get(id(skill)) if moved else None
-                part = entry[1] if entry is not None and entry[0] is skill else None
-            parts.append(part if part is not None else skill_bytes(skill, self._names))
-        return _PackedTask(list(task), parts)
+                found = (entry[1], entry[2]) if entry is not None and entry[0] is skill else None
+            if found is None:
+                writer.write(skill_bytes(skill, self._names, shared))
+                ends.append(writer.tell() - start)
+                index += 1
+                continue
+            source, at = found
+            run = _run_length(source.skills, at, task, index)
+            begin, end = source.span(at, at + run)
+            shift = writer.tell() - start - (begin - source.start)  # old place to new
+            writer.reuse(source.data, begin, end)
+            ends.extend(map(shift.__add__, source.ends[at : at + run]))
+            index += run
+        return ends
+
+
+def _run_length(old: list[SkillInstance], at: int, new: Sequence[SkillInstance], index: int) -> int:
+    """How many skills from ``new[index]`` on are the very skills from ``old[at]`` on."""
+    limit = min(len(old) - at, len(new) - index)
+    run = 1
+    while run < limit and old[at + run] is new[index + run]:
+        run += 1
+    return run
 
 
 _FEW_MISSES = 8  # skills of a task not found near their place before it looks them up by id
 
 
-def _near(sources: list[_PackedTask], index: int, skill: SkillInstance) -> bytes | None:
-    """The bytes of ``skill`` if a source holds it at ``index`` or one place off."""
+def _near(
+    sources: list[PackedTask], index: int, skill: SkillInstance
+) -> tuple[PackedTask, int] | None:
+    """Where a source holds ``skill``: at ``index`` or one place off."""
     for source in sources:
+        skills = source.skills
         for at in (index, index + 1, index - 1):
-            if 0 <= at < len(source.skills) and source.skills[at] is skill:
-                return source.parts[at]
+            if 0 <= at < len(skills) and skills[at] is skill:
+                return source, at
     return None
 
 
@@ -311,6 +358,37 @@ def _same_instances(old: list[SkillInstance], new: Sequence[SkillInstance]) -> b
     """Whether ``new`` holds the very instances of ``old``, in order (not merely equal ones:
     ``-0.0 == 0.0``, but their bytes differ)."""
     return len(old) == len(new) and all(map(operator.is_, old, new))
+
+
+def _head(content: MissionContent) -> bytes:
+    """A body's bytes before its first task: the library and the number of tasks."""
+    return string_bytes(content.library) + _COUNT.pack(len(content.tasks))
+
+
+def _task_head(agent: str, task: Sequence[SkillInstance]) -> bytes:
+    """A task's bytes before its skills: its agent and number of skills."""
+    return string_bytes(agent) + _COUNT.pack(len(task))
+
+
+def _tail(content: MissionContent) -> bytes:
+    """A body's bytes after its tasks: the barriers and markers."""
+    agent_of = _agents_of_members(content).__getitem__
+    barriers = _array(barrier_to_msg(b, agent_of) for b in content.barriers.values())
+    return barriers + _array(marker_to_msg(m) for m in content.markers.values())
+
+
+def _is_prepared(content: MissionContent, prepared: PackedBody) -> bool:
+    """Whether the prepared body is byte for byte the body of ``content``."""
+    tasks = prepared.tasks
+    if not tasks or list(tasks) != list(content.tasks):
+        return False
+    if not all(_same_instances(tasks[a].skills, t) for a, t in content.tasks.items()):
+        return False
+    head, tail, data = _head(content), _tail(content), prepared.data
+    size = len(head) + len(tail)
+    size += sum(len(_task_head(a, t)) + tasks[a].span(0, len(t))[1] - tasks[a].start
+                for a, t in content.tasks.items())  # fmt: skip
+    return len(data) == size and data.startswith(head) and data.endswith(tail)
 
 
 def _agents_of_members(content: MissionContent) -> dict[str, str]:

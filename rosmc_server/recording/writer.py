@@ -316,6 +316,7 @@ class JournalWriter:
             part = self._part
             channel_id = self._channels[topic]
             record = fmt.message(channel_id, part.section.sequence(channel_id), log_time_ns, data)
+            del data  # a snapshot's megabytes are in the record now: not held twice meanwhile
             chunk_index = None
             if part.chunked:
                 compress_from = self._options.compress_from

@@ -70,6 +70,7 @@ class SnapshotPublisher(rospy.SubscribeListener):  # type: ignore[misc]
         self._cost = 0.0  # seconds the last snapshot took to build and publish
         self._changed = threading.Condition()
         self._dirty_since: float | None = None
+        self._building = False  # a snapshot is being built and sent
         self._last_change = 0.0
         self._stopped = False
         self._thread = threading.Thread(target=self._run, name="snapshot", daemon=True)
@@ -99,6 +100,12 @@ class SnapshotPublisher(rospy.SubscribeListener):  # type: ignore[misc]
                 self._dirty_since = now
             self._changed.notify()
 
+    @property
+    def idle(self) -> bool:
+        """Whether no snapshot waits to be built or is being built."""
+        with self._changed:
+            return self._dirty_since is None and not self._building
+
     def stop(self) -> None:
         """Stop the publishing thread."""
         with self._changed:
@@ -117,18 +124,28 @@ class SnapshotPublisher(rospy.SubscribeListener):  # type: ignore[misc]
                 self._wait_for_pause()
                 broadcast = self._urgent or self._broadcast_changes
                 self._dirty_since, self._urgent = None, False
+                self._building = True
             started = time.monotonic()
-            try:
-                with self._sending:
-                    snapshot = self._build()
-                    if broadcast:
-                        self._publisher.publish(snapshot)
-                if self._on_built is not None:
-                    self._on_built(snapshot)
-            except Exception:  # keep building later snapshots whatever happened
-                _log.exception("could not build or publish the mission snapshot")
+            self._build_and_publish(broadcast)
+            with self._changed:
+                self._building = False
             self._published = time.monotonic()
             self._cost = self._published - started
+
+    def _build_and_publish(self, broadcast: bool) -> None:
+        """Build the snapshot, publish it if ``broadcast``, hand it to ``on_built``.
+
+        Not kept afterwards (megabytes): the next one is built from the mission.
+        """
+        try:
+            with self._sending:
+                snapshot = self._build()
+                if broadcast:
+                    self._publisher.publish(snapshot)
+            if self._on_built is not None:
+                self._on_built(snapshot)
+        except Exception:  # keep building later snapshots whatever happened
+            _log.exception("could not build or publish the mission snapshot")
 
     def _wait_for_pause(self) -> None:
         """Wait (lock held) until changes pause or the burst is old enough."""

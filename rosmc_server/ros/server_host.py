@@ -51,5 +51,8 @@ class ServerHost(Protocol):
     def snapshot_msg(self) -> PackedMission:
         """The full mission as a message, stamped now."""
 
+    def drop_snapshot(self) -> None:
+        """Let the snapshot's bytes go while a load reads its document."""
+
     def prepare_snapshot(self, content: MissionContent) -> None:
         """Serialize a mission about to replace this one (a load), outside the lock."""

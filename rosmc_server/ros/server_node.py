@@ -55,8 +55,6 @@ node shuts down, so that no change is ever acknowledged without being durable.
 from __future__ import annotations
 
 import argparse
-import ctypes
-import ctypes.util
 import dataclasses
 import logging
 import sys
@@ -93,6 +91,7 @@ from ..recording.high_water import RevisionMark, first_mark, read_mark, resumed_
 from ..recording.recovery import ResumeReport
 from . import station
 from .agent_states import AgentStatePublisher
+from .allocator import keep_large_blocks_apart
 from .ground_link import GroundLink
 from .heartbeat import Heartbeat
 from .logging_bridge import bridge_logging_to_rosout
@@ -267,6 +266,19 @@ class MissionServer:
         assert built is not None
         return PackedMission(built.revision, time_to_msg(rospy.get_time()), built.body)
 
+    def drop_snapshot(self) -> None:
+        """Let the snapshot's bytes go while a load reads its document (megabytes each).
+
+        A snapshot asked for before the load ends, or after a load that failed, is then
+        serialized afresh. Kept while the publisher has one to build (after a change just
+        before, such as the previous load): it would serialize the mission again.
+        """
+        if not self._snapshots.idle:
+            return
+        with self._building:
+            self._snapshot = None
+            self._packer.forget()
+
     def prepare_snapshot(self, content: MissionContent) -> None:
         """Serialize a mission about to replace this one (a load), outside the lock."""
         self._packer.prepare(content)
@@ -334,26 +346,6 @@ class MissionServer:
         self._snapshot_after_resume = writer.needs_snapshot or not report.clean
         _log.info("resumed from %s at revision %d", writer.path, mission.revision)
         return mission
-
-
-M_MMAP_THRESHOLD = -3  # glibc's mallopt parameter number
-MMAP_THRESHOLD = 128 * 1024  # glibc's default starting value
-
-
-def keep_large_blocks_apart() -> None:
-    """Make glibc give every large block (snapshots, documents) back to the system when freed.
-
-    glibc raises its mmap threshold to the size of the largest block freed so far, so after
-    the first multi-megabyte snapshot, later ones come from the heap, where the small
-    objects allocated between them pin the space: at 20 robots x 500 skills the server
-    grew by 15 MiB over a few hundred changes. A fixed threshold keeps the peak flat.
-    Without glibc (or ctypes) nothing changes.
-    """
-    try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
-        libc.mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD)
-    except (OSError, AttributeError):
-        _log.debug("mallopt is not available; large blocks stay with the allocator's defaults")
 
 
 CLOCK_CHECK_PERIOD = 5.0  # seconds between looks at /use_sim_time

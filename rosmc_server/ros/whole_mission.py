@@ -27,6 +27,7 @@ from ..core import InvalidRequest, MissionEvent, MissionFileError, load_mission,
 from ..core.collector import collector_paused
 from ..core.persistence import MissionDumper, write_document
 from ..core.validation import check_file_path
+from .allocator import release_free_memory
 from .server_host import ServerHost
 
 _log = logging.getLogger(__name__)
@@ -103,6 +104,8 @@ class WholeMissionServices:
         # document is read, they are not held beside it (a failed load only costs the next
         # save its cache).
         self._dumper = MissionDumper()
+        # So are the snapshot's bytes: the new mission's are made from its skills.
+        self._server.drop_snapshot()
         with collector_paused():  # the new mission is acyclic: nothing for it to find
             if req.path:
                 mission_dir = self._server.config.mission_dir
@@ -115,6 +118,8 @@ class WholeMissionServices:
                     too_deep = "the document nests its data too deeply to read"
                     raise InvalidRequest(too_deep) from None
                 source = "a document"
+                # rospy holds a persistent connection's request until its next one.
+                req.document = ""
             read = time.perf_counter()
             # Serialized now, outside the server lock: the new mission's journal snapshot,
             # written before the load is acknowledged, then only joins the bytes.
@@ -135,4 +140,5 @@ class WholeMissionServices:
         # counting; kept out of the collector's way, it does not lengthen every later
         # full collection (tens of milliseconds at 10,000 skills).
         gc.freeze()
+        release_free_memory()
         return event

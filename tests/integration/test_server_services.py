@@ -684,6 +684,7 @@ PYTHON_TAG = "!!python/object/apply:os.system ['touch {marker}']\n"
 
 def test_load_mission_rejects(scene: Scene, tmp_path: Path) -> None:
     document = accepted(scene.client.call("save_mission")).document
+    before = scene.client.call("get_mission").mission
     marker = tmp_path / "pwned"
     wrong_library = document.replace("library: mars_sample_return", "library: lunar")
     unknown_agent = document.replace("  drone:", "  zeppelin:")
@@ -709,6 +710,15 @@ def test_load_mission_rejects(scene: Scene, tmp_path: Path) -> None:
     for fields, code in cases:
         check_rejection(scene, "load_mission", dict(fields), code)
     assert not marker.exists(), "a Python object tag in a mission document was executed"
+    # A load lets the snapshot's bytes go while it reads; after a refused one the mission's
+    # snapshot is made afresh, the same as before.
+    after = scene.client.call("get_mission").mission
+    assert (after.revision, after.tasks, after.barriers, after.markers) == (
+        before.revision,
+        before.tasks,
+        before.barriers,
+        before.markers,
+    )
 
 
 def test_save_mission_to_an_unwritable_place_is_refused(scene: Scene, tmp_path: Path) -> None:

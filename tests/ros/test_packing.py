@@ -9,6 +9,7 @@ whole snapshot serialize exactly as the genpy messages of ``skill_to_msg`` and
 
 from __future__ import annotations
 
+import tracemalloc
 from dataclasses import replace
 from typing import Any
 
@@ -153,3 +154,33 @@ def test_skills_sharing_parameters_pack_as_genpy_serializes_them(library: Librar
     packer = SnapshotPacker()
     packer.prepare(content)
     assert serialized(packer.pack(content, 9, 0.0)) == serialized(mission_to_msg(content, 9, 0.0))
+
+
+def held_while(build: Any) -> tuple[Any, int]:
+    """What ``build()`` returns, and the bytes it left allocated (``tracemalloc``)."""
+    tracemalloc.start()
+    try:
+        before = tracemalloc.get_traced_memory()[0]
+        result = build()
+        return result, tracemalloc.get_traced_memory()[0] - before
+    finally:
+        tracemalloc.stop()
+
+
+def test_a_packer_holds_the_skills_bytes_once(library: Library) -> None:
+    # The skills' bytes live in the snapshot's body only (no copy per skill beside it), for
+    # a loaded mission's first snapshot and for one after a change alike.
+    content = random_content(library, 3000, seed=41)
+    packer = SnapshotPacker()
+
+    def load() -> bytes:
+        packer.prepare(content)
+        return bytes(packer.pack(content, 1, 0.0).body)
+
+    body, held = held_while(load)
+    assert held < 1.2 * len(body)
+    changed = content.copy()
+    changed.tasks["alpha"][7] = replace(changed.tasks["alpha"][7], label="renamed")
+    body, held = held_while(lambda: packer.pack(changed, 2, 0.0).body)
+    assert held < 1.2 * len(body)
+    assert body == SnapshotPacker().body(changed)

@@ -112,3 +112,24 @@ def test_an_unused_optional_module_is_kept_out_of_the_program(
         assert venv.run_entry_point(module) == 5  # installed and not kept out: imported
     finally:
         sys.modules.pop("entry_optional_extra", None)
+
+
+def test_a_deferred_module_is_imported_when_its_function_is_first_called(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    (tmp_path / "entry_costly.py").write_text(
+        "IMPORTS = []\nIMPORTS.append(1)\n\ndef twice(value, factor=2):\n"
+        "    return (value * factor, len(IMPORTS))\n",
+        encoding="utf-8",
+    )
+    body = (
+        "import sys\nfrom entry_costly import twice\n\ndef main():\n"
+        "    assert sys.modules['entry_costly'].__doc__.startswith('Stands in')\n"
+        "    assert twice(3) == (6, 1) and twice(2, factor=5) == (10, 1)\n"
+        "    return 0 if sys.modules['entry_costly'].__doc__ is None else 4  # the real one\n"
+    )
+    try:
+        module = _entry_module(tmp_path, monkeypatch, "entry_deferring", body)
+        assert venv.run_entry_point(module, deferred={"entry_costly": ("twice",)}) == 0
+    finally:
+        sys.modules.pop("entry_costly", None)
