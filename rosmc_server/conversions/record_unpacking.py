@@ -18,7 +18,8 @@ values is safe. Tests check the reader against genpy and ``mission_from_msg``.
 from __future__ import annotations
 
 import struct
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
+from itertools import repeat
 from typing import Any
 
 from ..core import InvalidRequest, Resolution, SkillInstance, SkillStatus, Transfer
@@ -52,17 +53,16 @@ def read_records(
     where the mission ends.
     """
     ids: list[bytes] = []
-    agents: list[str] = []
     labels: list[bytes] = []
     rests: list[Rest] = []
-    add_id, add_agent, add_label, add_rest = ids.append, agents.append, labels.append, rests.append
-    mark = starts.append if starts is not None else None
-    agent_field, agent = b"", ""  # the last agent read, with its length
-    kinds: dict[bytes, tuple[bytes, Rest]] = {}  # by name bytes: the kind's last rest
+    add_id, add_label, add_rest = ids.append, labels.append, rests.append
+    mark = (starts if starts is not None else []).append
+    agent_field = b""  # the last agent read, with its length
+    agents: list[tuple[int, str]] = []  # where the agent changes (a record's index), to what
+    kinds: dict[bytes, tuple[bytes, int, Rest]] = {}  # by name bytes: the kind's last rest
     rest_reader = _RestReader()
-    for _ in range(count):
-        if mark is not None:
-            mark(pos)
+    for index in range(count):
+        mark(pos)
         end = pos + 4 + _COUNT(data, pos)[0]
         add_id(data[pos + 4 : end])
         if agent_field and data.startswith(agent_field, end):
@@ -70,29 +70,39 @@ def read_records(
         else:
             pos = end + 4 + _COUNT(data, end)[0]
             agent_field = data[end:pos]
-            agent = agent_field[4:].decode("utf-8", "rosmsg")
-        add_agent(agent)
+            agents.append((index, agent_field[4:].decode("utf-8", "rosmsg")))
         end = pos + 4 + _COUNT(data, pos)[0]
         raw_name = data[pos + 4 : end]
         pos = end + 4 + _COUNT(data, end)[0]
         add_label(data[end + 4 : pos])
         kind = kinds.get(raw_name)
         if kind is not None and data.startswith(kind[0], pos):  # the rest of its kind's last
-            pos += len(kind[0])
-            add_rest(kind[1])
+            pos += kind[1]
+            add_rest(kind[2])
             continue
-        name = kind[1][0] if kind is not None else raw_name.decode("utf-8", "rosmsg")
+        name = kind[2][0] if kind is not None else raw_name.decode("utf-8", "rosmsg")
         start = pos
         rest, pos = rest_reader.read(data, pos, name)
-        kinds[raw_name] = (data[start:pos], rest)
+        kinds[raw_name] = (data[start:pos], pos - start, rest)
         add_rest(rest)
     if count:
         names, *others = zip(*rests, strict=True)  # each rest holds every field
         ids_read = [raw.decode("utf-8", "rosmsg") for raw in ids]
         labels_read = [raw.decode("utf-8", "rosmsg") for raw in labels]
-        columns = (ids_read, agents, names, labels_read, *others)
+        columns = (ids_read, _column(agents, count), names, labels_read, *others)
         skills += SkillInstance.assemble_columns(count, columns)
     return pos
+
+
+def _column(changes: list[tuple[int, str]], count: int) -> Iterable[str]:
+    """``count`` values that change where ``changes`` say (from which index, to what)."""
+    if len(changes) == 1:
+        return repeat(changes[0][1], count)
+    ends = [index for index, _ in changes[1:]] + [count]
+    column: list[str] = []
+    for (start, value), end in zip(changes, ends, strict=True):
+        column += repeat(value, end - start)
+    return column
 
 
 class _RestReader:
