@@ -5,7 +5,10 @@ that a baseline's figures come from the baseline's client code, not this one's. 
 the running server of ``ROS_MASTER_URI`` it times ``ServiceCaller.call("get_mission")``
 (what ``MissionClient`` calls): the first call, calls with nothing changed since the
 last, and calls after an edit of one skill (``skill`` argv[2], its float parameter
-``param`` argv[3]). Prints one JSON object of p50/p95 figures::
+``param`` argv[3]). ``first_state_ms`` is the first call and the ``MissionState`` that
+``MissionClient.fetch_mission`` builds from its answer (what a client waits for before it
+can show the mission); ``first_touched_ms`` the first call and a read of every skill's
+fields. Prints one JSON object of p50/p95 figures::
 
     python bench/_client_get.py CHECKOUT SKILL_ID PARAM CALLS
 """
@@ -26,6 +29,16 @@ def p50_p95(samples: list[float]) -> dict[str, float]:
     return {"p50_ms": round(statistics.median(ordered) * 1000, 3), "p95_ms": round(p95 * 1000, 3)}
 
 
+def every_field_read(content: Any) -> float:
+    """Seconds to read every field of every skill of ``content`` (a reader that built
+    skills only when asked for them would build them now)."""
+    started = time.perf_counter()
+    for task in content.tasks.values():
+        for skill in task:
+            skill.id, skill.label, skill.params, skill.status, skill.finished  # noqa: B018
+    return time.perf_counter() - started
+
+
 def main(argv: list[str]) -> int:
     """Time the calls; print the figures."""
     checkout, skill_id, param, calls = argv[1], argv[2], argv[3], int(argv[4])
@@ -33,6 +46,7 @@ def main(argv: list[str]) -> int:
     import rosmc.msg as wire
     import rospy
 
+    from rosmc_server.core import MissionState
     from rosmc_server.ros.client.connection import ServiceCaller
 
     rospy.init_node("bench_client_get", anonymous=True, disable_signals=True)
@@ -40,6 +54,10 @@ def main(argv: list[str]) -> int:
     started = time.perf_counter()
     answer: Any = caller.call("get_mission")
     first = time.perf_counter() - started
+    touched = first + every_field_read(answer.content)
+    started = time.perf_counter()
+    MissionState(answer.content, answer.revision)
+    state = first + time.perf_counter() - started
     same, changed = [], []
     for number in range(calls):
         started = time.perf_counter()
@@ -56,6 +74,8 @@ def main(argv: list[str]) -> int:
     caller.close()
     figures = {
         "first_ms": round(first * 1000, 3),
+        "first_touched_ms": round(touched * 1000, 3),
+        "first_state_ms": round(state * 1000, 3),
         "same_revision": p50_p95(same),
         "after_an_edit": p50_p95(changed),
     }

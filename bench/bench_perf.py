@@ -17,7 +17,8 @@ commit with this checkout's ``build`` and ``.venv`` linked in), it starts a real
 * ``get_mission`` (as this checkout's client reads it), ``save`` (to a file),
   ``load`` (of the saved file);
 * ``get_mission_own_client``: GetMission as each checkout's own client reads it, in a
-  process of its own (``_client_get.py``): the first call, with nothing changed, and
+  process of its own (``_client_get.py``): the first call (alone, with every skill's
+  fields read, and with the ``MissionState`` a client builds), with nothing changed, and
   after an edit of one skill;
 * ``add``, ``edit``, ``delete``, ``sync`` p50/p95 (``sync``: the first skill of a
   blueprint, then taken back); ``sync_3000`` / ``unsync_3000``: the first 3,000 skills

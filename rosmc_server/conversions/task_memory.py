@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from ..core import SkillInstance
 
 _COUNT = struct.Struct("<I").unpack_from
-_GIVE_UP = 16  # records read one after another before the rest is read without looking back
+_GIVE_UP = 16  # records read one after another before the rest is read at once
 
 # unpacking.read_records: read ``count`` records from ``pos`` onto the lists; where they end.
 ReadRecords = Callable[[bytes, int, int, list[SkillInstance], "list[int] | None"], int]
@@ -92,23 +92,24 @@ def _read_changed(
     after = 0  # the record of last that follows the last one taken over
     misses = 0
     while done < count:
-        if misses < _GIVE_UP:
-            # Where an unchanged stretch would resume: after the last one taken over (a
-            # record changed, one removed or one added), or where the rest ends as in last.
-            for first in (after, after + 1, after - 1, len(last.skills) - (count - done)):
-                taken = _unchanged(data, pos, last, first, count - done)
-                if taken:
-                    break
+        if misses >= _GIVE_UP:  # many changed records in a row: read the rest at once
+            return read(data, pos, count - done, skills, starts)
+        # Where an unchanged stretch would resume: after the last one taken over (a
+        # record changed, one removed or one added), or where the rest ends as in last.
+        for first in (after, after + 1, after - 1, len(last.skills) - (count - done)):
+            taken = _unchanged(data, pos, last, first, count - done)
             if taken:
-                for index in range(first, first + taken):
-                    starts.append(pos + last.starts[index] - last.starts[first])
-                skills += last.skills[first : first + taken]
-                pos += last.starts[first + taken] - last.starts[first]
-                done += taken
-                after = first + taken
-                misses = 0
-                continue
-            misses += 1
+                break
+        if taken:
+            for index in range(first, first + taken):
+                starts.append(pos + last.starts[index] - last.starts[first])
+            skills += last.skills[first : first + taken]
+            pos += last.starts[first + taken] - last.starts[first]
+            done += taken
+            after = first + taken
+            misses = 0
+            continue
+        misses += 1
         pos = read(data, pos, 1, skills, starts)
         done += 1
         after += 1  # a changed record in place of one of last's (or a new one)

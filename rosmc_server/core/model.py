@@ -8,8 +8,9 @@ from __future__ import annotations
 
 import enum
 import operator
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
+from itertools import repeat
 from types import MappingProxyType
 from typing import Any
 
@@ -135,6 +136,23 @@ class SkillInstance:
         _set_finished(made, finished)
         return made
 
+    @classmethod
+    def assemble_columns(cls, count: int, columns: Iterable[Iterable[Any]]) -> list[SkillInstance]:
+        """``count`` skills whose fields come a column at a time, in field order: the
+        first skill takes the first value of every column, and so on.
+
+        The fields must be as :meth:`assemble` takes them, with ``bindings`` already
+        :data:`NO_BINDINGS` where there are none. Each column fills its field of every
+        skill in one pass that runs in C (no Python call per skill and field): about half
+        the time of :meth:`assemble` per skill, for readers of thousands at once (a
+        snapshot). Columns must hold ``count`` values or more (a constant field can be an
+        ``itertools.repeat``). A test checks the skills equal the constructor's.
+        """
+        made = list(map(_new_object, repeat(cls, count)))
+        for set_field, column in zip(_SETTERS, columns, strict=True):
+            any(map(set_field, made, column))  # each set gives None: any() runs them all
+        return made
+
     @property
     def is_editable(self) -> bool:
         """In the blueprint and not being uploaded."""
@@ -164,7 +182,7 @@ class SkillInstance:
     _set_status_text,
     _set_started,
     _set_finished,
-) = (getattr(SkillInstance, name).__set__ for name in SkillInstance.__slots__)
+) = _SETTERS = tuple(getattr(SkillInstance, name).__set__ for name in SkillInstance.__slots__)
 skill_id_of = operator.attrgetter("id")  # a skill's id, in C (for map over thousands)
 _fields_of = operator.attrgetter(*SkillInstance.__slots__)
 _FIELD_PLACE = MappingProxyType({name: at for at, name in enumerate(SkillInstance.__slots__)})

@@ -30,7 +30,15 @@ from rosmc_server.conversions.unpacking import (
     UnpackedGetMissionResponse,
     mission_from_bytes,
 )
-from rosmc_server.core import InvalidRequest, Library, MissionContent, Pose, SkillInstance
+from rosmc_server.core import (
+    InvalidRequest,
+    Library,
+    MissionContent,
+    Pose,
+    SkillInstance,
+    SkillStatus,
+    Transfer,
+)
 from rosmc_server.core.library import library_from_dict
 from tests.unit.conftest import TEST_LIBRARY
 from tests.unit.random_missions import random_content
@@ -232,3 +240,45 @@ def test_repeated_parameters_read_as_genpy_reads_them_and_are_shared() -> None:
     # One dict per distinct block of parameters and binding, however often it comes.
     assert len({id(skill.params) for skill in alpha[300:]}) == len(pool)
     assert len({id(skill.agent) for skill in alpha}) == 1
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_records_whose_rest_repeats_or_not_read_as_genpy_reads_them(seed: int) -> None:
+    # The reader takes a record's rest (parameters, numbers, status text, times) from the
+    # last record of its kind when the bytes match, and numbers from any record before:
+    # rests that repeat, differ in one number, a sign, a status text or a time, records
+    # whose agent is not their task's, in a random order, must read as genpy reads them.
+    rng = random.Random(seed)
+    statuses = list(SkillStatus)
+    rests: list[dict[str, object]] = [
+        {},
+        {"status": SkillStatus.SUCCESS, "started": 1.5, "finished": 2.5},
+        {"status": SkillStatus.SUCCESS, "started": 1.5, "finished": -0.0},
+        {"status": SkillStatus.FAILURE, "status_text": "stuck", "attempt": 2},
+        {"status": SkillStatus.FAILURE, "status_text": "stück", "attempt": 2},
+        {"status": SkillStatus.IDLE_SYNCHRONIZED, "transfer": Transfer.UPLOADING},
+        {"timeout": 30.0, "max_retries": 3},
+    ]
+    pool = [{"seconds": 5.0}, {"seconds": 5.0, "note": "x"}, {"seconds": -0.0}, {}]
+
+    def task(agent: str) -> list[SkillInstance]:
+        skills = []
+        for number in range(400):
+            rest = dict(rng.choice(rests))
+            if rng.random() < 0.1:  # numbers never seen before
+                rest.update(status=rng.choice(statuses), started=rng.random())
+            owner = agent if rng.random() < 0.95 else "gamma"
+            name = rng.choice(["wait", "move", "w"])
+            label = "x" * rng.randrange(4)
+            params = rng.choice(pool)
+            skill = SkillInstance(f"{agent}{number}", owner, name, label, params, **rest)  # type: ignore[arg-type]
+            skills.append(skill)
+        return skills
+
+    content = MissionContent("lib", {"alpha": task("alpha"), "beta": task("beta")}, {}, {})
+    data = serialized(mission_to_msg(content, 5, 0.0))
+    read, revision, end = mission_from_bytes(data)
+    assert (read, revision) == genpy_read(data)
+    assert read == content and end == len(data)
+    for task_read, task_made in zip(read.tasks.values(), content.tasks.values(), strict=True):
+        assert [repr(s) for s in task_read] == [repr(s) for s in task_made]  # -0.0 stays

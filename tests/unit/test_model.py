@@ -16,7 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rosmc_server.core import Library, Pose, SkillInstance
-from rosmc_server.core.model import skill_with
+from rosmc_server.core.model import NO_BINDINGS, skill_with
 from tests.unit.random_missions import random_content
 
 
@@ -49,6 +49,24 @@ def test_an_assembled_skill_is_the_skill_the_constructor_builds(
         for made in task:
             fields = [getattr(made, f.name) for f in dataclasses.fields(made)]
             same_object(SkillInstance.assemble(*fields), SkillInstance(*fields))
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_skills_assembled_a_column_at_a_time_are_the_skills_the_constructor_builds(
+    library: Library, seed: int
+) -> None:
+    content = random_content(library, 40, seed=seed)
+    made = [skill for task in content.tasks.values() for skill in task]
+    rows = [[getattr(skill, f.name) for f in dataclasses.fields(skill)] for skill in made]
+    for row in rows:
+        row[5] = row[5] or NO_BINDINGS  # as assemble_columns takes bindings
+    columns = [list(column) for column in zip(*rows, strict=True)]
+    assembled = SkillInstance.assemble_columns(len(made), columns)
+    assert len(assembled) == len(made)
+    for one, other in zip(assembled, made, strict=True):
+        same_object(one, other)
+    assert SkillInstance.assemble_columns(0, [[]] * len(columns)) == []
 
 
 @settings(max_examples=20, deadline=None)

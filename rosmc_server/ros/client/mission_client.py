@@ -5,24 +5,18 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from ...conversions import marker_to_msg, moves_to_msgs, policy_to_request, pose_to_msg
+from ...conversions import moves_to_msgs, policy_to_request
 from ...conversions.move_fields import order_to_field
-from ...core import (
-    InvalidRequest,
-    LostLinkPolicy,
-    Pose,
-    TaskMarker,
-)
+from ...core import InvalidRequest, LostLinkPolicy
 from ...core.changes import SkillMove
 from ...core.editing import check_retries, check_timeout
-from .base import ClientBase
 from .connection import raise_for
+from .marker_calls import MarkerCalls
 from .results import (
     BarrierAdded,
     ControlCommand,
     ControlSent,
     EditUndone,
-    MarkerAdded,
     MissionSaved,
     Result,
     SkillAdded,
@@ -32,7 +26,7 @@ from .results import (
 )
 
 
-class MissionClient(ClientBase):
+class MissionClient(MarkerCalls):
     """The Python client of the mission server (command line, GUIs, scripted operators).
 
     Methods take core-level arguments (agent and skill names, parameter values as
@@ -276,7 +270,7 @@ class MissionClient(ClientBase):
             self._mutate("skip_skill", base_revision, retry_on_conflict, skill_id=skill_id).revision
         )
 
-    # -- barriers and task markers -------------------------------------------------------
+    # -- barriers (task markers: MarkerCalls) -------------------------------------------
     def add_barrier(
         self,
         skill_ids: Sequence[str],
@@ -298,61 +292,6 @@ class MissionClient(ClientBase):
             self._mutate(
                 "delete_barrier", base_revision, retry_on_conflict, barrier_id=barrier_id
             ).revision
-        )
-
-    def add_task_marker(
-        self,
-        marker: TaskMarker,
-        *,
-        base_revision: int | None = None,
-        retry_on_conflict: bool = False,
-    ) -> MarkerAdded:
-        """Add a task marker (an empty name gets a generated one)."""
-        response = self._mutate(
-            "add_task_marker", base_revision, retry_on_conflict, marker=marker_to_msg(marker)
-        )
-        return MarkerAdded(response.revision, response.name)
-
-    def move_task_marker(
-        self,
-        name: str,
-        pose: Pose,
-        vertices: Sequence[Pose] = (),
-        *,
-        base_revision: int | None = None,
-        retry_on_conflict: bool = False,
-    ) -> Result:
-        """Move a task marker (an AREA by its ``vertices``); bound parameters follow."""
-        response = self._mutate(
-            "move_task_marker",
-            base_revision,
-            retry_on_conflict,
-            name=name,
-            pose=pose_to_msg(pose),
-            vertices=[pose_to_msg(v) for v in vertices],
-        )
-        return Result(response.revision)
-
-    def rename_task_marker(
-        self,
-        name: str,
-        new_name: str,
-        *,
-        base_revision: int | None = None,
-        retry_on_conflict: bool = False,
-    ) -> Result:
-        """Rename a task marker; bindings follow."""
-        response = self._mutate(
-            "rename_task_marker", base_revision, retry_on_conflict, name=name, new_name=new_name
-        )
-        return Result(response.revision)
-
-    def delete_task_marker(
-        self, name: str, *, base_revision: int | None = None, retry_on_conflict: bool = False
-    ) -> Result:
-        """Delete a task marker that no skill is bound to."""
-        return Result(
-            self._mutate("delete_task_marker", base_revision, retry_on_conflict, name=name).revision
         )
 
     def undo_edit(
