@@ -315,8 +315,9 @@ class JournalWriter:
                 self._rotate()
             part = self._part
             channel_id = self._channels[topic]
-            record = fmt.message(channel_id, part.section.sequence(channel_id), log_time_ns, data)
-            del data  # a snapshot's megabytes are in the record now: not held twice meanwhile
+            sequence = part.section.sequence(channel_id)
+            # The record is written in parts: a snapshot's megabytes are never copied.
+            record = [fmt.message_head(channel_id, sequence, log_time_ns, len(data)), data]
             chunk_index = None
             if part.chunked:
                 compress_from = self._options.compress_from

@@ -466,13 +466,13 @@ def test_failed_write_leaves_a_valid_journal(
 ) -> None:
     path = tmp_path / "j.mcap"
     writer = JournalWriter.create(path, mission(0), T0)
-    real_write = os.write
 
-    def half_then_full(fd: int, data: Any) -> int:
-        real_write(fd, bytes(data[: len(data) // 2]))
+    def half_then_full(fd: int, parts: Any) -> int:
+        first = bytes(parts[0])
+        os.write(fd, first[: len(first) // 2])
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(os, "write", half_then_full)
+    monkeypatch.setattr(os, "writev", half_then_full)
     with pytest.raises(JournalError, match="No space left"):
         writer.append_event(event(1), T0 + 1)
     monkeypatch.undo()

@@ -10,7 +10,7 @@ against the ``mcap`` package's own readers.
 import importlib
 import struct
 import zlib
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -116,14 +116,22 @@ def channel(rec: ChannelRecord) -> bytes:
 
 def message(channel_id: int, sequence: int, log_time: int, data: bytes) -> bytes:
     """Encode a Message record; the publish time is the log time."""
-    head = _MESSAGE_HEAD.pack(
-        Opcode.MESSAGE, 22 + len(data), channel_id, sequence, log_time, log_time
-    )
-    return head + data
+    return message_head(channel_id, sequence, log_time, len(data)) + data
+
+
+def message_head(channel_id: int, sequence: int, log_time: int, size: int) -> bytes:
+    """The head of a Message record whose ``size`` bytes of data follow it."""
+    return _MESSAGE_HEAD.pack(Opcode.MESSAGE, 22 + size, channel_id, sequence, log_time, log_time)
 
 
 def chunk(rec: ChunkRecord) -> bytes:
     """Encode a Chunk record."""
+    return chunk_head(rec, len(rec.data)) + rec.data
+
+
+def chunk_head(rec: ChunkRecord, size: int) -> bytes:
+    """The head of a Chunk record whose ``size`` bytes of records follow it (``rec.data``
+    is not read: a writer may hold the records in parts)."""
     times = struct.pack(
         "<QQQI",
         rec.message_start_time,
@@ -131,8 +139,8 @@ def chunk(rec: ChunkRecord) -> bytes:
         rec.uncompressed_size,
         rec.uncompressed_crc,
     )
-    body = times + _str(rec.compression) + _U64.pack(len(rec.data)) + rec.data
-    return record(Opcode.CHUNK, body)
+    fields = times + _str(rec.compression) + _U64.pack(size)
+    return RECORD_HEAD.pack(Opcode.CHUNK, len(fields) + size) + fields
 
 
 def message_index(channel_id: int, entries: list[tuple[int, int]]) -> bytes:
@@ -186,6 +194,18 @@ def footer(summary_start: int, summary_offset_start: int, summary: bytes) -> byt
 def compress(data: bytes) -> tuple[str, bytes]:
     """Compress a chunk's records with zstd."""
     return "zstd", zstandard.ZstdCompressor(level=3).compress(data)
+
+
+def compress_parts(parts: Sequence[bytes]) -> tuple[str, list[bytes]]:
+    """Compress a chunk's records, held in parts, into one zstd frame held in parts.
+
+    The frame declares its content size, as :func:`compress`'s does; no part is joined
+    (a snapshot's megabytes are not copied to be compressed).
+    """
+    stream = zstandard.ZstdCompressor(level=3).compressobj(size=sum(map(len, parts)))
+    out = [stream.compress(part) for part in parts]
+    out.append(stream.flush())
+    return "zstd", [piece for piece in out if piece]
 
 
 def decompress(compression: str, data: bytes, size: int) -> bytes:

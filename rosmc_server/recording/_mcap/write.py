@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import os
 import zlib
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -80,32 +80,42 @@ class DataSection:
         return self.counts.get(channel_id, 0) & 0xFFFFFFFF
 
     def chunk(
-        self, offset: int, channel_id: int, log_time: int, message: bytes, compress_from: int
-    ) -> tuple[bytes, fmt.ChunkIndexRecord]:
-        """Wrap one message record in a chunk with its message index, to go at ``offset``.
+        self,
+        offset: int,
+        channel_id: int,
+        log_time: int,
+        message: Sequence[bytes],
+        compress_from: int,
+    ) -> tuple[list[bytes], fmt.ChunkIndexRecord]:
+        """Wrap one message record (held in parts) in a chunk with its message index.
 
-        The chunk is zstd-compressed when the record reaches ``compress_from`` bytes (> 0).
-        Returns the bytes and the chunk's index entry, for :meth:`count` once written.
+        The chunk goes at ``offset``; it is zstd-compressed when the record reaches
+        ``compress_from`` bytes (> 0). Returns the chunk's bytes in parts (the record's
+        parts are not joined: a snapshot's megabytes are not copied on their way to the
+        file) and its index entry, for :meth:`count` once written.
         """
-        compression, payload = "", message
-        if 0 < compress_from <= len(message):
-            compression, payload = fmt.compress(message)
-        chunk = fmt.chunk(
-            fmt.ChunkRecord(
-                log_time, log_time, len(message), zlib.crc32(message), compression, payload
-            )
-        )
+        size = crc = 0
+        for part in message:
+            size += len(part)
+            crc = zlib.crc32(part, crc)
+        compression, payload = "", list(message)
+        if 0 < compress_from <= size:
+            compression, payload = fmt.compress_parts(message)
+        payload_size = sum(map(len, payload))
+        record = fmt.ChunkRecord(log_time, log_time, size, crc, compression, b"")
+        head = fmt.chunk_head(record, payload_size)
+        chunk_length = len(head) + payload_size
         index = fmt.message_index(channel_id, [(log_time, 0)])
-        return chunk + index, fmt.ChunkIndexRecord(
+        return [head, *payload, index], fmt.ChunkIndexRecord(
             message_start_time=log_time,
             message_end_time=log_time,
             chunk_start_offset=offset,
-            chunk_length=len(chunk),
-            message_index_offsets=((channel_id, offset + len(chunk)),),
+            chunk_length=chunk_length,
+            message_index_offsets=((channel_id, offset + chunk_length),),
             message_index_length=len(index),
             compression=compression,
-            compressed_size=len(payload),
-            uncompressed_size=len(message),
+            compressed_size=payload_size,
+            uncompressed_size=size,
         )
 
     def restore_indexes(self, offset: int, missing: Mapping[int, list[tuple[int, int]]]) -> bytes:
@@ -209,16 +219,16 @@ class PartFile:
             raise JournalError(f"cannot create journal {path}: {err.strerror}") from err
         return part
 
-    def write(self, data: bytes, sync: bool, durable: bool) -> None:
-        """Write all of ``data`` at the end (fdatasync if ``sync and durable``).
+    def write(self, data: bytes | Sequence[bytes], sync: bool, durable: bool) -> None:
+        """Write all of ``data`` (bytes, or parts written in order) at the end.
 
-        On failure the file is cut back to where it was and JournalError raised.
+        fdatasync if ``sync and durable``. On failure the file is cut back to where it
+        was and JournalError raised.
         """
         fd = self.open_fd()
+        parts = [data] if isinstance(data, bytes) else data
         try:
-            view = memoryview(data)
-            while view:
-                view = view[os.write(fd, view) :]
+            size = _write_all(fd, parts)
             if sync and durable:
                 os.fdatasync(fd)
         except OSError as err:
@@ -228,7 +238,7 @@ class PartFile:
             except OSError:
                 self.abandon()
             raise JournalError(f"cannot write journal {self.path}: {err.strerror}") from err
-        self.offset += len(data)
+        self.offset += size
 
     def sync(self) -> None:
         """fdatasync the file."""
@@ -260,3 +270,16 @@ class PartFile:
         if self.fd is None:
             raise JournalError(f"journal {self.path} is closed")
         return self.fd
+
+
+def _write_all(fd: int, parts: Sequence[bytes]) -> int:
+    """Write every part in order with as few system calls as the kernel allows; the size."""
+    views = [memoryview(part) for part in parts if part]
+    size = sum(len(view) for view in views)
+    while views:
+        written = os.writev(fd, views)
+        while views and written >= len(views[0]):
+            written -= len(views.pop(0))
+        if written:
+            views[0] = views[0][written:]
+    return size
