@@ -149,6 +149,15 @@ def test_an_idle_policy_waits_for_the_robot_to_finish_and_then_returns(rover: Ro
     assert rover.engine.snapshot().policy.endswith("(done); holding")
 
 
+def assert_returns_to(rover: Rover, back: Pose) -> None:
+    """The rover remembers ``back`` and, left out of contact, its return skill drives there."""
+    assert rover.engine.lost_link.last_link_pose == back
+    rover.pose = Pose(30.0, 5.0)
+    rover.run_for(61.0)
+    ret = Timed.instances[-1]
+    assert ret.ctx is not None and ret.ctx.params["target"] == back
+
+
 def test_the_robot_returns_to_where_it_was_a_margin_before_the_last_contact(
     rover: Rover,
 ) -> None:
@@ -158,12 +167,7 @@ def test_the_robot_returns_to_where_it_was_a_margin_before_the_last_contact(
         rover.engine.report_acknowledged(0)
         rover.clock.now += 1.0
     # Last heard at x = 19 (perhaps already beyond the edge): it goes back LINK_MARGIN s.
-    back = Pose(19.0 - LINK_MARGIN, 5.0)
-    assert rover.engine.lost_link.last_link_pose == back
-    rover.pose = Pose(30.0, 5.0)
-    rover.run_for(61.0)
-    ret = Timed.instances[-1]
-    assert ret.ctx is not None and ret.ctx.params["target"] == back
+    assert_returns_to(rover, Pose(19.0 - LINK_MARGIN, 5.0))
 
 
 def test_a_robot_that_hears_the_ground_rarely_still_returns_a_margin_before_the_last_contact(
@@ -175,12 +179,7 @@ def test_a_robot_that_hears_the_ground_rarely_still_returns_a_margin_before_the_
         rover.pose = Pose(float(x), 5.0)
         rover.run_for(1.0)
     rover.engine.report_acknowledged(0)  # heard once more, at x = 19
-    back = Pose(19.0 - LINK_MARGIN, 5.0)
-    assert rover.engine.lost_link.last_link_pose == back
-    rover.pose = Pose(30.0, 5.0)
-    rover.run_for(61.0)
-    ret = Timed.instances[-1]
-    assert ret.ctx is not None and ret.ctx.params["target"] == back
+    assert_returns_to(rover, Pose(19.0 - LINK_MARGIN, 5.0))
 
 
 def test_without_a_known_position_the_robot_holds(rover: Rover) -> None:
