@@ -26,6 +26,7 @@ import subprocess
 import sys
 import threading
 import time
+import xmlrpc.client
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
@@ -370,6 +371,20 @@ def accepted(response: Any) -> Any:
 
 
 # -- subscribers ---------------------------------------------------------------------------
+def publishers_know_me(subscriber: Any) -> bool:
+    """Whether every publisher this ``rospy.Subscriber`` is connected to lists the connection.
+
+    Asks each publisher's node for its bus info (its XML-RPC ``getBusInfo``).
+    """
+    topic, me = subscriber.resolved_name, rospy.get_name()
+    for connection in subscriber.impl.connections:
+        node = xmlrpc.client.ServerProxy(connection.endpoint_id)
+        _, _, bus = node.getBusInfo(me)
+        if not any(row[1] == me and row[2] == "o" and row[4] == topic for row in bus):
+            return False
+    return True
+
+
 class Recorder:
     """Collects the messages of one topic, with their receive times."""
 
@@ -381,6 +396,11 @@ class Recorder:
         deadline = time.monotonic() + connect_timeout
         while self._subscriber.get_num_connections() == 0:
             assert time.monotonic() < deadline, f"no publisher of {topic} connected"
+            time.sleep(0.01)
+        # The subscriber counts the connection before the publisher does: a message
+        # published in between would not reach this recorder.
+        while not publishers_know_me(self._subscriber):
+            assert time.monotonic() < deadline, f"the publisher of {topic} never counted us"
             time.sleep(0.01)
 
     def _on_message(self, msg: Any) -> None:
