@@ -23,7 +23,6 @@ import threading
 import time
 import xmlrpc.client
 from collections.abc import Callable, Iterable
-from http.client import HTTPConnection
 from io import BytesIO
 from typing import Any
 
@@ -42,23 +41,11 @@ from ..core.radio import (
     parse_endpoint,
 )
 from ..interface import RADIO_DIRECTORY
+from .connections import TimeoutTransport
 
 _log = logging.getLogger(__name__)
 MASTER_TIMEOUT = 2.0  # seconds an XML-RPC call to the master may take
 GROUND = "ground"
-
-
-class _TimeoutTransport(xmlrpc.client.Transport):
-    """XML-RPC over HTTP whose connections time out (rospy's own calls never do)."""
-
-    def __init__(self, timeout: float) -> None:
-        super().__init__()
-        self._timeout = timeout
-
-    def make_connection(self, host: Any) -> HTTPConnection:
-        connection = super().make_connection(host)
-        connection.timeout = self._timeout
-        return connection
 
 
 class Radio:
@@ -95,7 +82,7 @@ class Radio:
         self._last_read = float("-inf")  # monotonic time of the last read of the directory
         self._registered = False
         self._master = xmlrpc.client.ServerProxy(
-            rosgraph.get_master_uri(), transport=_TimeoutTransport(MASTER_TIMEOUT)
+            rosgraph.get_master_uri(), transport=TimeoutTransport(MASTER_TIMEOUT)
         )
         self._threads = [
             threading.Thread(target=self._receive, name=f"radio-{name}-rx", daemon=True),

@@ -26,7 +26,6 @@ import subprocess
 import sys
 import threading
 import time
-import xmlrpc.client
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
@@ -38,6 +37,7 @@ import rosmc.srv as srv
 import rospy
 
 from rosmc_server import interface
+from rosmc_server.ros.connections import publishers_count_me
 
 REPO = Path(__file__).resolve().parents[2]
 SERVER_SCRIPT = REPO / "scripts" / "mission_server"
@@ -371,20 +371,6 @@ def accepted(response: Any) -> Any:
 
 
 # -- subscribers ---------------------------------------------------------------------------
-def publishers_know_me(subscriber: Any) -> bool:
-    """Whether every publisher this ``rospy.Subscriber`` is connected to lists the connection.
-
-    Asks each publisher's node for its bus info (its XML-RPC ``getBusInfo``).
-    """
-    topic, me = subscriber.resolved_name, rospy.get_name()
-    for connection in subscriber.impl.connections:
-        node = xmlrpc.client.ServerProxy(connection.endpoint_id)
-        _, _, bus = node.getBusInfo(me)
-        if not any(row[1] == me and row[2] == "o" and row[4] == topic for row in bus):
-            return False
-    return True
-
-
 class Recorder:
     """Collects the messages of one topic, with their receive times."""
 
@@ -399,7 +385,7 @@ class Recorder:
             time.sleep(0.01)
         # The subscriber counts the connection before the publisher does: a message
         # published in between would not reach this recorder.
-        while not publishers_know_me(self._subscriber):
+        while not publishers_count_me(self._subscriber):
             assert time.monotonic() < deadline, f"the publisher of {topic} never counted us"
             time.sleep(0.01)
 

@@ -23,6 +23,7 @@ import actionlib
 import rospy
 from actionlib_msgs.msg import GoalStatus
 
+from ...ros.connections import publishers_count_me
 from ..core import Outcome, SkillContext, ThreadedSkill
 from ..core.skills import Cancelled
 from .message_fields import MessageRecipe, Template, read_field
@@ -130,7 +131,15 @@ class ActionSkill(_BoundSkill):
             return self._reply.outcome(result, _failure(state))
 
     def _server_ready(self) -> bool:
-        return bool(self._client.wait_for_server(rospy.Duration(0.1)))
+        """The server is up and will reach this client with its feedback and result.
+
+        actionlib's own check counts the result topic connected from this side only: a
+        server that finishes at once could publish its one result before it writes to us.
+        """
+        if not self._client.wait_for_server(rospy.Duration(0.1)):
+            return False
+        action = self._client.action_client
+        return publishers_count_me(action.result_sub) and publishers_count_me(action.feedback_sub)
 
     def _on_done(self, state: int, result: Any) -> None:
         self._result = (state, result)
