@@ -883,9 +883,7 @@ def test_a_snapshot_overtaken_by_newer_reports_does_not_stall_the_report_stream(
     report(3, b, S.RUNNING, began + 0.3)
     wait_until(lambda: op.mission().skill(b).status is S.RUNNING, 30.0, "report 3 to be applied")
     # The ack travels on its own topic: the mission view can show report 3 before it lands.
-    wait_until(
-        lambda: 3 in [m.seq for m in robot.received("report_ack")], 30.0, "report 3's ack"
-    )
+    wait_until(lambda: 3 in [m.seq for m in robot.received("report_ack")], 30.0, "report 3's ack")
 
 
 def test_a_new_executor_does_not_inherit_the_previous_ones_parameters(rosmc: Start) -> None:
