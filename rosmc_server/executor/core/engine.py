@@ -15,7 +15,6 @@ from __future__ import annotations
 import functools
 import logging
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
 from typing import Protocol
 
 from rosmc_server.core import SkillStatus
@@ -31,12 +30,13 @@ from rosmc_server.core.protocol import (
 )
 
 from . import commanding, queueing
-from .barrier_wait import ANNOUNCE_PERIOD, Announcements, BarrierWaits
+from .active import ActiveSkill
+from .barrier_wait import ANNOUNCE_PERIOD, BarrierWaits
 from .barriers import BarrierBoard
 from .ledger import KEPT_ACKS, CommandLog, ReportOutputs, SkillLedger
 from .lost_link import LostLinkGuard, PoseSource, no_pose
 from .progress import ProgressBox
-from .skills import Outcome, SkillBehavior, SkillContext, SkillType
+from .skills import Outcome, SkillContext, SkillType
 
 _log = logging.getLogger(__name__)
 S = SkillStatus
@@ -52,20 +52,6 @@ class EngineOutputs(ReportOutputs, Protocol):
 
     def signal(self, signal: Signal) -> None:
         """A barrier signal for the peers."""
-
-
-@dataclass
-class _Active:
-    """The skill being worked on: waiting at its barrier, running or paused."""
-
-    skill_id: str
-    behavior: SkillBehavior | None = None
-    barrier: BarrierInfo | None = None
-    paused_from: SkillStatus | None = None
-    deadline: float = 0.0
-    paused_at: float = 0.0
-    retries_used: int = 0
-    told: Announcements = field(default_factory=Announcements)  # at its barrier
 
 
 class Engine:
@@ -95,7 +81,7 @@ class Engine:
         self.board = BarrierBoard(agent)
         self.waits = BarrierWaits(agent, self.board, clock, outputs.signal)
         self.lost_link = LostLinkGuard(agent, clock, self.skill_types, pose_source)
-        self._active: _Active | None = None
+        self._active: ActiveSkill | None = None
         # Progress texts from skill threads, applied by tick() at most once a period.
         self._progress_box = ProgressBox(pace_clock or clock)
 
@@ -131,7 +117,7 @@ class Engine:
         """A peer's barrier signal: answered if this robot started there, else weighed."""
         self.waits.hear(signal)
         active = self._active
-        if active is not None and active.barrier is not None and active.behavior is None:
+        if active is not None and active.at_barrier:
             self._try_release(active)
 
     def report_acknowledged(self, seq: int) -> None:
@@ -169,7 +155,7 @@ class Engine:
             elif self.waits.reannounce_due(active.told):
                 self._announce_wait(active)
 
-    def _update_running(self, active: _Active, now: float) -> None:
+    def _update_running(self, active: ActiveSkill, now: float) -> None:
         assert active.behavior is not None
         try:
             outcome = active.behavior.update(now)
@@ -221,7 +207,7 @@ class Engine:
         """Replace the barriers the robot knows; a skill waiting at one checks again."""
         self.board.replace(barriers)
         active = self._active
-        if active is None or active.behavior is not None or active.barrier is None:
+        if active is None or not active.at_barrier:
             return
         active.barrier = self.board.barrier_of(active.skill_id)
         if active.barrier is not None and self.ledger.status(active.skill_id) is S.SYNCWAITING:
@@ -235,7 +221,7 @@ class Engine:
         upcoming = queueing.upcoming(self.ledger.queue)
         if upcoming is None or upcoming.status is S.FAILURE:
             return  # finished, or holding after a failure
-        active = _Active(upcoming.id, barrier=self.board.barrier_of(upcoming.id))
+        active = ActiveSkill(upcoming.id, barrier=self.board.barrier_of(upcoming.id))
         self._active = active
         if active.barrier is None:
             self._run(active)
@@ -246,7 +232,7 @@ class Engine:
         self._announce_wait(active)
         self._try_release(active)
 
-    def _try_release(self, active: _Active) -> None:
+    def _try_release(self, active: ActiveSkill) -> None:
         if self.mode is not Mode.STARTED:
             return  # paused or stopped: the skill waits for the operator, barrier or not
         barrier = active.barrier
@@ -257,7 +243,7 @@ class Engine:
         if self.waits.try_release(active.skill_id, barrier, active.told):
             self._run(active)
 
-    def _give_up_waiting(self, active: _Active) -> None:
+    def _give_up_waiting(self, active: ActiveSkill) -> None:
         """The wait at the barrier outlasted the skill's timeout: it fails, partners are told.
 
         No automatic retry: those re-run a skill that failed running. The robot holds
@@ -270,15 +256,15 @@ class Engine:
         self._active = None
         self.ledger.set(skill.id, S.FAILURE, text=text, finished=self.clock())
 
-    def _announce_wait(self, active: _Active) -> None:
+    def _announce_wait(self, active: ActiveSkill) -> None:
         if active.barrier is not None:
             self.waits.announce_wait(active.skill_id, active.barrier, active.told)
 
-    def _announce(self, active: _Active, kind: SignalKind) -> None:
+    def _announce(self, active: ActiveSkill, kind: SignalKind) -> None:
         if active.barrier is not None:
             self.waits.announce(active.skill_id, active.barrier, active.told, kind)
 
-    def _run(self, active: _Active) -> None:
+    def _run(self, active: ActiveSkill) -> None:
         skill = self.ledger.find(active.skill_id)
         assert skill is not None
         kind = self.skill_types[skill.skill]
@@ -302,7 +288,7 @@ class Engine:
         except Exception as error:  # a skill that cannot start fails cleanly
             self._finish(active, Outcome.failed(f"could not start: {error}"))
 
-    def _finish(self, active: _Active, outcome: Outcome) -> None:
+    def _finish(self, active: ActiveSkill, outcome: Outcome) -> None:
         skill = self.ledger.find(active.skill_id)
         assert skill is not None
         if outcome.success:
@@ -348,7 +334,7 @@ class Engine:
         active.paused_from = status
         self.ledger.set(active.skill_id, S.PAUSED, text=why)
 
-    def _resume_active(self, active: _Active) -> None:
+    def _resume_active(self, active: ActiveSkill) -> None:
         if active.deadline:  # time spent paused counts against no timeout, running or waiting
             active.deadline += self.clock() - active.paused_at
         if active.paused_from is S.RUNNING and active.behavior is not None:
@@ -363,10 +349,10 @@ class Engine:
             self._try_release(active)  # runs it if its barrier went away meanwhile
         active.paused_from = None
 
-    def _drop_active(self, active: _Active, why: str) -> None:
+    def _drop_active(self, active: ActiveSkill, why: str) -> None:
         if active.behavior is not None:
             active.behavior.cancel()
-        if active.barrier is not None and active.behavior is None:
+        if active.at_barrier:
             self._announce(active, SignalKind.WITHDRAWN)
         self._active = None
         self.ledger.set(active.skill_id, S.IDLE_SYNCHRONIZED, text=why, started=0.0)
@@ -397,7 +383,7 @@ class Engine:
         """The state for the periodic snapshot: the queue only if ``full``, its digest always."""
         active = self._active
         waiting = ""
-        if active is not None and active.barrier is not None and active.behavior is None:
+        if active is not None and active.at_barrier and active.barrier is not None:
             waiting = self.waits.summary(active.barrier)
         return Snapshot(
             self.clock(),
