@@ -41,7 +41,7 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import pytest
 from hypothesis import HealthCheck, settings
@@ -168,6 +168,30 @@ def stop_process(process: subprocess.Popen[bytes], timeout: float = STOP_TIMEOUT
         os.killpg(process.pid, signal.SIGKILL)
     with contextlib.suppress(subprocess.TimeoutExpired):
         process.wait(timeout)
+
+
+def communicate_or_stacks(
+    process: subprocess.Popen[Any], timeout: float = 30.0, output: Callable[[], str] | None = None
+) -> tuple[Any, Any]:
+    """``process.communicate(timeout)``; if it is still running after ``timeout`` s, it is
+    asked for every thread's stack (SIGUSR1: the entry scripts' faulthandler hook writes
+    them to its stderr), killed, and the test fails with the end of its stderr (or of
+    ``output()``, e.g. a terminal's screen): a hang at exit then says where it hangs.
+    """
+    try:
+        return process.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        with contextlib.suppress(ProcessLookupError):
+            process.send_signal(signal.SIGUSR1)
+        time.sleep(1.0)  # written from a signal handler: a moment is enough
+        with contextlib.suppress(ProcessLookupError):
+            process.kill()
+        _, err = process.communicate()
+        written = output() if output is not None else str(err or "")
+        raise AssertionError(
+            f"{process.args} still ran {timeout:g} s after it was told to stop; it wrote "
+            f"last:\n{written[-6000:]}"
+        ) from None
 
 
 def log_tail(path: Path, lines: int = 40) -> str:

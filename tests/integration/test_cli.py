@@ -44,7 +44,7 @@ from rosmc_server.interface import SCIENCE_TOPIC
 from rosmc_server.ros.client import MissionClient, RevisionConflict, library_from_msg
 from rosmc_server.ros.node_setup import init_node
 from rosmc_server.text import mission_to_json
-from tests.conftest import wait_until
+from tests.conftest import communicate_or_stacks, wait_until
 
 REPO = Path(__file__).resolve().parents[2]
 ROSMC = REPO / "scripts" / "rosmc"
@@ -478,7 +478,7 @@ def test_watch_stops_cleanly_on_ctrl_c(server: Server) -> None:
     state = json.loads(watcher.stdout.readline())  # agent states arrive at 2 Hz
     assert state["agent"] == "drone" and "state" in state["state"]
     watcher.send_signal(signal.SIGINT)
-    _, err = watcher.communicate(timeout=30.0)
+    _, err = communicate_or_stacks(watcher)
     assert watcher.returncode == 0, err
     assert "Traceback" not in err
 

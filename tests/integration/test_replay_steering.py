@@ -38,7 +38,7 @@ from rosmc_server.recording import read_journal
 from rosmc_server.recording.history import MissionHistory
 from rosmc_server.recording.playback import Playlist
 from rosmc_server.ros.client import MissionClient, MissionFollower
-from tests.conftest import wait_until
+from tests.conftest import communicate_or_stacks, wait_until
 from tests.integration.server_fixtures import Recorder
 from tests.ros.recording_checks import SAMPLE, unstamped
 
@@ -295,14 +295,29 @@ class Terminal:
     def cbreak(self) -> bool:
         return not termios.tcgetattr(self.slave)[3] & termios.ICANON
 
-    def close(self) -> int:
-        code = self.process.wait(30.0)
-        while select.select([self.master], [], [], 0.1)[0]:
+    def close(self, timeout: float = 30.0) -> int:
+        """Wait for the replay to end, reading the terminal meanwhile (a terminal nobody
+        reads fills up, and then the replay blocks on its next write)."""
+        deadline = time.monotonic() + timeout
+        while self.process.poll() is None and time.monotonic() < deadline:
+            self._read(deadline)
+        communicate_or_stacks(self.process, 1.0, output=self._screen)
+        self._read(time.monotonic() + 1.0)
+        return self.process.returncode
+
+    def _read(self, until: float) -> None:
+        """Add what the terminal shows to ``output`` until nothing comes for 0.1 s (or
+        ``until``)."""
+        while time.monotonic() < until and select.select([self.master], [], [], 0.1)[0]:
             try:
                 self.output += os.read(self.master, 65536)
-            except OSError:
-                break
-        return code
+            except OSError:  # the replay closed the terminal: nothing more to read
+                return
+
+    def _screen(self) -> str:
+        """Everything the terminal showed, with what was still to be read."""
+        self._read(time.monotonic() + 1.0)
+        return self.output.decode(errors="replace")
 
     def kill(self) -> None:
         if self.process.poll() is None:
