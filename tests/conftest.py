@@ -77,6 +77,11 @@ def pytest_configure(config: pytest.Config) -> None:
     for profile, chosen in HYPOTHESIS_PROFILES.items():
         settings.register_profile(profile, chosen)
     settings.load_profile(name)
+    # A suite started as a background job of a non-interactive shell (`cmd &` in a script,
+    # nohup) inherits SIGINT ignored, and so would every process it starts: the tests'
+    # Ctrl-C would go unheard, and stopping a launch (SIGINT first) would wait for SIGKILL.
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:
