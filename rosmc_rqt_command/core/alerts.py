@@ -2,8 +2,8 @@
 
 * A synchronized barrier member whose partner is still in the blueprint: the robot will
   wait at the barrier for ever unless the partner is sent too.
-* A robot about to leave Wi-Fi coverage (weak signal) while it still has planned work
-  that is not on board: once out of range it cannot receive it.
+* A robot about to leave Wi-Fi coverage (weak signal), or out of it, while it still has
+  planned work not sent: once out of range, what is sent waits until it is heard again.
 * A skill whose parameter the library marks invalid (out of range, wrong type).
 
 No Qt here.
@@ -38,20 +38,27 @@ def barrier_warnings(view: MissionView, sending: Sequence[SkillInstance] = ()) -
 
 
 def coverage_warnings(view: MissionView) -> list[str]:
-    """Robots with a weak or lost Wi-Fi signal that still have planned work not on board."""
+    """Robots with a weak or lost Wi-Fi signal that still have planned work not sent.
+
+    Skills already sent (uploading, or waiting for contact) are not counted: they go out
+    by themselves once the robot is heard, and the robot's header says so.
+    """
     out = []
     for agent, status in view.statuses.items():
-        planned = len(view.view(agent).blueprint)
-        if not planned or status.wifi_signal is None:
+        task = view.view(agent)
+        unsent = len(task.skills) - task.editable_start
+        if not unsent or status.wifi_signal is None:
             continue
+        skills = f"{unsent} planned skill{'' if unsent == 1 else 's'}"
         if not status.in_coverage:
             out.append(
-                f"{agent} is out of Wi-Fi range; its {planned} planned skills cannot be sent."
+                f"{agent} is out of Wi-Fi range with {skills} not on board; what you send "
+                "now waits until it is heard again."
             )
         elif status.wifi_signal < WEAK_WIFI_DBM:
             out.append(
                 f"{agent} is about to leave Wi-Fi range ({status.wifi_signal:.0f} dBm) "
-                f"with {planned} planned skills not on board; send them now."
+                f"with {skills} not on board; send them now."
             )
     return out
 

@@ -69,7 +69,8 @@ def test_a_member_on_the_robot_with_its_partner_planned_is_a_standing_warning(gu
     [
         (-50.0, True, 2, None),
         (-80.0, True, 2, "alpha is about to leave Wi-Fi range (-80 dBm) with 2 planned skills"),
-        (-95.0, False, 1, "alpha is out of Wi-Fi range; its 1 planned skills cannot be sent."),
+        (-80.0, True, 1, "alpha is about to leave Wi-Fi range (-80 dBm) with 1 planned skill "),
+        (-95.0, False, 1, "alpha is out of Wi-Fi range with 1 planned skill not on board; what"),
         (-80.0, True, 0, None),  # nothing planned: nothing to lose
         (None, False, 2, None),  # no telemetry yet: no guess
     ],
@@ -93,6 +94,24 @@ def test_a_robot_leaving_coverage_with_planned_work(
     else:
         assert len(warnings) == 1 and warnings[0].startswith(expected), warnings
         assert gui.widget.messages.warnings == warnings
+
+
+def test_skills_sent_while_out_of_range_are_not_counted_again(gui: Gui) -> None:
+    """Sent out of range, they wait for contact (the header says so): no alert about them."""
+    feed = gui.feed
+    waiting = feed.add("alpha")
+    feed.add("alpha")
+    out_of_range = AgentStatus(
+        "alpha", link="down", wifi_signal=-95.0, in_coverage=False, battery=0.5
+    )
+    feed.statuses(out_of_range)
+    feed.sync("alpha", waiting, confirm=False)  # held for contact: no answer from the robot
+    assert alerts.coverage_warnings(gui.widget.view) == [
+        "alpha is out of Wi-Fi range with 1 planned skill not on board; what you send now "
+        "waits until it is heard again."
+    ]
+    feed.sync("alpha", confirm=False)
+    assert alerts.coverage_warnings(gui.widget.view) == []
 
 
 def stricter(library_data: dict[str, Any]) -> Library:

@@ -1155,6 +1155,23 @@ def test_safe_skill_runs_then_holds(robot: Robot) -> None:
     assert robot.status("a") is S.PAUSED and robot.status("b") is S.IDLE_SYNCHRONIZED
     robot.send(K.RESUME)
     assert robot.status("a") is S.RUNNING
+    assert "holding" not in robot.engine.snapshot().policy  # what it did is over
+
+
+def test_a_robot_started_while_its_safe_skill_runs_goes_on_after_it(robot: Robot) -> None:
+    argument = json.dumps(
+        {"lost_link": {"policy": "safe_skill", "after": 2, "skill": "home", "params": {}}}
+    )
+    robot.send(K.SET_OPTIONS, argument=argument)
+    robot.upload(make_skill("a", params={"duration": 20.0}))
+    robot.send(K.START)
+    robot.run_for(2.05)
+    robot.send(K.START)  # the operator, heard again, has it go on
+    assert robot.engine.state_name() == "contingency"
+    assert robot.engine.lost_link.note.startswith("ran 'home'")
+    robot.run_for(1.0)
+    assert robot.status("a") is S.RUNNING
+    assert robot.engine.lost_link.note == ""
 
 
 def test_safe_skill_is_not_run_with_nothing_to_do(robot: Robot) -> None:

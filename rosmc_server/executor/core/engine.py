@@ -143,7 +143,9 @@ class Engine:
             self.outputs.changed()
         if self.lost_link.step(now):
             self.outputs.changed()
-            self.advance()  # an operator who started the robot meanwhile has it go on
+            if self.mode is Mode.STARTED:  # an operator started it meanwhile: it goes on
+                self.lost_link.operator_took_over()
+                self.advance()
         active = self._active
         if active is None:
             return
@@ -192,6 +194,7 @@ class Engine:
     def start(self) -> None:
         """Execute: a paused skill resumes (or waits at its barrier again), else the next starts."""
         self.mode = Mode.STARTED
+        self.lost_link.operator_took_over()
         active = self._active
         if active is not None and self.ledger.status(active.skill_id) is S.PAUSED:
             self._resume_active(active)

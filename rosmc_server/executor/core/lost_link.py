@@ -113,6 +113,12 @@ class LostLinkGuard:
         self.note += "; ground contact is back"
         return True
 
+    def operator_took_over(self) -> None:
+        """The robot was started again: what the policy did is over (its note would still
+        say "holding"), unless its skill still runs (its note says so)."""
+        if self.contingency is None:
+            self.note = ""
+
     def observe(self, now: float) -> None:
         """Remember where the robot is, at most every :data:`POSE_SAMPLE_PERIOD` s."""
         if not self._recent or now - self._recent[-1][0] >= POSE_SAMPLE_PERIOD:
