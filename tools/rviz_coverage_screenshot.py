@@ -70,7 +70,8 @@ def take(args: argparse.Namespace) -> int:
         operator.wait_for(lambda: getattr(state(), "link", "") == "up", f"{ROBOT}'s link", 60.0)
         display = stack.enter_context(shots.virtual_screen(*args.size))
         env = shots.rviz_environment(display, os.environ)
-        rviz = stack.enter_context(shots.running_rviz(operator.CONFIG, env, home / "rviz.log"))
+        started = shots.drawn_rviz(operator.CONFIG, env, home / "rviz.log", check, attempts=3)
+        rviz = stack.enter_context(started).process  # restarted if it dies at start-up
         client = MissionClient(timeout=30.0)
         stack.callback(client.close)
         client.get_mission()

@@ -225,7 +225,8 @@ def take(args: argparse.Namespace) -> int:
             config = shots.with_saved_view(CONFIG, args.view, home)
         display = stack.enter_context(shots.virtual_screen(*args.size))
         env = shots.rviz_environment(display, os.environ)
-        rviz = stack.enter_context(shots.running_rviz(config, env, home / "rviz.log"))
+        started = shots.drawn_rviz(config, env, home / "rviz.log", check, attempts=3)
+        rviz = stack.enter_context(started).process  # restarted if it dies at start-up
         client = MissionClient(timeout=30.0)
         stack.callback(client.close)
         ids = plan_mission(client)

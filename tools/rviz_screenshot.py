@@ -420,29 +420,75 @@ def take_screenshot(
     check = check or DrawnCheck()
     with contextlib.ExitStack() as stack:
         scratch = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="rviz_")))
-        log = log or scratch / "log"
         if view is not None:
             config = with_saved_view(config, view, scratch)
         display = stack.enter_context(virtual_screen(*size))
         rviz_env = rviz_environment(display, env or os.environ)
-        crash = ""
-        for attempt in range(1, attempts + 1):
-            with running_rviz(config, rviz_env, log) as rviz:
-                try:
-                    shot, problems = _wait_until_drawn(display, rviz, check, timeout, log)
-                except _RvizCrashed as error:
-                    crash = str(error)
-                    continue
-                if problems and attempt < attempts:
-                    continue
-                if not problems and settle > 0:
-                    time.sleep(settle)
-                    shot = grab(display)
-                    problems = check.problems(shot)
-            shot.write_png(output)
-            return Result(shot=shot, problems=problems, display=display, attempts=attempt)
-        raise ScreenshotError(f"rviz crashed on all {attempts} attempts; the last:\n{crash}")
+        started = stack.enter_context(
+            drawn_rviz(
+                config, rviz_env, log or scratch / "log", check, timeout=timeout, attempts=attempts
+            )
+        )
+        shot, problems = started.shot, started.problems
+        if not problems and settle > 0:
+            time.sleep(settle)
+            shot = grab(display)
+            problems = check.problems(shot)
+        shot.write_png(output)
+        return Result(shot=shot, problems=problems, display=display, attempts=started.attempts)
     raise AssertionError("unreachable")  # ExitStack could swallow exceptions, for mypy
+
+
+@dataclass(frozen=True)
+class StartedRviz:
+    """What :func:`drawn_rviz` yields.
+
+    Attributes:
+        process: The running rviz.
+        shot: The screenshot that showed it drawn (or the last one, with ``problems``).
+        problems: Why ``shot`` does not count as drawn (empty: rviz drew).
+        attempts: How many times rviz was started.
+    """
+
+    process: subprocess.Popen[bytes]
+    shot: Screenshot
+    problems: list[str]
+    attempts: int
+
+
+@contextlib.contextmanager
+def drawn_rviz(
+    config: Path,
+    env: Mapping[str, str],
+    log: Path,
+    check: DrawnCheck,
+    *,
+    timeout: float = 45.0,
+    attempts: int = 2,
+) -> Iterator[StartedRviz]:
+    """rviz with ``config`` on ``env["DISPLAY"]``, once it has drawn; stopped afterwards.
+
+    rviz that crashes before it draws, or does not draw within ``timeout`` seconds, is
+    started again, up to ``attempts`` times in all; the last one that does not draw in
+    time is yielded with its ``problems``. ``log`` receives the output of the last rviz.
+
+    Raises:
+        ScreenshotError: rviz crashed on every attempt.
+    """
+    display = env["DISPLAY"]
+    crash = ""
+    for attempt in range(1, attempts + 1):
+        with running_rviz(config, env, log) as rviz:
+            try:
+                shot, problems = _wait_until_drawn(display, rviz, check, timeout, log)
+            except _RvizCrashed as error:
+                crash = str(error)
+                continue
+            if problems and attempt < attempts:
+                continue
+            yield StartedRviz(process=rviz, shot=shot, problems=problems, attempts=attempt)
+            return
+    raise ScreenshotError(f"rviz crashed on all {attempts} attempts; the last:\n{crash}")
 
 
 class _RvizCrashed(Exception):

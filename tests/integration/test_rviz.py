@@ -175,6 +175,35 @@ def _leftovers(master_uri: str) -> list[str]:
     return found
 
 
+@pytest.mark.usefixtures("gui_programs")
+def test_rviz_that_dies_at_start_up_is_started_again(ros_master: RosMaster, tmp_path: Path) -> None:
+    """The first rviz dies of SIGSEGV before it draws (as Mesa's now and then does)."""
+    wrappers, crashed = tmp_path / "bin", tmp_path / "crashed"
+    wrappers.mkdir()
+    rviz = wrappers / "rviz"
+    real = shutil.which("rviz")
+    rviz.write_text(
+        f"#!/bin/sh\nif [ ! -e {crashed} ]; then touch {crashed}; kill -SEGV $$; fi\n"
+        f'exec {real} "$@"\n'
+    )
+    rviz.chmod(0o755)
+    env = {**ros_master.env, "PATH": f"{wrappers}{os.pathsep}{ros_master.env['PATH']}"}
+    result = subprocess.run(
+        [
+            *(sys.executable, str(TOOL), "--config", str(CONFIG), "--output", tmp_path / "a.png"),
+            *("--timeout", "40", "--settle", "0", "--attempts", "2", "--min-colors", "8"),
+        ],  # no sim: the grid alone counts as drawn
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert crashed.exists(), "the wrapper did not run"
+    assert result.returncode == 0, f"{result.stdout}\n{result.stderr}"
+    assert "rviz started 2 time(s)" in result.stdout, result.stdout
+
+
 @pytest.mark.usefixtures("gui_programs", "sim")
 def test_rviz_draws_the_site_under_xvfb(ros_master: RosMaster, tmp_path: Path) -> None:
     config = load_config()
