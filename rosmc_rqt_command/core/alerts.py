@@ -16,6 +16,7 @@ import time
 from collections.abc import Iterable, Sequence
 
 from rosmc_server.core import Library, RosmcError, SkillInstance, SkillStatus
+from rosmc_server.core.vocabulary import counted
 
 from .mission_view import MissionView
 
@@ -49,7 +50,7 @@ def coverage_warnings(view: MissionView) -> list[str]:
         unsent = len(task.skills) - task.editable_start
         if not unsent or status.wifi_signal is None:
             continue
-        skills = f"{unsent} planned skill{'' if unsent == 1 else 's'}"
+        skills = counted(unsent, "planned skill")
         if not status.in_coverage:
             out.append(
                 f"{agent} is out of Wi-Fi range with {skills} not on board; what you send "

@@ -13,6 +13,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from rosmc_server.core import SkillInstance
+from rosmc_server.core.vocabulary import counted
 
 from . import alerts
 from .mission_view import MissionView
@@ -41,7 +42,9 @@ class TeamSend:
         for agent, skills in self.sending.items():
             last = skills[-1]
             how = "its whole task" if self.uploads[agent] is None else "up to"
-            out.append(f"{agent}: {len(skills)} skill(s), {how} '{last.label or last.skill}'")
+            out.append(
+                f"{agent}: {counted(len(skills), 'skill')}, {how} '{last.label or last.skill}'"
+            )
         return out
 
 

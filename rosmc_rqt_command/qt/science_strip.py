@@ -12,6 +12,7 @@ from html import escape
 from python_qt_binding.QtWidgets import QLabel, QWidget
 
 from rosmc_server.core.science import IDENTIFIED_WORDS, Science
+from rosmc_server.core.vocabulary import counted
 
 NO_SCORE = "Science: no score published"
 _MARK = {"": "○", "science_rover": "◐", "collaborative": "●"}
@@ -37,7 +38,7 @@ class ScienceStrip(QLabel):  # type: ignore[misc]
             return
         parts = [
             f"<b>Science score {science.score:.2f}</b>",
-            f"{science.stones_delivered} stone(s) delivered to the lander",
+            f"{counted(science.stones_delivered, 'stone')} delivered to the lander",
         ]
         for r in science.regions:
             parts.append(

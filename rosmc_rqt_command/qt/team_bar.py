@@ -21,6 +21,8 @@ from python_qt_binding.QtWidgets import (
     QWidget,
 )
 
+from rosmc_server.core.vocabulary import counted
+
 from ..core.mission_view import MissionView
 from ..core.team_filter import StatusFilter, TeamFilter, visible_agents
 from .task_widget import TaskWidget
@@ -108,7 +110,7 @@ class TeamBar(QWidget):  # type: ignore[misc]
         for agent, column in self._tasks.columns.items():
             column.set_compact(compact)
             column.setVisible(agent in shown)
-        self.count.setText(f"{len(shown)} of {len(agents)} robots shown")
+        self.count.setText(f"{len(shown)} of {counted(len(agents), 'robot')} shown")
         self.count.setStyleSheet("QLabel { color:#8a0010; }" if self.chosen.active else "")
 
     def visible(self) -> list[str]:

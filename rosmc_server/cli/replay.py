@@ -159,6 +159,7 @@ def at(ctx: Context) -> int:
 
 def timeline(ctx: Context) -> int:
     """Draw the recording's per-robot timeline into an SVG or PNG file."""
+    from ..core.vocabulary import counted
     from ..recording.overlays import timeline_with_overlays
     from ..recording.timeline_svg import write_timeline
 
@@ -171,8 +172,8 @@ def timeline(ctx: Context) -> int:
     path = write_timeline(drawn, ctx.args.output, title)
     runs = len(drawn.intervals)
     ctx.emit(
-        f"wrote {path}: {len(drawn.lanes)} robots, {runs} bars, "
-        f"{len(drawn.releases)} barrier releases",
+        f"wrote {path}: {counted(len(drawn.lanes), 'robot')}, {counted(runs, 'bar')}, "
+        f"{counted(len(drawn.releases), 'barrier release')}",
         {"path": str(path), "robots": list(drawn.lanes), "bars": runs},
     )
     return 0

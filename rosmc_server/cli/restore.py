@@ -40,6 +40,7 @@ def restore(ctx: Context) -> int:
     import sys
 
     from ..core.persistence import dump_mission
+    from ..core.vocabulary import counted
     from ..recording.diff import resolve_when
     from ..recording.history import MissionHistory
     from ..recording.restore import blueprint_from
@@ -53,7 +54,7 @@ def restore(ctx: Context) -> int:
     result = ctx.client.load_mission(document, **ctx.against())
     text = (
         f"revision {result.revision}: restored {history.path.name} at {moment.label} "
-        f"(r{moment.state.revision}) as a blueprint of {restored.kept} skills"
+        f"(r{moment.state.revision}) as a blueprint of {counted(restored.kept, 'skill')}"
     )
     if restored.dropped:
         text += f"; dropped {len(restored.dropped)} executed: {', '.join(restored.dropped)}"

@@ -25,6 +25,7 @@ from .legality import (
 from .model import Resolution, SkillInstance, SkillStatus, Transfer, skill_with
 from .state import MissionState
 from .validation import clip_status_text, excerpt
+from .vocabulary import counted
 
 S = SkillStatus
 
@@ -60,7 +61,7 @@ def plan_synchronize(state: MissionState, agent: str, upto_id: str | None) -> Pr
     return Proposal(
         EventKind.SYNC_REQUESTED,
         agent,
-        f"uploading {len(puts)} skill(s) to {agent}: {_ids(editable)}",
+        f"uploading {counted(len(puts), 'skill')} to {agent}: {_ids(editable)}",
         Change(put_skills=puts),
     )
 

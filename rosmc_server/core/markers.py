@@ -21,6 +21,7 @@ from .model import SkillInstance, TaskMarker
 from .params import MarkerType, Pose
 from .state import MissionState
 from .validation import MAX_NAME, check_corners, check_one_line
+from .vocabulary import counted
 
 _NAME_NUMBER = re.compile(r"(\d+)$")
 
@@ -100,7 +101,7 @@ def plan_move_marker(
         values = dict(skill.params)
         values.update(bound_values(find_marker, spec, names))
         puts.append(PlacedSkill(state.locate(skill.id)[1], replace(skill, params=values)))
-    follow = f"; {len(puts)} bound skill(s) follow" if puts else ""
+    follow = f"; {counted(len(puts), 'bound skill')} follow" if puts else ""
     return Proposal(
         EventKind.MARKER_MOVED,
         "",

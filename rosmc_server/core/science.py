@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from .vocabulary import counted
+
 # Who identified a region's stones, as the operator reads it.
 IDENTIFIED_WORDS = {
     "": "not identified",
@@ -33,7 +35,7 @@ class RegionScience:
         how = IDENTIFIED_WORDS.get(self.identified_by, f"identified by {self.identified_by}")
         return (
             f"{self.name} at ({self.x:g}, {self.y:g}): {how}, "
-            f"{self.stones_left} stone(s) left (best {self.max_score:g})"
+            f"{counted(self.stones_left, 'stone')} left (best {self.max_score:g})"
         )
 
 
@@ -49,7 +51,7 @@ class Science:
         """One line: the score and what was delivered and discovered."""
         found = ", ".join(r.name for r in self.regions) or "none yet"
         return (
-            f"science score {self.score:.2f}: {self.stones_delivered} stone(s) delivered "
+            f"science score {self.score:.2f}: {counted(self.stones_delivered, 'stone')} delivered "
             f"to the lander; regions discovered: {found}"
         )
 

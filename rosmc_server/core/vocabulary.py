@@ -118,3 +118,11 @@ def percent(fraction: float) -> str:
 def dbm(signal: float) -> str:
     """A radio signal strength: ``-54 dBm``."""
     return f"{signal:.0f} dBm"
+
+
+def counted(count: int, noun: str, plural: str = "") -> str:
+    """A count and its noun, plural unless the count is one: ``1 skill``, ``0 stones``.
+
+    ``plural`` is for nouns that do not just take an ``s``.
+    """
+    return f"{count} {noun if count == 1 else plural or noun + 's'}"

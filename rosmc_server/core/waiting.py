@@ -29,6 +29,7 @@ from typing import Any, Protocol, TypeVar
 
 from .commands import CommandKind
 from .link import Outbox, Outgoing
+from .vocabulary import counted
 
 MAX_WAITING = 50  # unsent commands per robot; more is refused before the mission changes
 
@@ -142,9 +143,8 @@ def waiting_text(count: int, seconds: float) -> str:
     """``2 commands waiting for contact 3 min`` (the oldest's age); "" if none waits."""
     if count <= 0:
         return ""
-    what = "1 command" if count == 1 else f"{count} commands"
     age = f" {duration_text(seconds)}" if seconds >= 0 else ""
-    return f"{what} waiting for contact{age}"
+    return f"{counted(count, 'command')} waiting for contact{age}"
 
 
 def queued_notes(waiting: Iterable[tuple[str, bool, float]]) -> list[str]:

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from rosmc_server.core.vocabulary import counted
 from rosmc_server.recording.damage import Damage, skipped_line
 from rosmc_server.recording.high_water import Mark, next_after_loss
 from rosmc_server.recording.reader import LatestState
@@ -107,7 +108,7 @@ class ResumeReport:
         if not self.gaps and not self.lost_at_end:
             count = len(self.damage)
             return (
-                f"journal: {count} damaged byte range{'s' if count > 1 else ''} skipped at "
+                f"journal: {counted(count, 'damaged byte range')} skipped at "
                 f"resume, no revision lost, see {self.path}"
             )
         ranges = [str(gap.revisions) for gap in self.gaps]
@@ -120,7 +121,7 @@ class ResumeReport:
             how = f"the mission resumed at r{self.resumed_at}, next revision r{self.next_revision}"
         else:
             how = f"the mission is intact from the snapshot of r{self.gaps[-1].resumed_at}"
-        lost = f"{self.lost} revision{'s' if self.lost > 1 else ''}"
+        lost = counted(self.lost, "revision")
         return f"journal: {lost} lost at resume ({shown}: {how}), see {self.path}"
 
     def _mission_lost(self) -> bool:

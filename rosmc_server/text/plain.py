@@ -24,7 +24,7 @@ from ..core import (
     Value,
 )
 from ..core.agent_status import AgentStatus
-from ..core.vocabulary import STATUS_MARKS, dbm, number, percent
+from ..core.vocabulary import STATUS_MARKS, counted, dbm, number, percent
 
 _RULE = "    " + "-" * 56
 
@@ -92,7 +92,7 @@ def format_agent_status(status: AgentStatus | None) -> str:
     if status.round_trip >= 0:
         details.append(f"round trip {status.round_trip * 1000:.0f} ms")
     if status.commands_in_flight and not status.commands_waiting:
-        details.append(f"{status.commands_in_flight} command(s) in flight")
+        details.append(f"{counted(status.commands_in_flight, 'command')} in flight")
     if status.hash_mismatch:
         details.append("repairing queue")
     parts = [f"{link} ({', '.join(details)})" if details else link]

@@ -34,7 +34,7 @@ import rospy
 
 from rosmc_server.core import MarkerType, Pose, RosmcError, SkillStatus, TaskMarker
 from rosmc_server.core.changes import EventKind
-from rosmc_server.core.vocabulary import OPERATOR_EVENTS
+from rosmc_server.core.vocabulary import OPERATOR_EVENTS, counted
 from rosmc_server.ros.client import ControlCommand, MissionClient, MissionWatch
 from rosmc_server.ros.station import launch_path
 
@@ -205,7 +205,9 @@ class DemoOperator:
             science = self.science
         lines = ["", "=== Demo mission summary ==="]
         if science is not None:
-            lines.append(f"score: {science.score:.2f} from {science.stones_delivered} stone(s)")
+            lines.append(
+                f"score: {science.score:.2f} from {counted(science.stones_delivered, 'stone')}"
+            )
             lines += [f"  {line}" for line in science.events]
         lines.append(
             f"sim time: {rospy.get_time() - self.started_sim:.1f} s, "
@@ -213,7 +215,7 @@ class DemoOperator:
         )
         for agent in mission.agents:
             done = [s.skill for s in mission.task(agent) if s.status is SkillStatus.SUCCESS]
-            lines.append(f"{agent}: {len(done)} skill(s) executed: {', '.join(done)}")
+            lines.append(f"{agent}: {counted(len(done), 'skill')} executed: {', '.join(done)}")
         changes = sum(n for kind, n in self.events.items() if kind in OPERATOR_EVENTS)
         lines.append(f"operator changes: {changes}; mission revision {mission.revision}")
         return "\n".join(lines)

@@ -26,7 +26,7 @@ from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
 from rosmc_rviz_markers.core.labels import CHAR_WIDTH
-from rosmc_server.core.vocabulary import PALETTE
+from rosmc_server.core.vocabulary import PALETTE, counted
 from rosmc_server.interface import MAP_FRAME
 
 from ..core.sim import LEVEL_COLLABORATIVE, LEVEL_SCIENCE, Simulation
@@ -178,7 +178,7 @@ def _science_markers(sim: Simulation) -> list[Marker]:
         out.append(label)
     score = _marker("score", 0, Marker.TEXT_VIEW_FACING, 0.0, 0.0, SCORE_HEIGHT)
     score.scale.z = SCORE_TEXT
-    score.text = f"science score {sim.score:.2f}\n{sim.delivered} stone(s) delivered"
+    score.text = f"science score {sim.score:.2f}\n{counted(sim.delivered, 'stone')} delivered"
     out.append(score)
     discovered = {name for name, r in sim.regions.items() if r.discovered}
     for i, stone in enumerate(sim.stones.values()):

@@ -645,8 +645,8 @@ def test_status_prints_the_science_score_when_published(
         publisher.publish(science_to_msg(Science(1.0, 1, (region,))))
         lines = rosmc(server, "status").splitlines()
         assert lines[1:3] == [
-            "science score 1.00: 1 stone(s) delivered to the lander; regions discovered: RSS A",
-            "  RSS A at (16, 9): identified by both rovers, 2 stone(s) left (best 1)",
+            "science score 1.00: 1 stone delivered to the lander; regions discovered: RSS A",
+            "  RSS A at (16, 9): identified by both rovers, 2 stones left (best 1)",
         ], lines
         science = status(server)["science"]
         assert (science["score"], science["stones_delivered"]) == (1.0, 1), science

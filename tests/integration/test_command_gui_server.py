@@ -342,7 +342,7 @@ def test_a_two_robot_barrier_plan_goes_out_with_one_click_and_one_question(
         questions.stop()
     assert len(questions.asked) == 2, questions.asked
     team = questions.asked[1]
-    assert "drone: 2 skill(s), its whole task" in team and "science_rover: 2 skill(s)" in team
+    assert "drone: 2 skills, its whole task" in team and "science_rover: 2 skills" in team
     assert "Warnings" not in team, team
     assert f"(revision {before + 1})" in message, message
     wait_until(
@@ -374,10 +374,10 @@ def test_the_science_score_is_in_view_once_published(
     finally:
         publisher.unregister()
     text = strip.text()
-    assert "Science score 1.10" in text and "2 stone(s) delivered" in text, text
+    assert "Science score 1.10" in text and "2 stones delivered" in text, text
     assert "RSS A (16, 9): identified by both rovers, 1 left" in text, text
     assert "RSS B (30, -16): not identified, 2 left" in text, text
-    assert "RSS B at (30, -16): not identified, 2 stone(s) left (best 0.8)" in strip.toolTip()
+    assert "RSS B at (30, -16): not identified, 2 stones left (best 0.8)" in strip.toolTip()
 
 
 def test_the_site_map_in_force_and_its_sender_are_in_view(

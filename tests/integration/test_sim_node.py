@@ -297,7 +297,7 @@ def test_fly_over_discovers_a_region(sim: dict[str, Robot]) -> None:
         # The site says what the science stands at: each region's label and the score.
         texts = {m.ns: m.text for m in world.last.markers if m.type == m.TEXT_VIEW_FACING}
         assert texts["region_labels"] == "RSS A (max 1)\nnot identified, 3 left", texts
-        assert texts["score"] == "science score 0.00\n0 stone(s) delivered", texts
+        assert texts["score"] == "science score 0.00\n0 stones delivered", texts
     finally:
         science.close()
         world.close()

@@ -397,9 +397,9 @@ def test_the_science_state_survives_and_reads_as_sentences() -> None:
     )
     assert science_from_msg(over_the_wire(science_to_msg(science))) == science
     assert science.lines() == [
-        "science score 0.85: 2 stone(s) delivered to the lander; regions discovered: RSS A, RSS B",
-        "  RSS A at (16, 9): identified by both rovers, 1 stone(s) left (best 1)",
-        "  RSS B at (30, -16): not identified, 2 stone(s) left (best 0.8)",
+        "science score 0.85: 2 stones delivered to the lander; regions discovered: RSS A, RSS B",
+        "  RSS A at (16, 9): identified by both rovers, 1 stone left (best 1)",
+        "  RSS B at (30, -16): not identified, 2 stones left (best 0.8)",
     ]
 
 

@@ -45,7 +45,7 @@ def test_send_all_robots_asks_once_and_sends_every_plan_in_one_request(gui: Gui)
     QTest.mouseClick(button, Qt.LeftButton)  # answered Yes
     assert len(asked) == 2
     text, warnings = asked[0]
-    assert "alpha: 2 skill(s), its whole task" in text and "bravo: 2 skill(s)" in text, text
+    assert "alpha: 2 skills, its whole task" in text and "bravo: 2 skills" in text, text
     assert warnings == []  # every barrier member goes: nobody waits for ever
     assert gui.backend.operations() == ["synchronize_team"]
     assert gui.backend.requests[0].args == ({"alpha": None, "bravo": None},)

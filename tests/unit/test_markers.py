@@ -106,7 +106,7 @@ def bound(mission: Any, drv: Any) -> dict[str, str]:
 def test_move_updates_bound_parameters(mission: Any, accepted: Any, bound: Any) -> None:
     new_pose = Pose(5.0, 6.0, 0.0, 0.0, 0.0, 1.0)
     event = accepted(mission, EventKind.MARKER_MOVED, mission.move_marker, "goal", new_pose)
-    assert "2 bound skill(s)" in event.summary
+    assert "2 bound skills" in event.summary
     assert mission.state.marker("goal").pose == new_pose
     for skill_id in (bound["move"], bound["move2"]):
         assert mission.state.skill(skill_id).params["target"] == new_pose

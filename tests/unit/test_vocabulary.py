@@ -22,6 +22,7 @@ from rosmc_server.core.vocabulary import (
     STATUS_COLOURS,
     STATUS_MARKS,
     STATUS_WORDS,
+    counted,
     number,
     rgb,
 )
@@ -97,3 +98,18 @@ def test_rviz_paints_bodies_with_the_simulators_palette() -> None:
     for kind in ("drone", "science_rover", "manipulator_rover", "lander"):
         body = geometry.BODY_COLORS[geometry.body_kind(kind)]
         assert (body.r, body.g, body.b, body.a) == PALETTE[kind]
+
+
+@pytest.mark.parametrize(
+    ("count", "noun", "plural", "text"),
+    [
+        (1, "skill", "", "1 skill"),
+        (0, "stone", "", "0 stones"),
+        (2, "planned skill", "", "2 planned skills"),
+        (3, "damaged byte range", "", "3 damaged byte ranges"),
+        (2, "barrier release", "", "2 barrier releases"),
+        (2, "batch", "batches", "2 batches"),
+    ],
+)
+def test_counts_take_the_plural_unless_one(count: int, noun: str, plural: str, text: str) -> None:
+    assert counted(count, noun, plural) == text
