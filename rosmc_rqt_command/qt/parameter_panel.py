@@ -122,6 +122,7 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
             self._clear_editors()
             for label in self.facts.values():
                 label.setText("")
+            self._show_options(None)
             self._enable(False)
             return
         self._spec = self._spec_of(skill)
@@ -137,12 +138,7 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
         }
         for name, text in facts.items():
             self.facts[name].setText(text)
-        if not self.label_edit.hasFocus():
-            self.label_edit.setText(skill.label)
-        if not self.timeout_spin.hasFocus():
-            self.timeout_spin.setValue(skill.timeout)
-        if not self.retries_spin.hasFocus():
-            self.retries_spin.setValue(skill.max_retries)
+        self._show_options(skill)
         if rebuild:
             self._build_editors()
         self._fill_editors()
@@ -154,6 +150,19 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
             newest = self._view.skill(self.skill.id)
             if force or newest is not self.skill:
                 self.show_skill(newest)
+
+    def _show_options(self, skill: SkillInstance | None) -> None:
+        """The label, time limit and retries of ``skill``; blank for none (not the last
+        skill's, which would pass for the selection's). A field being typed in is kept."""
+        values = (None, None) if skill is None else (skill.timeout, skill.max_retries)
+        if not self.label_edit.hasFocus():
+            self.label_edit.setText("" if skill is None else skill.label)
+        for spin, value in zip((self.timeout_spin, self.retries_spin), values, strict=True):
+            if spin.hasFocus():
+                continue
+            # Blank: the box's minimum (far below any allowed value) shown as a space.
+            spin.setSpecialValueText(" " if value is None else "")
+            spin.setValue(spin.minimum() if value is None else value)
 
     def _spec_of(self, skill: SkillInstance) -> SkillSpec | None:
         library = self._view.library

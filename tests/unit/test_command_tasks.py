@@ -155,6 +155,23 @@ def test_selection_follows_skills_across_updates(gui: Gui) -> None:
     assert gui.widget.tasks.selected_ids == [ids[1]]
 
 
+def test_several_selected_show_no_skills_label_or_options(gui: Gui) -> None:
+    feed = gui.feed
+    first, second = feed.add("alpha", "move"), feed.add("alpha", "move")
+    feed("edit_skill", first, label="sample the crater rim", timeout=30.0, max_retries=2)
+    panel = gui.widget.parameters
+    gui.click_row("alpha", True, 0)
+    assert panel.label_edit.text() == "sample the crater rim"
+    assert (panel.timeout_spin.text(), panel.retries_spin.text()) == ("30.00 s", "2")
+    gui.click_row("alpha", True, 1, Qt.ControlModifier)
+    assert gui.widget.tasks.selected_ids == [first, second]
+    assert panel.label_edit.text() == "", "the first skill's label passes for the selection's"
+    assert (panel.timeout_spin.text(), panel.retries_spin.text()) == (" ", " ")
+    gui.click_row("alpha", True, 1)  # the other one alone: its own values, zeros shown
+    assert panel.label_edit.text() == "move"
+    assert (panel.timeout_spin.text(), panel.retries_spin.text()) == ("0.00 s", "0")
+
+
 def test_ctrl_click_selects_across_columns_and_a_plain_click_lets_go(gui: Gui) -> None:
     feed = gui.feed
     a = [feed.add("alpha", "move") for _ in range(2)]
