@@ -28,7 +28,18 @@ BUILD := build
 # ROS 1 from Debian (actionlib for skills bound to action servers), message generation, Qt
 # bindings; rviz, a virtual screen and imagemagick for the GUIs and their screenshots; xdotool
 # drives them with a real mouse in tests; rostest's CMake module (add_rostest), rosdep,
-# catkin_lint and catkin_tools (`catkin build`).
+# catkin_lint and catkin_tools (`catkin build`). ROSDEP_PACKAGES is what rosdep resolves the
+# keys of package.xml to on Debian beyond those (the C++ halves of the ROS packages, the
+# message definitions a lab's own message or action package builds against): with them
+# `rosdep check --from-paths src --ignore-src` is clean after `make setup`
+# (tests/integration/test_rosdep.py keeps the two lists in step with package.xml).
+ROSDEP_PACKAGES := \
+	libgtest-dev libgmock-dev python3-setuptools python3-yaml python3-zstandard \
+	python3-rosgraph python3-roslib python3-rosgraph-msgs python3-tf2-msgs \
+	ros-rosgraph-msgs ros-nav-msgs ros-tf2-msgs ros-actionlib-msgs \
+	libactionlib-dev libactionlib-msgs-dev libgeometry-msgs-dev libstd-msgs-dev \
+	libros-rosgraph-msgs-dev libtf2-msgs-dev libtf2-ros-dev libvisualization-msgs-dev \
+	libnav-msgs-dev libinteractive-markers-dev libroslib-dev librosbag-dev librviz-dev
 APT_PACKAGES := \
 	python3-rospy python3-rosmaster python3-interactive-markers python3-visualization-msgs \
 	python3-geometry-msgs python3-std-msgs python3-std-srvs python3-rosbag python3-rostest \
@@ -38,7 +49,8 @@ APT_PACKAGES := \
 	ros-geometry-msgs ros-std-msgs ros-visualization-msgs ros-std-srvs rosbash \
 	python3-venv cmake make \
 	xvfb rviz python3-rviz imagemagick xdotool \
-	librostest-dev python3-rosdep2 catkin-lint catkin-tools
+	librostest-dev python3-rosdep2 catkin-lint catkin-tools \
+	$(ROSDEP_PACKAGES)
 
 # Everything the standalone message build reads. A new script, package or data folder at the
 # top also counts: catkin makes devel-space relays for scripts and top-level packages.
@@ -52,7 +64,7 @@ PACKAGES = $(patsubst %/__init__.py,%,$(wildcard rosmc_*/__init__.py))
 # Run a command inside the environment of env.sh.
 IN_ENV := source ./env.sh &&
 
-.PHONY: help setup apt venv requirements msgs demo sample test test-thorough test-busy pytest \
+.PHONY: help setup apt apt-packages venv requirements msgs demo sample test test-thorough test-busy pytest \
 	bench lint format clean
 
 help:
@@ -62,6 +74,10 @@ setup: apt requirements msgs
 
 apt:
 	@tools/ensure_apt_packages.sh $(APT_PACKAGES)
+
+# The Debian packages `make setup` installs, one a line (for tests and scripts).
+apt-packages:
+	@printf '%s\n' $(APT_PACKAGES)
 
 # A venv made from Debian's python with --system-site-packages, so it sees ROS 1. One made
 # from another python (or without system packages) is replaced.

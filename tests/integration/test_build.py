@@ -298,3 +298,45 @@ def test_install_space_runs_the_simulated_team(
 
     wait_until(team_is_up, timeout=180, what="the team from the install space is up", period=0.5)
     assert process.poll() is None, log_tail(process.log_path)
+
+
+def machine_paths(root: Path, forbidden: list[str]) -> list[str]:
+    """Files below ``root`` whose name or text holds one of the ``forbidden`` paths.
+
+    Compiled caches (``__pycache__``) are left out: Python records in them the path it
+    compiled, for tracebacks only.
+    """
+    found = []
+    for path in sorted(root.rglob("*")):
+        if "__pycache__" in path.parts or path.is_dir():
+            continue
+        rel = path.relative_to(root).as_posix()
+        if any(f in str(path.resolve()) or f.lstrip("/") in rel for f in forbidden):
+            found.append(f"{rel} (its path)")
+            continue
+        try:
+            text = path.read_text(encoding="utf-8")
+        except (UnicodeDecodeError, OSError):
+            continue
+        found += [f"{rel} names {f}" for f in forbidden if f in text]
+    return found
+
+
+@pytest.mark.parametrize("space", INSTALL_SPACES)
+def test_an_install_space_is_relocatable_and_holds_each_definition_once(
+    space: str, request: pytest.FixtureRequest
+) -> None:
+    workspace = install_space(request, space)
+    # The checkout, the workspace's src/ (a link to it) and build/ (both layouts have one
+    # beside install/).
+    root = workspace.setup.parent.parent
+    forbidden = [str(REPO_ROOT), str(root / "src"), str(root / "build")]
+    assert machine_paths(workspace.prefix, forbidden) == []
+
+    definitions = [p.relative_to(workspace.share).as_posix() for p in workspace.share.rglob("*")]
+    msgs = sorted(d for d in definitions if d.endswith(".msg"))
+    srvs = sorted(d for d in definitions if d.endswith(".srv"))
+    assert msgs == sorted(f"msg/{p.name}" for p in (REPO_ROOT / "rosmc_msgs" / "msg").iterdir())
+    assert srvs == sorted(f"srv/{p.name}" for p in (REPO_ROOT / "rosmc_msgs" / "srv").iterdir())
+    paths = (workspace.share / "cmake" / "rosmc-msg-paths.cmake").read_text()
+    assert '_prepend_path("${rosmc_DIR}/.." "msg" rosmc_MSG_INCLUDE_DIRS UNIQUE)' in paths

@@ -8,6 +8,7 @@ the project's rosdep/ files (as rosdep/sources.sh lists them, the line a user ad
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 
 from tests.integration.conftest import Run
@@ -58,3 +59,46 @@ def test_rosdep_install_accepts_the_workspace(tmp_path: Path, run: Run) -> None:
     argv += ["--from-paths", "src", "--ignore-src", "-y"]
     result = run(argv, dict(os.environ), cwd=tmp_path)
     assert "ERROR" not in result.stdout + result.stderr, result.stderr
+
+
+def requirement_names() -> set[str]:
+    """The PyPI packages requirements.txt installs into .venv (names as pip spells them)."""
+    lines = (REPO_ROOT / "requirements.txt").read_text().splitlines()
+    return {line.split("==")[0].strip().lower() for line in lines if "==" in line}
+
+
+def test_make_setup_installs_what_every_key_of_package_xml_resolves_to(
+    tmp_path: Path, run: Run
+) -> None:
+    db = tmp_path / "rosdep"
+    env = dict(os.environ)
+    keys = run([OFFLINE, db, "rosdep", "keys", "--from-paths", REPO_ROOT, "--ignore-src"], env)
+    names = sorted(set(keys.stdout.split()))
+    answers = resolved(run([OFFLINE, db, "rosdep", "resolve", *names], env).stdout)
+    apt = set(run(["make", "-s", "-C", REPO_ROOT, "apt-packages"], env).stdout.split())
+    pip = requirement_names()
+    missing = sorted(
+        f"{key}: {package} ({installer})"
+        for key, (installer, packages) in answers.items()
+        for package in packages
+        if package.lower() not in (apt if installer == "apt" else pip)
+    )
+    assert missing == [], f"add them to the Makefile's APT_PACKAGES or requirements.txt: {missing}"
+
+
+def test_rosdep_check_is_clean_after_make_setup(tmp_path: Path, run: Run) -> None:
+    # After `make setup`, in a shell with env.sh sourced (rosdep asks the `pip3` first on
+    # PATH, the venv's, about the -pip keys), as docs/workspace.md says.
+    (tmp_path / "src").mkdir()
+    (tmp_path / "src" / "rosmc").symlink_to(REPO_ROOT, target_is_directory=True)
+    argv = [OFFLINE, tmp_path / "rosdep", "rosdep", "check", "--from-paths", "src"]
+    result = run([*argv, "--ignore-src"], dict(os.environ), cwd=tmp_path)
+    assert "All system dependencies have been satisfied" in result.stdout, result.stdout
+
+
+def test_the_docs_name_every_pip_key() -> None:
+    package_xml = (REPO_ROOT / "package.xml").read_text()
+    keys = sorted(set(re.findall(r">(python3-[\w-]+-pip)<", package_xml)))
+    assert len(keys) >= 4
+    workspace = (REPO_ROOT / "docs" / "workspace.md").read_text()
+    assert [key for key in keys if f"`{key}`" not in workspace] == []
