@@ -187,9 +187,10 @@ def tobag(ctx: Context) -> int:
     if summary.skipped:
         print(f"rosmc: warning: {summary.skipped}", file=sys.stderr)
     counts = ", ".join(f"{topic} {count}" for topic, count in summary.counts.items())
+    clock = "log time" if summary.clock == "log time" else f"the clock of {summary.clock} stamps"
     ctx.emit(
-        f"wrote {summary.path}: {summary.total} messages ({counts})",
-        {"path": str(summary.path), "counts": summary.counts},
+        f"wrote {summary.path}: {summary.total} messages ({counts}); bag time is {clock}",
+        {"path": str(summary.path), "counts": summary.counts, "clock": summary.clock},
     )
     return 0
 

@@ -234,7 +234,7 @@ DOC_COMMANDS: dict[str, Evidence] = {
     "rosmc timeline $REC -o timeline.svg": _docs(REVIEW, "rosmc timeline $REC -o timeline.svg"),
     "rosmc diff $REC r100 0:09": _docs(REVIEW, "rosmc diff $REC r100 0:09"),
     "rosmc tobag $REC mission.bag": _docs(REVIEW, "rosmc tobag $REC mission.bag"),
-    "rosbag play mission.bag": _docs(REVIEW, "rosbag play mission.bag"),
+    "rosbag play --clock -r 20 mission.bag": _docs(REVIEW, "rosbag play --clock -r 20 mission.bag"),
     "rosmc restore $REC --at 9s": _cli(
         "test_diff_and_restore_a_past_moment", 'rosmc(server, "restore", journal, "--at"'
     ),

@@ -47,7 +47,7 @@ REVIEW_COMMANDS = (
     "rosmc timeline $REC -o timeline.svg",
     "rosmc diff $REC r100 0:09",
     "rosmc tobag $REC mission.bag",
-    "rosbag play mission.bag",
+    "rosbag play --clock -r 20 mission.bag",
 )
 REPLAY_COMMANDS = ("rosmc replay $REC --rate 5", "rosmc replay $REC --start 6 --prefix /replay")
 SEEK = 'rosservice call /rosmc/replay/control "{command: 2, time: 8.5}"'

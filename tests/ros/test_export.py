@@ -8,6 +8,7 @@ seeking matches, and the streaming one, both checking CRCs) and decoded with
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 from typing import Any
 
@@ -70,6 +71,22 @@ def test_chunks_of_a_reasonable_size_with_indexes_and_a_summary(
     assert all(index.compression == "zstd" for index in chunks)
     assert all(index.message_index_offsets for index in chunks)
     assert stats.chunk_count == len(chunks)
+
+
+def test_the_figures_of_docs_export_md_are_the_samples(
+    exported: Path, journal: JournalResult
+) -> None:
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "export.md").read_text()
+    found = re.search(
+        r"sample recording's ([\d,]+) messages\s+\(([\d,]+) exported\)\s+go into (\d+) chunks", doc
+    )
+    assert found, "docs/export.md names the sample's figures"
+    with exported.open("rb") as stream:
+        summary = SeekingReader(stream, validate_crcs=True).get_summary()
+    assert summary is not None and summary.statistics is not None
+    figures = [int(group.replace(",", "")) for group in found.groups()]
+    actual = [len(journal.records), summary.statistics.message_count, len(summary.chunk_indexes)]
+    assert figures == actual, "update the figures in docs/export.md"
 
 
 def test_every_recorded_message_on_one_clock(decoded: Decoded, journal: JournalResult) -> None:

@@ -40,6 +40,7 @@ from rosmc_server.core import (  # noqa: E402
 )
 from rosmc_server.interface import EVENTS_TOPIC, MISSION_TOPIC, ROBOT_REPORTS_TOPIC  # noqa: E402
 from rosmc_server.recording import JournalWriter, read_journal  # noqa: E402
+from rosmc_server.recording.bag_clock import MissionClock  # noqa: E402
 from rosmc_server.recording.history import MissionHistory  # noqa: E402
 from rosmc_server.recording.timeline_svg import (  # noqa: E402
     OLIVE,
@@ -349,7 +350,9 @@ def test_png_through_imagemagick_or_a_clear_error(
 # -- rosbag ------------------------------------------------------------------------------
 
 
-def test_rosbag_holds_every_message_at_its_log_time(recording: Recording, tmp_path: Path) -> None:
+def test_rosbag_holds_every_message_on_the_mission_clock(
+    recording: Recording, tmp_path: Path
+) -> None:
     journal = read_journal(recording.path)
     summary = journal_to_rosbag(recording.path, tmp_path / "mission.bag")
     expected: dict[str, int] = {}
@@ -357,6 +360,9 @@ def test_rosbag_holds_every_message_at_its_log_time(recording: Recording, tmp_pa
         expected[record.topic] = expected.get(record.topic, 0) + 1
     assert summary.counts == expected
     assert set(expected) == {MISSION_TOPIC, EVENTS_TOPIC, ROBOT_REPORTS_TOPIC}
+    # No TF here: the robots' report stamps are the clock, each report plays at its stamp.
+    assert summary.clock == ROBOT_REPORTS_TOPIC
+    clock = MissionClock.of(journal.records)
     with rosbag.Bag(str(summary.path)) as bag:
         info = bag.get_type_and_topic_info().topics
         assert {topic: info[topic].message_count for topic in info} == expected
@@ -366,11 +372,13 @@ def test_rosbag_holds_every_message_at_its_log_time(recording: Recording, tmp_pa
             key=lambda row: row[:2],
         )
         latched = {c.topic: c.header.get("latching") for c in bag._connections.values()}
-    recorded = sorted(((r.log_time, r.topic, r.message) for r in journal.records), key=_key)
+    recorded = sorted(((clock.time_of(r), r.topic, r.message) for r in journal.records), key=_key)
     assert [(t, topic) for t, topic, _ in played] == [(t, topic) for t, topic, _ in recorded]
     assert [m.revision for t, topic, m in played if topic == EVENTS_TOPIC] == [
         m.revision for t, topic, m in recorded if topic == EVENTS_TOPIC
     ]
+    reports = [(t, m) for t, topic, m in played if topic == ROBOT_REPORTS_TOPIC]
+    assert reports and all(t == m.stamp.to_nsec() for t, m in reports)
     assert latched[MISSION_TOPIC] == b"1"
 
 
