@@ -13,6 +13,7 @@ from typing import Any
 import rosmc.msg as wire
 
 from ..core import InvalidRequest, LostLinkKind, LostLinkPolicy, LostLinkTrigger
+from ..core.policy import DEFAULT_AFTER
 from .values import params_from_msgs
 
 
@@ -30,7 +31,10 @@ def policy_to_request(
 
 
 def policy_from_request(request: Any) -> LostLinkPolicy:
-    """The policy a ``rosmc/SetLostLinkPolicy`` request asks for (an empty kind: continue).
+    """The policy a ``rosmc/SetLostLinkPolicy`` request asks for.
+
+    Omitted fields take the defaults: an empty kind is continue, an empty ``when`` silent,
+    ``after`` 0 :data:`~rosmc_server.core.policy.DEFAULT_AFTER` seconds.
 
     The safe skill's parameters come as given; :meth:`LostLinkPolicy.checked` checks
     them against the library.
@@ -44,4 +48,5 @@ def policy_from_request(request: Any) -> LostLinkPolicy:
     if bindings:
         raise InvalidRequest("safe-skill parameters cannot be bound to task markers")
     when = LostLinkTrigger.parse(request.when or LostLinkTrigger.SILENT.value)
-    return LostLinkPolicy(kind, request.after, request.safe_skill, values, when)
+    after = request.after or DEFAULT_AFTER
+    return LostLinkPolicy(kind, after, request.safe_skill, values, when)

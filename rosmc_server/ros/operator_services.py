@@ -31,6 +31,7 @@ from ..conversions import (
     pose_from_msg,
 )
 from ..conversions.move_fields import order_from_field
+from ..conversions.request_fields import base_of, insert_index_from_msg
 from ..core import (
     InvalidRequest,
     LibraryError,
@@ -183,10 +184,10 @@ class OperatorServices:
                 values,
                 bindings=bindings,
                 label=req.label,
-                index=None if req.index < 0 else req.index,
+                index=insert_index_from_msg(req.index),
                 timeout=req.timeout,
                 max_retries=req.max_retries,
-                base_revision=req.base_revision,
+                base_revision=base_of(req),
             )
         )
         resp.skill_id = event.change.put_skills[0].skill.id
@@ -202,18 +203,16 @@ class OperatorServices:
                 label=req.label or None,
                 timeout=req.timeout if req.set_options else None,
                 max_retries=req.max_retries if req.set_options else None,
-                base_revision=req.base_revision,
+                base_revision=base_of(req),
             )
         )
 
     def _delete_skills(self, req: Any, resp: Any) -> MissionEvent:
-        return self._apply(
-            lambda m: m.delete_skills(req.skill_ids, base_revision=req.base_revision)
-        )
+        return self._apply(lambda m: m.delete_skills(req.skill_ids, base_revision=base_of(req)))
 
     def _reorder_skills(self, req: Any, resp: Any) -> MissionEvent:
         agent = _text(req.agent, "the agent name")
-        base = req.base_revision
+        base = base_of(req)
         if req.moves:
             if req.order:
                 raise InvalidRequest("give either a new order or moves, not both")
@@ -227,9 +226,7 @@ class OperatorServices:
         with self._server.locked():
             self._require_link(req.agent)
             event = self._apply(
-                lambda m: m.synchronize(
-                    req.agent, req.upto_id or None, base_revision=req.base_revision
-                )
+                lambda m: m.synchronize(req.agent, req.upto_id or None, base_revision=base_of(req))
             )
             resp.skill_ids = [placed.skill.id for placed in event.change.put_skills]
             partners = unsynced_partners(self._server.mission.state, resp.skill_ids)
@@ -246,7 +243,7 @@ class OperatorServices:
             if self._uploading(req.agent):
                 # An upload still unanswered (the robot may be out of reach) is cancelled:
                 # the operator can always take back what the robot has not confirmed.
-                base = req.base_revision
+                base = base_of(req)
                 upto = req.from_id or None
                 event = self._apply(lambda m: m.cancel_uploads(req.agent, upto, base_revision=base))
                 resp.skill_ids = [placed.skill.id for placed in event.change.put_skills]
@@ -254,7 +251,7 @@ class OperatorServices:
             self._require_link(req.agent)
             event = self._apply(
                 lambda m: m.unsynchronize(
-                    req.agent, req.from_id or None, base_revision=req.base_revision
+                    req.agent, req.from_id or None, base_revision=base_of(req)
                 )
             )
             resp.note = self._queued_note([req.agent])
@@ -304,7 +301,7 @@ class OperatorServices:
         with self._server.locked():
             agent, _ = self._server.mission.state.locate(_text(req.skill_id, "the skill id"))
             self._require_link(agent)
-            event = self._apply(lambda m: m.retry(req.skill_id, base_revision=req.base_revision))
+            event = self._apply(lambda m: m.retry(req.skill_id, base_revision=base_of(req)))
         resp.new_skill_id = event.change.put_skills[1].skill.id
         return event
 
@@ -312,21 +309,21 @@ class OperatorServices:
         with self._server.locked():
             agent, _ = self._server.mission.state.locate(_text(req.skill_id, "the skill id"))
             self._require_link(agent)
-            return self._apply(lambda m: m.skip(req.skill_id, base_revision=req.base_revision))
+            return self._apply(lambda m: m.skip(req.skill_id, base_revision=base_of(req)))
 
     # -- barriers and markers ---------------------------------------------------
     def _add_barrier(self, req: Any, resp: Any) -> MissionEvent:
-        event = self._apply(lambda m: m.add_barrier(req.skill_ids, base_revision=req.base_revision))
+        event = self._apply(lambda m: m.add_barrier(req.skill_ids, base_revision=base_of(req)))
         resp.barrier_id = event.change.put_barriers[0].id
         return event
 
     def _delete_barrier(self, req: Any, resp: Any) -> MissionEvent:
         barrier_id = _text(req.barrier_id, "the barrier id")
-        return self._apply(lambda m: m.delete_barrier(barrier_id, base_revision=req.base_revision))
+        return self._apply(lambda m: m.delete_barrier(barrier_id, base_revision=base_of(req)))
 
     def _add_task_marker(self, req: Any, resp: Any) -> MissionEvent:
         marker = marker_from_msg(req.marker)
-        event = self._apply(lambda m: m.add_marker(marker, base_revision=req.base_revision))
+        event = self._apply(lambda m: m.add_marker(marker, base_revision=base_of(req)))
         resp.name = event.change.put_markers[0].name
         return event
 
@@ -335,28 +332,28 @@ class OperatorServices:
         vertices = [pose_from_msg(v) for v in req.vertices]
         name = _text(req.name, "the marker name")
         return self._apply(
-            lambda m: m.move_marker(name, pose, vertices, base_revision=req.base_revision)
+            lambda m: m.move_marker(name, pose, vertices, base_revision=base_of(req))
         )
 
     def _rename_task_marker(self, req: Any, resp: Any) -> MissionEvent:
         name = _text(req.name, "the marker name")
         return self._apply(
-            lambda m: m.rename_marker(name, req.new_name, base_revision=req.base_revision)
+            lambda m: m.rename_marker(name, req.new_name, base_revision=base_of(req))
         )
 
     def _delete_task_marker(self, req: Any, resp: Any) -> MissionEvent:
         name = _text(req.name, "the marker name")
-        return self._apply(lambda m: m.delete_marker(name, base_revision=req.base_revision))
+        return self._apply(lambda m: m.delete_marker(name, base_revision=base_of(req)))
 
     def _undo_edit(self, req: Any, resp: Any) -> MissionEvent:
-        event = self._apply(lambda m: m.undo(req.undo_revision, base_revision=req.base_revision))
+        event = self._apply(lambda m: m.undo(req.undo_revision, base_revision=base_of(req)))
         resp.summary = event.summary
         return event
 
     # -- whole missions -------------------------------------------------------------
     def _new_mission(self, req: Any, resp: Any) -> MissionEvent:
         return self._apply(
-            lambda m: m.new_mission(keep_markers=req.keep_markers, base_revision=req.base_revision)
+            lambda m: m.new_mission(keep_markers=req.keep_markers, base_revision=base_of(req))
         )
 
     def _get_library(self, req: Any, resp: Any) -> None:

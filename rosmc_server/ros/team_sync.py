@@ -11,6 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from ..conversions.request_fields import base_of
 from ..core import InvalidRequest, MissionEvent
 from ..core.advice import unsynced_partners
 from ..core.team import robots_with_blueprints
@@ -46,7 +47,7 @@ def synchronize_team(
         uploads = uploads_from_request(server, req)
         for agent in uploads:
             require_link(agent)
-        event = server.apply(lambda m: m.synchronize_team(uploads, base_revision=req.base_revision))
+        event = server.apply(lambda m: m.synchronize_team(uploads, base_revision=base_of(req)))
         assert event is not None
         resp.agents = list(uploads)
         resp.skill_ids = [placed.skill.id for placed in event.change.put_skills]

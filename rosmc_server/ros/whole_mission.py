@@ -23,6 +23,7 @@ from typing import Any
 import rosmc.srv as srv
 
 from ..conversions.packing import PackedGetMissionResponse
+from ..conversions.request_fields import base_of
 from ..core import InvalidRequest, MissionEvent, MissionFileError, load_mission, parse_mission
 from ..core.collector import collector_paused
 from ..core.persistence import MissionDumper, write_document
@@ -125,9 +126,7 @@ class WholeMissionServices:
             # written before the load is acknowledged, then only joins the bytes.
             self._server.prepare_snapshot(content)
         serialized = time.perf_counter()
-        event = self._server.apply(
-            lambda m: m.load(content, source, base_revision=req.base_revision)
-        )
+        event = self._server.apply(lambda m: m.load(content, source, base_revision=base_of(req)))
         assert event is not None
         self._dumper = MissionDumper()  # again: a save meanwhile filled it with the old skills
         _log.info(

@@ -226,6 +226,11 @@ DOC_COMMANDS: dict[str, Evidence] = {
     "rosmc load --on-server team/plan.yaml": _cli(
         "test_save_and_load_on_the_servers_host", '"load", "--on-server", "team/plan.yaml"'
     ),
+    # docs/reference.md, calling a service by hand
+    'rosservice call /rosmc/add_skill "{agent: drone, skill: take_off}"': Evidence(
+        "tests/integration/test_rosservice_defaults.py::test_add_skill_typed_twice_appends_twice",
+        ('"/rosmc/add_skill", request', 'request = "{agent: drone, skill: take_off}"'),
+    ),
     # docs/replay.md
     "REC=bags/samples/demo.mcap": _docs(REVIEW, "REC=bags/samples/demo.mcap"),
     "rosmc info $REC": _docs(REVIEW, "rosmc info $REC"),

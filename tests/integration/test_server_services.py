@@ -289,7 +289,7 @@ ADD_REJECTIONS: list[Case] = [
     ("multi-line-label", _add(label="two\nlines"), E.INVALID),
     ("stale-revision", lambda s: {**_add()(s), "base_revision": s.rev - 1}, E.CONFLICT),
     ("future-revision", lambda s: {**_add()(s), "base_revision": s.rev + 7}, E.CONFLICT),
-    ("zero-revision", lambda s: {**_add()(s), "base_revision": 0}, E.CONFLICT),
+    ("first-revision", lambda s: {**_add()(s), "base_revision": 1}, E.CONFLICT),
 ]
 
 
@@ -803,7 +803,7 @@ EXECUTION_REJECTIONS: list[tuple[str, str, Callable[[Scene], dict[str, Any]], in
         lambda s: {"agent": "drone", "from_id": "x"},
         E.NOT_FOUND,
     ),
-    ("unsync-stale", "unsynchronize", lambda s: {"agent": "drone", "base_revision": 0}, E.CONFLICT),
+    ("unsync-stale", "unsynchronize", lambda s: {"agent": "drone", "base_revision": 1}, E.CONFLICT),
     ("retry-empty-id", "retry_skill", lambda s: {"skill_id": ""}, E.INVALID),
     ("retry-unknown-id", "retry_skill", lambda s: {"skill_id": "x"}, E.NOT_FOUND),
     ("retry-not-failed", "retry_skill", lambda s: {"skill_id": s.d1}, E.RULE),
@@ -832,7 +832,7 @@ def test_one_event_per_accepted_change_in_revision_order(scene: Scene, events: A
     do(c, "edit_skill", skill_id=scene.d1, parameters=[pf("altitude", 9)])
     expected.append(wire.MissionEvent.SKILL_EDITED)
     assert_rejected(c, "edit_skill", base_revision=c.revision(), skill_id="x", label="y")
-    assert_rejected(c, "add_skill", base_revision=0, agent="drone", skill="land")
+    assert_rejected(c, "add_skill", base_revision=1, agent="drone", skill="land")
     new = add(c, "drone", "land")
     expected.append(wire.MissionEvent.SKILL_ADDED)
     do(c, "reorder_skills", agent="drone", order=[new, scene.d3, scene.d2, scene.d1])

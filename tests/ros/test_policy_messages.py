@@ -9,6 +9,7 @@ import rosmc.srv as srv
 
 from rosmc_server.conversions import param_to_msg, policy_from_request, policy_to_request
 from rosmc_server.core import InvalidRequest, LostLinkKind, LostLinkPolicy, Pose
+from rosmc_server.core.policy import DEFAULT_AFTER
 
 POLICIES = [
     LostLinkPolicy(),
@@ -39,11 +40,17 @@ def test_an_empty_kind_is_continue() -> None:
     assert policy_from_request(request) == LostLinkPolicy(after=5.0)
 
 
+def test_an_omitted_delay_is_the_default_one() -> None:
+    # rosservice call /rosmc/set_lost_link_policy "{agent: r1, lost_link_policy: hold}"
+    request = srv.SetLostLinkPolicyRequest(agent="r1", lost_link_policy="hold")
+    assert policy_from_request(request) == LostLinkPolicy(LostLinkKind.HOLD, DEFAULT_AFTER)
+
+
 @pytest.mark.parametrize(
     ("fields", "needle"),
     [
         ({"lost_link_policy": "panic", "after": 5.0}, "must be one of"),
-        ({"lost_link_policy": "hold"}, "'after' must be a positive"),
+        ({"lost_link_policy": "hold", "after": -1.0}, "'after' must be a positive"),
         ({"lost_link_policy": "hold", "after": 1.0, "safe_skill": "x"}, "runs no safe skill"),
         (
             {

@@ -105,3 +105,20 @@ def test_check_mode_reports_a_stale_document(tool, tmp_path, monkeypatch) -> Non
     assert tool.main(["--check"]) == 0
     text = stale.read_text()
     assert text.startswith("# x\n\n") and text.endswith(f"{tool.END}\n\n## After\n")
+
+
+def test_every_request_field_of_a_service_says_what_it_means(generated) -> None:
+    # rosservice call users read the default of each field they leave out here.
+    services = generated[generated.index("## Service definitions") :]
+    blank = []
+    for block in services.split("\n### ")[1:]:
+        name = block.split("\n", 1)[0]
+        request = block.split("Request:")[1].split("Response:")[0] if "Request:" in block else ""
+        blank += [
+            f"{name}.{row.split('|')[1].strip()}"
+            for row in request.splitlines()
+            if row.startswith("| `")
+            and row.rstrip().endswith("|  |")
+            and row.count("|") == 4  # a field (a constant's row has its value too)
+        ]
+    assert blank == [], "give these fields a comment in rosmc_msgs/srv"

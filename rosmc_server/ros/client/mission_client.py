@@ -7,6 +7,7 @@ from typing import Any
 
 from ...conversions import moves_to_msgs, policy_to_request
 from ...conversions.move_fields import order_to_field
+from ...conversions.request_fields import insert_index_to_msg
 from ...core import InvalidRequest, LostLinkPolicy
 from ...core.changes import SkillMove
 from ...core.editing import check_retries, check_timeout
@@ -76,7 +77,7 @@ class MissionClient(MarkerCalls):
             agent=agent,
             skill=skill,
             label=label,
-            index=-1 if index is None else index,
+            index=insert_index_to_msg(index),
             parameters=parameters,
             timeout=check_timeout(timeout),
             max_retries=check_retries(max_retries),
