@@ -6,12 +6,18 @@ the core so that widgets and marker geometry can use it without importing rospy.
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from dataclasses import dataclass
 
 from .control import ExecutorState
 from .model import SkillStatus
 from .params import Pose
 from .waiting import waiting_text
+
+
+AGES = ("last_heard", "waiting_for")
+"""The fields of :class:`AgentStatus` that are ages in seconds, growing with the clock."""
 
 
 @dataclass(frozen=True)
@@ -49,6 +55,21 @@ class AgentStatus:
     commands_waiting: int = 0
     waiting_for: float = -1.0
     coverage_warning: str = ""
+
+    def news_since(self, old: AgentStatus | None) -> bool:
+        """Whether this status says something ``old`` did not, at the resolution shown.
+
+        ``last_heard`` and ``waiting_for`` are ages that grow with the clock: they count
+        only when their whole seconds change. So a robot heard twice a second, or one never
+        heard, has no news until something about it changes, and one out of contact has
+        news once a second (the seconds its link has been down).
+        """
+        if old is None:
+            return True
+        ages = {name: getattr(old, name) for name in AGES}
+        if dataclasses.replace(self, **ages) != old:
+            return True
+        return any(math.floor(getattr(self, name)) != math.floor(age) for name, age in ages.items())
 
     @property
     def executor(self) -> ExecutorState:

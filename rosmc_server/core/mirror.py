@@ -172,13 +172,18 @@ class MissionMirror:
             self._ask_snapshot()
 
     def on_agent_statuses(self, statuses: Mapping[str, AgentStatus]) -> None:
-        """Take the robots' latest statuses; listeners hear of those that changed."""
+        """Take the robots' latest statuses; listeners hear of those with news.
+
+        A status whose only change is an age within the same whole second
+        (:meth:`AgentStatus.news_since`) is kept without a word: the server publishes
+        every robot's status twice a second, most of the time only to say it is current.
+        """
         with self.lock:
             changes = []
             for agent, status in statuses.items():
                 old = self._statuses.get(agent)
-                if old != status:
-                    self._statuses[agent] = status
+                self._statuses[agent] = status
+                if status.news_since(old):
                     changes.append(AgentStatusChanged(old, status))
             if changes:
                 self._notify(MirrorUpdate(self.revision or 0, tuple(changes)))

@@ -206,6 +206,8 @@ def check_install_space(lines: list[str], prefix: Path, share: Path, bin_dir: Pa
         assert (site / rel).is_file(), f"{rel} is not installed"
     if (REPO_ROOT / "rosmc_server" / "config").is_dir():
         assert (share / "rosmc_server" / "config").is_dir()
+    for init in REPO_ROOT.glob("rosmc_*/__init__.py"):  # mypy reads installed annotations
+        assert (site / init.parent.name / "py.typed").is_file(), init.parent.name
 
 
 def test_colcon_build(colcon_ws: Workspace) -> None:

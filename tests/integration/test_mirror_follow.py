@@ -20,7 +20,7 @@ import rospy
 from rosmc_server import interface
 from rosmc_server.core import MarkerType, NotFound, Pose, TaskMarker
 from rosmc_server.core.errors import ServerUnavailable
-from rosmc_server.core.updates import MirrorUpdate, MissionReset, SkillAdded
+from rosmc_server.core.updates import AgentStatusChanged, MirrorUpdate, MissionReset, SkillAdded
 from rosmc_server.ros.client import AsyncMissionClient, MissionClient, MissionFollower, Outcome
 from tests.conftest import wait_until
 from tests.integration.server_fixtures import ServerProcess, StartServer
@@ -181,3 +181,49 @@ def test_async_calls_to_a_missing_server_fail_without_blocking_the_caller(
         assert "mission server is not reachable" in str(outcomes[0].error)
     finally:
         client.close()
+
+
+def test_a_robot_heard_all_along_is_news_only_when_it_changes(
+    server: ServerProcess, follower: MissionFollower, fake_robot: Any
+) -> None:
+    # The server publishes every robot's status twice a second; a robot heard all along
+    # changes only its last_heard there, which is no news for the GUIs.
+    wait_until(lambda: follower.mirror.state is not None, 30.0, "the first snapshot")
+    robot = fake_robot("drone")
+    stop = threading.Event()
+
+    def heartbeat() -> None:
+        while not stop.wait(0.2):
+            robot.announce()
+
+    beating = threading.Thread(target=heartbeat, daemon=True)
+    beating.start()
+    published: list[Any] = []
+    listener = rospy.Subscriber(
+        interface.AGENT_STATES_TOPIC, wire.AgentStates, published.append, queue_size=100
+    )
+    try:
+
+        def drone_up() -> bool:
+            status = follower.mirror.agent_status("drone")
+            return status is not None and status.link == "up"
+
+        wait_until(drone_up, 30.0, "the drone's link up")
+        updates: list[MirrorUpdate] = []
+        follower.mirror.subscribe(lambda update: updates.append(update))
+        updates.clear()  # a late listener first gets the whole mission
+        published.clear()
+        wait_until(lambda: len(published) >= 8, 60.0, "eight agent-state messages")
+    finally:
+        stop.set()
+        beating.join()
+        listener.unregister()
+    about_drone = [
+        change
+        for update in updates
+        for change in update.changes
+        if isinstance(change, AgentStatusChanged) and change.new.agent == "drone"
+    ]
+    # Before: one per message (8 or more). A busy machine may let last_heard pass a whole
+    # second once or twice between two heartbeats.
+    assert len(about_drone) <= 2, about_drone

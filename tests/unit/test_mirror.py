@@ -289,6 +289,38 @@ def test_agent_statuses_are_reported_when_they_change() -> None:
     assert mirror.agent_status("rover") is None
 
 
+def test_only_news_is_reported_not_every_tick_of_the_link_clock() -> None:
+    # The server publishes every robot's status twice a second. For 7 s: three robots heard
+    # each time (last_heard 0.0..0.4 s), one out of contact since 10 s before, one never heard.
+    mirror = MissionMirror()
+    view = View()
+    mirror.subscribe(view)
+    for tick in range(14):
+        heard = {
+            agent: AgentStatus(agent, link="up", last_heard=0.1 * (tick % 5), battery=0.8)
+            for agent in ("drone", "science_rover", "manipulator_rover")
+        }
+        lost = AgentStatus("box", link="down", last_heard=10.0 + 0.5 * tick, battery=0.3)
+        mirror.on_agent_statuses({**heard, "box": lost, "lander": AgentStatus("lander")})
+    changes = [c for u in view.updates for c in u.changes if isinstance(c, AgentStatusChanged)]
+    first = {c.new.agent for c in changes if c.old is None}
+    assert first == {"drone", "science_rover", "manipulator_rover", "box", "lander"}
+    later = [c for c in changes if c.old is not None]
+    # Only the robot out of contact, once per second of its outage (what "LINK DOWN 12 s"
+    # shows): 10 s .. 16.5 s crosses 6 whole seconds.
+    assert [c.new.agent for c in later] == ["box"] * 6
+    assert [int(c.new.last_heard) for c in later] == [11, 12, 13, 14, 15, 16]
+    assert len(changes) == 11  # before: 14 ticks x 4 robots with a changed age = 56 + 5
+    # The mirror holds the latest status all the same, and a real change is news.
+    assert mirror.agent_status("drone") == AgentStatus(
+        "drone", link="up", last_heard=0.1 * (13 % 5), battery=0.8
+    )
+    drone = mirror.agent_status("drone")
+    assert drone is not None
+    mirror.on_agent_statuses({"drone": replace(drone, battery=0.79)})
+    assert view.updates[-1].changes == (AgentStatusChanged(drone, replace(drone, battery=0.79)),)
+
+
 def test_a_restarted_server_s_robots_start_unknown() -> None:
     mission = make_mission()
     mirror = MissionMirror()

@@ -4,11 +4,15 @@
 those calls on a worker thread for GUIs. :class:`MissionFollower` keeps a
 :class:`~rosmc_server.core.mirror.MissionMirror` (a live copy of the mission) current from
 the events, agent states and snapshots; :class:`MissionWatch` queues the raw events
-(``rosmc watch``). All speak core objects and raise the core error family.
+(``rosmc watch``). All speak core objects and raise one error family, rooted in
+:class:`RosmcError`: the server's refusals (:class:`RevisionConflict` for a stale
+revision, ``NotFound``, ``InvalidRequest``, ``RuleViolation``, ... from
+:mod:`rosmc_server.core`) and :class:`ServerUnavailable` when no server answers. Catch
+``RosmcError`` for all of them; ``str(error)`` is one sentence an operator can read.
 """
 
 from ...conversions import agent_status_from_msg, agent_statuses_from_msg, library_from_msg
-from ...core.errors import ServerUnavailable
+from ...core.errors import RosmcError, ServerUnavailable
 from ..node_setup import init_node
 from .follow import MissionFollower
 from .mission_client import MissionClient
@@ -43,6 +47,7 @@ __all__ = [
     "Outcome",
     "Result",
     "RevisionConflict",
+    "RosmcError",
     "ScienceWatch",
     "ServerUnavailable",
     "SiteWatch",
