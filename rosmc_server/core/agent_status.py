@@ -15,7 +15,6 @@ from .model import SkillStatus
 from .params import Pose
 from .waiting import waiting_text
 
-
 AGES = ("last_heard", "waiting_for")
 """The fields of :class:`AgentStatus` that are ages in seconds, growing with the clock."""
 

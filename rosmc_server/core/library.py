@@ -19,6 +19,7 @@ from .bindings import BindingSpec, read_binding
 from .documents import DocumentReader, load_yaml, yaml_problem
 from .errors import InvalidRequest, LibraryError, NotFound, RuleViolation
 from .library_extends import merge_extension
+from .package_paths import PackageFinder, PackagePath, resolve_reference
 from .params import (
     COMPATIBLE_MARKERS,
     MARKER_PARAM_TYPE,
@@ -171,16 +172,19 @@ def check_polygon(value: object, what: str) -> None:
             raise InvalidRequest(f"corner {index} of {what} must be a point with x and y")
 
 
-def load_library(path: str | Path) -> Library:
+def load_library(path: str | Path, *, find_package: PackageFinder | None = None) -> Library:
     """Read a library YAML file; LibraryError names the file, key and problem.
 
-    A library with ``extends: OTHER.yaml`` (a path from its own folder) is that library
-    plus its own agents, models and skills (see :mod:`.library_extends`).
+    A library with ``extends: OTHER.yaml`` (a path from its own folder, or a package's file:
+    ``package://PKG/PATH``, ``$(find PKG)/PATH``) is that library plus its own agents,
+    models and skills (see :mod:`.library_extends`). ``find_package`` finds a package's
+    folder (:mod:`.package_paths`; by default through the environment's ROS_PACKAGE_PATH).
     """
-    return library_from_dict(_library_data(Path(path), ()), str(path))
+    finder = find_package if find_package is not None else PackagePath.from_environ()
+    return library_from_dict(_library_data(Path(path), (), finder), str(path))
 
 
-def _library_data(path: Path, chain: tuple[Path, ...]) -> object:
+def _library_data(path: Path, chain: tuple[Path, ...], find_package: PackageFinder) -> object:
     """The file's parsed data, with the libraries it extends merged in and checked."""
     source = str(path)
     try:
@@ -196,11 +200,16 @@ def _library_data(path: Path, chain: tuple[Path, ...]) -> object:
     if not isinstance(data, Mapping) or "extends" not in data:
         return data
     reader = DocumentReader(source, LibraryError)
-    base_path = path.parent / reader.text(data["extends"], "extends")
+    try:
+        base_path = resolve_reference(
+            reader.text(data["extends"], "extends"), path.parent, find_package
+        )
+    except LibraryError as error:
+        raise LibraryError(f"{source}: {error}") from error
     chain = (*chain, path.resolve())
     if base_path.resolve() in chain:
         reader.fail("extends", f"{base_path.name} extends this library again (a loop)")
-    base = _library_data(base_path, chain)
+    base = _library_data(base_path, chain, find_package)
     library_from_dict(base, str(base_path))  # its own mistakes are named in its own file
     return merge_extension(base, data, reader)
 

@@ -1,7 +1,8 @@
 """``extends``: a library that adds robots to another instead of copying it.
 
 An extending library names its base (``extends: mars_team.yaml``, a path from the
-extending file's folder) and gives its own ``name``. Its ``models`` add new robot kinds,
+extending file's folder, or a package's file: ``package://PKG/PATH``, ``$(find PKG)/PATH``,
+see :mod:`.package_paths`) and gives its own ``name``. Its ``models`` add new robot kinds,
 or new skills to a model of the base (a model entry then holds only ``skills``); its
 ``agents`` add team members. It may not redefine an agent, a model's description or
 lost-link policy, or a skill of the base: the base stays what it says.
