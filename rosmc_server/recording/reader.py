@@ -77,6 +77,8 @@ class LatestState:
         notes: What was left out on purpose (a change recorded but never acknowledged).
         gaps: The revisions that cannot be rebuilt (see :attr:`lost`).
         highest: The highest revision the journal holds (-1 for none).
+        unacknowledged: The revision of a replacement the journal ends with before its
+            snapshot (left out), or None.
     """
 
     snapshot: RosMessage
@@ -86,6 +88,7 @@ class LatestState:
     notes: tuple[str, ...] = ()
     gaps: tuple[Gap, ...] = ()
     highest: int = -1
+    unacknowledged: int | None = None
 
     @property
     def revision(self) -> int:
@@ -256,6 +259,7 @@ def latest_state(result: JournalResult) -> LatestState:
         tuple(notes),
         tuple(walk.gaps),
         walk.highest,
+        walk.unacknowledged,
     )
 
 

@@ -2,6 +2,7 @@
 
 import logging
 import threading
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from types import TracebackType
@@ -93,6 +94,8 @@ class JournalWriter:
         self._events_since_snapshot = 0
         self._rotation_failed = False
         self._telemetry_skipped = False
+        self._mark: dict[str, str | int] | None = None  # the revision mark, for new parts
+        self._mark_writes = 0
         self._lock = threading.RLock()
         self.space = DiskSpace(part.path.parent, options.reserve_bytes)
         """The free space of the journal's disk."""
@@ -226,12 +229,40 @@ class JournalWriter:
         """Record a full ``rosmc/Mission`` snapshot (and the library, once per part file);
         durable when this returns."""
         self._append(MISSION_TOPIC, mission, log_time_ns, sync=True)
+        self._append_library(log_time_ns)
+
+    def _append_library(self, log_time_ns: int) -> None:
+        """Write the library after the first snapshot of a part file."""
         with self._lock:
             part = self._part.number
             due = self._library is not None and self._library_part != part
             self._library_part = part
         if due:
             self._append(LIBRARY_TOPIC, self._library, log_time_ns, sync=True)
+
+    def append_replacement(
+        self, event: RosMessage, mission: RosMessage, log_time_ns: int
+    ) -> None:
+        """Record a change that replaces the mission (``rosmc/MissionEvent`` of kind
+        MISSION_REPLACED) together with the new mission's snapshot, as one unit: one chunk
+        written at once and synced, so that no crash leaves the event without the content
+        it stands for (a chunk torn by a crash fails its CRC and is cut off whole). Durable
+        when this returns."""
+        self._append_unit([(EVENTS_TOPIC, event), (MISSION_TOPIC, mission)], log_time_ns, True)
+        self._append_library(log_time_ns)
+
+    def write_mark(self, fields: Mapping[str, str | int]) -> None:
+        """Keep the revision mark's fields in the head of the file being written (in place,
+        never synced on its own; see :mod:`._mcap.head_mark`), and in every part started
+        after this.
+
+        Raises:
+            JournalError: The head cannot be written.
+        """
+        with self._lock:
+            self._mark = dict(fields)
+            self._mark_writes += 1
+            self._part.write_mark(self._mark, self._mark_writes)
 
     def append_due_snapshot(self, mission: RosMessage, log_time_ns: int) -> bool:
         """Record ``mission`` if a snapshot is due, the journal open and room left for it
@@ -303,34 +334,47 @@ class JournalWriter:
         self.close()
 
     def _append(self, topic: str, msg: RosMessage, log_time_ns: int, sync: bool) -> None:
-        expected = JOURNAL_TOPICS[topic]
-        if getattr(msg, "_type", None) != expected:
-            raise JournalError(f"{topic} records {expected}, not {type(msg).__name__}")
         if not sync and not self._room_for_telemetry(topic):
             return
-        data = serialize(msg)  # outside the lock: a big snapshot takes a while
+        self._append_unit([(topic, msg)], log_time_ns, sync)
+
+    def _append_unit(
+        self, messages: list[tuple[str, RosMessage]], log_time_ns: int, sync: bool
+    ) -> None:
+        """Write ``messages`` as one unit: one chunk (chunked layout) in one write."""
+        for topic, msg in messages:
+            expected = JOURNAL_TOPICS[topic]
+            if getattr(msg, "_type", None) != expected:
+                raise JournalError(f"{topic} records {expected}, not {type(msg).__name__}")
+        data = [serialize(msg) for _, msg in messages]  # outside the lock: snapshots are big
         with self._lock:
             self._part.open_fd()
-            if self._rotation_due(topic):
+            if self._rotation_due(messages[-1][0]):
                 self._rotate()
             part = self._part
-            channel_id = self._channels[topic]
-            sequence = part.section.sequence(channel_id)
-            # The record is written in parts: a snapshot's megabytes are never copied.
-            record = [fmt.message_head(channel_id, sequence, log_time_ns, len(data)), data]
+            records: list[tuple[int, int, list[bytes]]] = []
+            for (topic, _), body in zip(messages, data, strict=True):
+                channel_id = self._channels[topic]
+                earlier = sum(1 for r in records if r[0] == channel_id)
+                sequence = (part.section.sequence(channel_id) + earlier) & 0xFFFFFFFF
+                # The record is written in parts: a snapshot's megabytes are never copied.
+                head = fmt.message_head(channel_id, sequence, log_time_ns, len(body))
+                records.append((channel_id, log_time_ns, [head, body]))
+            written: list[bytes] = [piece for _, _, parts in records for piece in parts]
             chunk_index = None
             if part.chunked:
                 compress_from = self._options.compress_from
-                record, chunk_index = part.section.chunk(
-                    part.offset, channel_id, log_time_ns, record, compress_from
-                )
-            part.write(record, sync, self._options.fsync)
-            part.section.count(channel_id, log_time_ns, chunk_index)
-            if topic == MISSION_TOPIC:
-                self._events_since_snapshot = 0
-                part.snapshots += 1
-            elif topic == EVENTS_TOPIC:
-                self._events_since_snapshot += 1
+                written, chunk_index = part.section.chunk(part.offset, records, compress_from)
+            part.write(written, sync, self._options.fsync)
+            for channel_id, _, _ in records:
+                part.section.count(channel_id, log_time_ns, chunk_index)
+                chunk_index = None  # one index entry per chunk
+            for topic, _ in messages:
+                if topic == MISSION_TOPIC:
+                    self._events_since_snapshot = 0
+                    part.snapshots += 1
+                elif topic == EVENTS_TOPIC:
+                    self._events_since_snapshot += 1
 
     def _room_for_telemetry(self, topic: str) -> bool:
         """Whether telemetry may still be written; skipped (said once) near a full disk."""
@@ -372,6 +416,12 @@ class JournalWriter:
             return
         self._part = new
         self._channels = new.section.channel_ids()
+        if self._mark is not None:
+            self._mark_writes += 1
+            try:
+                new.write_mark(self._mark, self._mark_writes)
+            except JournalError as err:  # the side file and the older parts still hold it
+                _log.warning("journal %s: %s", self._base, err)
         try:
             old.close()
         except JournalError as err:  # readers recover an unclosed part all the same

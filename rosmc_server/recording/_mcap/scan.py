@@ -21,10 +21,11 @@ from pathlib import Path
 
 from mcap.opcode import Opcode
 
+from rosmc_server.recording._mcap import head_mark
 from rosmc_server.recording._mcap import records as fmt
 from rosmc_server.recording._mcap.checks import Declarations, RecordDamage
 from rosmc_server.recording._mcap.resync import Resync
-from rosmc_server.recording.channels import LIBRARY
+from rosmc_server.recording.channels import LIBRARY, PROFILE
 from rosmc_server.recording.damage import Damage
 from rosmc_server.recording.errors import JournalError
 
@@ -36,6 +37,7 @@ _JOURNAL_OPCODES = frozenset(
         Opcode.MESSAGE,
         Opcode.CHUNK,
         Opcode.MESSAGE_INDEX,
+        Opcode.METADATA,
         Opcode.DATA_END,
         Opcode.FOOTER,
     )
@@ -68,6 +70,8 @@ class ScanResult:
     warnings: list[str] = field(default_factory=list)
     damage: list[Damage] = field(default_factory=list)
     """Damaged byte ranges that were skipped, in file order."""
+    mark_slots: tuple[int, int] | None = None
+    """Where the revision mark's slots lie (:mod:`.head_mark`); None in older journals."""
 
 
 class _Short(Exception):
@@ -84,13 +88,38 @@ def scan(path: Path) -> ScanResult:
     size = len(data)
     if size == 0:
         raise JournalError(f"journal {path} is empty (0 bytes)")
-    if data[: len(fmt.MAGIC)] != fmt.MAGIC[:size]:
+    damaged_head = _damaged_journal_head(path, data)
+    if damaged_head is not None:
+        profile, library, start, damage = PROFILE, LIBRARY, damaged_head.end, [damaged_head]
+    elif data[: len(fmt.MAGIC)] != fmt.MAGIC[:size]:
         raise JournalError(f"{path} is not an MCAP file (it does not start with the MCAP magic)")
-    profile, library, start, damage = _header(path, data)
+    else:
+        profile, library, start, damage = _header(path, data)
     result = ScanResult(path=path, size=size, profile=profile, library=library)
     result.damage += damage
     _Walker(result, data).walk(start)
     return result
+
+
+_JOURNAL_HEAD = fmt.MAGIC + fmt.header(PROFILE, LIBRARY)
+"""The bytes every journal file starts with."""
+
+
+def _damaged_journal_head(path: Path, data: bytes) -> Damage | None:
+    """The damage of a journal whose magic or header has a few wrong bytes (or is zeroed),
+    None if its head is intact or it is not a journal at all.
+
+    A journal's head is always the same bytes, so a damaged one is known for what it was
+    and costs nothing but itself: the records after it are read as usual.
+    """
+    head = data[: len(_JOURNAL_HEAD)]
+    if len(head) < len(_JOURNAL_HEAD) or head == _JOURNAL_HEAD:
+        return None
+    pairs = enumerate(zip(head, _JOURNAL_HEAD, strict=True))
+    wrong = [i for i, (have, want) in pairs if have != want]
+    if len(wrong) > len(_JOURNAL_HEAD) // 4 and head.strip(b"\0"):
+        return None  # another file, not a damaged journal
+    return Damage(path, wrong[0], len(_JOURNAL_HEAD), "a damaged MCAP magic or header", kept=True)
 
 
 def _header(path: Path, data: bytes) -> tuple[str, str, int, list[Damage]]:
@@ -201,6 +230,8 @@ class _Walker:
             self._chunk(offset, fmt.parse_chunk(body), _HEAD + len(body))
         elif opcode == Opcode.MESSAGE_INDEX and (after_chunk or self._journal):
             self._message_index(offset, body, after_chunk)
+        elif opcode == Opcode.METADATA and self._journal:
+            r.mark_slots = head_mark.slots_of(body, offset) or r.mark_slots
         elif opcode == Opcode.DATA_END:
             self._in_summary = True
             self._tail = offset
