@@ -75,8 +75,9 @@ def new_epoch() -> str:
     return secrets.token_hex(4)
 
 
-MarkCopy = Callable[[Mapping[str, str | int]], None]
-"""Where a second copy of the mark goes (the journal's head: ``JournalWriter.write_mark``)."""
+MarkCopy = Callable[[Mapping[str, str | int], bool], None]
+"""Where a second copy of the mark goes, and whether to sync it (the journal's heads:
+``JournalWriter.write_mark``)."""
 
 
 class RevisionMark:
@@ -87,15 +88,28 @@ class RevisionMark:
         self, journal: Path, mark: Mark, durable: bool, copy: MarkCopy | None = None
     ) -> None:
         """Create or replace the mark file with ``mark`` (fsynced, with its directory), and
-        write it to ``copy`` (never synced on its own: the journal's next record is)."""
+        write it to ``copy`` (never synced on its own: the journal's next record is).
+
+        The file is written whole beside its place and renamed onto it, so that a crash
+        never leaves an empty or half-written mark file; later updates rewrite its one
+        short line in place (a write of one sector: whole or not at all).
+        """
         self.path = mark_path(journal)
         self._durable = durable
         self._copy = copy
-        self._fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
         self.mark = mark
-        self._write(sync=True)
+        staged = self.path.with_name(self.path.name + ".new")
+        self._fd = os.open(staged, os.O_RDWR | os.O_CREAT | os.O_TRUNC, 0o644)
+        try:
+            self._write(sync=True, to_copy=False)
+            os.replace(staged, self.path)
+        except OSError:
+            self.close()
+            raise
         if durable:
             fsync_directory(self.path.parent)
+        if copy is not None:  # second: a crash between the two leaves the side file newer
+            copy(mark_fields(mark), True)
 
     @property
     def epoch(self) -> str:
@@ -121,15 +135,15 @@ class RevisionMark:
             os.close(self._fd)
             self._fd = -1
 
-    def _write(self, sync: bool) -> None:
+    def _write(self, sync: bool, to_copy: bool = True) -> None:
         mark = self.mark
         line = json.dumps(mark_fields(mark))
         data = line.encode("ascii").ljust(_SIZE - 1) + b"\n"
-        if self._copy is not None:
-            self._copy(mark_fields(mark))
         os.pwrite(self._fd, data, 0)
         if sync and self._durable:
             os.fdatasync(self._fd)
+        if to_copy and self._copy is not None:  # second: the side file is never the older
+            self._copy(mark_fields(mark), sync)
 
 
 def mark_fields(mark: Mark) -> dict[str, str | int]:

@@ -17,6 +17,7 @@ from rosmc_server.interface import (
     ROBOT_COMMANDS_TOPIC,
     ROBOT_REPORTS_TOPIC,
 )
+from rosmc_server.recording._mcap import head_mark
 from rosmc_server.recording._mcap import records as fmt
 from rosmc_server.recording._mcap.codec import RosMessage, serialize
 from rosmc_server.recording._mcap.files import journal_parts, part_path
@@ -96,6 +97,8 @@ class JournalWriter:
         self._telemetry_skipped = False
         self._mark: dict[str, str | int] | None = None  # the revision mark, for new parts
         self._mark_writes = 0
+        self._first_head: head_mark.FirstFileHead | None = None  # once parts follow it
+        self._newest_revision = -1  # of any event or snapshot written
         self._lock = threading.RLock()
         self.space = DiskSpace(part.path.parent, options.reserve_bytes)
         """The free space of the journal's disk."""
@@ -167,6 +170,8 @@ class JournalWriter:
                 writer._events_since_snapshot = 0
             elif record.topic == EVENTS_TOPIC:
                 writer._events_since_snapshot += 1
+                revision = int(getattr(record.message, "revision", -1))
+                writer._newest_revision = max(writer._newest_revision, revision)
         _log.info(
             "resumed journal %s: %d records, continuing in %s at byte %d",
             reopened.base,
@@ -240,9 +245,7 @@ class JournalWriter:
         if due:
             self._append(LIBRARY_TOPIC, self._library, log_time_ns, sync=True)
 
-    def append_replacement(
-        self, event: RosMessage, mission: RosMessage, log_time_ns: int
-    ) -> None:
+    def append_replacement(self, event: RosMessage, mission: RosMessage, log_time_ns: int) -> None:
         """Record a change that replaces the mission (``rosmc/MissionEvent`` of kind
         MISSION_REPLACED) together with the new mission's snapshot, as one unit: one chunk
         written at once and synced, so that no crash leaves the event without the content
@@ -251,18 +254,27 @@ class JournalWriter:
         self._append_unit([(EVENTS_TOPIC, event), (MISSION_TOPIC, mission)], log_time_ns, True)
         self._append_library(log_time_ns)
 
-    def write_mark(self, fields: Mapping[str, str | int]) -> None:
-        """Keep the revision mark's fields in the head of the file being written (in place,
-        never synced on its own; see :mod:`._mcap.head_mark`), and in every part started
-        after this.
+    def write_mark(self, fields: Mapping[str, str | int], sync: bool = False) -> None:
+        """Keep the revision mark's fields in the head of the file being written and of the
+        journal's first file (in place; see :mod:`._mcap.head_mark`), and in every part
+        started after this. The part written is synced by its next record; the first file,
+        once it is no longer written, when ``sync`` (a lease renewed).
 
         Raises:
-            JournalError: The head cannot be written.
+            JournalError: A head cannot be written.
         """
         with self._lock:
             self._mark = dict(fields)
             self._mark_writes += 1
             self._part.write_mark(self._mark, self._mark_writes)
+            if self._part.number == 1:
+                return
+            if self._first_head is None:
+                self._first_head = head_mark.FirstFileHead(self._base)
+            try:
+                self._first_head.write(self._mark, self._mark_writes, sync and self._options.fsync)
+            except OSError as err:
+                raise JournalError(f"cannot write journal {self._base}: {err.strerror}") from err
 
     def append_due_snapshot(self, mission: RosMessage, log_time_ns: int) -> bool:
         """Record ``mission`` if a snapshot is due, the journal open and room left for it
@@ -315,12 +327,19 @@ class JournalWriter:
     def close(self) -> None:
         """Write the summary and footer, sync and close; a closed journal is complete MCAP."""
         with self._lock:
+            self._close_first_head()
             self._part.close()
 
     def abandon(self) -> None:
         """Close the file without a summary, as a crash leaves it; resume recovers it."""
         with self._lock:
+            self._close_first_head()
             self._part.abandon()
+
+    def _close_first_head(self) -> None:
+        if self._first_head is not None:
+            self._first_head.close()
+            self._first_head = None
 
     def __enter__(self) -> Self:
         return self
@@ -347,10 +366,15 @@ class JournalWriter:
             if getattr(msg, "_type", None) != expected:
                 raise JournalError(f"{topic} records {expected}, not {type(msg).__name__}")
         data = [serialize(msg) for _, msg in messages]  # outside the lock: snapshots are big
+        revision = -1  # of the snapshot or event written last: both start with a uint64 one
+        if messages[-1][0] in (MISSION_TOPIC, EVENTS_TOPIC):
+            revision = int.from_bytes(data[-1][:8], "little")
         with self._lock:
             self._part.open_fd()
-            if self._rotation_due(messages[-1][0]):
+            snapshot = messages[-1][0] == MISSION_TOPIC
+            if self._rotation_due(snapshot, late=snapshot and revision < self._newest_revision):
                 self._rotate()
+            self._newest_revision = max(self._newest_revision, revision)
             part = self._part
             records: list[tuple[int, int, list[bytes]]] = []
             for (topic, _), body in zip(messages, data, strict=True):
@@ -390,12 +414,16 @@ class JournalWriter:
         self._telemetry_skipped = False
         return True
 
-    def _rotation_due(self, topic: str) -> bool:
+    def _rotation_due(self, snapshot: bool, late: bool) -> bool:
+        """Whether the next append starts a new part: a full part starts one with a snapshot,
+        so the part can start the mission on its own (any record does at twice the size).
+        A periodic snapshot journaled late (older than events already written) never does:
+        a resume that read the new part alone would miss those events."""
         full = self._options.part_bytes
         offset = self._part.offset
-        if self._rotation_failed or offset < full:
+        if self._rotation_failed or offset < full or late:
             return False
-        return topic == MISSION_TOPIC or offset >= 2 * full
+        return snapshot or offset >= 2 * full
 
     def _rotate(self) -> None:
         """Go on in the next part file; on failure keep writing this one."""

@@ -16,22 +16,29 @@ valid MCAP), alternating between them; each slot is one line of JSON padded with
 
     {"seq": 41, "epoch": "3f9a01c2", "revision": 8000, "high_water": 8500, "crc": 1234}
 
-``seq`` counts the writes (the newer slot wins) and ``crc`` is the CRC-32 of the line
-without it, so a slot torn or damaged is recognised and the other one used. A reader
-finds the slots by their sector, without parsing the header: a damaged header does not
-hide the mark.
+The slots of the part being written and of the journal's first file
+(:class:`FirstFileHead`) hold the same mark. ``seq`` counts the writes (the newer slot
+wins) and ``crc`` is the CRC-32 of the line without it, so a slot torn or damaged is
+recognised and the other one used. A reader finds the slots by their sector, without
+parsing the header: a damaged header does not hide the mark.
 """
 
 from __future__ import annotations
 
 import json
+import logging
+import os
 import zlib
 from collections.abc import Mapping
 from dataclasses import dataclass
+from pathlib import Path
 
 from mcap.opcode import Opcode
 
 from rosmc_server.recording._mcap import records as fmt
+from rosmc_server.recording.channels import LIBRARY, PROFILE
+
+_log = logging.getLogger(__name__)
 
 NAME = "rosmc/revisions"
 """The Metadata record's name."""
@@ -120,3 +127,48 @@ def _string(text: str) -> bytes:
 
 def _entry(key: str, value: bytes) -> bytes:
     return _string(key) + len(value).to_bytes(4, "little") + value
+
+
+class FirstFileHead:
+    """The mark slots of a journal's first file, rewritten while later parts are written.
+
+    The first file is the one a person copies or restores; the part being written may be
+    the one that is lost. So the mark goes to both heads.
+    """
+
+    def __init__(self, path: Path) -> None:
+        """Open ``path`` to rewrite its slots; :attr:`slots` is None if it has none."""
+        self.path = path
+        self.slots: tuple[int, int] | None = None
+        self._fd = -1
+        try:
+            with path.open("rb") as stream:
+                head = stream.read(HEAD_BYTES)
+            start = len(fmt.MAGIC) + len(fmt.header(PROFILE, LIBRARY))
+            found = fmt.record_head(head, start)
+            if found is not None and found[0] == Opcode.METADATA:
+                body = head[start + fmt.RECORD_HEAD.size : start + fmt.RECORD_HEAD.size + found[1]]
+                self.slots = slots_of(body, start)
+            if self.slots is not None:
+                self._fd = os.open(path, os.O_WRONLY | os.O_CLOEXEC)
+        except OSError as err:
+            _log.warning("journal %s: its head cannot keep the revision mark (%s)", path, err)
+            self.slots = None
+
+    def write(self, fields: Mapping[str, str | int], seq: int, sync: bool) -> None:
+        """Rewrite the older slot (fdatasync if ``sync``); nothing if the file has no slots.
+
+        Raises:
+            OSError: The slot cannot be written.
+        """
+        if self.slots is None or self._fd < 0:
+            return
+        os.pwrite(self._fd, encode_slot(seq, fields), self.slots[seq % 2])
+        if sync:
+            os.fdatasync(self._fd)
+
+    def close(self) -> None:
+        """Close the file."""
+        if self._fd >= 0:
+            os.close(self._fd)
+            self._fd = -1
