@@ -33,13 +33,13 @@ import pytest
 
 pytest.importorskip("rosmc.msg", reason="rosmc messages are not built (source build/devel)")
 
-from rosmc_server.conversions import mission_to_msg  # noqa: E402
-from rosmc_server.conversions.packing import serialized  # noqa: E402
-from rosmc_server.core import Library, Mission, MissionEvent, load_library  # noqa: E402
-from rosmc_server.recording import JournalError, JournalOptions  # noqa: E402
-from rosmc_server.recording.history import MissionHistory  # noqa: E402
-from rosmc_server.recording.mission_journal import MissionJournal, Resumed  # noqa: E402
-from tests.ros.file_layer import FileLog  # noqa: E402
+from rosmc_server.conversions import mission_to_msg
+from rosmc_server.conversions.packing import serialized
+from rosmc_server.core import Library, Mission, MissionEvent, load_library
+from rosmc_server.recording import JournalError, JournalOptions
+from rosmc_server.recording.history import MissionHistory
+from rosmc_server.recording.mission_journal import MissionJournal, Resumed
+from tests.ros.file_layer import FileLog
 
 REPO = Path(__file__).resolve().parents[2]
 NAME = "mission.mcap"
@@ -147,7 +147,7 @@ def crash_points(log: FileLog) -> list[tuple[int, int]]:
         points.append((index, 0))
         if not op.name.endswith(".revisions"):
             points.append((index, max(1, len(op.data) // 2)))
-    return points + [(len(log.ops), 0)]
+    return [*points, (len(log.ops), 0)]
 
 
 def resume(folder: Path, library: Library) -> Resumed:
