@@ -33,6 +33,9 @@ Parameters (private):
     ``~agent_state_rate`` (float, Hz): rate of ``/rosmc/agent_states`` (2.0).
     ``~fsync`` (bool): fsync the journal on every change (survives power loss; true).
     ``~snapshot_every`` (int): mission events between two full snapshots in the journal (500).
+    ``~journal_reserve`` (int, bytes): free space on the journal's disk below which changes
+        are refused (1 MiB); a change bigger than it meets the full disk mid-write instead
+        and is never acknowledged (the server exits and resumes without it).
     ``~broadcast_snapshots`` (bool): also send ``/rosmc/mission`` to every subscriber after
         changes (coalesced), as before per-subscriber snapshots (false; for benchmarks).
     ``~operators`` (list of str, or one string of names): nodes (full names, or prefixes
@@ -290,7 +293,11 @@ class MissionServer:
         return "; ".join(a for a in (self._resume_alert, self._journal.space.alert()) if a)
 
     def _open_journal(self) -> tuple[Mission, MissionJournal]:
-        options = JournalOptions(fsync=self.config.fsync, snapshot_every=self.config.snapshot_every)
+        options = JournalOptions(
+            fsync=self.config.fsync,
+            snapshot_every=self.config.snapshot_every,
+            reserve_bytes=self.config.journal_reserve,
+        )
         library = library_to_msg(self.library)  # journaled: a replay shows the mission with it
         if self.config.resume:
             if self.config.journal is None:
