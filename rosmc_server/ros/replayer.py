@@ -189,6 +189,18 @@ class RecordingReplayer:
         self._clock.set_rate(rate)
         return self.status()
 
+    def mission_at(self, position: float) -> Any:
+        """Move the replay's mission to ``position`` (s) and return its snapshot message there.
+
+        What a seek publishes on ``/rosmc/mission`` (None if the recording holds no mission
+        at that moment); the replay's thread calls it on every seek, tests and benchmarks
+        may call it before :meth:`run`.
+        """
+        with self._lock:
+            self._current = self._history.revision_at(position).revision
+            self._stamp = self._mission_stamp(position)
+            return self._mission_msg(self._current, position)
+
     def stop(self) -> None:
         """End :meth:`run` early (thread-safe)."""
         self._stop.set()
@@ -306,8 +318,7 @@ class RecordingReplayer:
         """Publish the state at ``status.position``; return the index of the record after it."""
         position = status.position
         with self._handled:
-            self._current = self._history.revision_at(position).revision
-            self._stamp = self._mission_stamp(position)
+            self.mission_at(position)  # built here, published (from the cache) below
             self._publish_snapshot(self._current, position)
             self._out().publish_state_at(
                 self._playlist, position, moved=status.seeks > 0, paused=status.paused
