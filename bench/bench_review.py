@@ -81,7 +81,9 @@ def write_journal(path: Path, edits: int, closed: bool, agents: int, skills: int
         task = state.task(agent)
         roll = rng.random()
         if roll < 0.05:
-            event = mission.add_skill(agent, "wait", {"seconds": 2.0}, index=rng.randrange(len(task)))
+            event = mission.add_skill(
+                agent, "wait", {"seconds": 2.0}, index=rng.randrange(len(task))
+            )
         elif roll < 0.08 and len(task) > 10:
             event = mission.delete_skills([task[rng.randrange(len(task))].id])
         else:

@@ -151,7 +151,7 @@ class JournalRecord:
             no longer holds it.
     """
 
-    __slots__ = ("topic", "log_time", "_message", "_payload", "_leading")
+    __slots__ = ("_leading", "_message", "_payload", "log_time", "topic")
 
     def __init__(
         self,
@@ -193,6 +193,16 @@ class JournalRecord:
             if name in self._leading:
                 return self._leading[name]
         return getattr(self.message, name)
+
+    def raw(self, cls: Any) -> bytes | None:
+        """The message's bytes if it was recorded with the installed definition of the
+        generated class ``cls`` (e.g. ``rosmc.msg.Mission``), else None."""
+        payload = self._payload
+        if payload is None or payload.schema.name != cls._type:
+            return None
+        if payload.schema.data != str(cls._full_text).encode():
+            return None
+        return payload.record.data
 
     @property
     def revision(self) -> int:

@@ -138,7 +138,7 @@ class DeferredMessage(fmt.MessageRecord):
         object.__setattr__(self, "head", msg.data[:HEAD_BYTES])
         object.__setattr__(self, "source", source)
 
-    @property  # type: ignore[misc]  # a read-only field of the frozen base, read from the file
+    @property  # the frozen base's read-only field, read from the file
     def data(self) -> bytes:
         """The payload, read from the file (and checked against its chunk's CRC) each time."""
         return self.source.load()
