@@ -257,7 +257,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         for edits in (int(e) for e in args.edits.split(",")):
             for closed in (True, False):
-                name = f"review_{args.agents}x{args.skills}_{edits}_{'closed' if closed else 'crashed'}"
+                ending = "closed" if closed else "crashed"
+                name = f"review_{args.agents}x{args.skills}_{edits}_{ending}"
                 path = directory / f"{name}.mcap"
                 if not path.exists():
                     written = time.perf_counter()

@@ -16,6 +16,8 @@ import struct
 from dataclasses import dataclass
 from typing import Any
 
+import genpy
+
 from rosmc_server.recording._mcap import records as fmt
 from rosmc_server.recording._mcap.codec import Decoder, RosMessage, installed_class
 from rosmc_server.recording._mcap.scan import DeferredMessage, payload_head
@@ -65,7 +67,7 @@ def leading_fields(definition: bytes) -> tuple[tuple[str, str], ...]:
 
 def read_leading(fields: tuple[tuple[str, str], ...], data: bytes) -> dict[str, Any]:
     """The values of ``fields`` at the start of ``data``, as far as ``data`` holds them
-    (``time`` and ``duration`` as (secs, nsecs); strings decoded as genpy does)."""
+    (as genpy gives them: ``time`` a ``genpy.Time``, strings decoded from UTF-8)."""
     values: dict[str, Any] = {}
     pos = 0
     for type_, name in fields:
@@ -75,14 +77,19 @@ def read_leading(fields: tuple[tuple[str, str], ...], data: bytes) -> dict[str, 
             (size,) = struct.unpack_from("<I", data, pos)
             if pos + 4 + size > len(data):
                 break
-            values[name] = data[pos + 4 : pos + 4 + size].decode("utf-8", "replace")
+            values[name] = data[pos + 4 : pos + 4 + size].decode("utf-8", "rosmsg")
             pos += 4 + size
             continue
         layout = struct.Struct(_FIXED[type_])
         if pos + layout.size > len(data):
             break
         unpacked = layout.unpack_from(data, pos)
-        values[name] = unpacked[0] if len(unpacked) == 1 else unpacked
+        if type_ == "time":
+            values[name] = genpy.Time(*unpacked)
+        elif type_ == "duration":
+            values[name] = genpy.Duration(*unpacked)
+        else:
+            values[name] = unpacked[0]
         pos += layout.size
     return values
 
