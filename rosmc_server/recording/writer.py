@@ -170,8 +170,7 @@ class JournalWriter:
                 writer._events_since_snapshot = 0
             elif record.topic == EVENTS_TOPIC:
                 writer._events_since_snapshot += 1
-                revision = int(getattr(record.message, "revision", -1))
-                writer._newest_revision = max(writer._newest_revision, revision)
+                writer._newest_revision = max(writer._newest_revision, record.revision)
         _log.info(
             "resumed journal %s: %d records, continuing in %s at byte %d",
             reopened.base,

@@ -13,7 +13,11 @@ where the next record starts, so a wrong length never hides intact records.
 
 What it found is everything the writer needs to continue the file (schemas,
 channels, chunk indexes, statistics and the offset to continue at) and
-everything the reader needs to decode the messages.
+everything the reader needs to decode the messages. A big message (a snapshot)
+whose bytes a CRC vouches for, or that lies bare in the file, is not kept in
+memory: it is a :class:`DeferredMessage`, read again from the file when its
+``data`` is asked for, so a scan holds the file's small records only, however
+many snapshots the file holds.
 """
 
 from dataclasses import dataclass, field, replace
@@ -30,6 +34,10 @@ from rosmc_server.recording.damage import Damage
 from rosmc_server.recording.errors import JournalError
 
 _HEAD = fmt.RECORD_HEAD.size
+DEFER_BYTES = 65536
+"""A message payload this big or bigger stays in the file (see :class:`DeferredMessage`)."""
+HEAD_BYTES = 64
+"""Bytes of a deferred payload kept in memory (its leading fields: revision, stamp, kind)."""
 _JOURNAL_OPCODES = frozenset(
     (
         Opcode.SCHEMA,
@@ -72,6 +80,77 @@ class ScanResult:
     """Damaged byte ranges that were skipped, in file order."""
     mark_slots: tuple[int, int] | None = None
     """Where the revision mark's slots lie (:mod:`.head_mark`); None in older journals."""
+
+
+@dataclass(frozen=True)
+class PayloadSource:
+    """Where a deferred message's payload lies in its file.
+
+    Attributes:
+        path: The file.
+        record: Offset of the record that holds it (a chunk, or the message itself).
+        length: Bytes of that record, its opcode and length field included.
+        start: Offset of the payload in the chunk's records (in the file, when bare).
+        size: Bytes of the payload.
+        chunked: Whether the record is a chunk (read and checked against its CRC again).
+    """
+
+    path: Path
+    record: int
+    length: int
+    start: int
+    size: int
+    chunked: bool
+
+    def load(self) -> bytes:
+        """The payload's bytes; raise JournalError if the file no longer holds them."""
+        try:
+            with self.path.open("rb") as file:
+                if not self.chunked:
+                    file.seek(self.start)
+                    data = file.read(self.size)
+                else:
+                    file.seek(self.record)
+                    # By its own fields, as the scan kept it: its opcode or length may be
+                    # damaged (a chunk its CRC vouches for is kept whole).
+                    rec, _ = fmt.read_chunk(file.read(self.length), _HEAD)
+                    data = rec.data[self.start : self.start + self.size]
+        except (OSError, fmt.FormatError) as err:
+            raise JournalError(
+                f"journal {self.path} changed since it was read (byte {self.record}): {err}"
+            ) from err
+        if len(data) != self.size:
+            raise JournalError(f"journal {self.path} changed since it was read: it is shorter")
+        return data
+
+
+class DeferredMessage(fmt.MessageRecord):
+    """A Message record whose payload stays in the file until :attr:`data` is asked for.
+
+    Compares, hashes and reads like a :class:`~.records.MessageRecord`; :attr:`head`
+    holds the payload's first :data:`HEAD_BYTES` bytes, enough for a journal's reader
+    to learn a snapshot's or event's revision without reading the rest.
+    """
+
+    head: bytes
+    source: PayloadSource
+
+    def __init__(self, msg: fmt.MessageRecord, source: PayloadSource) -> None:
+        # Frozen fields, set as the dataclass's own __init__ sets them; data is not kept.
+        for name in ("channel_id", "sequence", "log_time", "publish_time"):
+            object.__setattr__(self, name, getattr(msg, name))
+        object.__setattr__(self, "head", msg.data[:HEAD_BYTES])
+        object.__setattr__(self, "source", source)
+
+    @property  # the frozen base's read-only field, read from the file
+    def data(self) -> bytes:
+        """The payload, read from the file (and checked against its chunk's CRC) each time."""
+        return self.source.load()
+
+
+def payload_head(msg: fmt.MessageRecord) -> bytes:
+    """The first bytes of a message's payload (at most :data:`HEAD_BYTES`), never from disk."""
+    return msg.head if isinstance(msg, DeferredMessage) else msg.data[:HEAD_BYTES]
 
 
 class _Short(Exception):
@@ -226,6 +305,7 @@ class _Walker:
                 r.spans.append((offset, offset + _HEAD + len(body)))
                 r.top_level_messages += 1
                 self._last_bare = offset
+                self._defer(offset, _HEAD + len(body))
         elif opcode == Opcode.CHUNK:
             self._chunk(offset, fmt.parse_chunk(body), _HEAD + len(body))
         elif opcode == Opcode.MESSAGE_INDEX and (after_chunk or self._journal):
@@ -252,10 +332,13 @@ class _Walker:
                 if opcode == Opcode.MESSAGE:
                     msg = messages[-1]
                     indexes.setdefault(msg.channel_id, []).append((msg.log_time, inner_offset))
+                    if rec.uncompressed_crc:  # its CRC vouches for it when read again
+                        self._defer_in(messages, offset, length, inner_offset + _HEAD + 22)
             if inner_end != len(rec.data):
                 raise RecordDamage("its content ends inside a record")
+        first = len(r.messages)
         r.messages.extend(messages)
-        r.spans += [(offset, offset + length)] * len(messages)
+        r.spans += [(offset, offset + length)] * (len(r.messages) - first)
         r.chunk_indexes.append(
             fmt.ChunkIndexRecord(
                 message_start_time=rec.message_start_time,
@@ -271,6 +354,24 @@ class _Walker:
         )
         r.missing_indexes = indexes
         self._after_chunk = True
+
+    def _defer(self, record: int, length: int) -> None:
+        """Leave the payload of the bare message just taken in the file if it is big."""
+        self._defer_in(self._r.messages, record, length, record + _HEAD + 22, chunked=False)
+
+    def _defer_in(
+        self,
+        messages: list[fmt.MessageRecord],
+        record: int,
+        length: int,
+        start: int,
+        chunked: bool = True,
+    ) -> None:
+        """Leave the payload of the last of ``messages`` in the file if it is big."""
+        msg = messages[-1]
+        if len(msg.data) >= DEFER_BYTES:
+            source = PayloadSource(self._r.path, record, length, start, len(msg.data), chunked)
+            messages[-1] = DeferredMessage(msg, source)
 
     def _message_index(self, offset: int, body: bytes, after_chunk: bool) -> None:
         r = self._r
