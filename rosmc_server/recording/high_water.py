@@ -15,6 +15,14 @@ keeps ``<journal>.revisions``, one fixed-size line of JSON::
 
 A resume that finds the journal behind ``revision`` (or damaged) goes on above
 ``high_water``, so no revision number repeats within a mission's life, whatever was lost.
+
+The same mark is kept a second time inside the journal, at the head of the file being
+written (:mod:`._mcap.head_mark`), where a journal copied without its side file, or cut
+short or zeroed from some point on, still holds it. :func:`recover_mark` reads both and
+takes the higher; when one copy had to stand in for the other, it says so as an alert.
+Only when both are lost (the side file gone *and* the head of every part damaged) is the
+mark unknown: the resume then goes on a whole :data:`LEASE` above the journal's last
+revision, in a new epoch, and says so.
 """
 
 from __future__ import annotations
@@ -23,6 +31,7 @@ import json
 import logging
 import os
 import secrets
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -66,18 +75,41 @@ def new_epoch() -> str:
     return secrets.token_hex(4)
 
 
-class RevisionMark:
-    """The open mark file of a journal being written. Not thread-safe (the server's lock)."""
+MarkCopy = Callable[[Mapping[str, str | int], bool], None]
+"""Where a second copy of the mark goes, and whether to sync it (the journal's heads:
+``JournalWriter.write_mark``)."""
 
-    def __init__(self, journal: Path, mark: Mark, durable: bool) -> None:
-        """Create or replace the mark file with ``mark`` (fsynced, with its directory)."""
+
+class RevisionMark:
+    """The open mark file of a journal being written, and its copy in the journal's head.
+    Not thread-safe (the server's lock)."""
+
+    def __init__(
+        self, journal: Path, mark: Mark, durable: bool, copy: MarkCopy | None = None
+    ) -> None:
+        """Create or replace the mark file with ``mark`` (fsynced, with its directory), and
+        write it to ``copy`` (never synced on its own: the journal's next record is).
+
+        The file is written whole beside its place and renamed onto it, so that a crash
+        never leaves an empty or half-written mark file; later updates rewrite its one
+        short line in place (a write of one sector: whole or not at all).
+        """
         self.path = mark_path(journal)
         self._durable = durable
-        self._fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+        self._copy = copy
         self.mark = mark
-        self._write(sync=True)
+        staged = self.path.with_name(self.path.name + ".new")
+        self._fd = os.open(staged, os.O_RDWR | os.O_CREAT | os.O_TRUNC, 0o644)
+        try:
+            self._write(sync=True, to_copy=False)
+            os.replace(staged, self.path)
+        except OSError:
+            self.close()
+            raise
         if durable:
             fsync_directory(self.path.parent)
+        if copy is not None:  # second: a crash between the two leaves the side file newer
+            copy(mark_fields(mark), True)
 
     @property
     def epoch(self) -> str:
@@ -103,15 +135,20 @@ class RevisionMark:
             os.close(self._fd)
             self._fd = -1
 
-    def _write(self, sync: bool) -> None:
+    def _write(self, sync: bool, to_copy: bool = True) -> None:
         mark = self.mark
-        line = json.dumps(
-            {"epoch": mark.epoch, "revision": mark.revision, "high_water": mark.high_water}
-        )
+        line = json.dumps(mark_fields(mark))
         data = line.encode("ascii").ljust(_SIZE - 1) + b"\n"
         os.pwrite(self._fd, data, 0)
         if sync and self._durable:
             os.fdatasync(self._fd)
+        if to_copy and self._copy is not None:  # second: the side file is never the older
+            self._copy(mark_fields(mark), sync)
+
+
+def mark_fields(mark: Mark) -> dict[str, str | int]:
+    """The mark as the fields of a JSON object."""
+    return {"epoch": mark.epoch, "revision": mark.revision, "high_water": mark.high_water}
 
 
 def first_mark(revision: int) -> Mark:

@@ -1,11 +1,15 @@
 """The mission at every revision of a journal, for people reviewing what happened.
 
-:class:`MissionHistory` reads a journal once: it starts from the first snapshot,
-applies every journaled event with :meth:`Mission.replay` and starts over from
-the snapshot that follows a ``MISSION_REPLACED`` event (such an event carries no
-content). It keeps a copy of the content every few hundred revisions, so any
-revision is rebuilt by replaying a short run of events. Times are seconds since
-the recording started (its first record) unless a log time (ns) is asked for.
+:class:`MissionHistory` reads a journal's records once, without decoding them: it
+follows the revisions from the first snapshot (starting over from the snapshot that
+follows a ``MISSION_REPLACED`` event, which carries no content) and notes, per
+revision, its time, kind and summary (read from the event's bytes) and any snapshot
+of it. The mission at a revision is rebuilt when asked for, from the nearest
+snapshot at or before it and the events after it (:mod:`.history_states`), so
+``rosmc at``, a replay's seek and ``rosmc info`` cost one snapshot and a few hundred
+events, not the whole recording. The timeline, which needs every event, is built on
+the first call of :meth:`MissionHistory.timeline`. Times are seconds since the
+recording started (its first record) unless a log time (ns) is asked for.
 
 Typical use::
 
@@ -20,12 +24,10 @@ import bisect
 from dataclasses import dataclass
 from pathlib import Path
 
-from rosmc_server.conversions import event_from_msg, mission_from_msg
+from rosmc_server.conversions import event_from_msg
 from rosmc_server.core import (
     EventKind,
     InvalidRequest,
-    MissionContent,
-    MissionEvent,
     MissionState,
     NotFound,
     RosmcError,
@@ -34,12 +36,17 @@ from rosmc_server.core.updates import apply_event
 from rosmc_server.interface import EVENTS_TOPIC, MISSION_TOPIC, ROBOT_REPORTS_TOPIC
 from rosmc_server.recording.damage import skipped_line
 from rosmc_server.recording.errors import JournalError
+from rosmc_server.recording.history_states import (
+    CHECKPOINT_EVERY,
+    StateBuilder,
+    Step,
+    snapshot_content,
+)
 from rosmc_server.recording.reader import JournalRecord, JournalResult, feed, read_journal
 from rosmc_server.recording.revisions import Gap, RevisionWalk
 from rosmc_server.recording.timeline import Timeline, TimelineBuilder
 
-CHECKPOINT_EVERY = 256
-"""Revisions between two kept copies of the content (bounds the replay per lookup)."""
+__all__ = ["CHECKPOINT_EVERY", "MissionHistory", "Revision"]
 
 
 @dataclass(frozen=True)
@@ -59,18 +66,11 @@ class Revision:
     summary: str
 
 
-@dataclass
-class _Entry:
-    info: Revision
-    event: MissionEvent | None
-    checkpoint: MissionContent | None
-
-
 class MissionHistory:
     """Every revision of the mission a journal holds; build it with :meth:`from_journal`."""
 
     def __init__(self, result: JournalResult) -> None:
-        """Replay ``result`` (a read journal); raises JournalError without a snapshot."""
+        """Index ``result`` (a read journal); raises JournalError without a snapshot."""
         self.path = result.path
         self.warnings: tuple[str, ...] = result.warnings
         """What reading the file found wrong (a cut-off tail, undecodable records)."""
@@ -80,27 +80,26 @@ class MissionHistory:
         """Log time (ns) of the first record: time 0 of the recording."""
         self.end = max(record.log_time for record in result.records)
         """Log time (ns) of the last record."""
-        self._entries: list[_Entry] = []
+        topics = (MISSION_TOPIC, EVENTS_TOPIC, ROBOT_REPORTS_TOPIC)
+        self._records = tuple(r for r in result.records if r.topic in topics)
+        self._infos: list[Revision] = []
+        self._steps: list[Step] = []
         self._problems: list[str] = []
-        self._mission: MissionState | None = None
-        self._timeline = TimelineBuilder(self.start)
+        self._timeline: Timeline | None = None
         self.gaps: tuple[Gap, ...] = ()
         """The revisions that cannot be rebuilt (damaged or missing records)."""
         self.damage = result.damage
         """The damaged byte ranges reading skipped."""
-        self._build(result)
+        self._index()
         skipped = skipped_line(self.path, self.damage, self.gaps)
-        self.problems: tuple[str, ...] = (skipped,) if skipped else ()
-        self.problems += tuple(f"journal {self.path}: {text}" for text in self._problems)
-        """What was skipped (one line: damaged bytes and the revisions they cost) and any
-        other revision that could not be rebuilt, one sentence each (empty when intact)."""
-        self._revisions = [entry.info.revision for entry in self._entries]
-        self._times = [entry.info.log_time for entry in self._entries]
-        self._cache: tuple[int, MissionState] | None = None
+        self._skipped: tuple[str, ...] = (skipped,) if skipped else ()
+        self._revisions = [info.revision for info in self._infos]
+        self._times = [info.log_time for info in self._infos]
+        self._builder = StateBuilder(self._steps, self._problems.append)
 
     @classmethod
     def from_journal(cls, path: str | Path) -> MissionHistory:
-        """Read and replay the journal at ``path``.
+        """Read and index the journal at ``path``.
 
         Raises:
             JournalError: The file is not a readable journal or holds no snapshot.
@@ -109,9 +108,19 @@ class MissionHistory:
 
     # -- queries ---------------------------------------------------------------------
     @property
+    def problems(self) -> tuple[str, ...]:
+        """What was skipped (one line: damaged bytes and the revisions they cost) and any
+        other revision that could not be rebuilt, one sentence each (empty when intact).
+
+        An event that does not apply is found once a state that needs it is built (the
+        timeline builds every one).
+        """
+        return self._skipped + tuple(f"journal {self.path}: {text}" for text in self._problems)
+
+    @property
     def revisions(self) -> tuple[Revision, ...]:
         """Every revision the history can show, oldest first."""
-        return tuple(entry.info for entry in self._entries)
+        return tuple(self._infos)
 
     @property
     def duration(self) -> float:
@@ -126,7 +135,7 @@ class MissionHistory:
         """The mission at ``revision``.
 
         Raises:
-            NotFound: The recording does not hold that revision.
+            NotFound: The recording does not hold that revision (or cannot rebuild it).
         """
         index = bisect.bisect_left(self._revisions, revision)
         if index == len(self._revisions) or self._revisions[index] != revision:
@@ -135,7 +144,7 @@ class MissionHistory:
                 f"{self._revisions[0]} to {self._revisions[-1]}"
                 + (", with gaps)" if self.problems else ")")
             )
-        return self._state(index)
+        return self._builder.state(index)
 
     def at_time(self, t: float, *, log_time: bool = False) -> MissionState:
         """The mission as it was at ``t`` seconds since the start (or at log time ``t`` ns).
@@ -148,49 +157,34 @@ class MissionHistory:
         """
         if not t >= 0:
             raise InvalidRequest(f"a time must be 0 or more, got {t}")
-        return self._state(self._index_of(int(t) if log_time else self._log_time(t)))
+        index = self._index_of(int(t) if log_time else self._log_time(t))
+        return self._builder.state(index)
 
     def revision_at(self, t: float) -> Revision:
         """The revision current ``t`` seconds after the start."""
-        return self._entries[self._index_of(self._log_time(max(t, 0.0)))].info
+        return self._infos[self._index_of(self._log_time(max(t, 0.0)))]
 
     def timeline(self) -> Timeline:
         """Every robot's skill executions, barrier waits and barrier releases."""
-        return self._timeline.build(self.seconds(self.end))
+        if self._timeline is None:
+            self._timeline = _timeline(self, self._records)
+        return self._timeline
 
-    # -- building ----------------------------------------------------------------------
+    # -- indexing --------------------------------------------------------------------
     def _log_time(self, seconds: float) -> int:
         return self.start + round(seconds * 1e9)
 
     def _index_of(self, log_time: int) -> int:
-        """The last entry journaled at or before ``log_time`` (the first if none was)."""
+        """The last revision journaled at or before ``log_time`` (the first if none was)."""
         return max(0, bisect.bisect_right(self._times, log_time) - 1)
 
-    def _state(self, index: int) -> MissionState:
-        start = index
-        while self._entries[start].checkpoint is None:
-            start -= 1
-        cached = self._cache
-        if cached is not None and start <= cached[0] <= index:
-            start, state = cached  # sequential lookups replay only the new events
-        else:
-            state = _state(self._entries[start].checkpoint, self._revisions[start])
-        for entry in self._entries[start + 1 : index + 1]:
-            if entry.checkpoint is not None:
-                state = _state(entry.checkpoint, entry.info.revision)
-            else:
-                assert entry.event is not None
-                apply_event(state, entry.event)
-        self._cache = (index, state)
-        return MissionState(state.content(), state.revision)
-
-    def _build(self, result: JournalResult) -> None:
-        walk: RevisionWalk[JournalRecord, JournalRecord] = RevisionWalk(self._restart, self._apply)
-        self._since_checkpoint = 0
-        for record in result.records:
-            if record.topic == ROBOT_REPORTS_TOPIC:
-                self._timeline.report(record.message, record.log_time)
-            else:
+    def _index(self) -> None:
+        """Follow the revisions through the records, decoding none of them."""
+        walk: RevisionWalk[JournalRecord, JournalRecord] = RevisionWalk(
+            self._restart, self._apply, self._covered
+        )
+        for record in self._records:
+            if record.topic != ROBOT_REPORTS_TOPIC:
                 feed(walk, record)
         walk.finish()
         if walk.unacknowledged is not None:
@@ -199,49 +193,78 @@ class MissionHistory:
                 "before the new mission's snapshot; it is left out"
             )
         self.gaps = tuple(walk.gaps)
-        if not self._entries:
+        if not self._infos:
             raise JournalError(f"journal {self.path} holds no mission snapshot to start from")
 
     def _restart(self, record: JournalRecord, replacing: JournalRecord | None) -> None:
         """(Re)start the history from a snapshot (of a replacement, if given)."""
-        revision = int(record.message.revision)
+        revision = record.revision
         info = Revision(revision, self._next_time(record.log_time), None, "")
         if replacing is not None:
-            kind, summary = EventKind.MISSION_REPLACED, str(replacing.message.summary)
+            kind, summary = EventKind.MISSION_REPLACED, str(replacing.field("summary"))
             info = Revision(revision, self._next_time(replacing.log_time), kind, summary)
-        content, _ = mission_from_msg(record.message)
-        self._mission = _state(content, revision)
-        self._entries.append(_Entry(info, None, content))
-        self._timeline.reset(self._mission, info.log_time)
-        self._since_checkpoint = 0
+        self._infos.append(info)
+        self._steps.append(Step(revision, None, record))
 
     def _apply(self, record: JournalRecord) -> bool:
-        """Apply the next event; False (and a problem) if it does not apply."""
-        mission = self._mission
-        assert mission is not None
-        revision = int(record.message.revision)
+        """Take the next event; False (and a problem) if it is not a change the core knows."""
+        revision = record.revision
         try:
-            event = event_from_msg(record.message)
-            self._timeline.event(mission, event, record.log_time)
-            apply_event(mission, event)
-        except RosmcError as err:
-            self._problems.append(f"revision {revision} does not apply ({err}); skipped")
+            kind = EventKind(record.kind)
+        except ValueError:
+            try:  # as a full decode says it
+                event_from_msg(record.message)
+                reason = f"kind {record.kind} is unknown"
+            except RosmcError as err:
+                reason = str(err)
+            self._problems.append(f"revision {revision} does not apply ({reason}); skipped")
             return False
-        self._since_checkpoint += 1
-        checkpoint = None
-        if self._since_checkpoint >= CHECKPOINT_EVERY:
-            checkpoint, self._since_checkpoint = mission.content(), 0
-        info = Revision(revision, self._next_time(record.log_time), event.kind, event.summary)
-        self._entries.append(_Entry(info, event if checkpoint is None else None, checkpoint))
+        summary = str(record.field("summary"))
+        self._infos.append(Revision(revision, self._next_time(record.log_time), kind, summary))
+        self._steps.append(Step(revision, record))
         return True
+
+    def _covered(self, record: JournalRecord) -> None:
+        """A periodic snapshot of a revision reached already: a place to rebuild from."""
+        index = bisect.bisect_left(self._steps, record.revision, key=_revision)
+        found = self._steps[index] if index < len(self._steps) else None
+        if found is not None and found.revision == record.revision and found.snapshot is None:
+            found.snapshot = record
 
     def _next_time(self, log_time: int) -> int:
         """``log_time``, or the previous revision's if later: an event journaled before a
         late snapshot is shown right after it, so times never go back."""
-        return max(log_time, self._entries[-1].info.log_time) if self._entries else log_time
+        return max(log_time, self._infos[-1].log_time) if self._infos else log_time
 
 
-def _state(content: MissionContent | None, revision: int) -> MissionState:
-    """A mission state to apply events on (applying needs no library)."""
-    assert content is not None
-    return MissionState(content, revision)
+def _revision(step: Step) -> int:
+    return step.revision
+
+
+def _timeline(history: MissionHistory, records: tuple[JournalRecord, ...]) -> Timeline:
+    """The timeline of every event and robot report, applied one after the other."""
+    builder = TimelineBuilder(history.start)
+    mission: list[MissionState] = []
+
+    def restart(record: JournalRecord, replacing: JournalRecord | None) -> None:
+        log_time = record.log_time if replacing is None else replacing.log_time
+        mission[:] = [MissionState(snapshot_content(record), record.revision)]
+        builder.reset(mission[0], log_time)
+
+    def apply(record: JournalRecord) -> bool:
+        try:
+            event = event_from_msg(record.message)
+            builder.event(mission[0], event, record.log_time)
+            apply_event(mission[0], event)
+        except RosmcError:
+            return False
+        return True
+
+    walk: RevisionWalk[JournalRecord, JournalRecord] = RevisionWalk(restart, apply)
+    for record in records:
+        if record.topic == ROBOT_REPORTS_TOPIC:
+            builder.report(record.message, record.log_time)
+        else:
+            feed(walk, record)
+    walk.finish()
+    return builder.build(history.duration)

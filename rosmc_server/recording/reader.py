@@ -12,18 +12,24 @@ from rosmc_server.recording._mcap.files import journal_parts
 from rosmc_server.recording.channels import LIBRARY
 from rosmc_server.recording.damage import Damage
 from rosmc_server.recording.errors import JournalError
+from rosmc_server.recording.lazy import JournalRecord, Leads, Payload
 from rosmc_server.recording.revisions import Gap, RevisionWalk
+
+__all__ = [
+    "JournalRecord",
+    "JournalResult",
+    "LatestState",
+    "decode_scan",
+    "feed",
+    "join_results",
+    "latest_state",
+    "read_journal",
+]
 
 _log = logging.getLogger(__name__)
 
-
-@dataclass(frozen=True)
-class JournalRecord:
-    """One recorded message: its topic, log time (ns) and the decoded genpy message."""
-
-    topic: str
-    log_time: int
-    message: RosMessage
+MISSION_REPLACED = 19
+"""``rosmc/MissionEvent.MISSION_REPLACED`` (a constant of the message, fixed for good)."""
 
 
 @dataclass(frozen=True)
@@ -77,6 +83,8 @@ class LatestState:
         notes: What was left out on purpose (a change recorded but never acknowledged).
         gaps: The revisions that cannot be rebuilt (see :attr:`lost`).
         highest: The highest revision the journal holds (-1 for none).
+        unacknowledged: The revision of a replacement the journal ends with before its
+            snapshot (left out), or None.
     """
 
     snapshot: RosMessage
@@ -86,6 +94,7 @@ class LatestState:
     notes: tuple[str, ...] = ()
     gaps: tuple[Gap, ...] = ()
     highest: int = -1
+    unacknowledged: int | None = None
 
     @property
     def revision(self) -> int:
@@ -157,11 +166,19 @@ def decode_scan(scan: _scan.ScanResult, topics: Collection[str] | None = None) -
 
     Damage is not logged here: whoever reads the journal reports it in one line (with
     the revisions it cost, which only they know).
+
+    The messages of a chunked journal, which the chunks' CRCs vouch for, are decoded on
+    first use (see :mod:`.lazy`), but for the first of each schema: a definition that
+    cannot decode is found here. Every other file's messages are decoded here, as a bare
+    message that does not decode is damage; a big one is not kept decoded.
     """
     decoder = Decoder()
+    leads = Leads()
     records: list[JournalRecord] = []
     failures: dict[str, list[str]] = {}
     damage = list(scan.damage)
+    lazy = scan.library == LIBRARY and bool(scan.chunk_indexes)
+    tried: set[int] = set()  # schemas one message of which was decoded
     for msg, (start, end) in zip(scan.messages, scan.spans, strict=True):
         channel = scan.channels[msg.channel_id]
         if topics is not None and channel.topic not in topics:
@@ -170,9 +187,13 @@ def decode_scan(scan: _scan.ScanResult, topics: Collection[str] | None = None) -
         try:
             if schema is None:
                 raise JournalError("its channel has no schema")
-            records.append(
-                JournalRecord(channel.topic, msg.log_time, decoder.decode(schema, msg.data))
-            )
+            payload = Payload(decoder, schema, msg, leads.of(schema))
+            message = None
+            if not lazy or schema.id not in tried:
+                message = payload.decode()
+                tried.add(schema.id)
+            keep = None if payload.big else message
+            records.append(JournalRecord(channel.topic, msg.log_time, keep, payload))
         except JournalError as err:
             # A journal's bare message (no CRC) that does not decode: its bytes are damaged.
             if schema is not None and scan.library == LIBRARY and not scan.chunk_indexes:
@@ -218,22 +239,22 @@ def latest_state(result: JournalResult) -> LatestState:
         JournalError: The journal holds no snapshot.
     """
     base: list[JournalRecord] = []
-    events: list[RosMessage] = []
+    events: list[JournalRecord] = []  # decoded at the end: only those after the base
 
     def restart(snapshot: JournalRecord, _replacing: JournalRecord | None) -> None:
         base[:] = [snapshot]
         events.clear()
 
     def apply(event: JournalRecord) -> bool:
-        events.append(event.message)
+        events.append(event)
         return True
 
     def covered(snapshot: JournalRecord) -> None:
         # A newer periodic snapshot saves replaying the events it already holds.
-        revision = int(snapshot.message.revision)
-        if base and revision >= int(base[0].message.revision):
+        revision = snapshot.revision
+        if base and revision >= base[0].revision:
             base[:] = [snapshot]
-            events[:] = [e for e in events if int(e.revision) > revision]
+            events[:] = [e for e in events if e.revision > revision]
 
     walk: RevisionWalk[JournalRecord, JournalRecord] = RevisionWalk(restart, apply, covered)
     for record in result.records:
@@ -251,18 +272,18 @@ def latest_state(result: JournalResult) -> LatestState:
     return LatestState(
         base[0].message,
         base[0].log_time,
-        tuple(events),
+        tuple(event.message for event in events),
         tuple(f"journal {result.path}: {gap}" for gap in walk.gaps),
         tuple(notes),
         tuple(walk.gaps),
         walk.highest,
+        walk.unacknowledged,
     )
 
 
 def feed(walk: RevisionWalk[JournalRecord, JournalRecord], record: JournalRecord) -> None:
     """Hand a snapshot or event record to ``walk``; records of other topics are ignored."""
     if record.topic == MISSION_TOPIC:
-        walk.snapshot(int(record.message.revision), record)
+        walk.snapshot(record.revision, record)
     elif record.topic == EVENTS_TOPIC:
-        replaced = record.message.kind == record.message.MISSION_REPLACED
-        walk.event(int(record.message.revision), replaced, record)
+        walk.event(record.revision, record.kind == MISSION_REPLACED, record)

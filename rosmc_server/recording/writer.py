@@ -2,6 +2,7 @@
 
 import logging
 import threading
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from types import TracebackType
@@ -16,6 +17,7 @@ from rosmc_server.interface import (
     ROBOT_COMMANDS_TOPIC,
     ROBOT_REPORTS_TOPIC,
 )
+from rosmc_server.recording._mcap import head_mark
 from rosmc_server.recording._mcap import records as fmt
 from rosmc_server.recording._mcap.codec import RosMessage, serialize
 from rosmc_server.recording._mcap.files import journal_parts, part_path
@@ -93,6 +95,10 @@ class JournalWriter:
         self._events_since_snapshot = 0
         self._rotation_failed = False
         self._telemetry_skipped = False
+        self._mark: dict[str, str | int] | None = None  # the revision mark, for new parts
+        self._mark_writes = 0
+        self._first_head: head_mark.FirstFileHead | None = None  # once parts follow it
+        self._newest_revision = -1  # of any event or snapshot written
         self._lock = threading.RLock()
         self.space = DiskSpace(part.path.parent, options.reserve_bytes)
         """The free space of the journal's disk."""
@@ -164,6 +170,7 @@ class JournalWriter:
                 writer._events_since_snapshot = 0
             elif record.topic == EVENTS_TOPIC:
                 writer._events_since_snapshot += 1
+                writer._newest_revision = max(writer._newest_revision, record.revision)
         _log.info(
             "resumed journal %s: %d records, continuing in %s at byte %d",
             reopened.base,
@@ -226,12 +233,47 @@ class JournalWriter:
         """Record a full ``rosmc/Mission`` snapshot (and the library, once per part file);
         durable when this returns."""
         self._append(MISSION_TOPIC, mission, log_time_ns, sync=True)
+        self._append_library(log_time_ns)
+
+    def _append_library(self, log_time_ns: int) -> None:
+        """Write the library after the first snapshot of a part file."""
         with self._lock:
             part = self._part.number
             due = self._library is not None and self._library_part != part
             self._library_part = part
         if due:
             self._append(LIBRARY_TOPIC, self._library, log_time_ns, sync=True)
+
+    def append_replacement(self, event: RosMessage, mission: RosMessage, log_time_ns: int) -> None:
+        """Record a change that replaces the mission (``rosmc/MissionEvent`` of kind
+        MISSION_REPLACED) together with the new mission's snapshot, as one unit: one chunk
+        written at once and synced, so that no crash leaves the event without the content
+        it stands for (a chunk torn by a crash fails its CRC and is cut off whole). Durable
+        when this returns."""
+        self._append_unit([(EVENTS_TOPIC, event), (MISSION_TOPIC, mission)], log_time_ns, True)
+        self._append_library(log_time_ns)
+
+    def write_mark(self, fields: Mapping[str, str | int], sync: bool = False) -> None:
+        """Keep the revision mark's fields in the head of the file being written and of the
+        journal's first file (in place; see :mod:`._mcap.head_mark`), and in every part
+        started after this. The part written is synced by its next record; the first file,
+        once it is no longer written, when ``sync`` (a lease renewed).
+
+        Raises:
+            JournalError: A head cannot be written.
+        """
+        with self._lock:
+            self._mark = dict(fields)
+            self._mark_writes += 1
+            self._part.write_mark(self._mark, self._mark_writes)
+            if self._part.number == 1:
+                return
+            if self._first_head is None:
+                self._first_head = head_mark.FirstFileHead(self._base)
+            try:
+                self._first_head.write(self._mark, self._mark_writes, sync and self._options.fsync)
+            except OSError as err:
+                raise JournalError(f"cannot write journal {self._base}: {err.strerror}") from err
 
     def append_due_snapshot(self, mission: RosMessage, log_time_ns: int) -> bool:
         """Record ``mission`` if a snapshot is due, the journal open and room left for it
@@ -284,12 +326,19 @@ class JournalWriter:
     def close(self) -> None:
         """Write the summary and footer, sync and close; a closed journal is complete MCAP."""
         with self._lock:
+            self._close_first_head()
             self._part.close()
 
     def abandon(self) -> None:
         """Close the file without a summary, as a crash leaves it; resume recovers it."""
         with self._lock:
+            self._close_first_head()
             self._part.abandon()
+
+    def _close_first_head(self) -> None:
+        if self._first_head is not None:
+            self._first_head.close()
+            self._first_head = None
 
     def __enter__(self) -> Self:
         return self
@@ -303,34 +352,52 @@ class JournalWriter:
         self.close()
 
     def _append(self, topic: str, msg: RosMessage, log_time_ns: int, sync: bool) -> None:
-        expected = JOURNAL_TOPICS[topic]
-        if getattr(msg, "_type", None) != expected:
-            raise JournalError(f"{topic} records {expected}, not {type(msg).__name__}")
         if not sync and not self._room_for_telemetry(topic):
             return
-        data = serialize(msg)  # outside the lock: a big snapshot takes a while
+        self._append_unit([(topic, msg)], log_time_ns, sync)
+
+    def _append_unit(
+        self, messages: list[tuple[str, RosMessage]], log_time_ns: int, sync: bool
+    ) -> None:
+        """Write ``messages`` as one unit: one chunk (chunked layout) in one write."""
+        for topic, msg in messages:
+            expected = JOURNAL_TOPICS[topic]
+            if getattr(msg, "_type", None) != expected:
+                raise JournalError(f"{topic} records {expected}, not {type(msg).__name__}")
+        data = [serialize(msg) for _, msg in messages]  # outside the lock: snapshots are big
+        revision = -1  # of the snapshot or event written last: both start with a uint64 one
+        if messages[-1][0] in (MISSION_TOPIC, EVENTS_TOPIC):
+            revision = int.from_bytes(data[-1][:8], "little")
         with self._lock:
             self._part.open_fd()
-            if self._rotation_due(topic):
+            snapshot = messages[-1][0] == MISSION_TOPIC
+            if self._rotation_due(snapshot, late=snapshot and revision < self._newest_revision):
                 self._rotate()
+            self._newest_revision = max(self._newest_revision, revision)
             part = self._part
-            channel_id = self._channels[topic]
-            sequence = part.section.sequence(channel_id)
-            # The record is written in parts: a snapshot's megabytes are never copied.
-            record = [fmt.message_head(channel_id, sequence, log_time_ns, len(data)), data]
+            records: list[tuple[int, int, list[bytes]]] = []
+            for (topic, _), body in zip(messages, data, strict=True):
+                channel_id = self._channels[topic]
+                earlier = sum(1 for r in records if r[0] == channel_id)
+                sequence = (part.section.sequence(channel_id) + earlier) & 0xFFFFFFFF
+                # The record is written in parts: a snapshot's megabytes are never copied.
+                head = fmt.message_head(channel_id, sequence, log_time_ns, len(body))
+                records.append((channel_id, log_time_ns, [head, body]))
+            written: list[bytes] = [piece for _, _, parts in records for piece in parts]
             chunk_index = None
             if part.chunked:
                 compress_from = self._options.compress_from
-                record, chunk_index = part.section.chunk(
-                    part.offset, channel_id, log_time_ns, record, compress_from
-                )
-            part.write(record, sync, self._options.fsync)
-            part.section.count(channel_id, log_time_ns, chunk_index)
-            if topic == MISSION_TOPIC:
-                self._events_since_snapshot = 0
-                part.snapshots += 1
-            elif topic == EVENTS_TOPIC:
-                self._events_since_snapshot += 1
+                written, chunk_index = part.section.chunk(part.offset, records, compress_from)
+            part.write(written, sync, self._options.fsync)
+            for channel_id, _, _ in records:
+                part.section.count(channel_id, log_time_ns, chunk_index)
+                chunk_index = None  # one index entry per chunk
+            for topic, _ in messages:
+                if topic == MISSION_TOPIC:
+                    self._events_since_snapshot = 0
+                    part.snapshots += 1
+                elif topic == EVENTS_TOPIC:
+                    self._events_since_snapshot += 1
 
     def _room_for_telemetry(self, topic: str) -> bool:
         """Whether telemetry may still be written; skipped (said once) near a full disk."""
@@ -346,12 +413,16 @@ class JournalWriter:
         self._telemetry_skipped = False
         return True
 
-    def _rotation_due(self, topic: str) -> bool:
+    def _rotation_due(self, snapshot: bool, late: bool) -> bool:
+        """Whether the next append starts a new part: a full part starts one with a snapshot,
+        so the part can start the mission on its own (any record does at twice the size).
+        A periodic snapshot journaled late (older than events already written) never does:
+        a resume that read the new part alone would miss those events."""
         full = self._options.part_bytes
         offset = self._part.offset
-        if self._rotation_failed or offset < full:
+        if self._rotation_failed or offset < full or late:
             return False
-        return topic == MISSION_TOPIC or offset >= 2 * full
+        return snapshot or offset >= 2 * full
 
     def _rotate(self) -> None:
         """Go on in the next part file; on failure keep writing this one."""
@@ -372,6 +443,12 @@ class JournalWriter:
             return
         self._part = new
         self._channels = new.section.channel_ids()
+        if self._mark is not None:
+            self._mark_writes += 1
+            try:
+                new.write_mark(self._mark, self._mark_writes)
+            except JournalError as err:  # the side file and the older parts still hold it
+                _log.warning("journal %s: %s", self._base, err)
         try:
             old.close()
         except JournalError as err:  # readers recover an unclosed part all the same

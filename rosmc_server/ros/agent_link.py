@@ -20,7 +20,9 @@ Operation = Callable[[Mission], MissionEvent | None]
 class LinkHost(Protocol):
     """What the ground link needs from the mission server."""
 
-    mission: Mission
+    @property
+    def mission(self) -> Mission:
+        """The mission (Unavailable once the journal failed)."""
 
     def apply(self, operation: Operation) -> MissionEvent | None:
         """Run a mission operation and record its event; the lock is held by the caller."""

@@ -12,6 +12,7 @@ waits for it (:mod:`rosmc_server.core.waiting`), and the answer's note says so.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import re
 from collections.abc import Callable
@@ -158,7 +159,8 @@ class OperatorServices:
         if hasattr(response, "error"):
             response.error_code = code
             response.error = message
-            response.revision = self._server.mission.revision
+            with contextlib.suppress(Unavailable):  # after a journal failure: nothing to name
+                response.revision = self._server.mission.revision
 
     def _apply(self, operation: Callable[[Mission], MissionEvent]) -> MissionEvent:
         event = self._server.apply(operation)

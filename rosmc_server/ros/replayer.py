@@ -49,7 +49,8 @@ import rosmc.srv as wire_srv
 import rospy
 
 from .. import interface
-from ..conversions import event_from_msg, mission_to_msg
+from ..conversions import event_from_msg
+from ..conversions.packing import PackedGetMissionResponse, PackedMission, SnapshotPacker
 from ..core import EventKind, InvalidRequest, MissionEvent, NotFound, RosmcError
 from ..recording import JournalRecord
 from ..recording.history import MissionHistory
@@ -149,6 +150,7 @@ class RecordingReplayer:
         self._current = history.revision_at(config.start).revision  # of the replay's mission
         self._stamp = self._mission_stamp(config.start)  # mission clock of _current
         self._built: tuple[int, Any] | None = None  # the last snapshot built, for get_mission
+        self._packer = SnapshotPacker()
 
     # -- steering (any thread) -------------------------------------------------------------
     def status(self) -> PlaybackStatus:
@@ -188,6 +190,18 @@ class RecordingReplayer:
         """
         self._clock.set_rate(rate)
         return self.status()
+
+    def mission_at(self, position: float) -> Any:
+        """Move the replay's mission to ``position`` (s) and return its snapshot message there.
+
+        What a seek publishes on ``/rosmc/mission`` (None if the recording holds no mission
+        at that moment); the replay's thread calls it on every seek, tests and benchmarks
+        may call it before :meth:`run`.
+        """
+        with self._lock:
+            self._current = self._history.revision_at(position).revision
+            self._stamp = self._mission_stamp(position)
+            return self._mission_msg(self._current, position)
 
     def stop(self) -> None:
         """End :meth:`run` early (thread-safe)."""
@@ -306,8 +320,7 @@ class RecordingReplayer:
         """Publish the state at ``status.position``; return the index of the record after it."""
         position = status.position
         with self._handled:
-            self._current = self._history.revision_at(position).revision
-            self._stamp = self._mission_stamp(position)
+            self.mission_at(position)  # built here, published (from the cache) below
             self._publish_snapshot(self._current, position)
             self._out().publish_state_at(
                 self._playlist, position, moved=status.seeks > 0, paused=status.paused
@@ -320,14 +333,15 @@ class RecordingReplayer:
 
     def _publish(self, record: JournalRecord) -> bool:
         """Publish one record; True if it replaced the mission (publish its snapshot now)."""
-        msg, topic = record.message, record.topic
+        topic = record.topic
         with self._lock:
             if topic not in (interface.MISSION_TOPIC, interface.EVENTS_TOPIC):
-                self._out().publish(topic, msg)
+                self._out().publish(topic, record.message)
                 return False
-            revision = int(msg.revision)
+            revision = record.revision  # read from the bytes: a snapshot is decoded only if new
             if revision <= self._current:
                 return False  # part of the mission published already
+            msg = record.message
             self._out().publish(topic, msg)
             self._current = revision
             if topic == interface.MISSION_TOPIC:  # a revision the history could not rebuild
@@ -362,7 +376,8 @@ class RecordingReplayer:
                     return None
                 recorded = self._playlist.latest(interface.MISSION_TOPIC, position)
                 return None if recorded is None else recorded.message
-            msg = mission_to_msg(state.content(), revision, self._stamp)
+            # Packed: a seek serializes only the skills not in the last snapshot built.
+            msg = self._packer.pack(state.content(), revision, self._stamp)
             self._built = (revision, msg)
             return msg
 
@@ -373,7 +388,7 @@ class RecordingReplayer:
             for topic in (interface.EVENTS_TOPIC, interface.MISSION_TOPIC)
         ]
         latest = max((r for r in records if r is not None), key=lambda r: r.log_time, default=None)
-        return 0.0 if latest is None else float(latest.message.stamp.to_sec())
+        return 0.0 if latest is None else float(latest.field("stamp").to_sec())
 
     def _out(self) -> ReplayOutput:
         assert self._output is not None, "the replay publishes only while it runs"
@@ -386,6 +401,8 @@ class RecordingReplayer:
     def _on_get_mission(self, _request: Any) -> Any:
         with self._lock:
             msg = self._mission_msg(self._current, self._clock.status().position)
+        if isinstance(msg, PackedMission):
+            return PackedGetMissionResponse(msg)
         return wire_srv.GetMissionResponse(mission=msg)
 
 

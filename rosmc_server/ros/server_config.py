@@ -33,6 +33,7 @@ class ServerConfig:
     fsync: bool = True
     mission_dir: Path = DEFAULT_MISSION_DIR
     snapshot_every: int = JournalOptions.snapshot_every
+    journal_reserve: int = JournalOptions.reserve_bytes
     operators: OperatorAllowList = field(default_factory=OperatorAllowList)
     broadcast_snapshots: bool = False
 
@@ -66,6 +67,7 @@ class ServerConfig:
                 str(rospy.get_param("~mission_dir", str(DEFAULT_MISSION_DIR)))
             ),
             snapshot_every=max(1, int(rospy.get_param("~snapshot_every", cls.snapshot_every))),
+            journal_reserve=max(0, int(rospy.get_param("~journal_reserve", cls.journal_reserve))),
             operators=OperatorAllowList.of(rospy.get_param("~operators", [])),
             broadcast_snapshots=bool(rospy.get_param("~broadcast_snapshots", False)),
         )

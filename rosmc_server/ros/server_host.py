@@ -20,7 +20,9 @@ from .server_config import ServerConfig
 class ServerHost(Protocol):
     """The mission server as its helpers see it: the mission, its lock and its one way in."""
 
-    mission: Mission
+    @property
+    def mission(self) -> Mission:
+        """The mission (Unavailable once the journal failed)."""
 
     @property
     def config(self) -> ServerConfig:

@@ -33,6 +33,9 @@ Parameters (private):
     ``~agent_state_rate`` (float, Hz): rate of ``/rosmc/agent_states`` (2.0).
     ``~fsync`` (bool): fsync the journal on every change (survives power loss; true).
     ``~snapshot_every`` (int): mission events between two full snapshots in the journal (500).
+    ``~journal_reserve`` (int, bytes): free space on the journal's disk below which changes
+        are refused (1 MiB); a change bigger than it meets the full disk mid-write instead
+        and is never acknowledged (the server exits and resumes without it).
     ``~broadcast_snapshots`` (bool): also send ``/rosmc/mission`` to every subscriber after
         changes (coalesced), as before per-subscriber snapshots (false; for benchmarks).
     ``~operators`` (list of str, or one string of names): nodes (full names, or prefixes
@@ -55,7 +58,6 @@ node shuts down, so that no change is ever acknowledged without being durable.
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import logging
 import sys
 import threading
@@ -67,14 +69,7 @@ import rosmc.msg as wire
 import rospy
 
 from .. import interface
-from ..conversions import (
-    event_from_msg,
-    library_to_msg,
-    mission_from_msg,
-    mission_to_msg,
-    time_to_msg,
-)
-from ..conversions.event_packing import packed_event
+from ..conversions import library_to_msg, time_to_msg
 from ..conversions.packing import PackedMission, SnapshotPacker
 from ..core import (
     Library,
@@ -86,9 +81,8 @@ from ..core import (
 )
 from ..core.changes import EventKind
 from ..core.commands import commands_for_event, default_policy_commands
-from ..recording import JournalOptions, JournalWriter, default_journal_path, latest_state
-from ..recording.high_water import RevisionMark, first_mark, read_mark, resumed_mark
-from ..recording.recovery import ResumeReport
+from ..recording import JournalOptions, default_journal_path
+from ..recording.mission_journal import MissionJournal
 from . import station
 from .agent_states import AgentStatePublisher
 from .allocator import keep_large_blocks_apart
@@ -116,13 +110,12 @@ class MissionServer:
         self._lock = threading.RLock()
         self._packer = SnapshotPacker()
         self._snapshot: PackedMission | None = None  # the newest one built
+        self._pending_snapshot: PackedMission | None = None  # a replacement's, until durable
         self._building = threading.Lock()  # one snapshot build at a time
         self._resume_alert = ""  # what resuming the journal could not recover
-        self._snapshot_after_resume = False
-        self.mission, self._journal = self._open_journal()
+        self._mission, self._mission_journal = self._open_journal()
+        self._journal = self._mission_journal.writer
         station.remember_journal(self._journal.path)
-        if self._snapshot_after_resume:  # the file now written must start the mission
-            self._journal.append_snapshot(self.snapshot_msg(), time.time_ns())
         self._events = rospy.Publisher(interface.EVENTS_TOPIC, wire.MissionEvent, queue_size=1000)
         self._snapshots = SnapshotPublisher(
             interface.MISSION_TOPIC,
@@ -164,9 +157,7 @@ class MissionServer:
             self._stopping = True
             self._snapshots.stop()
             self._recorder.stop()
-            if not self._journal.closed:
-                self._journal.close()
-            self._marks.close()
+            self._mission_journal.close()
 
     def _tick_link(self) -> None:
         next_clock_check = 0.0
@@ -179,6 +170,14 @@ class MissionServer:
             time.sleep(0.05)
 
     # -- the one way to change the mission ------------------------------------------
+    @property
+    def mission(self) -> Mission:
+        """The mission; Unavailable once the journal failed (the mission then holds a
+        change that is not durable, which nobody may see)."""
+        if self.failed:
+            raise Unavailable("the mission server is stopping: its journal cannot be written")
+        return self._mission
+
     def locked(self) -> AbstractContextManager[object]:
         """The server lock (re-entrant)."""
         return self._lock
@@ -200,33 +199,31 @@ class MissionServer:
             return event
 
     def _record(self, event: MissionEvent) -> None:
-        state = self.mission.state
-        # Bytes made once for the journal and the topic (a whole reorder is 10,000 moves).
-        msg = packed_event(event, lambda skill_id: state.locate(skill_id)[0], self.epoch)
-        stamp_ns = time.time_ns()
         try:
-            self._journal.append_event(msg, stamp_ns)
-            if event.kind is EventKind.MISSION_REPLACED:
-                # The new mission is only in the snapshot: it must be durable now. Its
-                # skills were serialized ahead (prepare_snapshot), off the lock.
-                snapshot = self._packer.pack(
-                    self.mission.state.content(), self.mission.revision, rospy.get_time()
-                )
-                self._snapshot = snapshot
-                self._journal.append_snapshot(snapshot, stamp_ns)
-            # The journal's high-water mark, kept apart; a replacement counts only with its
-            # snapshot (a journal ending in the event alone leaves it out on resume).
-            self._marks.record(event.revision)
+            msg = self._mission_journal.record(event, self._mission, self._replacement_snapshot)
         except Exception:
+            # The mission holds a change that is not durable: from now on nothing shows it
+            # (``mission`` raises), and the process exits for a supervisor to resume it.
             _log.critical("cannot write the journal; shutting down to protect the mission")
             self.failed = self._stopping = True  # a supervisor restarts it: exit status 1
+            self._snapshot = None
             # Shortly after, so that the caller hears this change failed (not a dropped link).
             threading.Timer(0.5, rospy.signal_shutdown, ("journal write failed",)).start()
             raise
+        if event.kind is EventKind.MISSION_REPLACED:  # durable now: it may be shown
+            self._snapshot, self._pending_snapshot = self._pending_snapshot, None
+        state = self._mission.state
         self._events.publish(msg)
         self._snapshots.changed(urgent=event.kind is EventKind.MISSION_REPLACED)
         for spec in commands_for_event(event, state):
             self.link.send(spec)
+
+    def _replacement_snapshot(self, mission: Mission) -> PackedMission:
+        """The snapshot journaled with a change that replaces the mission. Its skills were
+        serialized ahead (prepare_snapshot), off the lock; kept only once it is durable."""
+        snapshot = self._packer.pack(mission.state.content(), mission.revision, rospy.get_time())
+        self._pending_snapshot = snapshot
+        return snapshot
 
     def _journal_snapshot(self, snapshot: wire.Mission) -> None:
         """Journal a snapshot built after changes when one is due, off the service path.
@@ -254,7 +251,7 @@ class MissionServer:
         GetMission answer and the journal.
         """
         with self._lock:
-            revision = self.mission.revision
+            revision = self.mission.revision  # Unavailable once the journal failed
             built = self._snapshot
             fresh = built is not None and built.revision == revision
             content = None if fresh else self.mission.state.content()
@@ -288,65 +285,32 @@ class MissionServer:
     @property
     def epoch(self) -> str:
         """The mission's history: new whenever a resume lost history."""
-        return self._marks.epoch
+        return self._mission_journal.epoch
 
     @property
     def journal_alert(self) -> str:
         """What resuming the journal lost and whether its disk is full ("" if neither)."""
         return "; ".join(a for a in (self._resume_alert, self._journal.space.alert()) if a)
 
-    def _open_journal(self) -> tuple[Mission, JournalWriter]:
-        options = JournalOptions(fsync=self.config.fsync, snapshot_every=self.config.snapshot_every)
-        clock = rospy.get_time
+    def _open_journal(self) -> tuple[Mission, MissionJournal]:
+        options = JournalOptions(
+            fsync=self.config.fsync,
+            snapshot_every=self.config.snapshot_every,
+            reserve_bytes=self.config.journal_reserve,
+        )
         library = library_to_msg(self.library)  # journaled: a replay shows the mission with it
         if self.config.resume:
             if self.config.journal is None:
                 raise ValueError("~resume needs ~journal: the journal file to continue")
-            writer = JournalWriter.resume(self.config.journal, options, library)
-            return self._resumed(writer), writer
-        mission = Mission(self.library, MissionContent.empty(self.library), clock=clock)
+            resumed = MissionJournal.resume(
+                self.config.journal, self.library, options, library, clock=rospy.get_time
+            )
+            self._resume_alert = resumed.report.alert()
+            return resumed.mission, resumed.journal
+        mission = MissionJournal.new_mission(self.library, clock=rospy.get_time)
         path = self.config.journal or default_journal_path(self.config.journal_dir)
         path.parent.mkdir(parents=True, exist_ok=True)
-        snapshot = mission_to_msg(mission.state.content(), 0, time.time())
-        writer = JournalWriter.create(path, snapshot, time.time_ns(), options, library)
-        self._marks = RevisionMark(path, first_mark(0), options.fsync)
-        return mission, writer
-
-    def _resumed(self, writer: JournalWriter) -> Mission:
-        """The mission a resumed journal holds; says once, loudly, what it could not recover.
-
-        After lost revisions the mission goes on above the highest revision the journal
-        holds (an operator may have seen it), and a snapshot records where it stands.
-        """
-        assert writer.recovered is not None
-        latest = latest_state(writer.recovered)
-        for note in latest.notes:
-            _log.warning("%s", note)
-        content, revision = mission_from_msg(latest.snapshot)
-        mission = Mission(self.library, content, revision, clock=rospy.get_time)
-        for event_msg in latest.events:
-            mission.replay(event_from_msg(event_msg))
-        mark = read_mark(writer.path)
-        report = ResumeReport.of(
-            writer.path, writer.recovered.damage, latest, writer.part_path, mark
-        )
-        if report.lost and not writer.damaged:  # later resumes start after the loss
-            writer.start_next_part()
-            report = dataclasses.replace(report, written_to=writer.part_path)
-        if not report.clean:
-            _log.error("%s", report.log_line())
-            self._resume_alert = report.alert()
-        # After lost revisions the resumed mission is a revision of its own, so that a view
-        # that held lost changes is stale (refused, refetched) instead of taken as current.
-        revision = report.next_revision - (0 if report.lost else 1)
-        if revision > mission.revision:
-            content = mission.state.content()
-            mission = Mission(self.library, content, revision, clock=rospy.get_time)
-        marked = resumed_mark(mark, mission.revision, report.lost > 0)  # new epoch if lost
-        self._marks = RevisionMark(writer.path, marked, self.config.fsync)
-        self._snapshot_after_resume = writer.needs_snapshot or not report.clean
-        _log.info("resumed from %s at revision %d", writer.path, mission.revision)
-        return mission
+        return mission, MissionJournal.create(path, mission, options, library)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -41,7 +41,9 @@ UNKNOWN_SENDER = "an unknown node"
 class SiteHost(Protocol):
     """What the listener needs from the mission server."""
 
-    mission: Mission
+    @property
+    def mission(self) -> Mission:
+        """The mission (Unavailable once the journal failed)."""
 
     def locked(self) -> AbstractContextManager[object]:
         """The server lock, as a context manager."""

@@ -21,10 +21,18 @@ from pathlib import Path
 from typing import Any
 
 import rosmc.srv as srv
+import rospy
 
 from ..conversions.packing import PackedGetMissionResponse
 from ..conversions.request_fields import base_of
-from ..core import InvalidRequest, MissionEvent, MissionFileError, load_mission, parse_mission
+from ..core import (
+    InvalidRequest,
+    MissionEvent,
+    MissionFileError,
+    Unavailable,
+    load_mission,
+    parse_mission,
+)
 from ..core.collector import collector_paused
 from ..core.persistence import MissionDumper, write_document
 from ..core.validation import check_file_path
@@ -75,6 +83,8 @@ class WholeMissionServices:
             return PackedGetMissionResponse(
                 server.snapshot_msg(), server.journal_alert, server.epoch
             )
+        except Unavailable as error:  # the journal failed: no mission may be shown, not even
+            raise rospy.ServiceException(str(error)) from None  # an empty one
         except Exception:  # a server fault must not reach the caller as a stack trace
             _log.exception("service get_mission failed")
             return srv.GetMissionResponse()

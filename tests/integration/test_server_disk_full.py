@@ -19,6 +19,7 @@ from pathlib import Path
 
 import pytest
 import rosmc.msg as wire
+import rospy
 from rosmc.msg import ErrorCode
 
 pytest.register_assert_rewrite("tests.integration.server_fixtures")
@@ -26,6 +27,7 @@ pytest.register_assert_rewrite("tests.integration.server_fixtures")
 from rosmc_server.ros.client.follow import MissionFollower  # noqa: E402
 from tests.conftest import wait_until  # noqa: E402
 from tests.integration.server_fixtures import REPO, Client, ServerProcess  # noqa: E402
+from tests.integration.test_server_crash import large_document  # noqa: E402
 
 pytest_plugins = ["tests.integration.server_fixtures"]
 
@@ -143,3 +145,41 @@ def test_a_server_whose_journal_fails_exits_with_a_non_zero_status(
     start_server("limited", journal=journal, resume=True)
     with Client() as client:
         assert marker_names(client) == ["Kept"] and client.revision() == kept
+
+
+def test_a_load_the_disk_cannot_hold_is_never_shown_and_costs_nothing_at_later_restarts(
+    start_server: Callable[..., ServerProcess], small_disk: Path
+) -> None:
+    """The load passes the reserve check, then its snapshot meets a full disk mid-write: it
+    is refused, nobody sees it, and two restarts later every acknowledged change is there."""
+    journal = small_disk / "mission.mcap"
+    reserve = 8192  # far below the big load's snapshot (compressed: tens of kB)
+    server = start_server("loadfull", journal=journal, journal_reserve=reserve)
+    document = large_document("big", 15_000)
+    filler = small_disk / "filler"
+    with Client() as client:
+        assert add_marker(client, "Before", 1.0).error_code == ErrorCode.NONE
+        before = client.revision()
+        fill(filler)
+        with filler.open("r+b") as file:  # room for the reserve, not for the big snapshot
+            file.truncate(filler.stat().st_size - reserve - 4096)
+        failed = client.call("load_mission", base_revision=before, document=document)
+        assert failed.error_code != ErrorCode.NONE  # never acknowledged
+        with contextlib.suppress(rospy.ServiceException):  # or it is already gone
+            shown = client.call("get_mission").mission
+            assert shown.revision == before, "a change that is not durable was shown"
+    assert server.process is not None
+    wait_until(lambda: server.process.poll() is not None, 30.0, "the server exits")
+    filler.unlink()
+    server = start_server("loadfull", journal=journal, resume=True)
+    with Client() as client:
+        assert client.revision() == before and marker_names(client) == ["Before"]
+        for name in ("After1", "After2"):
+            assert add_marker(client, name, 2.0).error_code == ErrorCode.NONE
+        after = client.revision()
+    server.kill9()
+    start_server("loadfull", journal=journal, resume=True)
+    with Client() as client:
+        assert marker_names(client) == ["Before", "After1", "After2"]
+        assert client.revision() == after
+        assert client.call("get_mission").journal_alert == ""

@@ -113,17 +113,20 @@ def test_resume_reads_only_the_last_part_unless_it_needs_the_one_before(tmp_path
         assert resumed.recovered is not None
         assert resumed.recovered.files == (resumed.part_path,)  # bounded, however long
         assert latest_state(resumed.recovered).revision == 60
-        # A late snapshot (of revision 58, journaled after 59 and 60) starts the next part:
+        # A late snapshot (of revision 58, journaled after 59 and 60) never starts a part: a
+        # resume that read that part alone would miss r59 and r60. A current one does.
         while not resumed.snapshot_due:
             resumed.append_report(msg.RobotReport(agent="drone"), T0 + 61)
         previous = resumed.part_path
         resumed.append_snapshot(mission(58), T0 + 62)
+        assert resumed.part_path == previous
+        resumed.append_snapshot(mission(60), T0 + 63)
         assert resumed.part_path != previous
-        resumed.append_event(event(61), T0 + 63)
+        resumed.append_event(event(61), T0 + 64)
         resumed.abandon()
     with JournalWriter.resume(path, options) as again:
         assert again.recovered is not None
-        assert again.recovered.files == (previous, again.part_path)  # for r59 and r60
+        assert again.recovered.files == (again.part_path,)  # it starts the mission alone
         state = latest_state(again.recovered)
         assert state.revision == 61 and state.gaps == ()
 

@@ -13,7 +13,11 @@ where the next record starts, so a wrong length never hides intact records.
 
 What it found is everything the writer needs to continue the file (schemas,
 channels, chunk indexes, statistics and the offset to continue at) and
-everything the reader needs to decode the messages.
+everything the reader needs to decode the messages. A big message (a snapshot)
+whose bytes a CRC vouches for, or that lies bare in the file, is not kept in
+memory: it is a :class:`DeferredMessage`, read again from the file when its
+``data`` is asked for, so a scan holds the file's small records only, however
+many snapshots the file holds.
 """
 
 from dataclasses import dataclass, field, replace
@@ -21,14 +25,19 @@ from pathlib import Path
 
 from mcap.opcode import Opcode
 
+from rosmc_server.recording._mcap import head_mark
 from rosmc_server.recording._mcap import records as fmt
 from rosmc_server.recording._mcap.checks import Declarations, RecordDamage
 from rosmc_server.recording._mcap.resync import Resync
-from rosmc_server.recording.channels import LIBRARY
+from rosmc_server.recording.channels import LIBRARY, PROFILE
 from rosmc_server.recording.damage import Damage
 from rosmc_server.recording.errors import JournalError
 
 _HEAD = fmt.RECORD_HEAD.size
+DEFER_BYTES = 65536
+"""A message payload this big or bigger stays in the file (see :class:`DeferredMessage`)."""
+HEAD_BYTES = 64
+"""Bytes of a deferred payload kept in memory (its leading fields: revision, stamp, kind)."""
 _JOURNAL_OPCODES = frozenset(
     (
         Opcode.SCHEMA,
@@ -36,6 +45,7 @@ _JOURNAL_OPCODES = frozenset(
         Opcode.MESSAGE,
         Opcode.CHUNK,
         Opcode.MESSAGE_INDEX,
+        Opcode.METADATA,
         Opcode.DATA_END,
         Opcode.FOOTER,
     )
@@ -68,6 +78,79 @@ class ScanResult:
     warnings: list[str] = field(default_factory=list)
     damage: list[Damage] = field(default_factory=list)
     """Damaged byte ranges that were skipped, in file order."""
+    mark_slots: tuple[int, int] | None = None
+    """Where the revision mark's slots lie (:mod:`.head_mark`); None in older journals."""
+
+
+@dataclass(frozen=True)
+class PayloadSource:
+    """Where a deferred message's payload lies in its file.
+
+    Attributes:
+        path: The file.
+        record: Offset of the record that holds it (a chunk, or the message itself).
+        length: Bytes of that record, its opcode and length field included.
+        start: Offset of the payload in the chunk's records (in the file, when bare).
+        size: Bytes of the payload.
+        chunked: Whether the record is a chunk (read and checked against its CRC again).
+    """
+
+    path: Path
+    record: int
+    length: int
+    start: int
+    size: int
+    chunked: bool
+
+    def load(self) -> bytes:
+        """The payload's bytes; raise JournalError if the file no longer holds them."""
+        try:
+            with self.path.open("rb") as file:
+                if not self.chunked:
+                    file.seek(self.start)
+                    data = file.read(self.size)
+                else:
+                    file.seek(self.record)
+                    # By its own fields, as the scan kept it: its opcode or length may be
+                    # damaged (a chunk its CRC vouches for is kept whole).
+                    rec, _ = fmt.read_chunk(file.read(self.length), _HEAD)
+                    data = rec.data[self.start : self.start + self.size]
+        except (OSError, fmt.FormatError) as err:
+            raise JournalError(
+                f"journal {self.path} changed since it was read (byte {self.record}): {err}"
+            ) from err
+        if len(data) != self.size:
+            raise JournalError(f"journal {self.path} changed since it was read: it is shorter")
+        return data
+
+
+class DeferredMessage(fmt.MessageRecord):
+    """A Message record whose payload stays in the file until :attr:`data` is asked for.
+
+    Compares, hashes and reads like a :class:`~.records.MessageRecord`; :attr:`head`
+    holds the payload's first :data:`HEAD_BYTES` bytes, enough for a journal's reader
+    to learn a snapshot's or event's revision without reading the rest.
+    """
+
+    head: bytes
+    source: PayloadSource
+
+    def __init__(self, msg: fmt.MessageRecord, source: PayloadSource) -> None:
+        # Frozen fields, set as the dataclass's own __init__ sets them; data is not kept.
+        for name in ("channel_id", "sequence", "log_time", "publish_time"):
+            object.__setattr__(self, name, getattr(msg, name))
+        object.__setattr__(self, "head", msg.data[:HEAD_BYTES])
+        object.__setattr__(self, "source", source)
+
+    @property  # the frozen base's read-only field, read from the file
+    def data(self) -> bytes:
+        """The payload, read from the file (and checked against its chunk's CRC) each time."""
+        return self.source.load()
+
+
+def payload_head(msg: fmt.MessageRecord) -> bytes:
+    """The first bytes of a message's payload (at most :data:`HEAD_BYTES`), never from disk."""
+    return msg.head if isinstance(msg, DeferredMessage) else msg.data[:HEAD_BYTES]
 
 
 class _Short(Exception):
@@ -84,13 +167,38 @@ def scan(path: Path) -> ScanResult:
     size = len(data)
     if size == 0:
         raise JournalError(f"journal {path} is empty (0 bytes)")
-    if data[: len(fmt.MAGIC)] != fmt.MAGIC[:size]:
+    damaged_head = _damaged_journal_head(path, data)
+    if damaged_head is not None:
+        profile, library, start, damage = PROFILE, LIBRARY, damaged_head.end, [damaged_head]
+    elif data[: len(fmt.MAGIC)] != fmt.MAGIC[:size]:
         raise JournalError(f"{path} is not an MCAP file (it does not start with the MCAP magic)")
-    profile, library, start, damage = _header(path, data)
+    else:
+        profile, library, start, damage = _header(path, data)
     result = ScanResult(path=path, size=size, profile=profile, library=library)
     result.damage += damage
     _Walker(result, data).walk(start)
     return result
+
+
+_JOURNAL_HEAD = fmt.MAGIC + fmt.header(PROFILE, LIBRARY)
+"""The bytes every journal file starts with."""
+
+
+def _damaged_journal_head(path: Path, data: bytes) -> Damage | None:
+    """The damage of a journal whose magic or header has a few wrong bytes (or is zeroed),
+    None if its head is intact or it is not a journal at all.
+
+    A journal's head is always the same bytes, so a damaged one is known for what it was
+    and costs nothing but itself: the records after it are read as usual.
+    """
+    head = data[: len(_JOURNAL_HEAD)]
+    if len(head) < len(_JOURNAL_HEAD) or head == _JOURNAL_HEAD:
+        return None
+    pairs = enumerate(zip(head, _JOURNAL_HEAD, strict=True))
+    wrong = [i for i, (have, want) in pairs if have != want]
+    if len(wrong) > len(_JOURNAL_HEAD) // 4 and head.strip(b"\0"):
+        return None  # another file, not a damaged journal
+    return Damage(path, wrong[0], len(_JOURNAL_HEAD), "a damaged MCAP magic or header", kept=True)
 
 
 def _header(path: Path, data: bytes) -> tuple[str, str, int, list[Damage]]:
@@ -197,10 +305,13 @@ class _Walker:
                 r.spans.append((offset, offset + _HEAD + len(body)))
                 r.top_level_messages += 1
                 self._last_bare = offset
+                self._defer(offset, _HEAD + len(body))
         elif opcode == Opcode.CHUNK:
             self._chunk(offset, fmt.parse_chunk(body), _HEAD + len(body))
         elif opcode == Opcode.MESSAGE_INDEX and (after_chunk or self._journal):
             self._message_index(offset, body, after_chunk)
+        elif opcode == Opcode.METADATA and self._journal:
+            r.mark_slots = head_mark.slots_of(body, offset) or r.mark_slots
         elif opcode == Opcode.DATA_END:
             self._in_summary = True
             self._tail = offset
@@ -221,10 +332,13 @@ class _Walker:
                 if opcode == Opcode.MESSAGE:
                     msg = messages[-1]
                     indexes.setdefault(msg.channel_id, []).append((msg.log_time, inner_offset))
+                    if rec.uncompressed_crc:  # its CRC vouches for it when read again
+                        self._defer_in(messages, offset, length, inner_offset + _HEAD + 22)
             if inner_end != len(rec.data):
                 raise RecordDamage("its content ends inside a record")
+        first = len(r.messages)
         r.messages.extend(messages)
-        r.spans += [(offset, offset + length)] * len(messages)
+        r.spans += [(offset, offset + length)] * (len(r.messages) - first)
         r.chunk_indexes.append(
             fmt.ChunkIndexRecord(
                 message_start_time=rec.message_start_time,
@@ -240,6 +354,24 @@ class _Walker:
         )
         r.missing_indexes = indexes
         self._after_chunk = True
+
+    def _defer(self, record: int, length: int) -> None:
+        """Leave the payload of the bare message just taken in the file if it is big."""
+        self._defer_in(self._r.messages, record, length, record + _HEAD + 22, chunked=False)
+
+    def _defer_in(
+        self,
+        messages: list[fmt.MessageRecord],
+        record: int,
+        length: int,
+        start: int,
+        chunked: bool = True,
+    ) -> None:
+        """Leave the payload of the last of ``messages`` in the file if it is big."""
+        msg = messages[-1]
+        if len(msg.data) >= DEFER_BYTES:
+            source = PayloadSource(self._r.path, record, length, start, len(msg.data), chunked)
+            messages[-1] = DeferredMessage(msg, source)
 
     def _message_index(self, offset: int, body: bytes, after_chunk: bool) -> None:
         r = self._r

@@ -18,7 +18,7 @@ from pathlib import Path
 from mcap.opcode import Opcode
 
 from rosmc_server.core.durable import fsync_directory
-from rosmc_server.recording._mcap import layout
+from rosmc_server.recording._mcap import head_mark, layout
 from rosmc_server.recording._mcap import records as fmt
 from rosmc_server.recording._mcap.files import open_locked
 from rosmc_server.recording.channels import JOURNAL_TOPICS, LIBRARY, PROFILE
@@ -82,37 +82,49 @@ class DataSection:
     def chunk(
         self,
         offset: int,
-        channel_id: int,
-        log_time: int,
-        message: Sequence[bytes],
+        messages: Sequence[tuple[int, int, Sequence[bytes]]],
         compress_from: int,
     ) -> tuple[list[bytes], fmt.ChunkIndexRecord]:
-        """Wrap one message record (held in parts) in a chunk with its message index.
+        """Wrap message records (each ``(channel id, log time, record in parts)``) in one
+        chunk with its message indexes.
 
-        The chunk goes at ``offset``; it is zstd-compressed when the record reaches
-        ``compress_from`` bytes (> 0). Returns the chunk's bytes in parts (the record's
+        The chunk goes at ``offset``; it is zstd-compressed when its records reach
+        ``compress_from`` bytes (> 0). Returns the chunk's bytes in parts (the records'
         parts are not joined: a snapshot's megabytes are not copied on their way to the
-        file) and its index entry, for :meth:`count` once written.
+        file) and its index entry, for :meth:`count` once written. A chunk is one unit
+        for every reader: its CRC covers all its records, so a crash that tears it loses
+        all of them, never some.
         """
         size = crc = 0
-        for part in message:
-            size += len(part)
-            crc = zlib.crc32(part, crc)
-        compression, payload = "", list(message)
+        entries: dict[int, list[tuple[int, int]]] = {}
+        parts: list[bytes] = []
+        for channel_id, log_time, record in messages:
+            entries.setdefault(channel_id, []).append((log_time, size))
+            for part in record:
+                size += len(part)
+                crc = zlib.crc32(part, crc)
+            parts += record
+        start = min(log_time for _, log_time, _ in messages)
+        end = max(log_time for _, log_time, _ in messages)
+        compression, payload = "", parts
         if 0 < compress_from <= size:
-            compression, payload = fmt.compress_parts(message)
+            compression, payload = fmt.compress_parts(parts)
         payload_size = sum(map(len, payload))
-        record = fmt.ChunkRecord(log_time, log_time, size, crc, compression, b"")
-        head = fmt.chunk_head(record, payload_size)
+        chunk_record = fmt.ChunkRecord(start, end, size, crc, compression, b"")
+        head = fmt.chunk_head(chunk_record, payload_size)
         chunk_length = len(head) + payload_size
-        index = fmt.message_index(channel_id, [(log_time, 0)])
-        return [head, *payload, index], fmt.ChunkIndexRecord(
-            message_start_time=log_time,
-            message_end_time=log_time,
+        indexes: list[bytes] = []
+        index_offsets: list[tuple[int, int]] = []
+        for channel_id, channel_entries in entries.items():
+            index_offsets.append((channel_id, offset + chunk_length + sum(map(len, indexes))))
+            indexes.append(fmt.message_index(channel_id, channel_entries))
+        return [head, *payload, *indexes], fmt.ChunkIndexRecord(
+            message_start_time=start,
+            message_end_time=end,
             chunk_start_offset=offset,
             chunk_length=chunk_length,
-            message_index_offsets=((channel_id, offset + chunk_length),),
-            message_index_length=len(index),
+            message_index_offsets=tuple(index_offsets),
+            message_index_length=sum(map(len, indexes)),
             compression=compression,
             compressed_size=payload_size,
             uncompressed_size=size,
@@ -187,6 +199,8 @@ class PartFile:
         offset: Bytes handed to the operating system so far (the file size while open).
         chunked: Whether each append is written as its own chunk.
         snapshots: Snapshots in it (a part without one cannot start a mission).
+        slots: File offsets of the two revision-mark slots at its head (None: a file of
+            an older journal, written before the head held a mark; see :mod:`.head_mark`).
     """
 
     path: Path
@@ -196,6 +210,7 @@ class PartFile:
     offset: int
     chunked: bool
     snapshots: int = 0
+    slots: tuple[int, int] | None = None
 
     @classmethod
     def create(cls, path: Path, number: int, chunked: bool, durable: bool) -> PartFile:
@@ -205,8 +220,10 @@ class PartFile:
             JournalError: The file exists or cannot be written.
         """
         fd = open_locked(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL)
-        part = cls(path, number, fd, DataSection(), 0, chunked)
-        preamble = fmt.MAGIC + fmt.header(PROFILE, LIBRARY) + part.section.declare(JOURNAL_TOPICS)
+        head = fmt.MAGIC + fmt.header(PROFILE, LIBRARY)
+        mark = head_mark.mark_record(len(head))
+        part = cls(path, number, fd, DataSection(), 0, chunked, slots=mark.slots)
+        preamble = head + mark.data + part.section.declare(JOURNAL_TOPICS)
         try:
             part.write(preamble, sync=False, durable=False)
             if durable:
@@ -239,6 +256,21 @@ class PartFile:
                 self.abandon()
             raise JournalError(f"cannot write journal {self.path}: {err.strerror}") from err
         self.offset += size
+
+    def write_mark(self, fields: Mapping[str, str | int], seq: int) -> None:
+        """Rewrite the older of the head's two mark slots in place (never synced on its own:
+        the next record's fdatasync carries it). Nothing for a file without slots.
+
+        Raises:
+            JournalError: The slot cannot be written.
+        """
+        if self.slots is None:
+            return
+        slot = head_mark.encode_slot(seq, fields)
+        try:
+            os.pwrite(self.open_fd(), slot, self.slots[seq % 2])
+        except OSError as err:
+            raise JournalError(f"cannot write journal {self.path}: {err.strerror}") from err
 
     def sync(self) -> None:
         """fdatasync the file."""
