@@ -41,6 +41,7 @@ from ..core.link import (
     Outgoing,
 )
 from ..core.radio import BEACON_PERIOD, ROBOT_SILENCE, ContactWatch
+from ..core.radio_key import RadioKey
 from ..core.waiting import collapse
 from ..interface import ground_link
 from .agent_link import AgentLink, LinkHost, Operation
@@ -63,6 +64,7 @@ class GroundLink:
         self,
         host: LinkHost,
         agents: Iterable[str],
+        radio_key: RadioKey,
         timeout: float = 3.0,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
@@ -98,7 +100,7 @@ class GroundLink:
                 for topic, msg_type, handler in handlers
             ]
             self._links[agent] = link
-        self.radio = Radio(GROUND, self._on_beacon)
+        self.radio = Radio(GROUND, self._on_beacon, key=radio_key)
 
     @property
     def _mission(self) -> Mission:
@@ -113,6 +115,13 @@ class GroundLink:
         """The link report and tracked details of ``agent``, for display."""
         link = self._links[agent]
         return link.outbox.report(self._clock()), link
+
+    def radio_dropped(self, agent: str) -> int:
+        """Radio datagrams dropped on ``agent``'s link: by the robot (as its snapshot says)
+        and by the ground among those that named the robot."""
+        snapshot = self._links[agent].snapshot
+        robot = int(getattr(snapshot, "radio_dropped", 0)) if snapshot is not None else 0
+        return robot + self.radio.dropped_from(agent)
 
     def expected_hash(self, agent: str) -> str:
         """The queue hash the ground expects the robot to have."""

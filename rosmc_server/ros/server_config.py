@@ -35,6 +35,7 @@ class ServerConfig:
     snapshot_every: int = JournalOptions.snapshot_every
     operators: OperatorAllowList = field(default_factory=OperatorAllowList)
     broadcast_snapshots: bool = False
+    radio_key: str = ""  # "" = $ROS_HOME/rosmc/radio.key, made if missing
 
     @classmethod
     def from_params(cls) -> ServerConfig:
@@ -49,6 +50,7 @@ class ServerConfig:
         for once in ("~journal", "~resume"):
             if rospy.has_param(once):
                 rospy.delete_param(once)
+        radio_key = str(rospy.get_param("~radio_key", ""))
         previous = station.previous_journal()
         if previous is not None:  # restarted by roslaunch: go on where the last server was
             journal, resume = str(previous), True
@@ -68,4 +70,5 @@ class ServerConfig:
             snapshot_every=max(1, int(rospy.get_param("~snapshot_every", cls.snapshot_every))),
             operators=OperatorAllowList.of(rospy.get_param("~operators", [])),
             broadcast_snapshots=bool(rospy.get_param("~broadcast_snapshots", False)),
+            radio_key=str(station.launch_path(radio_key)) if radio_key else "",
         )
