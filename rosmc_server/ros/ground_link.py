@@ -42,7 +42,7 @@ from ..core.link import (
 )
 from ..core.radio import BEACON_PERIOD, ROBOT_SILENCE, ContactWatch
 from ..core.radio_key import RadioKey
-from ..core.waiting import collapse
+from ..core.waiting import collapse, waiting_work
 from ..interface import ground_link
 from .agent_link import AgentLink, LinkHost, Operation
 from .command_records import command_record
@@ -154,9 +154,9 @@ class GroundLink:
         delivered = wall if event == wire.CommandRecord.DELIVERED else 0.0
         self._host.record_command(command_record(event, item, asked, delivered, result))
 
-    def unsent(self, agent: str) -> int:
-        """How many commands wait, never transmitted, for ``agent``'s robot."""
-        return len(self._links[agent].outbox.unsent())
+    def waiting_work(self, agent: str) -> int:
+        """How much work (uploads, take-backs, retries, skips) waits unsent for ``agent``."""
+        return waiting_work(self._links[agent].outbox)
 
     def tick(self) -> None:
         """Retransmit whatever is due; repeat report acks as the ground's heartbeat."""
