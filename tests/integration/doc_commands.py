@@ -180,6 +180,7 @@ COLCON = f"{BUILD}::test_colcon_build"
 REVIEW = f"{DOCS}::test_the_review_commands_run_on_the_sample"
 REPLAY = f"{DOCS}::test_the_replay_commands_run_against_a_master"
 GUI = f"{DOCS}::test_the_command_gui_commands_start_the_window"
+KEYS = "tests/integration/test_radio_keys.py::test_the_key_commands_make_show_and_rotate_a_private_key"  # noqa: E501
 
 
 def _cli(test: str, *texts: str) -> Evidence:
@@ -320,6 +321,10 @@ DOC_COMMANDS: dict[str, Evidence] = {
         "test_the_guide_example_robot_runs_its_skill",
         ('blocks("bash")[0]', '["bash", "-c", command]'),
     ),
+    # docs/integrator-guide.md, "The radio key"
+    "rosmc key new": Evidence(KEYS, ('rosmc("rosmc key new", home)',)),
+    "rosmc key show": Evidence(KEYS, ('rosmc("rosmc key show", home)',)),
+    "rosmc key new --force": Evidence(KEYS, ('rosmc("rosmc key new --force", home)',)),
     "rostest rosmc server.test": Evidence(*ROSTEST),
     "rostest rosmc executor.test": Evidence(*RUN_TESTS),
     "rostest rosmc sim.test": Evidence(*RUN_TESTS),
