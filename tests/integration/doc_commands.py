@@ -180,7 +180,8 @@ COLCON = f"{BUILD}::test_colcon_build"
 REVIEW = f"{DOCS}::test_the_review_commands_run_on_the_sample"
 REPLAY = f"{DOCS}::test_the_replay_commands_run_against_a_master"
 GUI = f"{DOCS}::test_the_command_gui_commands_start_the_window"
-KEYS = "tests/integration/test_radio_keys.py::test_the_key_commands_make_show_and_rotate_a_private_key"  # noqa: E501
+RADIO_KEYS = "tests/integration/test_radio_keys.py"
+KEYS = f"{RADIO_KEYS}::test_the_key_commands_make_show_and_rotate_a_private_key"
 
 
 def _cli(test: str, *texts: str) -> Evidence:
