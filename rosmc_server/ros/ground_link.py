@@ -33,6 +33,7 @@ from ..conversions import time_to_msg
 from ..conversions.command_packing import command_msg
 from ..core import Mission, RosmcError, SkillStatus, StorageFull, Transfer
 from ..core.commands import CommandKind, CommandSpec, queued_barriers
+from ..core.drop_log import DropLog
 from ..core.link import (
     Arrival,
     LinkReport,
@@ -74,6 +75,7 @@ class GroundLink:
         self._links: dict[str, AgentLink] = {}
         self._next_heartbeat = self._next_beacon = 0.0
         self._contact = ContactWatch(silence=ROBOT_SILENCE)
+        self._dropped_reports = DropLog("robot report")  # counted, warned at a limited rate
         self._snapshots = SnapshotSync(
             host,
             clock,
@@ -286,7 +288,13 @@ class GroundLink:
         try:
             status = SkillStatus(msg.status.value)
         except ValueError:
-            _log.warning("link %s: report with unknown status %d", msg.agent, msg.status.value)
+            warning = self._dropped_reports.drop(
+                "its status is not one this server knows",
+                f"from {msg.agent} with unknown status {msg.status.value}",
+                self._clock(),
+            )
+            if warning is not None:
+                _log.warning("robot link: %s", warning)
             return
         stamp = msg.stamp.to_sec()
         self._apply(
