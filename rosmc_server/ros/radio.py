@@ -14,8 +14,10 @@ Every datagram is signed with the deployment's key and checked on arrival
 logged at a limited rate (:class:`~..core.drop_log.DropLog`), never acted on. Anyone can
 write the parameter server, so the directory is only a hint: a peer's address is where an
 authenticated datagram of its own last came from, and a datagram for it also goes to the
-address the directory lists when that differs (a peer that restarted on another port is
-reached that way until it speaks; a forged entry only ever gets a copy nobody can use).
+addresses the directory listed for it since (the newest only, once the peer was heard): a
+peer that restarted on another port is reached that way until it speaks, and a forged entry
+only ever gets copies it can neither alter nor play back, while the peer itself writes its
+entry back at its next read of the directory.
 
 :class:`TopicListener` is a subscriber that can be reconnected: when a beacon shows a
 peer is back after a silence, the link's subscribers for it connect afresh at once,
