@@ -232,9 +232,9 @@ DOC_COMMANDS: dict[str, Evidence] = {
     "REC=bags/samples/demo.mcap": _docs(REVIEW, "REC=bags/samples/demo.mcap"),
     "rosmc info $REC": _docs(REVIEW, "rosmc info $REC"),
     "rosmc at $REC 8.5": _docs(REVIEW, "rosmc at $REC 8.5"),
-    "rosmc at $REC r120 --json": _docs(REVIEW, "rosmc at $REC r120 --json"),
+    "rosmc at $REC r80 --json": _docs(REVIEW, "rosmc at $REC r80 --json"),
     "rosmc timeline $REC -o timeline.svg": _docs(REVIEW, "rosmc timeline $REC -o timeline.svg"),
-    "rosmc diff $REC r100 0:09": _docs(REVIEW, "rosmc diff $REC r100 0:09"),
+    "rosmc diff $REC r60 0:09": _docs(REVIEW, "rosmc diff $REC r60 0:09"),
     "rosmc tobag $REC mission.bag": _docs(REVIEW, "rosmc tobag $REC mission.bag"),
     "rosbag play mission.bag": _docs(REVIEW, "rosbag play mission.bag"),
     "rosmc restore $REC --at 9s": _cli(
