@@ -25,7 +25,11 @@ NODES: tuple[tuple[str, str, dict[str, tuple[str, ...] | None]], ...] = (
         "rosmc_server/ros/server_node.py",
         {"rosmc_server/ros/server_config.py": None, STATION: ("~cwd", "~station_journal")},
     ),
-    ("/<robot>/mission_executor", "rosmc_server/executor/ros/node.py", {STATION: ("~cwd",)}),
+    (
+        "/<robot>/mission_executor",
+        "rosmc_server/executor/ros/node.py",
+        {"rosmc_server/executor/ros/config.py": None, STATION: ("~cwd",)},
+    ),
     ("/rosmc/sim", "rosmc_sim/ros/sim_node.py", {STATION: ("~cwd",)}),
     (
         "/rosmc/markers",

@@ -5,6 +5,7 @@
 * A robot about to leave Wi-Fi coverage (weak signal), or out of it, while it still has
   planned work not sent: once out of range, what is sent waits until it is heard again.
 * A skill whose parameter the library marks invalid (out of range, wrong type).
+* A robot whose radio link dropped forged datagrams (unsigned, wrong key, replayed).
 
 No Qt here.
 """
@@ -62,6 +63,15 @@ def coverage_warnings(view: MissionView) -> list[str]:
                 f"with {skills} not on board; send them now."
             )
     return out
+
+
+def radio_warnings(view: MissionView) -> list[str]:
+    """Robots whose radio link dropped forged datagrams: someone without the key is talking."""
+    return [
+        f"{agent}: {status.radio_text} (someone without the deployment's key is sending)."
+        for agent, status in view.statuses.items()
+        if status.radio_dropped
+    ]
 
 
 class ParameterChecker:

@@ -131,6 +131,8 @@ def link_summary(status: AgentStatus | None) -> str:
         parts.append(status.executor_state)
     if status.policy:
         parts.append(status.policy)
+    if status.radio_dropped:
+        parts.append(status.radio_text)
     return " · ".join(parts)
 
 

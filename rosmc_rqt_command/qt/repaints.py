@@ -77,6 +77,7 @@ class Repaints(QObject):  # type: ignore[misc]
         warnings = [
             *alerts.barrier_warnings(view),
             *alerts.coverage_warnings(view),
+            *alerts.radio_warnings(view),
             *self.checker.warnings(view),
         ]
         self._messages.show_warnings(warnings)

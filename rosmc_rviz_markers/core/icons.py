@@ -91,10 +91,15 @@ def wifi_row(signal: float | None) -> IconRow:
     return IconRow("wifi", f"{word} {dbm(signal)}", color)
 
 
-def link_row(link: str, last_heard: float, waiting: int = 0, waiting_for: float = -1.0) -> IconRow:
-    """Ground link: up / down / never heard, with seconds since the robot was heard, and
-    how many commands wait for contact (for how long); waiting work is at least yellow."""
+def link_row(
+    link: str, last_heard: float, waiting: int = 0, waiting_for: float = -1.0, forged: int = 0
+) -> IconRow:
+    """Ground link: up / down / never heard, with seconds since the robot was heard, how
+    many commands wait for contact (for how long), and how many forged radio datagrams its
+    link dropped; waiting work and forged datagrams are at least yellow."""
     row = _link_only(link, last_heard)
+    if forged > 0:
+        row = IconRow("link", f"{row.text}, {forged} FORGED DROPPED", worst([row.color, WARN]))
     if waiting <= 0 or link == "up":
         return row
     age = f" {duration_text(waiting_for)}" if waiting_for >= 0 else ""
@@ -143,7 +148,13 @@ def status_parts(status: AgentStatus | None, skill_label: str = "") -> tuple[Ico
         )
     return (
         skill_row(skill_label or status.current_skill, status.current_status, status.waiting_on),
-        link_row(status.link, status.last_heard, status.commands_waiting, status.waiting_for),
+        link_row(
+            status.link,
+            status.last_heard,
+            status.commands_waiting,
+            status.waiting_for,
+            status.radio_dropped,
+        ),
         wifi_row(status.wifi_signal),
         battery_row(status.battery),
     )

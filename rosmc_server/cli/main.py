@@ -53,7 +53,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _command(name: str) -> Callable[..., int]:
-    from . import edits, replay, review, views
+    from . import edits, keys, replay, review, views
 
     read_only: dict[str, Callable[..., int]] = {
         "status": views.status,
@@ -61,7 +61,7 @@ def _command(name: str) -> Callable[..., int]:
         "markers": views.markers,
         "watch": views.watch,
     }
-    recording = {**replay.COMMANDS, **review.COMMANDS}
+    recording = {**replay.COMMANDS, **review.COMMANDS, **keys.COMMANDS}
     return read_only.get(name) or recording.get(name) or edits.COMMANDS[name]
 
 

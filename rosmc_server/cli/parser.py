@@ -6,6 +6,7 @@ import argparse
 from collections.abc import Callable, Sequence
 
 from ..core.policy import DEFAULT_AFTER, LostLinkKind, LostLinkTrigger
+from .keys import add_commands as _add_keys
 from .replay import add_commands as _add_recording
 from .review import add_commands as _add_review
 
@@ -99,6 +100,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_files(command)
     _add_recording(command)
     _add_review(command)
+    _add_keys(command)
     return parser
 
 

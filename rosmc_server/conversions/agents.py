@@ -48,6 +48,7 @@ def agent_status_from_msg(msg: wire.AgentState) -> AgentStatus:
         waiting_on=msg.waiting_on,
         policy=msg.policy,
         coverage_warning=msg.coverage_warning,
+        radio_dropped=getattr(msg.link, "radio_dropped", 0),
     )
 
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from .control import ExecutorState
 from .model import SkillStatus
 from .params import Pose
+from .vocabulary import counted
 from .waiting import waiting_text
 
 AGES = ("last_heard", "waiting_for")
@@ -32,6 +33,8 @@ class AgentStatus:
     commands wait for contact with the robot, the oldest for ``waiting_for`` seconds (-1:
     none waits). ``coverage_warning`` is the server's warning that the synchronized task ends
     out of coverage under a policy that would leave the robot there ("" if none).
+    ``radio_dropped`` radio datagrams were dropped at either end of the robot's link since
+    they started (unsigned, forged, replayed: never acted on; :attr:`radio_text`).
     """
 
     agent: str
@@ -54,6 +57,7 @@ class AgentStatus:
     commands_waiting: int = 0
     waiting_for: float = -1.0
     coverage_warning: str = ""
+    radio_dropped: int = 0
 
     def news_since(self, old: AgentStatus | None) -> bool:
         """Whether this status says something ``old`` did not, at the resolution shown.
@@ -79,3 +83,10 @@ class AgentStatus:
     def waiting_text(self) -> str:
         """``2 commands waiting for contact 3 min``, or "" when nothing waits."""
         return waiting_text(self.commands_waiting, self.waiting_for)
+
+    @property
+    def radio_text(self) -> str:
+        """``212 forged radio datagrams dropped``, or "" when none was."""
+        if self.radio_dropped <= 0:
+            return ""
+        return f"{counted(self.radio_dropped, 'forged radio datagram')} dropped"

@@ -87,3 +87,8 @@ class SkillSetupError(RosmcError):
 
 class MissionFileError(RosmcError):
     """A mission file cannot be loaded; the message names the file and the problem."""
+
+
+class RadioKeyError(RosmcError):
+    """The deployment's radio key file is missing, malformed or readable by others: the
+    node refuses to start, and the message names the file and the command that fixes it."""

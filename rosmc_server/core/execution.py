@@ -54,8 +54,9 @@ def plan_synchronize(state: MissionState, agent: str, upto_id: str | None) -> Pr
         end = index + 1
     editable = task[sections.editable_start : end]
     start = sections.editable_start
+    # A new upload: what an earlier one's fate left in the text (cancelled, declined) is over.
     puts = tuple(
-        PlacedSkill(start + offset, skill_with(skill, transfer=Transfer.UPLOADING))
+        PlacedSkill(start + offset, skill_with(skill, transfer=Transfer.UPLOADING, status_text=""))
         for offset, skill in enumerate(editable)
     )
     return Proposal(
@@ -73,7 +74,7 @@ def plan_confirm_sync(state: MissionState, agent: str, skill_ids: Sequence[str])
     puts = _placed(
         state,
         [
-            skill_with(s, status=S.IDLE_SYNCHRONIZED, transfer=Transfer.NONE)
+            skill_with(s, status=S.IDLE_SYNCHRONIZED, transfer=Transfer.NONE, status_text="")
             for s in uploading[: len(skill_ids)]
         ],
     )

@@ -7,8 +7,9 @@ datagrams, repeated by its senders: barrier signals between robots, and beacons 
 each end learns within a beacon period that the other is back (the ROS adapter then
 reconnects the link's topics instead of waiting on the kernel's backoff).
 
-A datagram is ``MAGIC``, one kind byte, and the payload: a beacon carries the sender's
-name (UTF-8), a barrier signal a serialized ``rosmc/BarrierSignal``.
+Every datagram is signed with the deployment's key and refused if it is not, or if it is
+an old one played again (:mod:`.radio_auth` has the layout and the rules): a beacon carries
+only its sender's name, a barrier signal a serialized ``rosmc/BarrierSignal`` as well.
 
 An idle radio should carry little: a robot that hears the ground beacons it only every
 :data:`IDLE_BEACON_PERIOD` s (:class:`BeaconPlan`). While it does not hear the ground, and
@@ -26,7 +27,6 @@ from dataclasses import dataclass, field
 
 from .errors import InvalidRequest
 
-MAGIC = b"RMC\x01"
 MAX_DATAGRAM = 1400  # bytes: one datagram fits an Ethernet frame, never fragmented
 BEACON_PERIOD = 0.5  # seconds between beacons to each peer (a robot's: while seeking)
 IDLE_BEACON_PERIOD = 4.0  # seconds between a robot's beacons while it hears the ground
@@ -42,28 +42,6 @@ class DatagramKind(enum.IntEnum):
     BEACON = 1
     BARRIER_SIGNAL = 2
     RETURN_BEACON = 3  # a beacon of a sender that does not hear the receiver, or just did again
-
-
-def encode_datagram(kind: DatagramKind, payload: bytes) -> bytes:
-    """One datagram (InvalidRequest if the payload does not fit)."""
-    data = MAGIC + bytes((int(kind),)) + payload
-    if len(data) > MAX_DATAGRAM:
-        raise InvalidRequest(
-            f"a {kind.name.lower()} datagram holds at most {MAX_DATAGRAM} bytes, "
-            f"this one {len(data)}"
-        )
-    return data
-
-
-def decode_datagram(data: bytes) -> tuple[DatagramKind, bytes]:
-    """The kind and payload of a datagram (InvalidRequest if it is not one of ours)."""
-    if len(data) <= len(MAGIC) or not data.startswith(MAGIC):
-        raise InvalidRequest("not a ROSMC radio datagram")
-    try:
-        kind = DatagramKind(data[len(MAGIC)])
-    except ValueError:
-        raise InvalidRequest(f"unknown radio datagram kind {data[len(MAGIC)]}") from None
-    return kind, data[len(MAGIC) + 1 :]
 
 
 def parse_endpoint(text: str) -> tuple[str, int]:

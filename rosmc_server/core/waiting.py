@@ -11,14 +11,20 @@ unsent ones it supersedes:
   (and the upload when it empties) and needs nothing sent for them: a take-back cancels a
   waiting send;
 * BARRIERS and SET_OPTIONS replace the robot's whole barrier set / options: an unsent older
-  one is withdrawn (a second policy change replaces the first);
-* a control equal to the last unsent command is a repeat; RESUME right after an unsent
-  PAUSE (or the reverse) cancels both; STOP withdraws the START, PAUSE and RESUME waiting
-  right before it (the robot is to end up stopped either way).
+  one is withdrawn (a second policy change replaces the first: the latest wins);
+* controls collapse with what waits, wherever it waits in the queue, so that at most one
+  STOP, one START and one PAUSE or RESUME wait at a time: a control equal to one still
+  waiting is a repeat (a START only if no upload waits after it: the robot is to start
+  what was sent after too); RESUME cancels a waiting PAUSE (and the reverse) and needs
+  nothing sent; STOP withdraws every waiting START, PAUSE and RESUME (the robot is to end
+  up stopped either way).
 
 Commands already transmitted are never touched: the robot may have them, and their sequence
-numbers are given out. At most :data:`MAX_WAITING` commands wait per robot;
-:func:`refusal` words the one-sentence answer beyond that.
+numbers are given out. Only *work* is bounded (:func:`is_work`: uploads, take-backs,
+retries, skips): at most :data:`MAX_WAITING` of it waits per robot, and :func:`refusal`
+words the one-sentence answer beyond that. Commands that make a robot safer or let it go on
+(stop, pause, resume, start, a lost-link policy) are never refused for lack of room: they
+collapse as above, so they cannot pile up.
 """
 
 from __future__ import annotations
@@ -31,12 +37,23 @@ from .commands import CommandKind
 from .link import Outbox, Outgoing
 from .vocabulary import counted
 
-MAX_WAITING = 50  # unsent commands per robot; more is refused before the mission changes
+MAX_WAITING = 50  # unsent work per robot; more is refused before the mission changes
 
 _REPLACING = (CommandKind.BARRIERS, CommandKind.SET_OPTIONS)
 _CONTROLS = (CommandKind.START, CommandKind.PAUSE, CommandKind.RESUME, CommandKind.STOP)
 _OPPOSITE = {CommandKind.PAUSE: CommandKind.RESUME, CommandKind.RESUME: CommandKind.PAUSE}
 _STOPPED_BY_STOP = (CommandKind.START, CommandKind.PAUSE, CommandKind.RESUME)
+_WORK = frozenset((CommandKind.UPLOAD, CommandKind.UNSYNC, CommandKind.RETRY, CommandKind.SKIP))
+
+
+def is_work(kind: int) -> bool:
+    """Whether a command of ``kind`` counts against :data:`MAX_WAITING` (see the module)."""
+    return kind in _WORK
+
+
+def waiting_work(outbox: Outbox[C]) -> int:
+    """How much work waits unsent in ``outbox`` (what the bound counts)."""
+    return sum(1 for item in outbox.unsent() if is_work(item.payload.type))
 
 
 class Command(Protocol):
@@ -82,20 +99,25 @@ def _withdraw(outbox: Outbox[C], item: Outgoing[C], withdrawn: list[Any]) -> Non
     withdrawn.append(item)
 
 
-def _last_unsent(outbox: Outbox[C]) -> Outgoing[C] | None:
-    pending = outbox.pending()
-    last = pending[-1] if pending else None
-    return last if last is not None and not (last.seq or last.attempts) else None
-
-
 def _control(outbox: Outbox[C], command: C, kind: CommandKind, withdrawn: list[Any]) -> C | None:
+    unsent = outbox.unsent()
     if kind is CommandKind.STOP:
-        while (last := _last_unsent(outbox)) is not None and last.payload.type in _STOPPED_BY_STOP:
-            _withdraw(outbox, last, withdrawn)
-    last = _last_unsent(outbox)
+        for item in unsent:
+            if item.payload.type in _STOPPED_BY_STOP:
+                _withdraw(outbox, item, withdrawn)
+        return None if any(i.payload.type == kind for i in unsent) else command
+    if kind is CommandKind.START:
+        starts = [n for n, item in enumerate(unsent) if item.payload.type == kind]
+        if starts and not any(
+            item.payload.type == CommandKind.UPLOAD for item in unsent[starts[-1] :]
+        ):
+            return None  # the waiting START starts all that waits
+        return command
+    waiting = [item for item in unsent if item.payload.type in _OPPOSITE]
+    last = waiting[-1] if waiting else None
     if last is not None and last.payload.type == kind:
         return None  # the same control is already waiting
-    if last is not None and _OPPOSITE.get(kind) == last.payload.type:
+    if last is not None:  # its opposite waits: neither needs to go
         _withdraw(outbox, last, withdrawn)
         return None
     return command
@@ -121,12 +143,13 @@ def _unsync(outbox: Outbox[C], command: C, withdrawn: list[Any]) -> C | None:
 
 
 def refusal(agent: str, waiting: int, limit: int = MAX_WAITING) -> str:
-    """The one-sentence refusal when ``agent`` has ``waiting`` unsent commands, "" below it."""
+    """The one-sentence refusal of more work when ``agent`` has ``waiting`` unsent work
+    commands (:func:`waiting_work`), "" below the bound."""
     if waiting < limit:
         return ""
     return (
-        f"{agent} already has {limit} commands waiting for contact; "
-        "take some back or wait until the robot is heard"
+        f"{agent} already has {limit} uploads and take-backs waiting for contact; take some "
+        "back or wait until the robot is heard (stop, pause, resume and policies still go)"
     )
 
 

@@ -97,6 +97,7 @@ class AgentStatePublisher:
             hash_mismatch=link.mismatch,
             commands_waiting=report.waiting,
             waiting_for=report.waiting_for,
+            radio_dropped=server.link.radio_dropped(agent),
         )
         current = next(
             (

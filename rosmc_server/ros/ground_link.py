@@ -33,6 +33,7 @@ from ..conversions import time_to_msg
 from ..conversions.command_packing import command_msg
 from ..core import Mission, RosmcError, SkillStatus, StorageFull, Transfer
 from ..core.commands import CommandKind, CommandSpec, queued_barriers
+from ..core.drop_log import DropLog
 from ..core.link import (
     Arrival,
     LinkReport,
@@ -41,7 +42,8 @@ from ..core.link import (
     Outgoing,
 )
 from ..core.radio import BEACON_PERIOD, ROBOT_SILENCE, ContactWatch
-from ..core.waiting import collapse
+from ..core.radio_key import RadioKey
+from ..core.waiting import collapse, waiting_work
 from ..interface import ground_link
 from .agent_link import AgentLink, LinkHost, Operation
 from .command_records import command_record
@@ -63,6 +65,7 @@ class GroundLink:
         self,
         host: LinkHost,
         agents: Iterable[str],
+        radio_key: RadioKey,
         timeout: float = 3.0,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
@@ -72,6 +75,7 @@ class GroundLink:
         self._links: dict[str, AgentLink] = {}
         self._next_heartbeat = self._next_beacon = 0.0
         self._contact = ContactWatch(silence=ROBOT_SILENCE)
+        self._dropped_reports = DropLog("robot report")  # counted, warned at a limited rate
         self._snapshots = SnapshotSync(
             host,
             clock,
@@ -98,7 +102,7 @@ class GroundLink:
                 for topic, msg_type, handler in handlers
             ]
             self._links[agent] = link
-        self.radio = Radio(GROUND, self._on_beacon)
+        self.radio = Radio(GROUND, self._on_beacon, key=radio_key)
 
     @property
     def _mission(self) -> Mission:
@@ -113,6 +117,13 @@ class GroundLink:
         """The link report and tracked details of ``agent``, for display."""
         link = self._links[agent]
         return link.outbox.report(self._clock()), link
+
+    def radio_dropped(self, agent: str) -> int:
+        """Radio datagrams dropped on ``agent``'s link: by the robot (as its snapshot says)
+        and by the ground among those that named the robot."""
+        snapshot = self._links[agent].snapshot
+        robot = int(getattr(snapshot, "radio_dropped", 0)) if snapshot is not None else 0
+        return robot + self.radio.dropped_from(agent)
 
     def expected_hash(self, agent: str) -> str:
         """The queue hash the ground expects the robot to have."""
@@ -145,9 +156,9 @@ class GroundLink:
         delivered = wall if event == wire.CommandRecord.DELIVERED else 0.0
         self._host.record_command(command_record(event, item, asked, delivered, result))
 
-    def unsent(self, agent: str) -> int:
-        """How many commands wait, never transmitted, for ``agent``'s robot."""
-        return len(self._links[agent].outbox.unsent())
+    def waiting_work(self, agent: str) -> int:
+        """How much work (uploads, take-backs, retries, skips) waits unsent for ``agent``."""
+        return waiting_work(self._links[agent].outbox)
 
     def tick(self) -> None:
         """Retransmit whatever is due; repeat report acks as the ground's heartbeat."""
@@ -277,7 +288,13 @@ class GroundLink:
         try:
             status = SkillStatus(msg.status.value)
         except ValueError:
-            _log.warning("link %s: report with unknown status %d", msg.agent, msg.status.value)
+            warning = self._dropped_reports.drop(
+                "its status is not one this server knows",
+                f"from {msg.agent} with unknown status {msg.status.value}",
+                self._clock(),
+            )
+            if warning is not None:
+                _log.warning("robot link: %s", warning)
             return
         stamp = msg.stamp.to_sec()
         self._apply(

@@ -167,12 +167,14 @@ class OperatorServices:
         assert event is not None
         return event
 
-    def _require_link(self, agent: str) -> None:
+    def _require_link(self, agent: str, work: bool = True) -> None:
+        """``agent`` has a robot link, and (for ``work``) room for more waiting work."""
         if agent not in self._server.library.dynamic_agents:
             self._server.library.agent(_text(agent, "the agent name"))
             raise RuleViolation(f"'{agent}' is a static agent and has no robot link")
-        # Out of contact is no reason to refuse (the command waits); only the bound is.
-        sentence = refusal(agent, self._server.link.unsent(agent))
+        # Out of contact is no reason to refuse (the command waits); only the bound is, and
+        # only for work: stop, pause, resume and policies collapse with what waits instead.
+        sentence = refusal(agent, self._server.link.waiting_work(agent)) if work else ""
         if sentence:
             raise Unavailable(sentence)
 
@@ -282,7 +284,7 @@ class OperatorServices:
         agents = [req.agent] if req.agent else list(self._server.library.dynamic_agents)
         with self._server.locked():
             for agent in agents:
-                self._require_link(agent)
+                self._require_link(agent, work=False)
             for agent in agents:
                 self._server.link.send(CommandSpec(agent, _CONTROL[req.command]))
             resp.note = self._queued_note(agents)
@@ -293,7 +295,7 @@ class OperatorServices:
         agent = _text(req.agent, "the agent name")
         policy = policy_from_request(req).checked(self._server.library, agent)
         with self._server.locked():
-            self._require_link(agent)
+            self._require_link(agent, work=False)
             argument = options_argument(policy)
             self._server.link.send(CommandSpec(agent, CommandKind.SET_OPTIONS, argument=argument))
             resp.note = self._queued_note([agent])

@@ -7,8 +7,17 @@ ROS_HOSTNAME give it, like every other address a node advertises). A background 
 reads that directory through the master with a timeout, so a cut radio never blocks
 anything else: every :data:`~..core.radio.DIRECTORY_PERIOD` seconds after a change, less
 often while it stays the same (:func:`~..core.radio.next_directory_period`), and at once
-when asked (:meth:`Radio.refresh`); the address a datagram came from counts too (the
-newest wins).
+when asked (:meth:`Radio.refresh`).
+
+Every datagram is signed with the deployment's key and checked on arrival
+(:mod:`..core.radio_auth`); one that fails is dropped, counted (:attr:`Radio.dropped`) and
+logged at a limited rate (:class:`~..core.drop_log.DropLog`), never acted on. Anyone can
+write the parameter server, so the directory is only a hint: a peer's address is where an
+authenticated datagram of its own last came from, and a datagram for it also goes to the
+addresses the directory listed for it since (the newest only, once the peer was heard): a
+peer that restarted on another port is reached that way until it speaks, and a forged entry
+only ever gets copies it can neither alter nor play back, while the peer itself writes its
+entry back at its next read of the directory.
 
 :class:`TopicListener` is a subscriber that can be reconnected: when a beacon shows a
 peer is back after a silence, the link's subscribers for it connect afresh at once,
@@ -18,12 +27,14 @@ instead of waiting for TCP's next retransmission of the stalled connection.
 from __future__ import annotations
 
 import logging
+import os
 import socket
 import threading
 import time
 import xmlrpc.client
 from collections.abc import Callable, Iterable
 from io import BytesIO
+from pathlib import Path
 from typing import Any
 
 import rosgraph
@@ -32,20 +43,40 @@ import rosmc.msg as wire
 import rospy
 
 from ..core import RosmcError
+from ..core.drop_log import DropLog
 from ..core.radio import (
     DIRECTORY_PERIOD,
     DatagramKind,
-    decode_datagram,
-    encode_datagram,
     next_directory_period,
     parse_endpoint,
 )
+from ..core.radio_auth import DatagramRefused, Opener, Sealer
+from ..core.radio_key import RadioKey, obtain_key
 from ..interface import RADIO_DIRECTORY
 from .connections import TimeoutTransport
 
 _log = logging.getLogger(__name__)
 MASTER_TIMEOUT = 2.0  # seconds an XML-RPC call to the master may take
 GROUND = "ground"
+MAX_HINTS = 4  # directory listings kept per peer until it is heard
+
+
+def node_radio_key(path: str, who: str) -> RadioKey:
+    """The key a node signs with: from ``path`` (its ``~radio_key``), else the default place.
+
+    Raises RadioKeyError (one sentence naming the file and the fix) if it is unusable. A key
+    made at the default place just now is announced: every other host needs a copy.
+    """
+    key, made = obtain_key(Path(path) if path else None, os.environ)
+    if made:
+        _log.warning(
+            "%s: made a new radio key %s (fingerprint %s); every host of the deployment needs "
+            "a copy of this file ('rosmc key show' prints a key's fingerprint)",
+            who,
+            key.path,
+            key.fingerprint,
+        )
+    return key
 
 
 class Radio:
@@ -57,6 +88,7 @@ class Radio:
             return beacon (on the receive thread).
         on_signal: Called with each barrier signal heard (on the receive thread).
         port: UDP port to bind (0: any free one).
+        key: The deployment's radio key: it signs what this end sends and checks what it hears.
     """
 
     def __init__(
@@ -65,24 +97,39 @@ class Radio:
         on_beacon: Callable[[str, bool], None],
         on_signal: Callable[[wire.BarrierSignal], None] | None = None,
         port: int = 0,
+        *,
+        key: RadioKey,
     ) -> None:
         self.name = name
         self._on_beacon = on_beacon
         self._on_signal = on_signal
+        self._sealer = Sealer(key, name)
+        self._opener = Opener(key, name)  # used by the receive thread only
+        self._drops = DropLog("radio datagram")
+        self._claimed: dict[str, int] = {}  # dropped datagrams by the sender they named
         self._socket = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self._socket.bind(("0.0.0.0", port))
         self._socket.settimeout(0.5)
         host = rosgraph.network.get_host_name()
         self.endpoint = f"{host}:{self._socket.getsockname()[1]}"
-        self._addresses: dict[str, tuple[str, int]] = {}  # where to send, by name
-        self._listed: dict[str, tuple[str, int]] = {}  # as last read from the directory
+        self._heard: dict[str, tuple[str, int]] = {}  # where each peer's own datagrams came from
+        # What the directory listed for each peer since it was last heard, newest last: hints
+        # (someone may have overwritten the entry; its owner puts it right again).
+        self._listed: dict[str, list[tuple[str, int]]] = {}
         self._lock = threading.Lock()
+        self._send_lock = threading.Lock()  # datagrams leave in the order they were stamped
         self._closed = threading.Event()
         self._wake = threading.Event()  # read the directory now
         self._last_read = float("-inf")  # monotonic time of the last read of the directory
         self._registered = False
         self._master = xmlrpc.client.ServerProxy(
             rosgraph.get_master_uri(), transport=TimeoutTransport(MASTER_TIMEOUT)
+        )
+        _log.info(
+            "radio %s: datagrams signed with the radio key %s (fingerprint %s)",
+            name,
+            key.path,
+            key.fingerprint,
         )
         self._threads = [
             threading.Thread(target=self._receive, name=f"radio-{name}-rx", daemon=True),
@@ -91,6 +138,17 @@ class Radio:
         for thread in self._threads:
             thread.start()
 
+    @property
+    def dropped(self) -> int:
+        """Datagrams dropped since start: unsigned, forged, replayed, reflected or unreadable."""
+        with self._lock:
+            return self._drops.total
+
+    def dropped_from(self, sender: str) -> int:
+        """Dropped datagrams that named ``sender`` (a claim: nothing proves who sent them)."""
+        with self._lock:
+            return self._claimed.get(sender, 0)
+
     # -- sending ------------------------------------------------------------------------
     def beacon(self, peer: str, kind: DatagramKind = DatagramKind.BEACON) -> None:
         """Tell ``peer`` this end is here (nothing if its address is not known yet).
@@ -98,30 +156,37 @@ class Radio:
         ``kind`` is BEACON or RETURN_BEACON (this end does not hear ``peer``, or just did
         again after a silence).
         """
-        self._send(peer, encode_datagram(kind, self.name.encode("utf-8")))
+        self._send([peer], kind, b"")
 
     def signal(self, msg: wire.BarrierSignal, peers: Iterable[str]) -> None:
         """Send a barrier signal to each of ``peers`` whose address is known."""
         buffer = BytesIO()
         msg.serialize(buffer)
-        data = encode_datagram(DatagramKind.BARRIER_SIGNAL, buffer.getvalue())
-        for peer in peers:
-            self._send(peer, data)
+        self._send(list(peers), DatagramKind.BARRIER_SIGNAL, buffer.getvalue())
 
     def robots(self) -> list[str]:
         """Every other end known but the ground: the robots' executors."""
         with self._lock:
-            return [n for n in self._addresses if n not in (self.name, GROUND)]
+            names = dict.fromkeys([*self._heard, *self._listed])
+        return [n for n in names if n not in (self.name, GROUND)]
 
-    def _send(self, peer: str, data: bytes) -> None:
+    def _targets(self, peer: str) -> list[tuple[str, int]]:
         with self._lock:
-            address = self._addresses.get(peer)
-        if address is None:
+            heard = self._heard.get(peer)
+            found = [*([heard] if heard is not None else []), *self._listed.get(peer, [])]
+        return list(dict.fromkeys(found))
+
+    def _send(self, peers: list[str], kind: DatagramKind, payload: bytes) -> None:
+        targets = [(peer, address) for peer in peers for address in self._targets(peer)]
+        if not targets:
             return
-        try:
-            self._socket.sendto(data, address)
-        except OSError as error:  # a radio that is down: the sender repeats anyway
-            _log.debug("radio %s: cannot send to %s: %s", self.name, peer, error)
+        with self._send_lock:
+            data = self._sealer.seal(kind, payload)
+            for peer, address in targets:
+                try:
+                    self._socket.sendto(data, address)
+                except OSError as error:  # a radio that is down: the sender repeats anyway
+                    _log.debug("radio %s: cannot send to %s: %s", self.name, peer, error)
 
     # -- receiving ----------------------------------------------------------------------
     def _receive(self) -> None:
@@ -141,30 +206,41 @@ class Radio:
 
     def _dispatch(self, data: bytes, source: tuple[str, int]) -> None:
         try:
-            kind, payload = decode_datagram(data)
-            if kind in (DatagramKind.BEACON, DatagramKind.RETURN_BEACON):
-                sender = payload.decode("utf-8")
-                self._learn(sender, source)
-                self._on_beacon(sender, kind is DatagramKind.RETURN_BEACON)
-                return
+            opened = self._opener.open(data)
+        except DatagramRefused as refused:
+            self._drop(refused.refusal.value, refused.sender, source)
+            return
+        msg: wire.BarrierSignal | None = None
+        if opened.kind is DatagramKind.BARRIER_SIGNAL:
             msg = wire.BarrierSignal()
-            msg.deserialize(payload)
-        except (RosmcError, UnicodeDecodeError, ValueError) as error:
-            _log.debug("radio %s: ignoring a datagram from %s: %s", self.name, source, error)
-            return
-        except Exception as error:  # genpy raises struct.error and others on short input
-            _log.debug(
-                "radio %s: ignoring a malformed signal from %s: %s", self.name, source, error
-            )
-            return
-        self._learn(msg.agent, source)
-        if self._on_signal is not None:
+            try:
+                msg.deserialize(opened.payload)
+            except Exception as error:  # genpy raises struct.error and others on short input
+                self._drop(f"its barrier signal cannot be read ({error})", opened.sender, source)
+                return
+            if msg.agent != opened.sender:
+                self._drop(f"it speaks for {msg.agent!r}", opened.sender, source)
+                return
+        # Authenticated and fresh: only now does its address count.
+        with self._lock:
+            self._heard[opened.sender] = source
+            hints = self._listed.get(opened.sender)
+            if hints:
+                del hints[:-1]  # the peer is found: older listings are of no more use
+        if msg is None:
+            self._on_beacon(opened.sender, opened.kind is DatagramKind.RETURN_BEACON)
+        elif self._on_signal is not None:
             self._on_signal(msg)
 
-    def _learn(self, name: str, source: tuple[str, int]) -> None:
-        if name and name != self.name:
-            with self._lock:
-                self._addresses[name] = source
+    def _drop(self, reason: str, sender: str, source: tuple[str, int]) -> None:
+        claim = f" naming {sender!r}" if sender else ""
+        with self._lock:
+            self._claimed[sender] = self._claimed.get(sender, 0) + 1
+            warning = self._drops.drop(
+                reason, f"from {source[0]}:{source[1]}{claim}", time.monotonic()
+            )
+        if warning is not None:
+            _log.warning("radio %s: %s", self.name, warning)
 
     # -- the directory on the parameter server -------------------------------------------
     def refresh(self) -> None:
@@ -204,11 +280,14 @@ class Radio:
                 _log.debug("radio %s: skipping %s's endpoint: %s", self.name, name, error)
                 continue
             with self._lock:
-                # A new entry (a restarted peer) wins; an unchanged one does not override
-                # where the peer was last heard from.
-                if self._listed.get(name) != address:
-                    self._listed[name] = address
-                    self._addresses[name] = address
+                # A hint only: datagrams for the peer also go there until the peer is heard
+                # from it (a restarted peer's new port); what it says is never trusted.
+                hints = self._listed.setdefault(name, [])
+                if not hints or hints[-1] != address:
+                    if address in hints:
+                        hints.remove(address)
+                    hints.append(address)
+                    del hints[:-MAX_HINTS]
                     changed = True
         return changed
 

@@ -36,6 +36,7 @@ class ServerConfig:
     journal_reserve: int = JournalOptions.reserve_bytes
     operators: OperatorAllowList = field(default_factory=OperatorAllowList)
     broadcast_snapshots: bool = False
+    radio_key: str = ""  # "" = $ROS_HOME/rosmc/radio.key, made if missing
 
     @classmethod
     def from_params(cls) -> ServerConfig:
@@ -50,6 +51,7 @@ class ServerConfig:
         for once in ("~journal", "~resume"):
             if rospy.has_param(once):
                 rospy.delete_param(once)
+        radio_key = str(rospy.get_param("~radio_key", ""))
         previous = station.previous_journal()
         if previous is not None:  # restarted by roslaunch: go on where the last server was
             journal, resume = str(previous), True
@@ -70,4 +72,5 @@ class ServerConfig:
             journal_reserve=max(0, int(rospy.get_param("~journal_reserve", cls.journal_reserve))),
             operators=OperatorAllowList.of(rospy.get_param("~operators", [])),
             broadcast_snapshots=bool(rospy.get_param("~broadcast_snapshots", False)),
+            radio_key=str(station.launch_path(radio_key)) if radio_key else "",
         )

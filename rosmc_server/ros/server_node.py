@@ -45,6 +45,9 @@ Parameters (private):
     ``~mission_dir`` (str): the only directory (with its subdirectories) where SaveMission
         and LoadMission read or write files on the server's host (default ``missions/``);
         elsewhere, clients pass the document itself.
+    ``~radio_key`` (str): the deployment's radio key file, which signs the radio side
+        channel's datagrams (default ``$ROS_HOME/rosmc/radio.key``, made there if missing;
+        a key given here must exist: see :mod:`rosmc_server.core.radio_key`).
     ``~cwd`` (str): relative paths above are resolved against it (launch files pass the
         directory the user typed the command in; see :mod:`.station`).
     ``~station_journal`` (str): set by a launch file that restarts the server: a server that
@@ -92,6 +95,7 @@ from .heartbeat import Heartbeat
 from .logging_bridge import bridge_logging_to_rosout
 from .operator_services import OperatorServices
 from .publishing import SnapshotPublisher
+from .radio import node_radio_key
 from .recorder import TelemetryRecorder
 from .server_config import ServerConfig
 from .site_listener import SiteListener
@@ -123,7 +127,8 @@ class MissionServer:
             on_built=self._journal_snapshot,
             broadcast_changes=config.broadcast_snapshots,
         )
-        self.link = GroundLink(self, library.dynamic_agents, timeout=config.link_timeout)
+        key = node_radio_key(config.radio_key, "mission server")
+        self.link = GroundLink(self, library.dynamic_agents, key, timeout=config.link_timeout)
         self._recorder = TelemetryRecorder(lambda: self._journal, frozenset(library.dynamic_agents))
         self._agent_states = AgentStatePublisher(
             self, config.agent_state_rate, on_published=self._recorder.agent_states

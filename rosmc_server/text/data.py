@@ -106,6 +106,7 @@ def agent_status_to_json(status: AgentStatus) -> dict[str, Any]:
         "waiting_on": status.waiting_on,
         "policy": status.policy,
         "coverage_warning": status.coverage_warning,
+        "radio_dropped": status.radio_dropped,
     }
 
 

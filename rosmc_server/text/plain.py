@@ -114,6 +114,8 @@ def format_agent_status(status: AgentStatus | None) -> str:
         parts.append(status.policy)
     if status.coverage_warning:
         parts.append(f"WARNING: {status.coverage_warning}")
+    if status.radio_dropped:
+        parts.append(f"WARNING: {status.radio_text}")
     return ", ".join(parts)
 
 

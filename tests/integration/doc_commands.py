@@ -180,6 +180,8 @@ COLCON = f"{BUILD}::test_colcon_build"
 REVIEW = f"{DOCS}::test_the_review_commands_run_on_the_sample"
 REPLAY = f"{DOCS}::test_the_replay_commands_run_against_a_master"
 GUI = f"{DOCS}::test_the_command_gui_commands_start_the_window"
+RADIO_KEYS = "tests/integration/test_radio_keys.py"
+KEYS = f"{RADIO_KEYS}::test_the_key_commands_make_show_and_rotate_a_private_key"
 
 
 def _cli(test: str, *texts: str) -> Evidence:
@@ -235,9 +237,9 @@ DOC_COMMANDS: dict[str, Evidence] = {
     "REC=bags/samples/demo.mcap": _docs(REVIEW, "REC=bags/samples/demo.mcap"),
     "rosmc info $REC": _docs(REVIEW, "rosmc info $REC"),
     "rosmc at $REC 8.5": _docs(REVIEW, "rosmc at $REC 8.5"),
-    "rosmc at $REC r120 --json": _docs(REVIEW, "rosmc at $REC r120 --json"),
+    "rosmc at $REC r80 --json": _docs(REVIEW, "rosmc at $REC r80 --json"),
     "rosmc timeline $REC -o timeline.svg": _docs(REVIEW, "rosmc timeline $REC -o timeline.svg"),
-    "rosmc diff $REC r100 0:09": _docs(REVIEW, "rosmc diff $REC r100 0:09"),
+    "rosmc diff $REC r60 0:09": _docs(REVIEW, "rosmc diff $REC r60 0:09"),
     "rosmc tobag $REC mission.bag": _docs(REVIEW, "rosmc tobag $REC mission.bag"),
     "rosbag play --clock -r 20 mission.bag": _docs(REVIEW, "rosbag play --clock -r 20 mission.bag"),
     "rosmc restore $REC --at 9s": _cli(
@@ -325,6 +327,10 @@ DOC_COMMANDS: dict[str, Evidence] = {
         "test_the_guide_example_robot_runs_its_skill",
         ('blocks("bash")[0]', '["bash", "-c", command]'),
     ),
+    # docs/integrator-guide.md, "The radio key"
+    "rosmc key new": Evidence(KEYS, ('rosmc("rosmc key new", home)',)),
+    "rosmc key show": Evidence(KEYS, ('rosmc("rosmc key show", home)',)),
+    "rosmc key new --force": Evidence(KEYS, ('rosmc("rosmc key new --force", home)',)),
     "rostest rosmc server.test": Evidence(*ROSTEST),
     "rostest rosmc executor.test": Evidence(*RUN_TESTS),
     "rostest rosmc sim.test": Evidence(*RUN_TESTS),

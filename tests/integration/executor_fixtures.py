@@ -39,7 +39,9 @@ from rosmc_server import interface
 from rosmc_server.conversions import mission_from_msg, param_to_msg, skill_to_msg
 from rosmc_server.core import MissionState, SkillInstance, SkillStatus
 from rosmc_server.core.commands import CommandKind
-from rosmc_server.core.radio import DatagramKind, encode_datagram, parse_endpoint
+from rosmc_server.core.radio import DatagramKind, parse_endpoint
+from rosmc_server.core.radio_auth import Sealer
+from rosmc_server.core.radio_key import RadioKey, obtain_key
 from rosmc_server.recording import read_journal
 from tests.conftest import wait_until
 
@@ -385,11 +387,18 @@ def command_msg(
     )
 
 
-def signal_datagram(msg: wire.BarrierSignal) -> bytes:
-    """A barrier signal as the radio side channel carries it."""
+def team_key() -> RadioKey:
+    """The radio key of the nodes this session starts (they share this process's ROS_HOME)."""
+    return obtain_key(None, os.environ)[0]
+
+
+def signal_datagram(msg: wire.BarrierSignal, sealer: Sealer | None = None) -> bytes:
+    """A barrier signal as the radio side channel carries it, signed by ``sealer`` (default:
+    a sender named as the signal's agent, holding the team's key)."""
     buffer = BytesIO()
     msg.serialize(buffer)
-    return encode_datagram(DatagramKind.BARRIER_SIGNAL, buffer.getvalue())
+    sealer = sealer or Sealer(team_key(), msg.agent)
+    return sealer.seal(DatagramKind.BARRIER_SIGNAL, buffer.getvalue())
 
 
 def send_datagrams(name: str, *datagrams: bytes) -> None:

@@ -5,12 +5,15 @@ from __future__ import annotations
 import socket
 import threading
 from io import BytesIO
+from pathlib import Path
 
 import rosmc.msg as wire
 import rospy
 
 from rosmc_server import interface
-from rosmc_server.core.radio import DatagramKind, encode_datagram
+from rosmc_server.core.radio import DatagramKind
+from rosmc_server.core.radio_auth import Sealer
+from rosmc_server.core.radio_key import RadioKey
 from rosmc_server.ros.radio import Radio
 from tests.conftest import RosMaster, wait_until
 
@@ -38,7 +41,8 @@ class Heard:
 def test_endpoints_find_each_other_through_the_directory(ros_master: RosMaster) -> None:
     # Names of this test's own: the session's master may list endpoints of earlier tests.
     heard = {name: Heard() for name in ("ground", "radio_r1", "radio_r2")}
-    radios = {name: Radio(name, h.beacon, h.signal) for name, h in heard.items()}
+    key = RadioKey(bytes(32), Path("test.key"))
+    radios = {name: Radio(name, h.beacon, h.signal, key=key) for name, h in heard.items()}
     try:
         directory = ros_master.proxy()
         wait_until(
@@ -77,7 +81,8 @@ def test_endpoints_find_each_other_through_the_directory(ros_master: RosMaster) 
         signal.serialize(buffer)
         port = int(radios["radio_r2"].endpoint.rsplit(":", 1)[1])
         with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as udp:
-            for stray in (b"junk", encode_datagram(DatagramKind.BARRIER_SIGNAL, b"\x01\x02")):
+            short = Sealer(key, "radio_r1").seal(DatagramKind.BARRIER_SIGNAL, b"\x01\x02")
+            for stray in (b"junk", short):
                 udp.sendto(stray, ("127.0.0.1", port))
         count = len(heard["radio_r2"].signals)
         wait_until(

@@ -114,6 +114,32 @@ def test_skills_sent_while_out_of_range_are_not_counted_again(gui: Gui) -> None:
     assert alerts.coverage_warnings(gui.widget.view) == []
 
 
+def test_forged_radio_datagrams_on_a_robots_link_are_a_warning_and_in_its_header(
+    gui: Gui,
+) -> None:
+    from rosmc_rqt_command.core.presentation import link_summary
+    from rosmc_rviz_markers.core.icons import link_row
+    from rosmc_server.text import format_agent_status
+
+    quiet = AgentStatus("alpha", link="up", last_heard=0.1)
+    attacked = AgentStatus("alpha", link="up", last_heard=0.1, radio_dropped=212)
+    gui.feed.statuses(quiet)
+    assert alerts.radio_warnings(gui.widget.view) == []
+    assert "forged" not in link_summary(quiet) and "forged" not in format_agent_status(quiet)
+    gui.feed.statuses(attacked)
+    gui.widget.repaints.show_statuses_now()
+    _warn_now(gui)
+    assert gui.widget.messages.warnings == [
+        "alpha: 212 forged radio datagrams dropped (someone without the deployment's key is "
+        "sending)."
+    ]
+    assert link_summary(attacked).endswith("212 forged radio datagrams dropped")
+    assert "WARNING: 212 forged radio datagrams dropped" in format_agent_status(attacked)
+    assert AgentStatus("alpha", radio_dropped=1).radio_text == "1 forged radio datagram dropped"
+    row = link_row("up", 0.1, forged=212)
+    assert row.text == "link up, 212 FORGED DROPPED" and row.color != link_row("up", 0.1).color
+
+
 def stricter(library_data: dict[str, Any]) -> Library:
     """The unit library after an update: 'move' may go at most 1.5 m/s."""
     library_data["models"]["walker"]["skills"]["move"]["parameters"]["speed"]["max"] = 1.5

@@ -362,6 +362,21 @@ def test_cancelling_an_unanswered_upload_returns_the_skills_to_the_blueprint(
     mission.edit_skill(first, label="edited after the cancel")
 
 
+def test_a_skill_sent_again_after_a_cancelled_upload_no_longer_says_cancelled(
+    mission: Any,
+) -> None:
+    # Sync, take back, sync again (during a cut): the second upload is delivered and runs.
+    skill_id = mission.add_skill("alpha", "noop").change.put_skills[0].skill.id
+    mission.synchronize("alpha")
+    mission.cancel_uploads("alpha")
+    mission.synchronize("alpha")
+    assert mission.state.skill(skill_id).status_text == "", "uploading, nothing cancelled"
+    mission.confirm_synchronized("alpha", [skill_id])
+    mission.report_status(skill_id, SkillStatus.RUNNING)
+    skill = mission.state.skill(skill_id)
+    assert (skill.status, skill.status_text) == (SkillStatus.RUNNING, "")
+
+
 def test_taking_back_the_later_of_two_waiting_uploads_keeps_the_first(mission: Any) -> None:
     first = mission.add_skill("alpha", "noop").change.put_skills[0].skill.id
     second = mission.add_skill("alpha", "noop").change.put_skills[0].skill.id

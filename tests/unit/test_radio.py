@@ -11,39 +11,12 @@ from rosmc_server.core.link import Outbox
 from rosmc_server.core.radio import (
     DIRECTORY_MAX_PERIOD,
     DIRECTORY_PERIOD,
-    MAX_DATAGRAM,
     BeaconPlan,
     ContactWatch,
     DatagramKind,
-    decode_datagram,
-    encode_datagram,
     next_directory_period,
     parse_endpoint,
 )
-
-
-def test_a_datagram_reads_back_as_its_kind_and_payload() -> None:
-    for kind in DatagramKind:
-        assert decode_datagram(encode_datagram(kind, b"r1")) == (kind, b"r1")
-
-
-@pytest.mark.parametrize(
-    ("data", "sentence"),
-    [
-        (b"", "not a ROSMC radio datagram"),
-        (b"GET / HTTP/1.0\r\n", "not a ROSMC radio datagram"),
-        (b"RMC\x01", "not a ROSMC radio datagram"),
-        (b"RMC\x01\x63payload", "unknown radio datagram kind 99"),
-    ],
-)
-def test_foreign_datagrams_are_refused_in_a_sentence(data: bytes, sentence: str) -> None:
-    with pytest.raises(InvalidRequest, match=sentence):
-        decode_datagram(data)
-
-
-def test_a_payload_that_does_not_fit_one_datagram_is_refused() -> None:
-    with pytest.raises(InvalidRequest, match=f"at most {MAX_DATAGRAM} bytes"):
-        encode_datagram(DatagramKind.BARRIER_SIGNAL, bytes(MAX_DATAGRAM))
 
 
 @pytest.mark.parametrize(

@@ -14,6 +14,7 @@ from rosmc_server.core.waiting import (
     queued_notes,
     refusal,
     waiting_text,
+    waiting_work,
 )
 
 TIMEOUT = 3.0
@@ -191,8 +192,8 @@ def test_the_bound_is_refused_with_one_sentence() -> None:
     assert refusal("rover", MAX_WAITING - 1) == ""
     sentence = refusal("rover", MAX_WAITING)
     assert sentence == (
-        f"rover already has {MAX_WAITING} commands waiting for contact; "
-        "take some back or wait until the robot is heard"
+        f"rover already has {MAX_WAITING} uploads and take-backs waiting for contact; take "
+        "some back or wait until the robot is heard (stop, pause, resume and policies still go)"
     )
     assert sentence.count(".") == 0 and "\n" not in sentence
 
@@ -217,3 +218,52 @@ def test_robots_never_heard_share_one_note_and_lost_ones_keep_their_age() -> Non
         "queued for b: out of contact (last heard 1 min ago); "
         "it goes out when the robot is heard again",
     ]
+
+
+def test_at_the_bound_controls_and_policies_still_go_and_collapse_the_latest_winning() -> None:
+    outbox = lost_outbox()
+    for n in range(MAX_WAITING):
+        queue(outbox, command(CommandKind.UPLOAD, (f"s{n}",)), 10.0)
+    assert waiting_work(outbox) == MAX_WAITING and refusal("rover", waiting_work(outbox))
+    # Safety commands and policy changes, many times over: none counts against the bound,
+    # and what waits of them stays small.
+    for _ in range(20):
+        for kind in (CommandKind.PAUSE, CommandKind.RESUME, CommandKind.PAUSE):
+            queue(outbox, command(kind), 10.0)
+        queue(outbox, Cmd(int(CommandKind.SET_OPTIONS), argument="hold"), 10.0)
+        queue(outbox, Cmd(int(CommandKind.SET_OPTIONS), argument="return"), 10.0)
+    assert waiting_work(outbox) == MAX_WAITING
+    extra = [(CommandKind(i.payload.type), i.payload.argument) for i in outbox.unsent()][
+        MAX_WAITING:
+    ]
+    assert extra == [(CommandKind.PAUSE, ""), (CommandKind.SET_OPTIONS, "return")]
+    queue(outbox, command(CommandKind.STOP), 10.0)
+    queue(outbox, command(CommandKind.STOP), 10.0)
+    extra = [CommandKind(i.payload.type) for i in outbox.unsent()][MAX_WAITING:]
+    assert extra == [CommandKind.SET_OPTIONS, CommandKind.STOP], "stop took the pause back"
+    assert len(outbox.unsent()) == MAX_WAITING + 2
+
+
+def test_a_resume_cancels_a_waiting_pause_whatever_came_between() -> None:
+    outbox = lost_outbox()
+    queue(outbox, command(CommandKind.PAUSE), 10.0)
+    queue(outbox, command(CommandKind.UPLOAD, ("a",)), 10.0)
+    queue(outbox, Cmd(int(CommandKind.SET_OPTIONS), argument="hold"), 10.0)
+    withdrawn = queue(outbox, command(CommandKind.RESUME), 10.0)
+    assert [CommandKind(c.type) for c in withdrawn] == [CommandKind.PAUSE]
+    assert kinds(outbox) == [(CommandKind.UPLOAD, ["a"]), (CommandKind.SET_OPTIONS, [])]
+
+
+def test_a_start_after_new_uploads_is_kept_a_start_with_nothing_new_is_a_repeat() -> None:
+    outbox = lost_outbox()
+    queue(outbox, command(CommandKind.START), 10.0)
+    queue(outbox, command(CommandKind.UPLOAD, ("a",)), 10.0)
+    queue(outbox, command(CommandKind.START), 10.0)
+    queue(outbox, command(CommandKind.START), 10.0)
+    assert kinds(outbox) == [
+        (CommandKind.START, []),
+        (CommandKind.UPLOAD, ["a"]),
+        (CommandKind.START, []),
+    ]
+    queue(outbox, command(CommandKind.STOP), 10.0)
+    assert kinds(outbox) == [(CommandKind.UPLOAD, ["a"]), (CommandKind.STOP, [])]

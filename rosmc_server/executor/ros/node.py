@@ -32,6 +32,9 @@ Parameters (private):
     ``~snapshot_period`` (float, s, 1.0), ``~idle_snapshot_period`` (float, s, 5.0),
     ``~report_retry`` (float, s, 0.5),
     ``~tick_rate`` (float, Hz, 50), ``~robot_side`` (bool, false).
+    ``~radio_key`` (str): the deployment's radio key file, which signs the radio side
+        channel's datagrams (default ``$ROS_HOME/rosmc/radio.key``, made there if missing;
+        a key given here must exist: see :mod:`rosmc_server.core.radio_key`).
     ``~cwd`` (str): a relative ``~state_file`` is taken from there (launch files pass the
     directory roslaunch was typed in).
 
@@ -44,12 +47,10 @@ from __future__ import annotations
 import argparse
 import importlib
 import logging
-import os
 import sys
 import threading
 import time
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import cast
 
@@ -69,16 +70,19 @@ from ...conversions.robot_link import (
     snapshot_to_msg,
 )
 from ...core import LibraryError, RosmcError, SkillSetupError
+from ...core.drop_log import DropLog
+from ...core.errors import RadioKeyError
 from ...core.radio import BeaconPlan, ContactWatch
-from ...ros.radio import GROUND, Radio, TopicListener, reconnect_in_background
+from ...core.radio_key import RadioKey
+from ...ros.radio import GROUND, Radio, TopicListener, node_radio_key, reconnect_in_background
 from ..core import Command, Engine, Report, Signal, SkillType
 from ..core.lost_link import PoseSource, no_pose
-from ..core.pacing import IDLE_PERIOD, SnapshotPacer
+from ..core.pacing import SnapshotPacer
 from ..core.state_file import load_state, save_state
+from .config import ExecutorConfig
 from .skill_setup import default_library, robot_skill_types
 
 _log = logging.getLogger(__name__)
-DEFAULT_SKILLS = "rosmc_server.executor.basic_skills:skill_types"
 
 
 def load_skill_types(spec: str, agent: str) -> dict[str, SkillType]:
@@ -110,6 +114,8 @@ class ExecutorNode:
         state_file: Path | None,
         robot_side: bool = False,
         pose_source: PoseSource = no_pose,
+        *,
+        radio_key: RadioKey,
     ) -> None:
         self.agent = agent
         self._lock = threading.RLock()
@@ -150,7 +156,10 @@ class ExecutorNode:
         ]
         self._contact = ContactWatch()
         self._beacons = BeaconPlan()
-        self.radio = Radio(agent, self._on_beacon, self._on_signal)
+        self._drop_lock = threading.Lock()
+        self._dropped_commands = DropLog("command")
+        self._dropped_signals = DropLog("barrier signal")
+        self.radio = Radio(agent, self._on_beacon, self._on_signal, key=radio_key)
 
     # -- engine outputs (called with the lock held) ------------------------------------
     def report(self, report: Report) -> None:
@@ -174,7 +183,7 @@ class ExecutorNode:
     # -- inputs ------------------------------------------------------------------------
     def _on_command(self, msg: wire.RobotCommand) -> None:
         if msg.agent != self.agent:
-            _log.warning("%s: ignoring a command for %s", self.agent, msg.agent)
+            self._dropped(self._dropped_commands, "it is for another robot", f"for {msg.agent!r}")
             return
         command: Command | None = None
         reason = ""
@@ -220,6 +229,7 @@ class ExecutorNode:
         if snapshot is None:
             return None
         msg = snapshot_to_msg(self.agent, snapshot)
+        msg.radio_dropped = self.radio.dropped
         self._full_snapshot = False
         if self._echo is not None:
             sent, received = self._echo
@@ -240,11 +250,18 @@ class ExecutorNode:
     def _on_signal(self, msg: wire.BarrierSignal) -> None:
         try:
             signal = signal_from_msg(msg)
-        except ValueError:
-            _log.warning("%s: ignoring a malformed barrier signal", self.agent)
+        except ValueError as error:
+            self._dropped(self._dropped_signals, "it cannot be read", f"from {msg.agent}: {error}")
             return
         with self._lock:
             self.engine.hear(signal)
+
+    def _dropped(self, log: DropLog, reason: str, detail: str) -> None:
+        """Count a dropped input; warn at a limited rate (a flood must not flood the log)."""
+        with self._drop_lock:
+            warning = log.drop(reason, detail, time.monotonic())
+        if warning is not None:
+            _log.warning("%s: %s", self.agent, warning)
 
     # -- the loop ------------------------------------------------------------------------
     def spin(self, tick_rate: float, report_retry: float) -> None:
@@ -281,71 +298,6 @@ class ExecutorNode:
         self._dirty = False
 
 
-def default_state_file(agent: str) -> Path:
-    """``$ROS_HOME/rosmc/<agent>_executor.json``."""
-    ros_home = os.environ.get("ROS_HOME") or os.path.join(os.path.expanduser("~"), ".ros")
-    return Path(ros_home) / "rosmc" / f"{agent}_executor.json"
-
-
-@dataclass(frozen=True)
-class ExecutorConfig:
-    """The executor's private parameters (``~name``), read once at start."""
-
-    agent: str
-    skills: str = DEFAULT_SKILLS
-    library: str = ""
-    pose_source: str = ""
-    state_file: Path | None = None
-    robot_side: bool = False
-    tick_rate: float = 50.0
-    snapshot_period: float = 1.0
-    idle_snapshot_period: float = IDLE_PERIOD
-    report_retry: float = 0.5
-
-    @classmethod
-    def from_params(cls) -> ExecutorConfig:
-        """Read every private parameter, then delete them from the parameter server.
-
-        Left there, they would configure the next executor started under the same name:
-        a ``~robot_side`` left by a run behind the link emulator made a later direct
-        executor talk on the wrong topics and never link.
-        """
-        agent = str(rospy.get_param("~agent", ""))
-        default_state = str(default_state_file(agent)) if agent else ""
-        state = str(rospy.get_param("~state_file", default_state))
-        config = cls(
-            agent=agent,
-            skills=str(rospy.get_param("~skills", DEFAULT_SKILLS)),
-            library=str(rospy.get_param("~library", "")),
-            pose_source=str(rospy.get_param("~pose_source", "")),
-            state_file=launch_path(state) if state else None,
-            robot_side=bool(rospy.get_param("~robot_side", False)),
-            tick_rate=float(rospy.get_param("~tick_rate", 50.0)),
-            snapshot_period=float(rospy.get_param("~snapshot_period", 1.0)),
-            idle_snapshot_period=float(rospy.get_param("~idle_snapshot_period", IDLE_PERIOD)),
-            report_retry=float(rospy.get_param("~report_retry", 0.5)),
-        )
-        for name in PRIVATE_PARAMS:
-            if rospy.has_param(f"~{name}"):
-                rospy.delete_param(f"~{name}")
-        return config
-
-
-PRIVATE_PARAMS = (
-    "agent",
-    "skills",
-    "library",
-    "pose_source",
-    "state_file",
-    "robot_side",
-    "tick_rate",
-    "snapshot_period",
-    "idle_snapshot_period",
-    "report_retry",
-    "cwd",
-)
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``mission_executor``."""
     args = rospy.myargv(list(argv) if argv is not None else sys.argv)
@@ -372,11 +324,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         skill_types = robot_skill_types(
             config.agent, skill_types, launch_path(library) if library else None
         )
-    except (LibraryError, SkillSetupError) as error:
+        radio_key = node_radio_key(config.radio_key, f"mission executor {config.agent}")
+    except (LibraryError, SkillSetupError, RadioKeyError) as error:
         _log.critical("mission executor %s: %s", config.agent, error)
         return 1
     node = ExecutorNode(
-        config.agent, skill_types, config.state_file, config.robot_side, pose_source
+        config.agent,
+        skill_types,
+        config.state_file,
+        config.robot_side,
+        pose_source,
+        radio_key=radio_key,
     )
     _log.info(
         "%s: mission executor ready with skills %s (%s link)",
