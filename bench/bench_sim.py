@@ -1,6 +1,6 @@
 """Benchmark of the sim node ``/rosmc/sim``; prints one JSON object.
 
-For the 3-robot Mars scenario and a 20-robot team (``tests/data/sim_20_robots.yaml``)
+For the 3-robot Mars scenario and a 20-robot team (``rosmc_sim/scenarios/twenty_robots.yaml``)
 it starts a private ``rosmaster`` and the real sim node headless, keeps every robot
 busy (drones take off, then fly back and forth; rovers drive back and forth, planned
 around the obstacles), and measures over a window of wall time:
@@ -56,7 +56,7 @@ from rosmc_sim.ros.topics import skill_run_status_topic, skill_run_topic
 REPO = Path(__file__).resolve().parents[1]
 SCENARIOS = {
     3: REPO / "rosmc_sim" / "scenarios" / "mars_sample_return.yaml",
-    20: REPO / "tests" / "data" / "sim_20_robots.yaml",
+    20: REPO / "rosmc_sim" / "scenarios" / "twenty_robots.yaml",
 }
 TARGETS = {3: 20.0, 20: 2.0}
 WARM_UP = 3.0

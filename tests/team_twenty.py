@@ -1,4 +1,5 @@
-"""The 20-robot team of ``tests/data/sim_20_robots.yaml`` as a mission the command GUI shows.
+"""The 20-robot team of ``rosmc_sim/scenarios/twenty_robots.yaml`` as a mission the command GUI
+shows.
 
 :func:`twenty_robot_library` gives the shipped Mars library with the scenario's 20 robots
 as its agents (each robot kind on its model). :func:`stage` fills a mission through the
@@ -9,7 +10,6 @@ contact). Used by the large-team GUI tests and ``tools/command_gui_team_screensh
 
 from __future__ import annotations
 
-import copy
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -21,8 +21,8 @@ from rosmc_server.core.library import library_from_dict
 from rosmc_sim.core.scenario import load_scenario
 
 REPO = Path(__file__).resolve().parents[1]
-SCENARIO = REPO / "tests" / "data" / "sim_20_robots.yaml"
-MARS_LIBRARY = REPO / "rosmc_server" / "config" / "mars_team.yaml"
+SCENARIO = REPO / "rosmc_sim" / "scenarios" / "twenty_robots.yaml"
+TWENTY_LIBRARY = REPO / "rosmc_server" / "config" / "mars_twenty_robots.yaml"
 MODELS = {"drone": "drone_scout", "science_rover": "rover_science"}
 MODELS["manipulator_rover"] = "rover_manipulator"
 FIRST_SKILL = {"drone": "take_off", "science_rover": "explore"}
@@ -47,15 +47,9 @@ def twenty_robot_library() -> Library:
 
 
 def twenty_robot_library_data() -> dict[str, Any]:
-    """:func:`twenty_robot_library` as library file data (for a server to load)."""
-    data: dict[str, Any] = copy.deepcopy(yaml.safe_load(MARS_LIBRARY.read_text()))
-    agents = {
-        robot.name: {"kind": "dynamic", "model": MODELS[robot.kind]}
-        for robot in load_scenario(SCENARIO).robots
-    }
-    agents["lander"] = data["agents"]["lander"]
-    data["agents"] = agents
-    data["name"] = "mars_twenty_robots"
+    """:func:`twenty_robot_library` as library file data (for a server to load): the shipped
+    ``mars_twenty_robots.yaml`` (``tools/team_library.py`` makes it)."""
+    data: dict[str, Any] = yaml.safe_load(TWENTY_LIBRARY.read_text())
     return data
 
 

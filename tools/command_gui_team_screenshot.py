@@ -2,7 +2,7 @@
 """Take the docs' picture of the command GUI with the 20-robot team (1600x1000).
 
 Builds the real command widget offscreen, feeds it the staged 20-robot mission of
-``tests/team_twenty.py`` (the robots of ``tests/data/sim_20_robots.yaml``, each with work
+``tests/team_twenty.py`` (the robots of ``rosmc_sim/scenarios/twenty_robots.yaml``, each with work
 on board and planned; one drone failed, two rovers waiting at a barrier, two robots out of
 contact) through a real mission and mirror, sets the large-team bar as asked (``--compact``,
 ``--status failed|waiting|out_of_contact``, ``--filter TEXT``) and writes the picture of

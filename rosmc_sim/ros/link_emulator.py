@@ -14,7 +14,8 @@ sim time scales it), drop probability and blackout state of that agent.
 Subscribes ``/<agent>/link/blackout`` (std_msgs/Bool): true cuts the link (the
 simulator's coverage model, or a test, publishes it).
 
-Parameters (private): ``~agents`` (list of str, required), ``~latency`` (float, s, 0),
+Parameters (private): ``~agents`` (list of str), or ``~scenario`` (str, its robots; relative
+to ``~cwd``), ``~latency`` (float, s, 0),
 ``~drop`` (float, 0..1, 0), ``~seed`` (int, for reproducible loss), ``~rate`` (Hz, 200).
 """
 
@@ -22,11 +23,13 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import random
 import sys
 import threading
 import time
 from collections.abc import Sequence
+from pathlib import Path
 
 import rosmc.msg as wire
 import rospy
@@ -36,6 +39,7 @@ from rosmc_server.interface import ground_link, robot_link
 from rosmc_server.ros.logging_bridge import bridge_logging_to_rosout
 
 from ..core.delay_line import DelayLine
+from ..core.scenario import load_scenario
 
 _log = logging.getLogger(__name__)
 
@@ -110,8 +114,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     agents = rospy.get_param("~agents", [])
     if isinstance(agents, str):
         agents = [a for a in agents.replace(",", " ").split() if a]
+    scenario = str(rospy.get_param("~scenario", ""))
+    if not agents and scenario:
+        cwd = str(rospy.get_param("~cwd", "") or os.getcwd())
+        agents = [robot.name for robot in load_scenario(Path(cwd, scenario)).robots]
     if not agents:
-        _log.critical("link emulator: set ~agents to the robots whose links to relay")
+        _log.critical("link emulator: set ~agents (or ~scenario) to the robots to relay")
         return 2
     rng = random.Random(int(rospy.get_param("~seed", 0)))
     latency = float(rospy.get_param("~latency", 0.0))

@@ -1,9 +1,10 @@
 """The command GUI with the 20-robot team against a real server and real executors.
 
-A real rosmaster, the mission server with the 20 robots of ``tests/data/sim_20_robots.yaml``
-and the executors of two of them (the other eighteen are never heard: out of contact). The
-real command window (offscreen Qt, 1600x1000) follows; the operator scrolls to every
-robot, makes the columns compact and narrows the team with the mouse and the keyboard.
+A real rosmaster, the mission server with the 20 robots of
+``rosmc_sim/scenarios/twenty_robots.yaml`` and the executors of two of them (the other
+eighteen are never heard: out of contact). The real command window (offscreen Qt, 1600x1000)
+follows; the operator scrolls to every robot, makes the columns compact and narrows the team
+with the mouse and the keyboard.
 """
 
 from __future__ import annotations

@@ -65,7 +65,7 @@ def test_relative_paths_are_taken_from_where_roslaunch_was_typed(
     rviz = loaded("rviz.launch", ["rviz_config:=views/mine.rviz"])
     assert [node.args for node in rviz.nodes] == [f"-d {tmp_path}/views/mine.rviz"]
     team = loaded("operator.launch", ["sim:=true"])
-    with_cwd = {"/rosmc/mission_server", "/rosmc/sim", "/drone/mission_executor"}
+    with_cwd = {"/rosmc/mission_server", "/rosmc/sim", "/rosmc/team_executors"}
     for node in with_cwd:
         assert team.params[f"{node}/cwd"].value == str(tmp_path), node
     # the launch's server notes its journal there, so that a respawned one resumes it
