@@ -141,8 +141,11 @@ class Payload:
         return self.decoder.decode(self.schema, self.record.data)
 
     def leading(self) -> dict[str, Any]:
-        """The leading fields the payload's head holds."""
-        return read_leading(self.leads, payload_head(self.record))
+        """The leading fields the payload holds: all of them when it is in memory (an
+        event's summary often ends past the head a deferred snapshot keeps)."""
+        record = self.record
+        data = payload_head(record) if isinstance(record, DeferredMessage) else record.data
+        return read_leading(self.leads, data)
 
 
 class JournalRecord:
