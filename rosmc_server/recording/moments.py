@@ -6,8 +6,8 @@ with a snapshot of the mission (:mod:`.writer`). ``rosmc at``, ``rosmc diff`` an
 that costs the whole history. :func:`review_histories` instead reads each part's
 opening snapshot (its revision and log time, from the file's first bytes, see
 :mod:`._mcap.opening`), picks the part the moment falls in and reads that part alone
-(with the one before when the moment is the part's first revision, which the event
-that made it, journaled in the part before, names). The history of those parts gives
+(the part before, for the revision a part opens with: the event that made it is there),
+or with the part before when that alone cannot tell. The history of those parts gives
 the same answer as the whole journal's: it starts from the same snapshot and applies
 the same events, and time 0 is the journal's own (its first part's opening snapshot).
 
@@ -114,15 +114,16 @@ def _from_parts(path: str | Path, found: list[Segment], text: str) -> MissionHis
         keys = [segment.opening.log_time for segment in found]
         at = bisect.bisect_right(keys, start + round(target.seconds * 1e9)) - 1
     at = max(at, 0)
-    firsts: tuple[int, ...] = (at, at - 1)  # the segment alone, then with the one before
+    # The segment alone, then with the one before. A revision that opens a segment was
+    # made by the last event of the one before: that one alone holds it, event and all.
+    tries = [(at, at), (at - 1, at)]
     if target.revision is not None and target.revision == keys[at]:
-        firsts = (at - 1,)  # its first revision: the event that made it is in the one before
-    for first in firsts:
+        tries = [(at - 1, at - 1), (at - 1, at)]
+    for first, last in tries:
         if first < 0:
             break
-        chosen = found[first : at + 1]
-        history = _read(path, chosen, start)
-        if history is not None and _verified(history, text, first == 0, at == len(found) - 1):
+        history = _read(path, found[first : last + 1], start)
+        if history is not None and _verified(history, text, first == 0, last == len(found) - 1):
             return history
     return None
 
