@@ -212,6 +212,10 @@ def measure_replay(path: Path, seeks: int) -> dict[str, Any]:
 def child(kind: str, path: Path, extra: str) -> None:
     """Run one measurement in this process and print its figures (with the peak RSS)."""
     logging.basicConfig(level=logging.ERROR)  # a crash-left journal warns; expected here
+    if kind == "write":
+        edits, closed, agents, skills = (int(value) for value in extra.split(","))
+        write_journal(path, edits, bool(closed), agents, skills)
+        return
     if kind == "resume":
         figures = measure_resume(path)
     elif kind == "at":
@@ -267,9 +271,13 @@ def main(argv: Sequence[str] | None = None) -> int:
                 ending = "closed" if closed else "crashed"
                 name = f"review_{args.agents}x{args.skills}_{edits}_{ending}"
                 path = directory / f"{name}.mcap"
-                if not path.exists():
+                if not path.exists():  # in a process of its own: a child forked from a
+                    # big parent would report the parent's RSS as its own peak
                     written = time.perf_counter()
-                    write_journal(path, edits, closed, args.agents, args.skills)
+                    how = f"{edits},{int(closed)},{args.agents},{args.skills}"
+                    subprocess.run(
+                        [sys.executable, __file__, "--child", "write", str(path), how], check=True
+                    )
                     figures.setdefault("write_s", {})[name] = round(
                         time.perf_counter() - written, 1
                     )
