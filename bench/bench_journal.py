@@ -5,10 +5,11 @@ layouts), bytes per small event, bytes and time per snapshot of a 20-agent x
 500-skill mission, recovery time of a 10,000-event journal killed before
 closing, what a damaged 12,000-revision journal still recovers (one byte flipped
 at half, and 0.01 % of its bytes), and the memory the writer keeps as a journal
-grows (tracemalloc over 100,000 changes). Run from the repository root with the messages built::
+grows (tracemalloc over 100,000 changes), and what part files cost the writer (``--only
+parts``, :mod:`_journal_parts`). Run from the repository root with the messages built::
 
     source build/devel/setup.bash
-    python bench/bench_journal.py [--dir DIR] [--events N] [--changes N] [--only memory]
+    python bench/bench_journal.py [--dir DIR] [--events N] [--changes N] [--only memory|parts]
 
 ``--dir`` should be on the disk the server journals to: fsync figures depend on it.
 """
@@ -30,6 +31,7 @@ from pathlib import Path
 from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import rosmc.msg as wire
 
@@ -302,13 +304,20 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--events", type=int, default=10_000, help="events in the recovery journal")
     parser.add_argument("--appends", type=int, default=2_000, help="appends per latency run")
     parser.add_argument("--changes", type=int, default=100_000, help="changes of the memory run")
-    parser.add_argument("--only", choices=["memory", "append"], help="run only this measurement")
+    parser.add_argument(
+        "--only", choices=["memory", "append", "parts"], help="run only this measurement"
+    )
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.ERROR)  # recovery warnings are expected here
     with tempfile.TemporaryDirectory(dir=args.dir) as tmp:
         directory = Path(tmp)
         if args.only == "memory":
             print(json.dumps({"memory": bench_memory(directory, args.changes)}, indent=2))
+            return 0
+        if args.only == "parts":
+            from _journal_parts import bench_parts
+
+            print(json.dumps({"parts": bench_parts(directory)}, indent=2))
             return 0
         if args.only == "append":
             print(json.dumps({"append": bench_all_appends(directory, args.appends)}, indent=2))

@@ -1,12 +1,13 @@
 """Benchmark of reading a big journal back: resume, ``rosmc at``, ``rosmc info``, replay.
 
-Writes journals of a 2 x 5,000-skill mission with 6,000 and with 12,000 operator
-changes through the real JournalWriter (a snapshot every 500 events, as the server
-writes them: events packed by ``packed_event``, snapshots by ``SnapshotPacker``),
-each once closed and once left as a crash leaves it (``abandon()`` and a torn record).
+Writes journals of a 2 x 5,000-skill mission with 6,000, 12,000, 24,000 and 48,000
+operator changes through the real JournalWriter with the server's options (a snapshot
+every 500 events, a part file every 4,000 changes or 4 MiB; events packed by
+``packed_event``, snapshots by ``SnapshotPacker``), each once closed and once left as a
+crash leaves it (``abandon()`` and a torn record in its last part).
 Then measures, each in a process of its own (wall time and peak RSS of that process):
 
-* ``resume``: what the server's resume does (``JournalWriter.resume`` on a copy,
+* ``resume``: what the server's resume does (``JournalWriter.resume`` on a copy of every part,
   ``latest_state``, the mission rebuilt from the snapshot and the events after it);
   ``held_mib`` is the process's RSS once only the resumed mission is left (the
   server's live memory for it, imports included);
@@ -19,7 +20,7 @@ Then measures, each in a process of its own (wall time and peak RSS of that proc
 Prints one JSON object, with the machine's load average before and after. Run from the
 repository root after ``source env.sh``::
 
-    python bench/bench_review.py [--edits 6000,12000] [--dir DIR] [--keep]
+    python bench/bench_review.py [--edits 6000,12000,24000,48000] [--dir DIR] [--keep]
 
 ``--dir DIR --keep`` writes the journals into DIR once and reuses them on later runs.
 """
@@ -103,7 +104,7 @@ def write_journal(path: Path, edits: int, closed: bool, agents: int, skills: int
         writer.close()
     else:
         writer.abandon()
-        with path.open("ab") as file:
+        with writer.part_path.open("ab") as file:
             file.write(b"\x06\x40\x00")  # a record cut short, as kill -9 can leave
 
 
@@ -125,9 +126,11 @@ def measure_resume(path: Path) -> dict[str, Any]:
     from rosmc_server.core import Mission
     from rosmc_server.core.library import Library  # noqa: F401  (import cost before timing)
     from rosmc_server.recording import JournalOptions, JournalWriter, latest_state
+    from rosmc_server.recording._mcap.files import journal_parts, part_path
 
     copy = path.with_name(f"resume-{os.getpid()}.mcap")
-    shutil.copyfile(path, copy)
+    for number, part in journal_parts(path)[1]:
+        shutil.copyfile(part, part_path(copy, number))
     try:
         gc.collect()
         base = _rss_mib()
@@ -152,7 +155,7 @@ def measure_resume(path: Path) -> dict[str, Any]:
             "held_mib": _rss_mib(),
         }
     finally:
-        for leftover in copy.parent.glob(f"{copy.name}*"):
+        for leftover in copy.parent.glob(f"{copy.stem}*"):
             leftover.unlink()
 
 
@@ -209,6 +212,10 @@ def measure_replay(path: Path, seeks: int) -> dict[str, Any]:
 def child(kind: str, path: Path, extra: str) -> None:
     """Run one measurement in this process and print its figures (with the peak RSS)."""
     logging.basicConfig(level=logging.ERROR)  # a crash-left journal warns; expected here
+    if kind == "write":
+        edits, closed, agents, skills = (int(value) for value in extra.split(","))
+        write_journal(path, edits, bool(closed), agents, skills)
+        return
     if kind == "resume":
         figures = measure_resume(path)
     elif kind == "at":
@@ -236,8 +243,12 @@ def run_child(kind: str, path: Path, extra: str = "") -> dict[str, Any]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Write the journals (or reuse them), measure each path and print the figures."""
+    from rosmc_server.recording._mcap.files import journal_parts
+
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--edits", default="6000,12000", help="changes per journal, by commas")
+    parser.add_argument(
+        "--edits", default="6000,12000,24000,48000", help="changes per journal, by commas"
+    )
     parser.add_argument("--agents", type=int, default=2)
     parser.add_argument("--skills", type=int, default=5000, help="skills per agent")
     parser.add_argument("--seeks", type=int, default=10, help="seeks per replay run")
@@ -260,13 +271,21 @@ def main(argv: Sequence[str] | None = None) -> int:
                 ending = "closed" if closed else "crashed"
                 name = f"review_{args.agents}x{args.skills}_{edits}_{ending}"
                 path = directory / f"{name}.mcap"
-                if not path.exists():
+                if not path.exists():  # in a process of its own: a child forked from a
+                    # big parent would report the parent's RSS as its own peak
                     written = time.perf_counter()
-                    write_journal(path, edits, closed, args.agents, args.skills)
+                    how = f"{edits},{int(closed)},{args.agents},{args.skills}"
+                    subprocess.run(
+                        [sys.executable, __file__, "--child", "write", str(path), how], check=True
+                    )
                     figures.setdefault("write_s", {})[name] = round(
                         time.perf_counter() - written, 1
                     )
-                entry: dict[str, Any] = {"bytes": path.stat().st_size}
+                files = [part for _, part in journal_parts(path)[1]]
+                entry: dict[str, Any] = {
+                    "bytes": sum(part.stat().st_size for part in files),
+                    "parts": len(files),
+                }
                 for kind in kinds:
                     extra = {"at": f"r{edits // 2}", "replay": str(args.seeks)}.get(kind, "")
                     entry[kind] = run_child(kind, path, extra)

@@ -129,16 +129,19 @@ def at(ctx: Context) -> int:
     """Print the mission at a time (seconds since the start) or a revision (rN)."""
     from ..recording.diff import resolve_when
     from ..recording.history import MissionHistory
+    from ..recording.moments import review_histories
     from ..text import format_markers, format_tasks, mission_to_json
     from .context import UsageError
 
-    history = _history(MissionHistory.from_journal(ctx.args.file))
     when = ctx.args.when.strip()
     if not re.fullmatch(r"[rR]\d+", when):
         try:
             float(when)
         except ValueError:
+            _history(MissionHistory.from_journal(ctx.args.file))
             raise UsageError(f"WHEN must be seconds or rN, got {when!r}") from None
+    # Only the part files that hold the moment, when a long journal has several.
+    history = _history(review_histories(ctx.args.file, [when])[0])
     moment = resolve_when(history, when)  # refuses a revision or time it does not hold
     state, when = moment.state, moment.label
     info = next(r for r in history.revisions if r.revision == state.revision)

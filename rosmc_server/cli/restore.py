@@ -42,10 +42,10 @@ def restore(ctx: Context) -> int:
     from ..core.persistence import dump_mission
     from ..core.vocabulary import counted
     from ..recording.diff import resolve_when
-    from ..recording.history import MissionHistory
+    from ..recording.moments import review_histories
     from ..recording.restore import blueprint_from
 
-    history = MissionHistory.from_journal(ctx.args.file)
+    history = review_histories(ctx.args.file, [ctx.args.at])[0]  # the parts that hold it
     for line in history.problems:
         print(f"rosmc: warning: {line}", file=sys.stderr)
     moment = resolve_when(history, ctx.args.at)

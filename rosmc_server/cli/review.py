@@ -117,14 +117,14 @@ def _duration(seconds: float) -> str:
 def diff(ctx: Context) -> int:
     """Print what changed between two moments of a recording."""
     from ..recording.diff import diff_missions, resolve_when
-    from ..recording.history import MissionHistory
+    from ..recording.moments import review_histories
 
-    history = MissionHistory.from_journal(ctx.args.file)
-    for line in history.problems:
+    moments = (ctx.args.first, ctx.args.second)
+    histories = review_histories(ctx.args.file, moments)  # the parts that hold each moment
+    for line in dict.fromkeys(line for history in histories for line in history.problems):
         print(f"rosmc: warning: {line}", file=sys.stderr)
-    changes = diff_missions(
-        resolve_when(history, ctx.args.first), resolve_when(history, ctx.args.second)
-    )
+    before, after = (resolve_when(h, t) for h, t in zip(histories, moments, strict=True))
+    changes = diff_missions(before, after)
     ctx.emit(format_diff(changes), diff_data(changes))
     return 0
 

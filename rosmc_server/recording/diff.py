@@ -83,12 +83,12 @@ def resolve_when(history: MissionHistory, text: str) -> Moment:
         NotFound: A revision the recording does not hold.
     """
     when = text.strip()
-    revision = re.fullmatch(r"[rR](\d+)", when)
-    if revision:
-        state = history.at_revision(int(revision.group(1)))
+    target = parse_when(when, history.start)
+    if target.revision is not None:
+        state = history.at_revision(target.revision)
         label = f"r{state.revision}"
     else:
-        seconds = _seconds(history, when)
+        seconds = target.seconds
         if not 0.0 <= seconds <= history.duration + _SLACK:
             raise InvalidRequest(
                 f"{excerpt(when)} is outside the recording ({seconds:+.1f} s from its start; "
@@ -100,7 +100,29 @@ def resolve_when(history: MissionHistory, text: str) -> Moment:
     return Moment(state, label, history.seconds(info.log_time))
 
 
-def _seconds(history: MissionHistory, when: str) -> float:
+@dataclass(frozen=True)
+class When:
+    """A moment as written: a revision, or else seconds since the recording started."""
+
+    revision: int | None
+    seconds: float = 0.0
+
+
+def parse_when(text: str, start: int) -> When:
+    """What ``text`` (see :data:`WHEN_HELP`) names in a recording that started at log time
+    ``start`` (ns).
+
+    Raises:
+        InvalidRequest: ``text`` is none of the accepted forms.
+    """
+    when = text.strip()
+    revision = re.fullmatch(r"[rR](\d+)", when)
+    if revision:
+        return When(int(revision.group(1)))
+    return When(None, _seconds(start, when))
+
+
+def _seconds(start: int, when: str) -> float:
     clock = _CLOCK.fullmatch(when)
     if clock:
         hours, minutes, seconds = clock.groups()
@@ -115,7 +137,7 @@ def _seconds(history: MissionHistory, when: str) -> float:
         raise InvalidRequest(f"cannot read {excerpt(when)} as a time: give {WHEN_HELP}") from None
     if moment.tzinfo is None:
         moment = moment.replace(tzinfo=UTC)
-    return history.seconds(round(moment.timestamp() * 1e9))
+    return (round(moment.timestamp() * 1e9) - start) / 1e9
 
 
 def diff_missions(before: Moment, after: Moment) -> MissionDiff:

@@ -69,14 +69,18 @@ class Revision:
 class MissionHistory:
     """Every revision of the mission a journal holds; build it with :meth:`from_journal`."""
 
-    def __init__(self, result: JournalResult) -> None:
-        """Index ``result`` (a read journal); raises JournalError without a snapshot."""
+    def __init__(self, result: JournalResult, start: int | None = None) -> None:
+        """Index ``result`` (a read journal); raises JournalError without a snapshot.
+
+        ``start``: time 0 of the recording (log time, ns) when ``result`` holds only some
+        of its part files (see :mod:`.moments`); by default its first record's.
+        """
         self.path = result.path
         self.warnings: tuple[str, ...] = result.warnings
         """What reading the file found wrong (a cut-off tail, undecodable records)."""
         if not result.records:
             raise JournalError(f"journal {result.path} holds no records")
-        self.start = min(record.log_time for record in result.records)
+        self.start = min(record.log_time for record in result.records) if start is None else start
         """Log time (ns) of the first record: time 0 of the recording."""
         self.end = max(record.log_time for record in result.records)
         """Log time (ns) of the last record."""

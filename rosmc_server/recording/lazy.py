@@ -44,6 +44,9 @@ _FIXED = {
     "duration": "<ii",
 }
 
+_LAYOUTS = {type_: struct.Struct(layout) for type_, layout in _FIXED.items()}
+"""Each fixed-size type's layout, compiled once (read for every record of a journal)."""
+
 
 def leading_fields(definition: bytes) -> tuple[tuple[str, str], ...]:
     """The (type, name) of the fields a ROS 1 definition begins with, up to the first
@@ -80,7 +83,7 @@ def read_leading(fields: tuple[tuple[str, str], ...], data: bytes) -> dict[str, 
             values[name] = data[pos + 4 : pos + 4 + size].decode("utf-8", "rosmsg")
             pos += 4 + size
             continue
-        layout = struct.Struct(_FIXED[type_])
+        layout = _LAYOUTS[type_]
         if pos + layout.size > len(data):
             break
         unpacked = layout.unpack_from(data, pos)
@@ -141,8 +144,11 @@ class Payload:
         return self.decoder.decode(self.schema, self.record.data)
 
     def leading(self) -> dict[str, Any]:
-        """The leading fields the payload's head holds."""
-        return read_leading(self.leads, payload_head(self.record))
+        """The leading fields the payload holds: all of them when it is in memory (an
+        event's summary often ends past the head a deferred snapshot keeps)."""
+        record = self.record
+        data = payload_head(record) if isinstance(record, DeferredMessage) else record.data
+        return read_leading(self.leads, data)
 
 
 class JournalRecord:

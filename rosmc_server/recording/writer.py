@@ -48,8 +48,12 @@ class JournalOptions:
             0 never compresses.
         part_bytes: Once a file holds this many bytes, ``snapshot_due`` turns true and the
             next snapshot starts the next part file (any append does at twice the size), so
-            the writer's memory and the reading a resume does stay bounded however long the
-            journal grows.
+            the writer's memory and the reading a resume or a review does stay bounded
+            however long the journal grows.
+        part_changes: Once a file holds this many mission events, ``snapshot_due`` turns
+            true and the next snapshot starts the next part file: a small mission's events
+            would otherwise fill ``part_bytes`` with tens of thousands of changes, all of
+            them read again by a resume.
         reserve_bytes: Free bytes on the journal's disk below which :meth:`JournalWriter.
             require_space` refuses changes (twice this stops telemetry), see :mod:`.space`.
     """
@@ -58,7 +62,8 @@ class JournalOptions:
     chunked: bool = True
     snapshot_every: int = 500
     compress_from: int = 16384
-    part_bytes: int = 32 * 1024 * 1024
+    part_bytes: int = 4 * 1024 * 1024
+    part_changes: int = 4000
     reserve_bytes: int = RESERVE_BYTES
 
 
@@ -93,6 +98,7 @@ class JournalWriter:
         self._options = options
         self._channels = part.section.channel_ids()
         self._events_since_snapshot = 0
+        self._events_in_part = part.section.counts.get(self._channels.get(EVENTS_TOPIC, -1), 0)
         self._rotation_failed = False
         self._telemetry_skipped = False
         self._mark: dict[str, str | int] | None = None  # the revision mark, for new parts
@@ -209,9 +215,13 @@ class JournalWriter:
     def snapshot_due(self) -> bool:
         """Whether a snapshot should be appended: ``snapshot_every`` events since the last
         one, or the current file is full (the snapshot then starts the next part)."""
+        return self._events_since_snapshot >= self._options.snapshot_every or self._part_full()
+
+    def _part_full(self) -> bool:
+        """Whether the current file holds ``part_bytes`` bytes or ``part_changes`` events."""
         return (
-            self._events_since_snapshot >= self._options.snapshot_every
-            or self._part.offset >= self._options.part_bytes
+            self._part.offset >= self._options.part_bytes
+            or self._events_in_part >= self._options.part_changes
         )
 
     @property
@@ -398,6 +408,7 @@ class JournalWriter:
                     part.snapshots += 1
                 elif topic == EVENTS_TOPIC:
                     self._events_since_snapshot += 1
+                    self._events_in_part += 1
 
     def _room_for_telemetry(self, topic: str) -> bool:
         """Whether telemetry may still be written; skipped (said once) near a full disk."""
@@ -418,11 +429,9 @@ class JournalWriter:
         so the part can start the mission on its own (any record does at twice the size).
         A periodic snapshot journaled late (older than events already written) never does:
         a resume that read the new part alone would miss those events."""
-        full = self._options.part_bytes
-        offset = self._part.offset
-        if self._rotation_failed or offset < full or late:
+        if self._rotation_failed or late or not self._part_full():
             return False
-        return snapshot or offset >= 2 * full
+        return snapshot or self._part.offset >= 2 * self._options.part_bytes
 
     def _rotate(self) -> None:
         """Go on in the next part file; on failure keep writing this one."""
@@ -443,6 +452,7 @@ class JournalWriter:
             return
         self._part = new
         self._channels = new.section.channel_ids()
+        self._events_in_part = 0
         if self._mark is not None:
             self._mark_writes += 1
             try:

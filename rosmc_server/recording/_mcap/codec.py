@@ -60,6 +60,16 @@ def installed_class(type_name: str) -> Any:
     return cls
 
 
+def is_installed(schema: fmt.SchemaRecord) -> bool:
+    """Whether ``schema`` is the installed definition of its type, word for word (the
+    generated class then decodes whatever was serialized with it)."""
+    try:
+        cls = installed_class(schema.name)
+    except JournalError:
+        return False
+    return schema.encoding == SCHEMA_ENCODING and str(cls._full_text).encode() == schema.data
+
+
 # genpy generates Python source from a recorded definition and imports it, so a damaged
 # definition fails in whatever way that source fails; so may decoding with it.
 _GENERATION_ERRORS: tuple[type[Exception], ...] = (

@@ -189,7 +189,9 @@ def _needs_earlier(results: list[JournalResult]) -> bool:
     """
     first: int | None = None
     for record in (r for result in results for r in result.records):
-        revision = int(getattr(record.message, "revision", -1))
+        if record.topic not in (MISSION_TOPIC, EVENTS_TOPIC):
+            continue
+        revision = record.revision  # read from the bytes: a snapshot is not decoded
         if record.topic == MISSION_TOPIC and first is None:
             first = revision
         elif record.topic == EVENTS_TOPIC and first is not None and revision > first:
