@@ -428,8 +428,9 @@ class JournalWriter:
         """Whether the next append starts a new part: a full part starts one with a snapshot,
         so the part can start the mission on its own (any record does at twice the size).
         A periodic snapshot journaled late (older than events already written) never does:
-        a resume that read the new part alone would miss those events."""
-        if self._rotation_failed or late or not self._part_full():
+        a resume that read the new part alone would miss those events. Nor is a part left
+        before it holds a snapshot: it could start nothing."""
+        if self._rotation_failed or late or not self._part_full() or not self._part.snapshots:
             return False
         return snapshot or self._part.offset >= 2 * self._options.part_bytes
 

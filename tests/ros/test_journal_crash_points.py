@@ -238,8 +238,8 @@ def test_a_journal_that_lost_its_end_names_the_loss_and_reuses_no_revision(
         where = f"{how} in {op.name} at {op.offset + len(op.data) // 2}, side file {side_file}"
         try:
             resumed = resume(folder, library)
-        except JournalError:  # no snapshot left to start from: nothing to resume, nothing reused
-            assert op.name == NAME and op.offset < 4096, where
+        except JournalError as err:  # the first file lost its first snapshot: nothing to resume
+            assert op.name == NAME and "holds no mission snapshot" in str(err), where
             continue
         kept = resumed.mission.revision
         if kept < top or side_file != "kept":
