@@ -36,6 +36,7 @@ from ..core.legality import RobotAction
 from ..core.mission_view import MissionView
 from ..core.view_state import SkillDelta
 from .coverage_warning import coverage_warning_label, show_coverage_warning
+from .labels import never_widen
 from .policy_dialog import ask_policy
 from .row_delegate import RowDelegate
 from .task_model import NUMBER, PARAMS, SKILL, STATUS, TAG, TaskModel
@@ -158,7 +159,7 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         self.name_label = QLabel(NAME_STYLE[False].format(agent=agent))
         self.name_label.setToolTip(agent)
         self.status_label = QLabel(presentation.link_summary(None))
-        self.status_label.setWordWrap(True)
+        never_widen(self.status_label)
         self.status_label.setObjectName(f"status_{agent}")
         self.warning_label = coverage_warning_label(agent)
         self.policy_in_force = ""

@@ -14,6 +14,8 @@ from python_qt_binding.QtWidgets import QLabel, QWidget
 from rosmc_server.core.science import IDENTIFIED_WORDS, Science
 from rosmc_server.core.vocabulary import counted
 
+from .labels import never_widen
+
 NO_SCORE = "Science: no score published"
 _MARK = {"": "○", "science_rover": "◐", "collaborative": "●"}
 
@@ -24,7 +26,7 @@ class ScienceStrip(QLabel):  # type: ignore[misc]
     def __init__(self, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("science")
-        self.setWordWrap(True)
+        never_widen(self)
         self.setStyleSheet("QLabel#science { background:#eef5e9; padding:3px; }")
         self.science: Science | None = None
         self.show_science(None)
