@@ -67,7 +67,8 @@ def status_text(
 ) -> str:
     """The status cell: a word, and what matters about it (pending transfer, wait, reason).
 
-    ``out_of_contact``: the robot cannot be heard, so a transfer waits for contact.
+    ``out_of_contact``: the robot cannot be heard, so a transfer waits for contact, and
+    what the robot last said of an unfinished skill may be old: it is marked last known.
     """
     if skill.transfer is Transfer.UPLOADING and out_of_contact:
         return "waiting for contact"
@@ -84,7 +85,19 @@ def status_text(
         word += f" ({skill.resolution.name.lower()})"
     if skill.attempt > 1:
         word += f", try {skill.attempt}"
+    if is_last_known(skill, out_of_contact):
+        word += " (last known)"
     return word
+
+
+def is_last_known(skill: SkillInstance, out_of_contact: bool) -> bool:
+    """The row shows what an unheard robot last said of a skill that may have moved on."""
+    return (
+        out_of_contact
+        and skill.transfer is Transfer.NONE
+        and skill.status is not SkillStatus.IDLE
+        and not skill.status.is_final
+    )
 
 
 def value_summary(value: Value) -> str:

@@ -284,8 +284,14 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.send(ask(lambda c: c.add_skill, what, self.view.revision, select_new)(agent, skill))
 
     def _on_tasks_policy_chosen(self, agent: str, policy: LostLinkPolicy) -> None:
+        def forget_if_refused(answer: Answer) -> None:
+            column = self.tasks.columns.get(agent)
+            if not answer.ok and column is not None:
+                column.policy_refused()
+
         what = f"set {agent}'s policy ({policy.describe()})"
-        self.dispatcher.call(lambda c: c.set_lost_link_policy, what)(agent, policy)
+        call = ask(lambda c: c.set_lost_link_policy, what, self.view.revision, forget_if_refused)
+        self.send(call(agent, policy))
 
     def _on_tasks_reorder_requested(self, agent: str, order: list[str]) -> None:
         self.dispatcher.call(lambda c: c.reorder_skills, f"reorder {agent}'s task")(agent, order)
