@@ -233,6 +233,7 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         text = presentation.link_summary(status)
         colour = "#a00000" if status is not None and status.link == "down" else "#333333"
         self.status_label.setText(f"<span style='color:{colour}'>{text}</span>")
+        self.status_label.setToolTip(presentation.link_details(status))
         out_of_contact = self._view.out_of_contact(self.agent)
         if out_of_contact != self._out_of_contact:  # transfers now wait (or go): say so
             self._out_of_contact = out_of_contact

@@ -25,13 +25,13 @@ from ..core.phrasing import answer_message
 from ..core.requests import Answer, Backend, Request, ask
 from ..core.view_state import ViewUpdate
 from .actions import CommandActions
-from .agent_column import SectionTable
 from .control_panel import ControlPanel
 from .enabling import Enabling
 from .file_menu import FileController
 from .message_area import MessageArea
 from .parameter_panel import ParameterPanel
 from .repaints import Repaints
+from .section_table import SectionTable
 from .task_widget import TaskWidget
 from .team_bar import TeamBar
 from .team_dialog import ask_send_anyway, ask_team_send

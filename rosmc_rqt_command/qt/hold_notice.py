@@ -21,7 +21,7 @@ STYLE = (
 
 
 class HoldNotice(QFrame):  # type: ignore[misc]
-    """"r4 is holding after its link came back: …" and a *Resume r4* button."""
+    """ "r4 is holding after its link came back: …" and a *Resume r4* button."""
 
     resume_requested = Signal()
 

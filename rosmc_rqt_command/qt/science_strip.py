@@ -17,6 +17,7 @@ from rosmc_server.core.vocabulary import counted
 from .labels import never_widen
 
 NO_SCORE = "Science: no score published"
+NO_REPLAY_SCORE = "Science (replay): no score in this recording yet"
 _MARK = {"": "○", "science_rover": "◐", "collaborative": "●"}
 
 
@@ -52,6 +53,11 @@ class ScienceStrip(QLabel):  # type: ignore[misc]
             parts.append("no region discovered yet")
         self.setText(" · ".join(parts))
         self.setToolTip("\n".join(science.lines()))
+
+    def show_replay_start(self) -> None:
+        """A replay begins: the live score must not pass for the recording's."""
+        self.show_science(None)
+        self.setText(NO_REPLAY_SCORE)
 
     def plain_text(self) -> str:
         """What the strip says, without markup (for tests and screen readers)."""

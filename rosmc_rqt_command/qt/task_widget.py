@@ -25,7 +25,8 @@ from rosmc_server.core import AgentStatus, Library
 
 from ..core.mission_view import MissionView
 from ..core.view_state import ViewUpdate, delta_agent
-from .agent_column import COMPACT_WIDTH, AgentColumn, SectionTable
+from .agent_column import COMPACT_WIDTH, AgentColumn
+from .section_table import SectionTable
 
 # A mission's first columns are built at once, as many as fit on screen (at least this
 # many); the others follow in groups of LATER_COLUMNS, LATER_MS apart (a zero timer could

@@ -23,8 +23,8 @@ from python_qt_binding.QtTest import QTest
 from python_qt_binding.QtWidgets import QApplication, QMessageBox
 
 from rosmc_rqt_command.core import presentation
-from rosmc_rqt_command.qt.agent_column import SectionTable
 from rosmc_rqt_command.qt.command_widget import CommandWidget
+from rosmc_rqt_command.qt.section_table import SectionTable
 from rosmc_rqt_command.qt.task_model import SKILL, STATUS, TAG
 from rosmc_rqt_command.ros_bridge import RosBridge
 from rosmc_rqt_command.standalone import build

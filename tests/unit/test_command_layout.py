@@ -114,6 +114,8 @@ def test_warnings_never_widen_the_window_nor_push_the_parameters_off(
     assert main.rect().contains(inside(main, control))
     for name, button in control.buttons.items():  # no button is cut short
         assert button.width() >= button.sizeHint().width(), name
+    live = gui.widget.findChild(ReplayBar).live_button
+    assert live.isVisible() and live.width() >= live.sizeHint().width()  # "Return to live"
 
 
 def test_the_splitter_drags_both_ways_and_never_hides_the_parameters(

@@ -121,18 +121,20 @@ def test_adding_a_skill_keeps_the_task_panel_still_under_the_pointer() -> None:
         # The rightmost column whose Add button is on screen, partly cut off at the edge.
         column = max(
             (c for c in columns(gui.widget).values() if c.isVisible()),
-            key=lambda c: c.add_button.mapTo(viewport, QPoint(0, 0)).x()
-            if c.add_button.mapTo(viewport, QPoint(0, 0)).x() < viewport.width() - 40
-            else -1,
+            key=lambda c: (
+                c.add_button.mapTo(viewport, QPoint(0, 0)).x()
+                if c.add_button.mapTo(viewport, QPoint(0, 0)).x() < viewport.width() - 40
+                else -1
+            ),
         )
         where = column.add_button.mapTo(viewport, QPoint(0, 0))
         scrolled = bar.value()
 
-        def choose_first(menu_owner: object = column) -> None:
+        def choose_first() -> None:
             menu = column.add_menu
             if menu.isVisible():
-                action = menu.actions()[0]
-                QTest.mouseClick(menu, Qt.LeftButton, Qt.NoModifier, menu.actionGeometry(action).center())
+                centre = menu.actionGeometry(menu.actions()[0]).center()
+                QTest.mouseClick(menu, Qt.LeftButton, Qt.NoModifier, centre)
             else:
                 QTimer.singleShot(20, choose_first)
 
@@ -160,7 +162,7 @@ def held(gui: Gui) -> tuple[str, str]:
     feed.sync("alpha")
     feed.sync("bravo")
     feed.statuses(
-        AgentStatus("alpha", link="up", last_heard=0.0, executor_state="paused", policy=HELD_POLICY),
+        AgentStatus("alpha", link="up", executor_state="paused", policy=HELD_POLICY),
         AgentStatus("bravo", link="up", last_heard=0.0, executor_state="waiting"),
     )
     settle(gui.widget)
