@@ -152,7 +152,7 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         layout.setContentsMargins(4, 4, 4, 4)
         layout.addLayout(header)
         self.blueprint_caption = QLabel(BLUEPRINT_CAPTION[False])
-        self.synced_caption = never_widen(QLabel(ON_ROBOT), wrap=False)
+        self.synced_caption = never_widen(QLabel(ON_ROBOT))
         self.synced_caption.setObjectName(f"synced_caption_{agent}")
         layout.addWidget(self.synced_caption)
         layout.addWidget(self.synced_table, 2)

@@ -81,7 +81,7 @@ def lay_out(window: QWidget, panels: Panels) -> Layout:
     splitter.setStretchFactor(1, 0)
     # Neither side can be dragged away: a collapsed parameter panel took edits nowhere.
     splitter.setChildrenCollapsible(False)
-    splitter.setSizes([1230, 370])
+    splitter.setSizes([1200, 400])
     layout = QVBoxLayout(window)
     layout.setContentsMargins(2, 2, 2, 2)
     layout.setMenuBar(menu_bar)
