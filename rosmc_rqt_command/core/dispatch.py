@@ -137,8 +137,7 @@ class Dispatcher:
         if kind is RobotAction.SYNC_ALL and agent is None:
             self.send_team(whole_team(self._view))
         elif kind is RobotAction.SYNC_ALL and agent is not None:
-            if self._barriers_ok(self._view.view(agent).editable):
-                self.call(lambda c: c.synchronize, f"send {agent}'s whole task")(agent, None)
+            self._send_whole_task(agent)
         elif kind is RobotAction.UNSYNC_ALL and agent is not None:
             self.call(lambda c: c.unsynchronize, f"take back {agent}'s task")(agent, None)
         elif kind in CONTROLS:
@@ -154,6 +153,16 @@ class Dispatcher:
             robots = ", ".join(send.sending)
             what = f"send the tasks of {robots}"
             self.call(lambda c: c.synchronize_team, what)(dict(send.uploads))
+
+    def _send_whole_task(self, agent: str) -> None:
+        """Send ``agent``'s whole task after one question naming what goes (a button beside
+        *Add skill* must never send a task by a slip of the mouse)."""
+        send = plan_team_send(self._view, {agent: None})
+        if send is None:
+            return
+        text, warnings = team_question(self._view, send)
+        if self.confirm_team(text, warnings):
+            self.call(lambda c: c.synchronize, f"send {agent}'s whole task")(agent, None)
 
     def _barriers_ok(self, sending: Sequence[SkillInstance]) -> bool:
         warnings = alerts.barrier_warnings(self._view, sending)

@@ -67,7 +67,8 @@ def status_text(
 ) -> str:
     """The status cell: a word, and what matters about it (pending transfer, wait, reason).
 
-    ``out_of_contact``: the robot cannot be heard, so a transfer waits for contact.
+    ``out_of_contact``: the robot cannot be heard, so a transfer waits for contact, and
+    what the robot last said of an unfinished skill may be old: it is marked last known.
     """
     if skill.transfer is Transfer.UPLOADING and out_of_contact:
         return "waiting for contact"
@@ -84,7 +85,19 @@ def status_text(
         word += f" ({skill.resolution.name.lower()})"
     if skill.attempt > 1:
         word += f", try {skill.attempt}"
+    if is_last_known(skill, out_of_contact):
+        word += " (last known)"
     return word
+
+
+def is_last_known(skill: SkillInstance, out_of_contact: bool) -> bool:
+    """The row shows what an unheard robot last said of a skill that may have moved on."""
+    return (
+        out_of_contact
+        and skill.transfer is Transfer.NONE
+        and skill.status is not SkillStatus.IDLE
+        and not skill.status.is_final
+    )
 
 
 def value_summary(value: Value) -> str:
@@ -125,8 +138,7 @@ def link_summary(status: AgentStatus | None) -> str:
     if status.battery is not None:
         parts.append(f"battery {percent(status.battery)}")
     if status.wifi_signal is not None:
-        coverage = "" if status.in_coverage else " (out of range)"
-        parts.append(f"Wi-Fi {dbm(status.wifi_signal)}{coverage}")
+        parts.append(f"Wi-Fi {wifi_words(status.wifi_signal, status.in_coverage)}")
     if status.executor_state:
         parts.append(status.executor_state)
     if status.policy:
@@ -134,6 +146,37 @@ def link_summary(status: AgentStatus | None) -> str:
     if status.radio_dropped:
         parts.append(status.radio_text)
     return " · ".join(parts)
+
+
+# Wi-Fi signal bands (dBm), as rviz colours them: yellow below the first, red below the second.
+WIFI_FAIR_DBM = -60.0
+WIFI_WEAK_DBM = -68.0
+
+
+def wifi_words(signal: float, in_coverage: bool) -> str:
+    """A Wi-Fi signal for an operator: good, fair, weak or out of range (the dBm are in the
+    header's tooltip, :func:`link_details`)."""
+    if not in_coverage:
+        word = "out of range"
+    elif signal >= WIFI_FAIR_DBM:
+        word = "good"
+    elif signal >= WIFI_WEAK_DBM:
+        word = "fair"
+    else:
+        word = "weak"
+    return word
+
+
+def link_details(status: AgentStatus | None) -> str:
+    """The numbers behind a robot's header, for its tooltip (signal, round trip)."""
+    if status is None:
+        return ""
+    parts = []
+    if status.wifi_signal is not None:
+        parts.append(f"Wi-Fi signal {dbm(status.wifi_signal)}")
+    if status.round_trip >= 0:
+        parts.append(f"round trip {status.round_trip * 1000:.0f} ms")
+    return ", ".join(parts)
 
 
 def is_alarm(skill: SkillInstance) -> bool:

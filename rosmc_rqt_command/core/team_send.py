@@ -16,6 +16,7 @@ from rosmc_server.core import SkillInstance
 from rosmc_server.core.vocabulary import counted
 
 from . import alerts
+from .holding import hold_warnings
 from .mission_view import MissionView
 
 
@@ -76,9 +77,11 @@ def up_to_selection(view: MissionView, selected: list[SkillInstance]) -> dict[st
 
 def team_question(view: MissionView, send: TeamSend) -> tuple[str, list[str]]:
     """The question to ask before ``send`` and the warnings it must list."""
-    warnings = alerts.barrier_warnings(view, send.skills)
+    warnings = alerts.barrier_warnings(view, send.skills) + hold_warnings(view, send.sending)
     robots = ", ".join(send.sending)
-    text = f"Send in one step to {robots} (all of them or none):\n" + "\n".join(
-        f"  • {line}" for line in send.lines()
-    )
+    if len(send.sending) == 1:
+        head = f"Send to {robots}:\n"
+    else:
+        head = f"Send in one step to {robots} (all of them or none):\n"
+    text = head + "\n".join(f"  • {line}" for line in send.lines())
     return text, warnings

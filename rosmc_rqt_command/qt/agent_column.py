@@ -9,19 +9,18 @@ can be reordered by drag and drop. The buttons act on this robot; they are enabl
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from html import escape
 
 from python_qt_binding.QtCore import QSize, Qt, Signal
 from python_qt_binding.QtGui import QIcon
 from python_qt_binding.QtWidgets import (
-    QAbstractItemView,
     QFrame,
+    QGridLayout,
     QHBoxLayout,
-    QHeaderView,
     QLabel,
     QMenu,
     QSizePolicy,
     QStyle,
-    QTableView,
     QToolButton,
     QVBoxLayout,
     QWidget,
@@ -30,17 +29,20 @@ from python_qt_binding.QtWidgets import (
 from rosmc_server.core import AgentStatus, LostLinkPolicy, SkillStatus
 from rosmc_server.core.legality import TaskView
 from rosmc_server.core.updates import SkillAdded, SkillChanged, SkillRemoved
+from rosmc_server.core.waiting import duration_text
 
 from ..core import presentation
+from ..core.holding import lost_link_hold
 from ..core.legality import RobotAction
 from ..core.mission_view import MissionView
 from ..core.view_state import SkillDelta
 from .coverage_warning import coverage_warning_label, show_coverage_warning
+from .hold_notice import HoldNotice
+from .labels import never_widen
 from .policy_dialog import ask_policy
-from .row_delegate import RowDelegate
-from .task_model import NUMBER, PARAMS, SKILL, STATUS, TAG, TaskModel
+from .section_table import SectionTable
+from .task_model import TaskModel
 
-ROW_HEIGHT = 22
 # A column is at least this wide (more robots than fit: the task panel scrolls sideways)
 # and at most that wide (few robots: the columns share the width).
 COLUMN_WIDTH = 330
@@ -48,87 +50,26 @@ MAX_COLUMN_WIDTH = 460
 # Compact mode (a large team): narrower columns without the number and parameter cells.
 COMPACT_WIDTH = 222
 COMPACT_MAX_WIDTH = 226
-SKILL_WIDTH = 100
-STATUS_WIDTH = 174
-WIDTHS = ((TAG, 26), (NUMBER, 22), (SKILL, SKILL_WIDTH), (STATUS, STATUS_WIDTH))
 # The robot's name and the blueprint's caption, by compact or not.
 NAME_STYLE = {
     False: "<b style='font-size:13pt'>{agent}</b>",
     True: "<b style='font-size:10.5pt'>{agent}</b>",
 }
-BLUEPRINT_CAPTION = {False: "<i>Blueprint (planned, editable)</i>", True: "<i>Blueprint</i>"}
-AskPolicy = Callable[[str, Sequence[str], QWidget, str], LostLinkPolicy | None]
-
-
-class SectionTable(QTableView):  # type: ignore[misc]
-    """A table of skills with row selection; a click on empty space clears it."""
-
-    empty_clicked = Signal()
-    plain_clicked = Signal()  # a row clicked without Ctrl or Shift
-
-    def __init__(self, model: TaskModel, parent: QWidget | None = None) -> None:
-        super().__init__(parent)
-        self.last_modifiers = Qt.NoModifier  # of the last click or key press here
-        self.setModel(model)
-        self.setItemDelegate(RowDelegate(self))
-        self.setSelectionBehavior(QAbstractItemView.SelectRows)
-        self.setSelectionMode(QAbstractItemView.ExtendedSelection)
-        self.setContextMenuPolicy(Qt.CustomContextMenu)
-        self.setEditTriggers(QAbstractItemView.NoEditTriggers)
-        self.setWordWrap(False)
-        self.setShowGrid(False)
-        self.setAlternatingRowColors(False)
-        self.setHorizontalScrollBarPolicy(Qt.ScrollBarAlwaysOff)
-        rows = self.verticalHeader()
-        rows.setVisible(False)
-        rows.setSectionResizeMode(QHeaderView.Fixed)
-        rows.setDefaultSectionSize(ROW_HEIGHT)
-        columns = self.horizontalHeader()
-        columns.setHighlightSections(False)
-        for column, width in WIDTHS:
-            columns.resizeSection(column, width)
-        columns.setSectionResizeMode(PARAMS, QHeaderView.Stretch)
-        self.compact = False
-        if model.blueprint:
-            self.setDragEnabled(True)
-            self.setAcceptDrops(True)
-            self.setDropIndicatorShown(True)
-            self.setDragDropMode(QAbstractItemView.InternalMove)
-            self.setDefaultDropAction(Qt.MoveAction)
-
-    @property
-    def section(self) -> TaskModel:
-        """The model shown."""
-        model: TaskModel = self.model()
-        return model
-
-    def set_compact(self, compact: bool) -> None:
-        """Compact: no number or parameter cells; skill and status share the width."""
-        self.compact = compact
-        self.setColumnHidden(NUMBER, compact)
-        self.setColumnHidden(PARAMS, compact)
-        columns = self.horizontalHeader()
-        mode = QHeaderView.Stretch if compact else QHeaderView.Interactive
-        for column in (SKILL, STATUS):
-            columns.setSectionResizeMode(column, mode)
-        if not compact:
-            for column, width in WIDTHS[2:]:
-                columns.resizeSection(column, width)
-
-    def mousePressEvent(self, event: object) -> None:
-        """Clicking below the rows clears the selection (of every column)."""
-        self.last_modifiers = event.modifiers()  # type: ignore[attr-defined]
-        if not self.indexAt(event.pos()).isValid():  # type: ignore[attr-defined]
-            self.empty_clicked.emit()
-            return
-        if not self.last_modifiers & (Qt.ControlModifier | Qt.ShiftModifier):
-            self.plain_clicked.emit()
-        super().mousePressEvent(event)
-
-    def keyPressEvent(self, event: object) -> None:
-        """Shift+arrows extend the selection across the keyboard too."""
-        self.last_modifiers = event.modifiers()  # type: ignore[attr-defined]
-        super().keyPressEvent(event)
+BLUEPRINT_CAPTION = {
+    False: "<i>Planned (not sent yet, editable)</i>",
+    True: "<i>Planned (not sent yet)</i>",
+}
+SEND_TEXT = {False: "Send to robot…", True: "Send…"}
+# The robot controls, written out (an operator should not have to know the icons).
+CONTROLS = (
+    (RobotAction.START, "Start"),
+    (RobotAction.PAUSE, "Pause"),
+    (RobotAction.RESUME, "Resume"),
+    (RobotAction.STOP, "Stop"),
+)
+ON_ROBOT = "<i>On the robot</i>"
+# agent, its skills, parent, the policy in force as reported[, the policy waiting]
+AskPolicy = Callable[..., LostLinkPolicy | None]
 
 
 class AgentColumn(QFrame):  # type: ignore[misc]
@@ -158,10 +99,13 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         self.name_label = QLabel(NAME_STYLE[False].format(agent=agent))
         self.name_label.setToolTip(agent)
         self.status_label = QLabel(presentation.link_summary(None))
-        self.status_label.setWordWrap(True)
+        never_widen(self.status_label)
         self.status_label.setObjectName(f"status_{agent}")
         self.warning_label = coverage_warning_label(agent)
+        self.hold_notice = HoldNotice(agent, self)
+        self.hold_notice.resume_requested.connect(self._on_hold_notice_resume_requested)
         self.policy_in_force = ""
+        self.pending_policy: LostLinkPolicy | None = None  # chosen here, not yet in force
         self.skill_names: list[str] = []
         self.ask_policy: AskPolicy = ask_policy  # tests answer the dialog through this
         self.policy_button = self._tool(
@@ -172,17 +116,17 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         self.policy_button.clicked.connect(self._on_policy_button_clicked)
 
         self.add_menu = QMenu(self)
-        self.add_button = self._tool("Add skill", "", f"Add a skill to {agent}'s blueprint")
+        self.add_button = self._tool("Add skill", "", f"Add a skill to {agent}'s plan")
         self.add_button.setMenu(self.add_menu)
         self.add_button.setPopupMode(QToolButton.InstantPopup)
         self.add_menu.triggered.connect(self._on_add_menu_triggered)
         self.buttons: dict[RobotAction, QToolButton] = {
-            RobotAction.SYNC_ALL: self._tool("Sync all", "", f"Send {agent}'s whole blueprint"),
-            RobotAction.START: self._tool("", "SP_MediaPlay", f"Start {agent}"),
-            RobotAction.PAUSE: self._tool("", "SP_MediaPause", f"Pause {agent}"),
-            RobotAction.RESUME: self._tool("", "SP_MediaSeekForward", f"Resume {agent}"),
-            RobotAction.STOP: self._tool("", "SP_MediaStop", f"Stop {agent}"),
+            RobotAction.SYNC_ALL: self._tool(
+                SEND_TEXT[False], "", f"Send {agent}'s whole plan to the robot (asks first)"
+            ),
         }
+        for action, text in CONTROLS:
+            self.buttons[action] = self._tool(text, "", f"{text} {agent}")
         for action, button in self.buttons.items():
             button.setObjectName(f"{action.value}_{agent}")
             button.clicked.connect(lambda _=False, a=action: self.robot_action.emit(self.agent, a))
@@ -195,19 +139,26 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         header.addLayout(top)
         header.addWidget(self.status_label)
         header.addWidget(self.warning_label)
-        bar = self._bar = QHBoxLayout()
-        bar.addWidget(self.add_button)
-        for button in self.buttons.values():
-            bar.addWidget(button)
-        bar.addStretch(1)
+        header.addWidget(self.hold_notice)
+        # Adding and sending sit at opposite ends of their row, the controls on a row of
+        # their own: a click meant for one never lands on the other.
+        plan = QHBoxLayout()
+        plan.addWidget(self.add_button)
+        plan.addStretch(1)
+        plan.addWidget(self.buttons[RobotAction.SYNC_ALL])
+        bar = self._bar = QGridLayout()
+        self._place_controls(compact=False)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(4, 4, 4, 4)
         layout.addLayout(header)
         self.blueprint_caption = QLabel(BLUEPRINT_CAPTION[False])
-        layout.addWidget(QLabel("<i>On the robot</i>"))
+        self.synced_caption = never_widen(QLabel(ON_ROBOT))
+        self.synced_caption.setObjectName(f"synced_caption_{agent}")
+        layout.addWidget(self.synced_caption)
         layout.addWidget(self.synced_table, 2)
         layout.addWidget(self.blueprint_caption)
         layout.addWidget(self.blueprint_table, 3)
+        layout.addLayout(plan)
         layout.addLayout(bar)
 
     def _tool(self, text: str, icon: str, tip: str) -> QToolButton:
@@ -221,6 +172,14 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         button.setToolTip(tip)
         button.setAutoRaise(False)
         return button
+
+    def _place_controls(self, compact: bool) -> None:
+        """Start, Pause, Resume, Stop in a row; two rows of two in a compact column."""
+        for position, (action, _text) in enumerate(CONTROLS):
+            row, column = divmod(position, 2) if compact else (0, position)
+            self._bar.addWidget(self.buttons[action], row, column)
+        self._bar.setColumnStretch(4, 0 if compact else 1)
+        self._bar.setColumnStretch(2, 1 if compact else 0)
 
     @property
     def tables(self) -> tuple[SectionTable, SectionTable]:
@@ -241,7 +200,9 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         for table in self.tables:
             table.set_compact(compact)
         self.add_button.setText("+" if compact else "Add skill")
-        self.buttons[RobotAction.SYNC_ALL].setText("Sync" if compact else "Sync all")
+        self.buttons[RobotAction.SYNC_ALL].setText(SEND_TEXT[compact])
+        self._place_controls(compact)
+        self.hold_notice.resume_button.setText("Resume" if compact else f"Resume {self.agent}")
         # Compact, the robot's name needs the room: the policy button shows an icon only.
         self.policy_button.setText("" if compact else "Link loss…")
         self.policy_button.setIcon(self._link_icon if compact else QIcon())
@@ -272,13 +233,24 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         text = presentation.link_summary(status)
         colour = "#a00000" if status is not None and status.link == "down" else "#333333"
         self.status_label.setText(f"<span style='color:{colour}'>{text}</span>")
+        self.status_label.setToolTip(presentation.link_details(status))
         out_of_contact = self._view.out_of_contact(self.agent)
         if out_of_contact != self._out_of_contact:  # transfers now wait (or go): say so
             self._out_of_contact = out_of_contact
             self.synced_model.refresh()
             self.blueprint_model.refresh()
         self.policy_in_force = status.policy if status is not None else ""
+        pending = self.pending_policy
+        if pending is not None and self.policy_in_force.startswith(pending.describe()):
+            self.pending_policy = None  # the robot took it
+        if self.pending_policy is not None:
+            self.status_label.setText(
+                f"{self.status_label.text()}<br><span style='color:#8a5a00'>new policy waiting "
+                f"for contact: {escape(self.pending_policy.describe())}</span>"
+            )
         show_coverage_warning(self.warning_label, status)
+        self.hold_notice.show_hold(lost_link_hold(self._view, self.agent))
+        self.synced_caption.setText(on_robot_caption(status))
 
     def set_skills(self, names: Sequence[str]) -> None:
         """The skills the Add menu offers (the robot's skills)."""
@@ -295,13 +267,33 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         self.policy_button.setEnabled(not read_only and bool(self.skill_names))
         self.blueprint_table.setDragEnabled(not read_only)  # no reordering a replay
 
+    def _on_hold_notice_resume_requested(self) -> None:
+        self.robot_action.emit(self.agent, RobotAction.RESUME)
+
     def _on_add_menu_triggered(self, action: object) -> None:
         self.add_requested.emit(self.agent, action.text())  # type: ignore[attr-defined]
 
     def _on_policy_button_clicked(self) -> None:
-        policy = self.ask_policy(self.agent, self.skill_names, self, self.policy_in_force)
+        args = (self.agent, self.skill_names, self, self.policy_in_force)
+        pending = self.pending_policy
+        policy = self.ask_policy(*args) if pending is None else self.ask_policy(*args, pending)
         if policy is not None:
+            self.pending_policy = policy  # shown as waiting until the robot reports it
             self.policy_chosen.emit(self.agent, policy)
+
+    def policy_refused(self) -> None:
+        """The server refused the policy chosen here: nothing waits for the robot."""
+        self.pending_policy = None
+
+
+def on_robot_caption(status: AgentStatus | None) -> str:
+    """The caption over the robot's section: marked last known while it is not heard."""
+    if status is None or status.link == "up":
+        return ON_ROBOT
+    if status.link == "unknown" or status.last_heard < 0:
+        return "<i>On the robot</i> <span style='color:#a00000'>(last known, not heard yet)</span>"
+    age = duration_text(status.last_heard)
+    return f"<i>On the robot</i> <span style='color:#a00000'>(last known, {age} ago)</span>"
 
 
 def _row_edit(delta: SkillDelta, synced_end: int, synced: TaskModel, blueprint: TaskModel) -> bool:

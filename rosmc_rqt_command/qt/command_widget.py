@@ -25,13 +25,13 @@ from ..core.phrasing import answer_message
 from ..core.requests import Answer, Backend, Request, ask
 from ..core.view_state import ViewUpdate
 from .actions import CommandActions
-from .agent_column import SectionTable
 from .control_panel import ControlPanel
 from .enabling import Enabling
 from .file_menu import FileController
 from .message_area import MessageArea
 from .parameter_panel import ParameterPanel
 from .repaints import Repaints
+from .section_table import SectionTable
 from .task_widget import TaskWidget
 from .team_bar import TeamBar
 from .team_dialog import ask_send_anyway, ask_team_send
@@ -284,8 +284,14 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.send(ask(lambda c: c.add_skill, what, self.view.revision, select_new)(agent, skill))
 
     def _on_tasks_policy_chosen(self, agent: str, policy: LostLinkPolicy) -> None:
+        def forget_if_refused(answer: Answer) -> None:
+            column = self.tasks.columns.get(agent)
+            if not answer.ok and column is not None:
+                column.policy_refused()
+
         what = f"set {agent}'s policy ({policy.describe()})"
-        self.dispatcher.call(lambda c: c.set_lost_link_policy, what)(agent, policy)
+        call = ask(lambda c: c.set_lost_link_policy, what, self.view.revision, forget_if_refused)
+        self.send(call(agent, policy))
 
     def _on_tasks_reorder_requested(self, agent: str, order: list[str]) -> None:
         self.dispatcher.call(lambda c: c.reorder_skills, f"reorder {agent}'s task")(agent, order)

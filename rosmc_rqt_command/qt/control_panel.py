@@ -21,11 +21,14 @@ from python_qt_binding.QtWidgets import (
 from ..core.legality import Action, RobotAction
 from .actions import CommandActions
 
-# Three to a row, so the panel stays narrow and the task panel gets the width.
+# Two to a row, each beside its opposite, so the panel stays narrow (the task panel gets
+# the width) and no button is ever cut.
 SKILL_ROWS = (
-    (Action.SYNC, Action.UNSYNC, Action.DELETE),
-    (Action.MOVE_UP, Action.MOVE_DOWN, Action.BARRIER),
-    (Action.DELETE_BARRIER, Action.RETRY, Action.SKIP),
+    (Action.SYNC, Action.UNSYNC),
+    (Action.MOVE_UP, Action.MOVE_DOWN),
+    (Action.BARRIER, Action.DELETE_BARRIER),
+    (Action.RETRY, Action.SKIP),
+    (Action.DELETE,),
 )
 ROBOT_ROW = (RobotAction.START, RobotAction.PAUSE, RobotAction.RESUME, RobotAction.STOP)
 
@@ -47,9 +50,10 @@ class ControlPanel(QGroupBox):  # type: ignore[misc]
         send = actions.all_robots[RobotAction.SYNC_ALL]
         layout.addWidget(self._button(send, "send_all"))
         robots = QGridLayout()
-        for column, robot_action in enumerate(ROBOT_ROW):
+        for position, robot_action in enumerate(ROBOT_ROW):
             action = actions.all_robots[robot_action]
-            robots.addWidget(self._button(action, f"{robot_action.value}_all"), 0, column)
+            row, column = divmod(position, 2)  # two to a row: the panel stays narrow
+            robots.addWidget(self._button(action, f"{robot_action.value}_all"), row, column)
         layout.addLayout(robots)
 
     def _button(self, action: object, name: str) -> QToolButton:

@@ -11,6 +11,8 @@ from python_qt_binding.QtWidgets import QLabel
 
 from rosmc_server.core import AgentStatus
 
+from .labels import never_widen
+
 STYLE = (
     "QLabel { color:#7a4b00; background:#fff3cd; border:1px solid #e0a800;"
     " border-radius:3px; padding:2px; }"
@@ -21,7 +23,7 @@ def coverage_warning_label(agent: str) -> QLabel:
     """The (hidden) warning label of ``agent``'s column."""
     label = QLabel("")
     label.setObjectName(f"coverage_warning_{agent}")
-    label.setWordWrap(True)
+    never_widen(label)
     label.setStyleSheet(STYLE)
     label.setVisible(False)
     return label

@@ -1,15 +1,19 @@
-"""A one-line key of the row colours, under the task panel: what each colour means.
+"""A key of the row colours, under the task panel: what each colour means.
 
-Built from :mod:`.presentation`, so the key always matches the rows.
+Built from :mod:`.presentation`, so the key always matches the rows. One label that wraps
+onto a second line in a narrow window (a row of chips would hold the window wide).
 """
 
 from __future__ import annotations
 
-from python_qt_binding.QtWidgets import QHBoxLayout, QLabel, QWidget
+from html import escape
+
+from python_qt_binding.QtWidgets import QLabel, QWidget
 
 from rosmc_server.core import SkillStatus
 
 from ..core import presentation
+from .labels import never_widen
 
 # (words, background, text colour) in the order a skill lives through them.
 ENTRIES = (
@@ -34,23 +38,21 @@ ENTRIES = (
 )
 
 
-class StatusLegend(QWidget):  # type: ignore[misc]
-    """Colour chips with the status words, in one row."""
+class StatusLegend(QLabel):  # type: ignore[misc]
+    """Colour chips with the status words, wrapped to the width given."""
 
     def __init__(self, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("legend")
-        layout = QHBoxLayout(self)
-        layout.setContentsMargins(4, 0, 4, 2)
-        layout.setSpacing(4)
-        layout.addWidget(QLabel("Colours:"))
-        self.chips: dict[str, QLabel] = {}
+        never_widen(self)
+        self.setContentsMargins(4, 0, 4, 2)
+        self.chips: dict[str, str] = {}  # words -> background colour
+        chips = []
         for words, background, text in ENTRIES:
-            chip = QLabel(words)
-            chip.setStyleSheet(
-                f"QLabel {{ background:{background}; color:{text}; border:1px solid #9a9a9a;"
-                " border-radius:3px; padding:1px 6px; }"
+            # Non-breaking spaces: a line breaks between chips, never inside one.
+            shown = escape(words).replace(" ", "&nbsp;")
+            chips.append(
+                f"<span style='background:{background}; color:{text};'>&nbsp;{shown}&nbsp;</span>"
             )
-            layout.addWidget(chip)
-            self.chips[words] = chip
-        layout.addStretch(1)
+            self.chips[words] = background
+        self.setText("Colours: " + " &nbsp;".join(chips))

@@ -12,6 +12,8 @@ from collections.abc import Sequence
 from python_qt_binding.QtGui import QBrush, QColor
 from python_qt_binding.QtWidgets import QLabel, QListWidget, QListWidgetItem, QVBoxLayout, QWidget
 
+from .labels import never_widen
+
 MAX_MESSAGES = 300
 SEVERITY_COLOURS = {"info": "#1d1d1d", "ok": "#11632b", "warning": "#8a5a00", "error": "#b00020"}
 
@@ -23,7 +25,7 @@ class MessageArea(QWidget):  # type: ignore[misc]
         super().__init__(parent)
         self.warnings_label = QLabel("")
         self.warnings_label.setObjectName("warnings")
-        self.warnings_label.setWordWrap(True)
+        never_widen(self.warnings_label)  # a long warning wraps, the window keeps its width
         self.warnings_label.setStyleSheet(
             "QLabel { background:#fff3c4; border:1px solid #e0b000; padding:4px; }"
         )

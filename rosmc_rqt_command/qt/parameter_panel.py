@@ -47,6 +47,7 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
         self.skill: SkillInstance | None = None
         self.editors: dict[str, Editor] = {}
         self.pickers: dict[str, MarkerPicker] = {}
+        self._shown: dict[str, object] = {}  # what each editor showed of the skill
         self._spec: SkillSpec | None = None
         self.setWidgetResizable(True)
         self.setMinimumWidth(320)
@@ -115,6 +116,9 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
         """Show ``skill`` (None: nothing); editors are rebuilt only for another skill."""
         rebuild = skill is None or self.skill is None or skill.id != self.skill.id
         self.skill = skill
+        if rebuild:  # a refusal's tint belongs to the skill it was typed for
+            for widget in (self.label_edit, self.timeout_spin, self.retries_spin):
+                widget.setStyleSheet("")
         if skill is None:
             self.title.setText(
                 f"<i>{count} skills selected.</i>" if count > 1 else "<i>Select a skill.</i>"
@@ -151,14 +155,15 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
             if force or newest is not self.skill:
                 self.show_skill(newest)
 
-    def _show_options(self, skill: SkillInstance | None) -> None:
+    def _show_options(self, skill: SkillInstance | None, force: bool = False) -> None:
         """The label, time limit and retries of ``skill``; blank for none (not the last
-        skill's, which would pass for the selection's). A field being typed in is kept."""
+        skill's, which would pass for the selection's). A field being typed in is kept
+        (unless ``force``)."""
         values = (None, None) if skill is None else (skill.timeout, skill.max_retries)
-        if not self.label_edit.hasFocus():
+        if force or not self.label_edit.hasFocus():
             self.label_edit.setText("" if skill is None else skill.label)
         for spin, value in zip((self.timeout_spin, self.retries_spin), values, strict=True):
-            if spin.hasFocus():
+            if spin.hasFocus() and not force:
                 continue
             # Blank: the box's minimum (far below any allowed value) shown as a space.
             spin.setSpecialValueText(" " if value is None else "")
@@ -200,16 +205,18 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
                 self.params_form.addRow("   marker", picker)
                 self.pickers[spec.name] = picker
 
-    def _fill_editors(self) -> None:
+    def _fill_editors(self, force: bool = False) -> None:
+        """Show the skill's values (``force``: also in the editor being typed in)."""
         skill, spec = self.skill, self._spec
         if skill is None or spec is None:
             return
         for name, editor in self.editors.items():
-            if name in skill.params and not editor.isAncestorOf(editor.focusWidget()):
+            if name in skill.params and (force or not editor.isAncestorOf(editor.focusWidget())):
                 editor.blockSignals(True)
                 editor.set_value(skill.params[name])
                 editor.mark_invalid(False)
                 editor.blockSignals(False)
+                self._shown[name] = _typed(editor)
         for name, picker in self.pickers.items():
             param = spec.parameter(name)
             names = [m.name for m in self._view.markers.values() if param.accepts_marker(m.type)]
@@ -227,7 +234,12 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
     def _on_editor_committed(self, name: str) -> None:
         skill, spec = self.skill, self._spec
         editor = self.editors.get(name)
-        if skill is None or spec is None or editor is None or not self.editable:
+        if skill is None or spec is None or editor is None:
+            return
+        if not self.editable:
+            if _typed(editor) != self._shown.get(name):  # typed in, not just left
+                self._not_planned(skill, name)
+                self._fill_editors(force=True)
             return
         try:
             value = spec.parameter(name).check(editor.value(), skill.skill)
@@ -247,7 +259,11 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
     def _on_label_edit_editing_finished(self) -> None:
         skill = self.skill
         text = self.label_edit.text().strip()
-        if skill is None or not self.editable or text == skill.label:
+        if skill is None or text == skill.label:
+            return
+        if not self.editable:
+            self._not_planned(skill, "label")
+            self.label_edit.setText(skill.label)
             return
         invalid = not text
         self.label_edit.setStyleSheet(INVALID_STYLE if invalid else "")
@@ -258,9 +274,14 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
 
     def _on_options_editing_finished(self) -> None:
         skill = self.skill
-        if skill is None or not self.editable:
+        if skill is None:
             return
         timeout, retries = self.timeout_spin.value(), self.retries_spin.value()
+        if not self.editable:
+            if timeout != skill.timeout or retries != skill.max_retries:
+                self._not_planned(skill, "time limit and retries")
+                self._show_options(skill, force=True)
+            return
         for spin in (self.timeout_spin, self.retries_spin):
             spin.setStyleSheet("")
         try:
@@ -301,9 +322,28 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
 
         return revert
 
+    def _not_planned(self, skill: SkillInstance, what: str) -> None:
+        """Say that an edit typed while the skill left the plan was not sent (never lose it
+        without a word: the skill may have been sent to the robot meanwhile)."""
+        if self._read_only:
+            return
+        self.problem.emit(
+            f"Not sent: '{skill.label or skill.skill}' on {skill.agent} is no longer planned "
+            f"(it is {self._view.status_text(skill)}), so its {what} stays as it was; "
+            "take it back from the robot to change it."
+        )
+
     def _send(self, fields: dict[str, Any]) -> None:
         assert self.skill is not None
         self.edit_requested.emit(self.skill.id, fields)
+
+
+def _typed(editor: Editor) -> object:
+    """What ``editor`` holds, as the mission keeps it (None when it cannot be read)."""
+    try:
+        return editor.value()
+    except (InvalidRequest, ValueError):
+        return None
 
 
 def _data(value: object) -> object:

@@ -26,6 +26,8 @@ from python_qt_binding.QtWidgets import (
 from rosmc_server.core import InvalidRequest, LostLinkKind, LostLinkPolicy, LostLinkTrigger
 from rosmc_server.core.policy import DEFAULT_AFTER
 
+from ..core.policy_words import policy_in_force
+
 KIND_WORDS = {
     LostLinkKind.CONTINUE: "keep going",
     LostLinkKind.HOLD: "hold (pause) after a while",
@@ -43,6 +45,10 @@ class PolicyDialog(QDialog):  # type: ignore[misc]
         skills: The skills the robot can run as its safe skill.
         preferred: The safe skill offered first if the robot has it.
         in_force: The policy the robot reports in force, as it words it ("" if unknown).
+        pending: A policy chosen and waiting for contact with the robot (None if none).
+
+    It opens on the pending policy, else on the policy in force (never on a choice the
+    operator did not make).
     """
 
     def __init__(
@@ -52,6 +58,7 @@ class PolicyDialog(QDialog):  # type: ignore[misc]
         preferred: str = "return_to_lander",
         parent: QWidget | None = None,
         in_force: str = "",
+        pending: LostLinkPolicy | None = None,
     ) -> None:
         super().__init__(parent)
         self.setWindowTitle(f"{agent}: when the link is lost")
@@ -77,6 +84,15 @@ class PolicyDialog(QDialog):  # type: ignore[misc]
         self.in_force = QLabel(f"In force: {in_force or 'not reported yet'}")
         self.in_force.setObjectName("policy_in_force")
         self.in_force.setWordWrap(True)
+        self.pending = QLabel(
+            f"Waiting for contact: {pending.describe()} (sent, not on the robot yet)"
+            if pending is not None
+            else ""
+        )
+        self.pending.setObjectName("policy_pending")
+        self.pending.setWordWrap(True)
+        self.pending.setStyleSheet("QLabel { color:#8a5a00; }")
+        self.pending.setVisible(pending is not None)
         self.problem = QLabel("")
         self.problem.setStyleSheet("QLabel { color:#b00020; }")
         self.problem.setWordWrap(True)
@@ -84,6 +100,7 @@ class PolicyDialog(QDialog):  # type: ignore[misc]
         form = QFormLayout(self)
         form.addRow(QLabel(f"What should <b>{agent}</b> do when it stops hearing the ground?"))
         form.addRow(self.in_force)
+        form.addRow(self.pending)
         form.addRow("Then", self.kind_combo)
         form.addRow("After", self.after_spin)
         form.addRow("", self.idle_check)
@@ -94,6 +111,20 @@ class PolicyDialog(QDialog):  # type: ignore[misc]
         self.buttons.rejected.connect(self.reject)
         self.kind_combo.currentIndexChanged.connect(self._on_kind_combo_current_index_changed)
         self._on_kind_combo_current_index_changed(0)
+        shown = pending or policy_in_force(in_force)
+        if shown is not None:
+            self.show_policy(shown)
+
+    def show_policy(self, policy: LostLinkPolicy) -> None:
+        """Fill the fields with ``policy`` (the one in force, or the one waiting)."""
+        self.set_kind(policy.kind)
+        if policy.kind is LostLinkKind.CONTINUE:
+            return
+        self.after_spin.setValue(policy.after)
+        self.idle_check.setChecked(policy.when is LostLinkTrigger.IDLE)
+        index = self.skill_combo.findText(policy.skill)
+        if policy.kind.runs_skill and index >= 0:
+            self.skill_combo.setCurrentIndex(index)
 
     def set_kind(self, kind: LostLinkKind) -> None:
         """Pick ``kind`` (as the operator would in the first list)."""
@@ -135,10 +166,14 @@ class PolicyDialog(QDialog):  # type: ignore[misc]
 
 
 def ask_policy(
-    agent: str, skills: Sequence[str], parent: QWidget | None = None, in_force: str = ""
+    agent: str,
+    skills: Sequence[str],
+    parent: QWidget | None = None,
+    in_force: str = "",
+    pending: LostLinkPolicy | None = None,
 ) -> LostLinkPolicy | None:
     """Show the dialog; the chosen policy, or None if the operator cancels."""
-    dialog = PolicyDialog(agent, skills, parent=parent, in_force=in_force)
+    dialog = PolicyDialog(agent, skills, parent=parent, in_force=in_force, pending=pending)
     if dialog.exec_() != QDialog.Accepted:
         return None
     return dialog.policy()

@@ -14,7 +14,7 @@ from python_qt_binding.QtCore import QObject, QTimer
 
 from rosmc_server.core import AgentStatus
 
-from ..core import alerts
+from ..core import alerts, holding
 from ..core.mission_view import MissionView
 from .message_area import MessageArea
 
@@ -75,6 +75,7 @@ class Repaints(QObject):  # type: ignore[misc]
         """Show every warning now (the warning timer's slot)."""
         view = self._view
         warnings = [
+            *(hold.sentence() for hold in holding.holds(view)),
             *alerts.barrier_warnings(view),
             *alerts.coverage_warnings(view),
             *alerts.radio_warnings(view),

@@ -24,6 +24,7 @@ from python_qt_binding.QtWidgets import (
 )
 
 from ..replay_ticks import RecordingOutline, ReplayTick, TickKind
+from .labels import never_widen
 
 if TYPE_CHECKING:  # the recording modules load when a replay starts, not with the window
     from rosmc_server.recording.playback import PlaybackStatus
@@ -164,7 +165,7 @@ class ReplayBar(QFrame):  # type: ignore[misc]
         self.setObjectName("replay_bar")
         self.setFrameShape(QFrame.StyledPanel)
         self.setStyleSheet("#replay_bar { background:#eef3fb; }")
-        self.title = QLabel()
+        self.title = never_widen(QLabel(), wrap=False)  # a long file name is cut, not the bar
         self.play_button = QPushButton("Play")
         self.play_button.setObjectName("replay_play")
         self.slower_button = QPushButton("Slower")

@@ -93,6 +93,7 @@ class ReplayMode(QObject):  # type: ignore[misc]
         self._backend: Any = None
         self._link: ReplaySteering | None = None
         self._ended_said = False
+        self._live_science: Any = None  # the live score, shown again on the way back
         self.bar = ReplayBar()
         self.bar.hide()
         widget.layout().insertWidget(1, self.bar)  # under the banner, above the task panel
@@ -132,7 +133,10 @@ class ReplayMode(QObject):  # type: ignore[misc]
         self._link.state_received.connect(self._on_link_state_received)
         self._link.refused.connect(lambda text: self._widget.messages.say(text, "warning"))
         self._backend = self._hooks.follow(self.prefix)
+        if self._live is self._widget.backend:  # not from one replay to the next
+            self._live_science = self._widget.science.science
         self._switch(self._live, self._backend)
+        self._widget.science.show_replay_start()
         self._ended_said = False
         self.bar.set_outline(outline)
         self.bar.show()
@@ -149,6 +153,7 @@ class ReplayMode(QObject):  # type: ignore[misc]
             return
         self._leave_replay()
         self._switch(None, self._live)
+        self._widget.science.show_science(self._live_science)
         self._live.refresh()
         self.bar.hide()
         self._widget.messages.say("Back to the live mission.", "ok")

@@ -14,7 +14,10 @@ from python_qt_binding.QtWidgets import QLabel, QWidget
 from rosmc_server.core.science import IDENTIFIED_WORDS, Science
 from rosmc_server.core.vocabulary import counted
 
+from .labels import never_widen
+
 NO_SCORE = "Science: no score published"
+NO_REPLAY_SCORE = "Science (replay): no score in this recording yet"
 _MARK = {"": "○", "science_rover": "◐", "collaborative": "●"}
 
 
@@ -24,7 +27,7 @@ class ScienceStrip(QLabel):  # type: ignore[misc]
     def __init__(self, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("science")
-        self.setWordWrap(True)
+        never_widen(self)
         self.setStyleSheet("QLabel#science { background:#eef5e9; padding:3px; }")
         self.science: Science | None = None
         self.show_science(None)
@@ -50,6 +53,11 @@ class ScienceStrip(QLabel):  # type: ignore[misc]
             parts.append("no region discovered yet")
         self.setText(" · ".join(parts))
         self.setToolTip("\n".join(science.lines()))
+
+    def show_replay_start(self) -> None:
+        """A replay begins: the live score must not pass for the recording's."""
+        self.show_science(None)
+        self.setText(NO_REPLAY_SCORE)
 
     def plain_text(self) -> str:
         """What the strip says, without markup (for tests and screen readers)."""

@@ -12,6 +12,8 @@ from python_qt_binding.QtWidgets import QLabel, QWidget
 
 from rosmc_server.core.site_source import NO_SITE, SiteInForce, site_line
 
+from .labels import never_widen
+
 _TIP = (
     "The mission server checks skill targets against the newest sane map on /rosmc/site; "
     "a map with impossible numbers or too many obstacles is refused (see the server log)."
@@ -24,7 +26,7 @@ class SiteStrip(QLabel):  # type: ignore[misc]
     def __init__(self, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("site")
-        self.setWordWrap(True)
+        never_widen(self)
         self.setStyleSheet("QLabel#site { color:#444; font-size:small; padding:0 3px; }")
         self.setToolTip(_TIP)
         self.source: SiteInForce | None = None

@@ -168,7 +168,8 @@ class TaskModel(QAbstractTableModel):  # type: ignore[misc]
                 return self._brush("#ffffff")
             return self._brush(presentation.text_colour(skill))
         if role == Qt.FontRole:
-            if skill.transfer.value:
+            out = self._view.out_of_contact(skill.agent)
+            if skill.transfer.value or presentation.is_last_known(skill, out):
                 return self._italic
             if column == TAG or (column == STATUS and presentation.is_alarm(skill)):
                 return self._bold

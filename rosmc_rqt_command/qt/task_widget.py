@@ -25,7 +25,8 @@ from rosmc_server.core import AgentStatus, Library
 
 from ..core.mission_view import MissionView
 from ..core.view_state import ViewUpdate, delta_agent
-from .agent_column import COMPACT_WIDTH, AgentColumn, SectionTable
+from .agent_column import COMPACT_WIDTH, AgentColumn
+from .section_table import SectionTable
 
 # A mission's first columns are built at once, as many as fit on screen (at least this
 # many); the others follow in groups of LATER_COLUMNS, LATER_MS apart (a zero timer could
@@ -136,10 +137,18 @@ class TaskWidget(QScrollArea):  # type: ignore[misc]
         for table in self.tables():
             row = table.section.row_of(self._selected[0]) if self._selected else -1
             if row >= 0:
-                self.ensureWidgetVisible(table.parentWidget())
+                self._reveal(table.parentWidget())
                 table.scrollTo(table.section.index(row, 0))
                 break
         self.selection_changed.emit(self.selected_ids)
+
+    def _reveal(self, column: QWidget) -> None:
+        """Scroll sideways to ``column`` only if none of it is in view: a column the
+        operator just clicked in must stay under the pointer (after *Add skill*, a sideways
+        jump put another robot's button where the next click went)."""
+        left = column.mapTo(self._inner, QPoint(0, 0)).x() - self.horizontalScrollBar().value()
+        if left >= self.viewport().width() or left + column.width() <= 0:
+            self.ensureWidgetVisible(column)
 
     def clear_selection(self) -> None:
         """Select nothing."""

@@ -25,6 +25,7 @@ from rosmc_server.core.vocabulary import counted
 
 from ..core.mission_view import MissionView
 from ..core.team_filter import StatusFilter, TeamFilter, visible_agents
+from .labels import never_widen
 from .task_widget import TaskWidget
 
 
@@ -56,6 +57,7 @@ class TeamBar(QWidget):  # type: ignore[misc]
         self.text.setClearButtonEnabled(True)
         self.text.setToolTip("Names or parts of names, separated by commas: drone, rover_3")
         self.text.setMaximumWidth(220)
+        self.text.setMinimumWidth(90)
         # Not the window's first focus: the task panel's shortcuts (Delete, arrows) stay live.
         self.text.setFocusPolicy(Qt.ClickFocus)
         self.text.textChanged.connect(self._on_text_text_changed)
@@ -86,6 +88,8 @@ class TeamBar(QWidget):  # type: ignore[misc]
         self.compact.toggled.connect(self._on_compact_toggled)
         self.count = QLabel(self)
         self.count.setObjectName("team_count")
+        never_widen(self.count, wrap=False)
+        self.count.setAlignment(Qt.AlignRight | Qt.AlignVCenter)
         layout = QHBoxLayout(self)
         layout.setContentsMargins(2, 0, 2, 0)
         layout.addWidget(self.text)

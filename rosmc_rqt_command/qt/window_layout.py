@@ -9,6 +9,7 @@ from python_qt_binding.QtWidgets import QLabel, QMenuBar, QSplitter, QVBoxLayout
 
 from .actions import CommandActions
 from .control_panel import ControlPanel
+from .labels import never_widen
 from .legend import StatusLegend
 from .message_area import MessageArea
 from .parameter_panel import ParameterPanel
@@ -20,6 +21,10 @@ from .undo_history import UndoHistory
 
 FILE_ITEMS = ("new", "open", "open_server", None, "save", "save_as", "save_server")
 BANNER_STYLE = "QLabel { background:#fde2e1; color:#8a0010; padding:4px; }"
+# The right-hand panels (parameters, control, messages) keep this width range: never so
+# narrow that an editor is cut, never wider than they need (the tasks take the rest).
+RIGHT_MIN_WIDTH = 330
+RIGHT_MAX_WIDTH = 460
 
 
 @dataclass(frozen=True)
@@ -52,14 +57,15 @@ def lay_out(window: QWidget, panels: Panels) -> Layout:
     menu_bar = _menus(window, panels)
     banner = QLabel()
     banner.setObjectName("banner")
-    banner.setWordWrap(True)
+    never_widen(banner)
     banner.setStyleSheet(BANNER_STYLE)
     right = QSplitter(Qt.Vertical)
     for panel in (panels.parameters, panels.control, panels.messages):
         right.addWidget(panel)
     right.setStretchFactor(0, 3)
     right.setStretchFactor(2, 1)
-    right.setMaximumWidth(370)
+    right.setMinimumWidth(RIGHT_MIN_WIDTH)
+    right.setMaximumWidth(RIGHT_MAX_WIDTH)
     science, site, legend = ScienceStrip(), SiteStrip(), StatusLegend()
     left = QWidget()
     left_layout = QVBoxLayout(left)
@@ -73,7 +79,9 @@ def lay_out(window: QWidget, panels: Panels) -> Layout:
     splitter.addWidget(right)
     splitter.setStretchFactor(0, 1)
     splitter.setStretchFactor(1, 0)
-    splitter.setSizes([1230, 370])
+    # Neither side can be dragged away: a collapsed parameter panel took edits nowhere.
+    splitter.setChildrenCollapsible(False)
+    splitter.setSizes([1200, 400])
     layout = QVBoxLayout(window)
     layout.setContentsMargins(2, 2, 2, 2)
     layout.setMenuBar(menu_bar)

@@ -23,8 +23,8 @@ from python_qt_binding.QtTest import QTest
 from python_qt_binding.QtWidgets import QApplication, QMessageBox
 
 from rosmc_rqt_command.core import presentation
-from rosmc_rqt_command.qt.agent_column import SectionTable
 from rosmc_rqt_command.qt.command_widget import CommandWidget
+from rosmc_rqt_command.qt.section_table import SectionTable
 from rosmc_rqt_command.qt.task_model import SKILL, STATUS, TAG
 from rosmc_rqt_command.ros_bridge import RosBridge
 from rosmc_rqt_command.standalone import build
@@ -313,7 +313,8 @@ def test_operator_builds_edits_runs_and_adapts_a_two_robot_mission(team: Any) ->
     wait_until(lambda: gui.rows("r1", False) and gui.rows("r1", False)[0].id == first, 30, "synced")
     assert operator.mission().skill(first).status is S.IDLE_SYNCHRONIZED
     assert w.tasks.selected_ids == [first]  # followed into the synchronized table
-    # Send r2's wait (with its long duration first set) with the column's Sync all button.
+    # Send r2's wait (with its long duration first set) with the column's Send to robot
+    # button, answering its question with Send.
     gui.click_row("r2", True, 1)
     wait_until(lambda: w.parameters.skill and w.parameters.skill.id == long_wait, 30, "shown")
     spin = w.parameters.editors["duration"].spin
@@ -321,6 +322,7 @@ def test_operator_builds_edits_runs_and_adapts_a_two_robot_mission(team: Any) ->
     QTest.keyClicks(spin.lineEdit(), "30")
     QTest.keyClick(spin.lineEdit(), Qt.Key_Return)
     wait_until(lambda: operator.mission().skill(long_wait).params["duration"] == 30.0, 30, "30 s")
+    gui.answer_dialog(QMessageBox.Yes)
     gui.click("synchronize_all_r2")
     wait_until(lambda: len(gui.rows("r2", False)) == 2, 30, "r2 synced")
 

@@ -25,7 +25,9 @@ from python_qt_binding.QtTest import QTest
 from python_qt_binding.QtWidgets import QApplication
 
 from rosmc_rqt_command.core.legality import RobotAction
+from rosmc_rqt_command.qt.science_strip import NO_REPLAY_SCORE
 from rosmc_rqt_command.replay_ticks import TickKind
+from rosmc_server.core.science import Science
 from rosmc_server.recording import read_journal
 from rosmc_server.recording.history import MissionHistory
 from rosmc_server.ros.client import agent_statuses_from_msg
@@ -134,6 +136,8 @@ def test_open_a_recording_seek_to_an_event_play_to_the_end_and_return_to_live(
     live_ids = window.ids("drone")
     widget, mode = window.w, window.w.replay
 
+    live_score = Science(0.7, 1)
+    widget.science.show_science(live_score)  # as the live simulator published it
     # File > Open recording…, the file chosen in the dialog.
     file_menu = widget.menu_bar.actions()[0].menu()
     assert mode.open_action in file_menu.actions()
@@ -145,6 +149,9 @@ def test_open_a_recording_seek_to_an_event_play_to_the_end_and_return_to_live(
     start = history.revision_at(0.0).revision
     wait_until(lambda: widget.view.revision == start, 20, f"the recording's r{start}")
     assert widget.backend.read_only and bar.play_button.text() == "Play"
+    # Paused at the start, the live score is not shown as the recording's.
+    assert widget.science.text() == NO_REPLAY_SCORE and widget.science.science is None
+    assert bar.live_button.width() >= bar.live_button.sizeHint().width()  # not cut off
 
     # Paused at the start, the robots stand where the recording first heard them.
     expected = first_poses()
@@ -195,6 +202,7 @@ def test_open_a_recording_seek_to_an_event_play_to_the_end_and_return_to_live(
     for pid in children:
         assert not os.path.exists(f"/proc/{pid}") or _zombie(pid), f"replay child {pid} runs"
     window.said("Back to the live mission")
+    assert widget.science.science == live_score
     no_traceback(window)
 
 

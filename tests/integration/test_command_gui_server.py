@@ -482,8 +482,13 @@ def test_a_send_to_a_robot_out_of_contact_is_shown_waiting(
     wait_until(lambda: window.ids("drone"), 30, "take_off shown")
     column = window.w.tasks.columns["drone"]
     send = column.buttons[RobotAction.SYNC_ALL]
-    wait_until(send.isEnabled, 30, "Sync all enabled")
-    QTest.mouseClick(send, Qt.LeftButton)
+    wait_until(send.isEnabled, 30, "Send to robot enabled")
+    questions = Questions([QMessageBox.Yes])  # the question before a whole task goes
+    try:
+        QTest.mouseClick(send, Qt.LeftButton)
+    finally:
+        questions.stop()
+    assert len(questions.asked) == 1 and "drone: 1 skill, its whole task" in questions.asked[0]
     window.said("queued for drone: not heard since the server started")
     model = column.blueprint_model
     wait_until(

@@ -27,8 +27,8 @@ from python_qt_binding.QtWidgets import QApplication
 from rosmc_rqt_command.core.legality import Action
 from rosmc_rqt_command.core.requests import Request
 from rosmc_rqt_command.core.view_state import ViewUpdate, view_update
-from rosmc_rqt_command.qt.agent_column import SectionTable
 from rosmc_rqt_command.qt.command_widget import CommandWidget
+from rosmc_rqt_command.qt.section_table import SectionTable
 from rosmc_rqt_command.qt.task_model import SKILL, STATUS
 from rosmc_server.core import AgentStatus, Library, Mission, MissionEvent, MissionState
 from rosmc_server.core.mirror import MissionMirror

@@ -167,7 +167,11 @@ def test_barrier_members_share_a_tag_and_say_whom_they_wait_on(gui: Gui) -> None
 def test_robot_headers_in_words() -> None:
     assert p.link_summary(None) == "never heard"
     up = AgentStatus("alpha", link="up", last_heard=0.3, battery=0.72, wifi_signal=-61.0)
-    assert p.link_summary(up) == "link up · battery 72% · Wi-Fi -61 dBm (out of range)"
+    assert p.link_summary(up) == "link up · battery 72% · Wi-Fi out of range"
+    inside = replace(up, in_coverage=True)
+    assert p.link_summary(inside) == "link up · battery 72% · Wi-Fi fair"
+    assert p.wifi_words(-50.0, True) == "good" and p.wifi_words(-76.0, True) == "weak"
+    assert p.link_details(inside) == "Wi-Fi signal -61 dBm"
     down = AgentStatus("alpha", link="down", last_heard=42.0, in_coverage=True, wifi_signal=-90)
     assert p.link_summary(down).startswith("LINK DOWN, heard 42 s ago")
     held = replace(down, commands_waiting=2, waiting_for=130.0)
