@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
-STATION = "rosmc_server/ros/station.py"
+STATION = "rosmc_server/common/ros/station.py"
 
 # (node name, its module, more modules it reads parameters through: path -> the names it
 # reads there, None for all). The node module's docstring describes every parameter.

@@ -16,7 +16,8 @@ import itertools
 import time
 from collections.abc import Iterable, Sequence
 
-from rosmc_server.core import Library, RosmcError, SkillInstance, SkillStatus
+from rosmc_server.core import Library, RosmcError, SkillInstance
+from rosmc_server.core.advice import stranded_barriers
 from rosmc_server.core.vocabulary import counted
 
 from .mission_view import MissionView
@@ -25,17 +26,13 @@ WEAK_WIFI_DBM = -75.0  # below this a robot is about to lose the link
 
 
 def barrier_warnings(view: MissionView, sending: Sequence[SkillInstance] = ()) -> list[str]:
-    """Barrier members on a robot (or being sent) whose partners are still planned."""
-    sending_ids = {skill.id for skill in sending}
+    """Barrier members on a robot (or being sent) whose partners are still planned (the
+    core's rule, :func:`~rosmc_server.core.advice.stranded_barriers`, worded here)."""
     out = []
-    for barrier in view.barriers:
-        members = view.skills(barrier.skill_ids)
-        on_robot = [s for s in members if s.id in sending_ids or s.status is not SkillStatus.IDLE]
-        planned = [s for s in members if s.status is SkillStatus.IDLE and s.id not in sending_ids]
-        if on_robot and planned and not all(s.status.has_started for s in on_robot):
-            robots = ", ".join(s.agent for s in on_robot)
-            missing = ", ".join(f"{s.agent}'s '{s.label or s.skill}'" for s in planned)
-            out.append(f"{robots} will wait at a barrier for ever unless you also send {missing}.")
+    for stranded in stranded_barriers(view, view.barriers, [s.id for s in sending]):
+        robots = ", ".join(s.agent for s in stranded.going)
+        missing = ", ".join(f"{s.agent}'s '{s.label or s.skill}'" for s in stranded.planned)
+        out.append(f"{robots} will wait at a barrier for ever unless you also send {missing}.")
     return out
 
 

@@ -10,9 +10,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from rosmc_server.core.geometry import Color
 from rosmc_server.core.radio_map import RadioMap, reading_text
-
-from .geometry import Color
 
 STRONG, WEAK = -50.0, -90.0  # dBm shaded full green and full red
 OLD_AFTER = 10.0  # seconds: a reading older than this is shown as old

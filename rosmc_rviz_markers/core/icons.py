@@ -23,6 +23,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from rosmc_server.core.agent_status import AgentStatus
+from rosmc_server.core.geometry import Color, Point
 from rosmc_server.core.model import SkillStatus
 from rosmc_server.core.vocabulary import (
     STATUS_COLOURS,
@@ -34,7 +35,6 @@ from rosmc_server.core.vocabulary import (
 )
 from rosmc_server.core.waiting import duration_text
 
-from .geometry import Color, Point
 from .labels import LINE_SPACING, VIEW_PITCH, Box, Label
 
 GOOD = Color(0.30, 1.00, 0.35)

@@ -15,7 +15,8 @@ import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
-CHAR_WIDTH = 0.62  # a character's width in letter heights (rviz's text font, generously)
+from rosmc_server.core.geometry import CHAR_WIDTH
+
 LINE_SPACING = 1.25  # from one line's centre to the next, in letter heights
 VIEW_PITCH = 1.25  # the steepest shipped view looks north, this far below the horizon (rad)
 GAP = 0.15  # between two stacked labels (view-plane metres)

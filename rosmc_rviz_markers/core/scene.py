@@ -13,6 +13,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field, replace
 
+from rosmc_server.core import geometry as geo
 from rosmc_server.core.agent_status import AgentStatus
 from rosmc_server.core.library import AgentKind, Library
 from rosmc_server.core.model import SkillInstance
@@ -29,7 +30,6 @@ from rosmc_server.core.updates import (
 )
 from rosmc_server.interface import MAP_FRAME
 
-from . import geometry as geo
 from .labels import Label, layout
 from .menus import UNDO_MENU, flatten, robot_menu, static_agent_menu, task_marker_menu
 from .specs import MarkerSpec, agent_spec, describe, task_label, task_specs

@@ -13,13 +13,13 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
+from rosmc_server.core import geometry as geo
 from rosmc_server.core.frames import IDENTITY, Quaternion
+from rosmc_server.core.geometry import Color, Point, Primitive
 from rosmc_server.core.model import SkillInstance, TaskMarker
 from rosmc_server.core.params import MarkerType
 from rosmc_server.interface import MAP_FRAME, base_link
 
-from . import geometry as geo
-from .geometry import Color, Point, Primitive
 from .labels import Label
 from .menus import FlatMenu
 from .styling import HIGHLIGHT, LOCK_COLOR, USE_COLORS, MarkerUse

@@ -14,9 +14,9 @@ from visualization_msgs.msg import (
 )
 
 from rosmc_server.conversions.primitives import color_msg, primitive_msg
+from rosmc_server.core import geometry as geo
 from rosmc_server.core.frames import quaternion_from_rpy, yaw_of
 
-from ..core import geometry as geo
 from ..core.icons import ICON_TEXT, IconRow, block_centre
 from ..core.menus import FlatMenu
 from ..core.specs import ControlSpec, MarkerSpec

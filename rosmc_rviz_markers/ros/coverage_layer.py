@@ -23,6 +23,7 @@ from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
 from rosmc_server.conversions.coverage import prediction_from_msg, reading_from_telemetry
+from rosmc_server.core.geometry import Color
 from rosmc_server.core.radio_map import RadioMap
 from rosmc_server.interface import (
     AGENT_STATES_TOPIC,
@@ -33,7 +34,6 @@ from rosmc_server.interface import (
 )
 
 from ..core.coverage import Cell, LastLink, last_links, measured_cells, model_cells
-from ..core.geometry import Color
 
 PERIOD = 1.0
 POLE_HEIGHT = 1.6

@@ -31,12 +31,11 @@ from geometry_msgs.msg import PointStamped, PoseStamped, PoseWithCovarianceStamp
 from visualization_msgs.msg import InteractiveMarkerFeedback as Feedback
 
 from rosmc_server import interface
-from rosmc_server.core import InvalidRequest, MarkerType, Pose, RosmcError
+from rosmc_server.core import InvalidRequest, MarkerType, Pose, RosmcError, areas
 from rosmc_server.core.params import value_to_data
 from rosmc_server.ros.client import AsyncMissionClient, MissionClient, Outcome
 
 from .. import topics
-from ..core import areas
 from ..core.edit_history import EditHistory
 from ..core.menus import AddSkill, DeleteMarker, EditAction, RenameMarker, UndoEdit
 from ..core.requests import SkillPlan, moved_area, moved_pose, new_marker, robot_skill_plan

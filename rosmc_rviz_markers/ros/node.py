@@ -35,15 +35,15 @@ from collections.abc import Mapping, Sequence
 import rospy
 from visualization_msgs.msg import Marker, MarkerArray
 
+from rosmc_server.common.ros.logging_bridge import bridge_logging_to_rosout
 from rosmc_server.core import AgentStatus, Library, MissionState, load_library
+from rosmc_server.core.geometry import Point
 from rosmc_server.core.mirror import MissionMirror
 from rosmc_server.core.updates import MirrorUpdate, MissionReset
 from rosmc_server.interface import MAP_FRAME, base_link
 from rosmc_server.ros.client import MissionFollower, Outcome
-from rosmc_server.ros.logging_bridge import bridge_logging_to_rosout
 
 from .. import topics
-from ..core.geometry import Point
 from ..core.icons import WARN, IconRow, block_label, icon_levels, status_rows
 from ..core.labels import Label
 from ..core.scene import Scene, Touched

@@ -9,11 +9,53 @@ status.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from typing import Protocol
 
 from .model import Barrier, SkillInstance, SkillStatus
 from .state import MissionState
+
+
+class Members(Protocol):
+    """What the barrier advice reads of a mission: the server's state (through
+    :class:`~.legality.StatePicture`) or a GUI's copy of it."""
+
+    def skills(self, skill_ids: Sequence[str]) -> list[SkillInstance]:
+        """The skills with these ids that exist."""
+
+
+@dataclass(frozen=True)
+class StrandedBarrier:
+    """A barrier some of whose members are on their robots (or being sent) and not yet
+    past it, while others are still in a blueprint: those robots would wait at it for ever
+    unless the planned members are sent too."""
+
+    barrier: Barrier
+    going: tuple[SkillInstance, ...]  # synchronized, uploading or being sent, not finished
+    planned: tuple[SkillInstance, ...]  # editable blueprint members, not being sent
+
+
+def stranded_barriers(
+    mission: Members, barriers: Iterable[Barrier], sending: Iterable[str] = ()
+) -> list[StrandedBarrier]:
+    """The ``barriers`` that would strand a robot, if the skills ``sending`` were sent too.
+
+    The one rule of the barrier warnings: the command GUI's standing warning and its
+    question before a send pass every barrier; the server's note on an upload passes only
+    the barriers of the skills it uploads (so it costs the change, not the mission). A
+    member is *planned* while it is editable (:attr:`SkillInstance.is_editable`: in the
+    blueprint, not being uploaded) and not in ``sending``.
+    """
+    sending_ids = set(sending)
+    found = []
+    for barrier in barriers:
+        members = mission.skills(barrier.skill_ids)
+        planned = tuple(s for s in members if s.is_editable and s.id not in sending_ids)
+        going = tuple(s for s in members if s not in planned and not s.status.is_final)
+        if going and planned:
+            found.append(StrandedBarrier(barrier, going, planned))
+    return found
 
 
 @dataclass(frozen=True)
@@ -33,18 +75,27 @@ class UnsyncedPartner:
         )
 
 
+class _StateMembers:
+    def __init__(self, state: MissionState) -> None:
+        self._state = state
+
+    def skills(self, skill_ids: Sequence[str]) -> list[SkillInstance]:
+        return [self._state.skill(i) for i in skill_ids if self._state.has_skill(i)]
+
+
 def unsynced_partners(state: MissionState, skill_ids: Iterable[str]) -> list[UnsyncedPartner]:
-    """Barrier partners, still in a blueprint, of the skills ``skill_ids``."""
+    """Barrier partners, still in a blueprint, of the skills ``skill_ids`` (by
+    :func:`stranded_barriers`, over their barriers only)."""
+    wanted = list(skill_ids)
+    barriers = {b.id: b for i in wanted if (b := state.barrier_of(i)) is not None}
     found = []
-    for skill_id in skill_ids:
-        barrier = state.barrier_of(skill_id)
-        if barrier is None:
-            continue
-        skill = state.skill(skill_id)
-        for partner_id in barrier.skill_ids:
-            partner = state.skill(partner_id)
-            if partner_id != skill_id and partner.is_editable:
-                found.append(UnsyncedPartner(barrier, skill, partner))
+    for stranded in stranded_barriers(_StateMembers(state), barriers.values()):
+        going = {s.id: s for s in stranded.going}
+        for skill_id in wanted:
+            if skill_id in going:
+                found += [
+                    UnsyncedPartner(stranded.barrier, going[skill_id], p) for p in stranded.planned
+                ]
     return found
 
 

@@ -14,12 +14,13 @@ from dataclasses import replace
 
 from .barriers import after_retry, after_skip
 from .changes import Change, EventKind, PlacedSkill, Proposal
+from .commands import CommandKind
 from .errors import InvalidRequest, RuleViolation
 from .legality import (
     TaskView,
     failure_refusal,
     sync_refusal,
-    unsync_refusal,
+    take_back_refusal,
     unsync_start,
 )
 from .model import Resolution, SkillInstance, SkillStatus, Transfer, skill_with
@@ -130,6 +131,37 @@ def plan_cancel_uploads(state: MissionState, agent: str, from_id: str | None = N
     )
 
 
+def plan_take_back(state: MissionState, agent: str, from_id: str | None) -> Proposal:
+    """Take back ``from_id`` (None: all that may come back) and every later sent skill.
+
+    The operator's *Take back* (the ``unsynchronize`` service), decided by
+    :func:`~.legality.take_back_refusal`, the rule the GUIs enable it by: with an upload
+    awaiting the robot's answer it cancels the upload (:func:`plan_cancel_uploads`),
+    otherwise it asks the robot to give the skills back (:func:`plan_request_unsync`).
+    """
+    view = TaskView.live(state, agent)
+    index = None
+    if from_id:
+        agent_of, index = state.locate(from_id)
+        if agent_of != agent or index >= view.editable_start:
+            raise RuleViolation(f"skill '{from_id}' is not in {agent}'s synchronized section")
+    refusal = take_back_refusal(view, index)
+    if refusal is not None:
+        raise RuleViolation(refusal)
+    if view.uploading:
+        return plan_cancel_uploads(state, agent, from_id)
+    return plan_request_unsync(state, agent, from_id)
+
+
+def take_back_command(state: MissionState, agent: str) -> CommandKind | None:
+    """The new work a take-back on ``agent`` gives the robot link now (for the bound of
+    :func:`~.waiting.room_refusal`): an UNSYNC request, or None when it cancels an
+    unanswered upload (that withdraws waiting work, or cleans up after it, and so is
+    never refused for lack of room)."""
+    cancels = agent in state.agents and state.pending(agent, Transfer.UPLOADING)
+    return None if cancels else CommandKind.UNSYNC
+
+
 def plan_request_unsync(state: MissionState, agent: str, from_id: str | None) -> Proposal:
     """Ask the robot to give back ``from_id`` and every later synchronized skill."""
     view = TaskView.live(state, agent)
@@ -139,9 +171,9 @@ def plan_request_unsync(state: MissionState, agent: str, from_id: str | None) ->
         agent_of, index = state.locate(from_id)
         if agent_of != agent or index >= len(synced):
             raise RuleViolation(f"skill '{from_id}' is not in {agent}'s synchronized section")
-    refusal = unsync_refusal(view, index)
-    if refusal is not None:
-        raise RuleViolation(refusal)
+    refusal = take_back_refusal(view, index)
+    if refusal is not None or view.uploading:
+        raise RuleViolation(refusal or f"an upload to {agent} awaits the robot's answer")
     start = unsync_start(view) if index is None else index
     pulled = synced[start:]
     puts = tuple(

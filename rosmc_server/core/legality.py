@@ -192,11 +192,30 @@ def unsync_start(task: TaskView) -> int:
     return start
 
 
-def unsync_refusal(task: TaskView, index: int | None) -> str | None:
-    """Why ``task``'s synced skills from ``index`` (None: all it may) cannot be pulled back."""
-    agent = task.agent
+def take_back_refusal(task: TaskView, index: int | None) -> str | None:
+    """Why ``task``'s skills from ``index`` (None: all it may) cannot be taken back now.
+
+    The one rule of *Take back* (the server's ``unsynchronize``, ``rosmc unsync`` and both
+    GUIs). While an upload awaits the robot's answer (the robot may be out of contact for
+    minutes), taking back cancels that upload: from ``index`` if it is one of the skills
+    being uploaded, all of it for None. The operator can always take back what the robot
+    has not confirmed; what it has confirmed comes back once it has answered. Otherwise the
+    robot is asked to give back its not-started skills (:func:`unsync_refusal`).
+    """
     if task.uploading:
-        return f"an upload to {agent} awaits the robot's answer; unsynchronize after it"
+        if index is None or task.synced_end <= index < task.editable_start:
+            return None
+        return (
+            f"an upload to {task.agent} awaits the robot's answer; take back the upload "
+            "first, or the skills on the robot once it has answered"
+        )
+    return unsync_refusal(task, index)
+
+
+def unsync_refusal(task: TaskView, index: int | None) -> str | None:
+    """Why ``task``'s synced skills from ``index`` (None: all it may) cannot be pulled back
+    from the robot (no upload pending: see :func:`take_back_refusal`)."""
+    agent = task.agent
     if task.removing:
         return f"an unsynchronize on {agent} already awaits the robot's answer"
     start = unsync_start(task)
@@ -273,11 +292,12 @@ def _unsync_actions(picture: Picture, selected: Sequence[SkillInstance]) -> set[
     if agent is None:
         return set()
     task = picture.view(agent)
-    synced = {skill.id: index for index, skill in enumerate(task.synced)}
-    if not all(skill.id in synced for skill in selected):
+    # On the robot, or being uploaded to it: what a take-back can start from.
+    sent = {skill.id: index for index, skill in enumerate(task.skills[: task.editable_start])}
+    if not all(skill.id in sent for skill in selected):
         return set()
-    first = min(synced[skill.id] for skill in selected)
-    return {SkillAction.UNSYNC} if unsync_refusal(task, first) is None else set()
+    first = min(sent[skill.id] for skill in selected)
+    return {SkillAction.UNSYNC} if take_back_refusal(task, first) is None else set()
 
 
 def _barrier_ok(picture: Picture, selected: Sequence[SkillInstance]) -> bool:
@@ -297,7 +317,7 @@ def legal_robot_actions(task: TaskView, executor: ExecutorState) -> set[RobotAct
     legal: set[RobotAction] = set()
     if sync_refusal(task) is None:
         legal.add(RobotAction.SYNC_ALL)
-    if unsync_refusal(task, None) is None:
+    if take_back_refusal(task, None) is None:
         legal.add(RobotAction.UNSYNC_ALL)
     return legal | _control_actions(task, executor)
 

@@ -182,9 +182,11 @@ class Mission:
         *,
         base_revision: int | None = None,
     ) -> MissionEvent:
-        """Ask the robot to give back not-started skills from ``from_id`` on."""
+        """Take back ``from_id`` (None: all that may come back) and the later sent skills:
+        cancel an unanswered upload, or ask the robot to give back its not-started skills
+        (:func:`~.execution.plan_take_back`, the rule the GUIs enable *Take back* by)."""
         self._check_revision(base_revision)
-        return self._commit(execution.plan_request_unsync(self.state, agent, from_id))
+        return self._commit(execution.plan_take_back(self.state, agent, from_id))
 
     def cancel_uploads(
         self, agent: str, from_id: str | None = None, *, base_revision: int | None = None

@@ -142,6 +142,19 @@ def _unsync(outbox: Outbox[C], command: C, withdrawn: list[Any]) -> C | None:
     return command
 
 
+def room_refusal(
+    agent: str, kind: CommandKind | None, waiting: int, limit: int = MAX_WAITING
+) -> str:
+    """The bound on waiting work, as the services apply it before the mission changes: the
+    one-sentence refusal of a command of ``kind`` for ``agent``, which has ``waiting`` unsent
+    work commands (:func:`waiting_work`); "" if it may wait. Only work is bounded: a control
+    or a policy collapses with what waits, and ``kind`` None (a take-back that cancels an
+    unanswered upload) withdraws work rather than adding some."""
+    if kind is None or not is_work(kind):
+        return ""
+    return refusal(agent, waiting, limit)
+
+
 def refusal(agent: str, waiting: int, limit: int = MAX_WAITING) -> str:
     """The one-sentence refusal of more work when ``agent`` has ``waiting`` unsent work
     commands (:func:`waiting_work`), "" below the bound."""

@@ -10,9 +10,9 @@ from typing import Protocol
 import rosmc.msg as wire
 import rospy
 
+from ..common.ros.radio import TopicListener
 from ..core import Barrier, Mission, MissionEvent
 from ..core.link import InboundSequence, Outbox
-from .radio import TopicListener
 
 Operation = Callable[[Mission], MissionEvent | None]
 

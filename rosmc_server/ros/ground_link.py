@@ -29,6 +29,7 @@ from collections.abc import Callable, Iterable
 import rosmc.msg as wire
 import rospy
 
+from ..common.ros.radio import GROUND, Radio, TopicListener, reconnect_in_background
 from ..conversions import time_to_msg
 from ..conversions.command_packing import command_msg
 from ..core import Mission, RosmcError, SkillStatus, StorageFull, Transfer
@@ -47,7 +48,6 @@ from ..core.waiting import collapse, waiting_work
 from ..interface import ground_link
 from .agent_link import AgentLink, LinkHost, Operation
 from .command_records import command_record
-from .radio import GROUND, Radio, TopicListener, reconnect_in_background
 from .snapshot_sync import SnapshotSync
 
 _log = logging.getLogger(__name__)

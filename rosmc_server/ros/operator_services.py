@@ -34,6 +34,7 @@ from ..conversions import (
 from ..conversions.move_fields import order_from_field
 from ..conversions.request_fields import base_of, insert_index_from_msg
 from ..core import (
+    EventKind,
     InvalidRequest,
     LibraryError,
     Mission,
@@ -44,14 +45,14 @@ from ..core import (
     RosmcError,
     RuleViolation,
     StaleRevision,
-    Transfer,
     Unavailable,
 )
 from ..core.advice import unsynced_partners
 from ..core.commands import CommandKind, CommandSpec
+from ..core.execution import take_back_command
 from ..core.link import LinkStatus
 from ..core.policy import options_argument
-from ..core.waiting import queued_notes, refusal
+from ..core.waiting import queued_notes, room_refusal
 from .caller_id import caller_id
 from .server_host import ServerHost
 from .team_sync import synchronize_team
@@ -167,14 +168,14 @@ class OperatorServices:
         assert event is not None
         return event
 
-    def _require_link(self, agent: str, work: bool = True) -> None:
-        """``agent`` has a robot link, and (for ``work``) room for more waiting work."""
+    def _require_link(self, agent: str, kind: CommandKind | None = CommandKind.UPLOAD) -> None:
+        """``agent`` has a robot link, and room for a command of ``kind`` (None: one that
+        adds no work) by the core's bound (:func:`~rosmc_server.core.waiting.room_refusal`)."""
         if agent not in self._server.library.dynamic_agents:
             self._server.library.agent(_text(agent, "the agent name"))
             raise RuleViolation(f"'{agent}' is a static agent and has no robot link")
-        # Out of contact is no reason to refuse (the command waits); only the bound is, and
-        # only for work: stop, pause, resume and policies collapse with what waits instead.
-        sentence = refusal(agent, self._server.link.waiting_work(agent)) if work else ""
+        # Out of contact is no reason to refuse (the command waits); only the core's bound is.
+        sentence = room_refusal(agent, kind, self._server.link.waiting_work(agent))
         if sentence:
             raise Unavailable(sentence)
 
@@ -243,22 +244,17 @@ class OperatorServices:
         return synchronize_team(self._server, self._require_link, self._queued_note, req, resp)
 
     def _unsynchronize(self, req: Any, resp: Any) -> MissionEvent:
+        # Take back: the core decides whether it cancels an unanswered upload or asks the
+        # robot (plan_take_back), and whether that needs room on the link.
+        agent = _text(req.agent, "the agent name")
         with self._server.locked():
-            if self._uploading(req.agent):
-                # An upload still unanswered (the robot may be out of reach) is cancelled:
-                # the operator can always take back what the robot has not confirmed.
-                base = base_of(req)
-                upto = req.from_id or None
-                event = self._apply(lambda m: m.cancel_uploads(req.agent, upto, base_revision=base))
-                resp.skill_ids = [placed.skill.id for placed in event.change.put_skills]
-                return event
-            self._require_link(req.agent)
+            state = self._server.mission.state
+            self._require_link(agent, take_back_command(state, agent))
             event = self._apply(
-                lambda m: m.unsynchronize(
-                    req.agent, req.from_id or None, base_revision=base_of(req)
-                )
+                lambda m: m.unsynchronize(agent, req.from_id or None, base_revision=base_of(req))
             )
-            resp.note = self._queued_note([req.agent])
+            if event.kind is EventKind.UNSYNC_REQUESTED:
+                resp.note = self._queued_note([agent])
         resp.skill_ids = [placed.skill.id for placed in event.change.put_skills]
         return event
 
@@ -272,19 +268,13 @@ class OperatorServices:
         ]
         return notes(*queued_notes(waiting))
 
-    def _uploading(self, agent: str) -> bool:
-        state = self._server.mission.state
-        if agent not in state.agents:
-            return False
-        return bool(state.pending(agent, Transfer.UPLOADING))
-
     def _control(self, req: Any, resp: Any) -> None:
         if req.command not in _CONTROL:
             raise InvalidRequest(f"unknown control command {req.command}")
         agents = [req.agent] if req.agent else list(self._server.library.dynamic_agents)
         with self._server.locked():
             for agent in agents:
-                self._require_link(agent, work=False)
+                self._require_link(agent, None)
             for agent in agents:
                 self._server.link.send(CommandSpec(agent, _CONTROL[req.command]))
             resp.note = self._queued_note(agents)
@@ -295,7 +285,7 @@ class OperatorServices:
         agent = _text(req.agent, "the agent name")
         policy = policy_from_request(req).checked(self._server.library, agent)
         with self._server.locked():
-            self._require_link(agent, work=False)
+            self._require_link(agent, None)
             argument = options_argument(policy)
             self._server.link.send(CommandSpec(agent, CommandKind.SET_OPTIONS, argument=argument))
             resp.note = self._queued_note([agent])
@@ -304,7 +294,7 @@ class OperatorServices:
     def _retry_skill(self, req: Any, resp: Any) -> MissionEvent:
         with self._server.locked():
             agent, _ = self._server.mission.state.locate(_text(req.skill_id, "the skill id"))
-            self._require_link(agent)
+            self._require_link(agent, CommandKind.RETRY)
             event = self._apply(lambda m: m.retry(req.skill_id, base_revision=base_of(req)))
         resp.new_skill_id = event.change.put_skills[1].skill.id
         return event
@@ -312,7 +302,7 @@ class OperatorServices:
     def _skip_skill(self, req: Any, resp: Any) -> MissionEvent:
         with self._server.locked():
             agent, _ = self._server.mission.state.locate(_text(req.skill_id, "the skill id"))
-            self._require_link(agent)
+            self._require_link(agent, CommandKind.SKIP)
             return self._apply(lambda m: m.skip(req.skill_id, base_revision=base_of(req)))
 
     # -- barriers and markers ---------------------------------------------------

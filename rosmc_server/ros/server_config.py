@@ -10,9 +10,9 @@ from pathlib import Path
 
 import rospy
 
+from ..common.ros import station
 from ..core.operators import OperatorAllowList
 from ..recording import JournalOptions
-from . import station
 
 PACKAGE_ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_LIBRARY = PACKAGE_ROOT / "rosmc_server" / "config" / "mars_team.yaml"

@@ -72,6 +72,9 @@ import rosmc.msg as wire
 import rospy
 
 from .. import interface
+from ..common.ros import station
+from ..common.ros.logging_bridge import bridge_logging_to_rosout
+from ..common.ros.radio import node_radio_key
 from ..conversions import library_to_msg, time_to_msg
 from ..conversions.packing import PackedMission, SnapshotPacker
 from ..core import (
@@ -86,16 +89,13 @@ from ..core.changes import EventKind
 from ..core.commands import commands_for_event, default_policy_commands
 from ..recording import JournalOptions, default_journal_path
 from ..recording.mission_journal import MissionJournal
-from . import station
 from .agent_states import AgentStatePublisher
 from .allocator import keep_large_blocks_apart
 from .clock_watch import CLOCK_CHECK_PERIOD, ClockWatch
 from .ground_link import GroundLink
 from .heartbeat import Heartbeat
-from .logging_bridge import bridge_logging_to_rosout
 from .operator_services import OperatorServices
 from .publishing import SnapshotPublisher
-from .radio import node_radio_key
 from .recorder import TelemetryRecorder
 from .server_config import ServerConfig
 from .site_listener import SiteListener

@@ -32,11 +32,11 @@ from typing import TypeVar
 import rosmc.msg as wire
 import rospy
 
+from rosmc_server.common.ros.station import launch_path
 from rosmc_server.core import MarkerType, Pose, RosmcError, SkillStatus, TaskMarker
 from rosmc_server.core.changes import EventKind
 from rosmc_server.core.vocabulary import OPERATOR_EVENTS, counted
 from rosmc_server.ros.client import ControlCommand, MissionClient, MissionWatch
-from rosmc_server.ros.station import launch_path
 
 from .topics import SCIENCE_TOPIC
 

@@ -35,8 +35,8 @@ import rosmc.msg as wire
 import rospy
 from std_msgs.msg import Bool
 
+from rosmc_server.common.ros.logging_bridge import bridge_logging_to_rosout
 from rosmc_server.interface import ground_link, robot_link
-from rosmc_server.ros.logging_bridge import bridge_logging_to_rosout
 
 from ..core.delay_line import DelayLine
 from ..core.scenario import load_scenario

@@ -49,8 +49,8 @@ import rospy.impl.simtime
 import rospy.rostime
 from rosgraph_msgs.msg import Clock
 
-from rosmc_server.ros.logging_bridge import bridge_logging_to_rosout
-from rosmc_server.ros.station import CWD_PARAM, resolve_against
+from rosmc_server.common.ros.logging_bridge import bridge_logging_to_rosout
+from rosmc_server.common.ros.station import CWD_PARAM, resolve_against
 
 from ..core.scenario import Scenario, ScenarioError, load_scenario
 from ..core.sim import Simulation

@@ -25,7 +25,7 @@ from geometry_msgs.msg import Point
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
-from rosmc_rviz_markers.core.labels import CHAR_WIDTH
+from rosmc_server.core.geometry import CHAR_WIDTH
 from rosmc_server.core.vocabulary import PALETTE, counted
 from rosmc_server.interface import MAP_FRAME
 

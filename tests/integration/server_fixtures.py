@@ -37,7 +37,7 @@ import rosmc.srv as srv
 import rospy
 
 from rosmc_server import interface
-from rosmc_server.ros.connections import publishers_count_me
+from rosmc_server.common.ros.connections import publishers_count_me
 
 REPO = Path(__file__).resolve().parents[2]
 SERVER_SCRIPT = REPO / "scripts" / "mission_server"

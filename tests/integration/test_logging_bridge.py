@@ -19,7 +19,7 @@ NODE = textwrap.dedent(
     """
     import logging, sys, time
     import rospy, rospy.impl.paramserver
-    from rosmc_server.ros.logging_bridge import ROSOUT_FLAG, bridge_logging_to_rosout
+    from rosmc_server.common.ros.logging_bridge import ROSOUT_FLAG, bridge_logging_to_rosout
 
     rospy.init_node("logging_bridge_probe", disable_signals=True)
     bridge_logging_to_rosout()

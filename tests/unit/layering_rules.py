@@ -42,8 +42,14 @@ Besides the order, by what a module imports from outside:
 * **The executor is the robot's**: the ground (``rosmc_server`` outside its ``executor/``)
   imports nothing of it; what both ends speak (the robot link's protocol) is in
   ``rosmc_server/core``. A robot may run without the ground's code and the other way round.
+* **The packages in order** (:data:`PACKAGE_RANK`): ``rosmc_server`` < ``rosmc_sim`` <
+  the GUIs. The server imports no GUI and no simulator (drawing primitives are in
+  ``rosmc_server/core/geometry.py``), the simulator no GUI.
+* **The executor imports nothing of the ground's own modules** (:data:`GROUND_ONLY`): the
+  ROS helpers both ends run (radio, station, logging bridge) are ``rosmc_server/common``.
 * **The server's insides**: apps reach the graph through the client. They import nothing
-  of ``rosmc_server.ros`` but the client, the replayer and the logging bridge; a GUI
+  of ``rosmc_server.ros`` but the client and the replayer (their ROS adapters may use
+  ``rosmc_server.common.ros``); a GUI
   model or widget (neither a ROS adapter nor an entry module) imports nothing of
   ``rosmc_server.ros`` at all: the bridge hands it core objects.
 
@@ -79,6 +85,7 @@ LAYER_OF_PATH = {
     "rosmc_server/conversions/": "conversions",
     "rosmc_server/recording/": "recording",
     "rosmc_server/ros/": "ros",
+    "rosmc_server/common/": "ros",  # ROS helpers of every node, ground or robot
     "rosmc_server/executor/ros/": "ros",
     "rosmc_server/ros/client/": "client",
     "rosmc_server/cli/": "app",
@@ -139,12 +146,30 @@ WHY = {
 GUI_PACKAGES = ("rosmc_rviz_markers/", "rosmc_rqt_command/")
 EXECUTOR = "rosmc_server/executor/"
 PYBULLET_ALLOWED = ("rosmc_sim/core/",)
-# What the apps may use of rosmc_server.ros: the client and what serves clients.
+# What the apps may use of rosmc_server.ros: the client and what serves clients. (The
+# shared helpers of rosmc_server.common.ros, logging to rosout and the station's paths
+# among them, are any ROS adapter's; a GUI model or widget uses none of them.)
 FOR_APPS = (
     "rosmc_server.ros.client",
     "rosmc_server.ros.replayer",
-    "rosmc_server.ros.logging_bridge",
-    "rosmc_server.ros.station",  # where a launched node's relative paths point
+)
+COMMON_ROS = "rosmc_server.common.ros"
+# The packages in their order: a package imports only from its own rank or below (the
+# GUIs draw with rosmc_server.core.geometry; the server never imports a GUI or the sim).
+PACKAGE_RANK = {
+    "rosmc_server": 0,
+    "rosmc_sim": 1,
+    "rosmc_rviz_markers": 2,
+    "rosmc_rqt_command": 2,
+}
+# The ground's own modules: the executor (the robot's) imports none of them. It shares the
+# core, the graph names, the message conversions and rosmc_server/common with the ground.
+GROUND_ONLY = (
+    "rosmc_server/ros/",
+    "rosmc_server/recording/",
+    "rosmc_server/cli/",
+    "rosmc_server/text/",
+    "rosmc_server/demo.py",
 )
 CONVERSIONS = "rosmc_server.conversions"
 CLIENT = "rosmc_server.ros.client"  # a GUI module may name its types for the type checker
@@ -281,16 +306,22 @@ def _inside_rule(relative: str, module: str, root: Path) -> str | None:
         return None  # reported by the test that every module has a layer
     if RANK[target_layer] > RANK[layer]:
         return f"the {target_layer} layer, above this {layer} module"
+    package, target_package = relative.split("/")[0], target.split("/")[0]
+    if PACKAGE_RANK.get(target_package, 0) > PACKAGE_RANK.get(package, 0):
+        return f"the package {target_package}, above {package}"
     ground = relative.startswith("rosmc_server/") and not relative.startswith(EXECUTOR)
     if ground and target.startswith(EXECUTOR):
         return "the executor runs on the robot: the ground shares only rosmc_server.core with it"
+    if relative.startswith(EXECUTOR) and target.startswith(GROUND_ONLY):
+        return "the ground's modules: the executor shares rosmc_server/common with the ground"
     if layer == "app" and module.startswith(CONVERSIONS) and not is_ros_adapter(relative):
         return "message conversions: apps get core objects from the client"
-    if layer == "app" and module.startswith("rosmc_server.ros"):
+    if layer == "app" and module.startswith(("rosmc_server.ros", COMMON_ROS)):
         gui_model = not (is_ros_adapter(relative) or is_gui_entry(relative))
         if relative.startswith(GUI_PACKAGES) and gui_model:
             return "rosmc_server.ros: a GUI model or widget gets it from the GUI's ROS adapter"
-        if module != "rosmc_server.ros" and not module.startswith(FOR_APPS):
+        ours = module == "rosmc_server.ros" or module.startswith((*FOR_APPS, COMMON_ROS))
+        if not ours:
             return "the server's ROS adapters: apps go through the client"
     return None
 

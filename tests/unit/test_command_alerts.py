@@ -219,3 +219,19 @@ def test_a_journal_alert_is_said_when_it_begins_and_when_it_clears(gui: Gui) -> 
         "The journal's alert cleared: changes are recorded again.",
         f"Journal: {full.format(1000)}.",
     ]
+
+
+def test_the_gui_and_the_server_warn_of_the_same_barriers(gui: Gui, mission: Mission) -> None:
+    """One rule (rosmc_server.core.advice): a partner being uploaded is on its way, not
+    planned; the GUI's standing warning and the server's note on an upload agree."""
+    from rosmc_server.core.advice import unsynced_partners
+
+    feed = gui.feed
+    first, partner = feed.add("alpha", "wait"), feed.add("bravo", "wait")
+    feed("add_barrier", [first, partner])
+    feed.sync("alpha")
+    assert len(alerts.barrier_warnings(gui.widget.view)) == 1
+    assert len(unsynced_partners(mission.state, [first])) == 1
+    feed.sync("bravo", confirm=False)  # bravo's upload awaits its (out-of-contact) robot
+    assert alerts.barrier_warnings(gui.widget.view) == []
+    assert unsynced_partners(mission.state, [first]) == []

@@ -95,7 +95,9 @@ def test_uploading_and_removing_skills_are_pending(gui: Gui) -> None:
     skill = feed.add("alpha")
     feed.sync("alpha", confirm=False)
     gui.click_row("alpha", True, 0)
-    assert gui.enabled() == set()  # uploading: neither editable nor on the robot yet
+    # Uploading: not editable, but the robot has not confirmed it, so Take back (which the
+    # server turns into cancelling the upload) is offered, as the server accepts it.
+    assert gui.enabled() == {"unsynchronize"}
     feed("confirm_synchronized", "alpha", [skill])
     assert gui.enabled() == {"unsynchronize"}
     feed("unsynchronize", "alpha", skill)

@@ -89,7 +89,7 @@ def test_every_module_has_a_layer() -> None:
         ("rosmc_server/ros/replayer.py", "ros"),
         ("rosmc_server/text/plain.py", "core"),
         ("rosmc_server/cli/replay.py", "app"),
-        ("rosmc_rviz_markers/core/geometry.py", "core"),
+        ("rosmc_rviz_markers/core/labels.py", "core"),
         ("rosmc_rviz_markers/ros/node.py", "app"),
         ("rosmc_rqt_command/ros_bridge.py", "app"),
         ("rosmc_rqt_command/task_model.py", "app"),
@@ -210,11 +210,18 @@ def fake_repo(tmp_path: Path) -> Path:
         "rosmc_rqt_command/core",
         "rosmc_rviz_markers/core",
         "rosmc_rviz_markers/ros",
+        "rosmc_server/common",
+        "rosmc_server/common/ros",
+        "rosmc_server/executor",
+        "rosmc_server/executor/ros",
     ):
         (tmp_path / package).mkdir(parents=True)
         (tmp_path / package / "__init__.py").write_text("", encoding="utf-8")
     (tmp_path / "rosmc_server/ros/replayer.py").write_text("", encoding="utf-8")
     (tmp_path / "rosmc_server/ros/server_node.py").write_text("", encoding="utf-8")
+    for module in ("radio", "station", "logging_bridge"):
+        (tmp_path / f"rosmc_server/common/ros/{module}.py").write_text("", encoding="utf-8")
+    (tmp_path / "rosmc_rviz_markers/core/labels.py").write_text("", encoding="utf-8")
     return tmp_path
 
 
@@ -353,10 +360,10 @@ def _scan_source(root: Path, relative: str, source: str) -> list[str]:
         ("rosmc_rqt_command/standalone.py", "from rosmc_server.ros import operator_services"),
         ("rosmc_rqt_command/widgets/plugin.py", "import rospy"),
         ("rosmc_rqt_command/widgets/panel.py", "import rospy"),
-        ("rosmc_rviz_markers/core/geometry.py", "import rospy"),
-        ("rosmc_rviz_markers/core/geometry.py", "from visualization_msgs.msg import Marker"),
-        ("rosmc_rviz_markers/core/geometry.py", "from python_qt_binding import QtCore"),
-        ("rosmc_rviz_markers/core/geometry.py", "from rosmc_server.ros.client import X"),
+        ("rosmc_rviz_markers/core/labels.py", "import rospy"),
+        ("rosmc_rviz_markers/core/labels.py", "from visualization_msgs.msg import Marker"),
+        ("rosmc_rviz_markers/core/labels.py", "from python_qt_binding import QtCore"),
+        ("rosmc_rviz_markers/core/labels.py", "from rosmc_server.ros.client import X"),
         ("rosmc_rqt_command/core/x.py", "from rosmc_server.ros.client import MissionClient"),
         # under TYPE_CHECKING only the client's types, and only in a GUI
         ("rosmc_rqt_command/core/x.py", "if TYPE_CHECKING:\n    import rospy"),
@@ -367,6 +374,17 @@ def _scan_source(root: Path, relative: str, source: str) -> list[str]:
         ("rosmc_rviz_markers/ros/markers.py", "from rosmc_server.ros import ground_link"),
         # Qt only in the GUIs
         ("rosmc_server/cli/x.py", "from python_qt_binding import QtWidgets"),
+        # the packages in order: the server and the sim import no GUI, the server no sim
+        ("rosmc_server/conversions/x.py", "from rosmc_rviz_markers.core import labels"),
+        ("rosmc_server/recording/x.py", "from rosmc_rviz_markers.core import labels"),
+        ("rosmc_server/core/x.py", "from rosmc_sim.core import world"),
+        ("rosmc_sim/ros/x.py", "from rosmc_rviz_markers.core.labels import CHAR_WIDTH"),
+        # the executor (the robot's) imports none of the ground's modules
+        ("rosmc_server/executor/ros/node.py", "from rosmc_server.ros.radio import Radio"),
+        ("rosmc_server/executor/ros/node.py", "from ...ros import station"),
+        ("rosmc_server/executor/ros/node.py", "from rosmc_server.recording import writer"),
+        # a GUI model or widget uses no ROS helper, shared or not
+        ("rosmc_rqt_command/task_model.py", "from rosmc_server.common.ros import station"),
     ],
 )
 def test_scanner_catches_a_layer_break(fake_repo: Path, relative: str, source: str) -> None:
@@ -407,10 +425,16 @@ def test_scanner_catches_a_layer_break(fake_repo: Path, relative: str, source: s
         ("rosmc_rviz_markers/ros/node.py", "import rospy\nfrom interactive_markers import x"),
         ("rosmc_rviz_markers/ros/node.py", "from visualization_msgs.msg import Marker"),
         ("rosmc_rviz_markers/ros/node.py", "from rosmc_server.ros.client import MissionFollower"),
-        ("rosmc_rviz_markers/ros/node.py", "from rosmc_server.ros.logging_bridge import x"),
-        ("rosmc_rviz_markers/ros/node.py", "from ..core import geometry"),
-        ("rosmc_rviz_markers/core/geometry.py", "from rosmc_server.core.frames import yaw_of"),
-        ("rosmc_rviz_markers/core/geometry.py", "from rosmc_server.interface import MAP_FRAME"),
+        ("rosmc_rviz_markers/ros/node.py", "from rosmc_server.common.ros.logging_bridge import x"),
+        ("rosmc_rviz_markers/ros/node.py", "from ..core import labels"),
+        ("rosmc_rviz_markers/core/labels.py", "from rosmc_server.core.frames import yaw_of"),
+        ("rosmc_rviz_markers/core/labels.py", "from rosmc_server.interface import MAP_FRAME"),
+        ("rosmc_rviz_markers/core/labels.py", "from rosmc_server.core import geometry"),
+        ("rosmc_server/conversions/x.py", "from ..core import geometry as geo"),
+        # the executor and the ground share rosmc_server/common
+        ("rosmc_server/executor/ros/node.py", "from ...common.ros.radio import Radio"),
+        ("rosmc_server/executor/ros/node.py", "from rosmc_server.common.ros import station"),
+        ("rosmc_server/ros/x.py", "from ..common.ros.radio import Radio"),
     ],
 )
 def test_scanner_allows_the_layers(fake_repo: Path, relative: str, source: str) -> None:
@@ -431,5 +455,5 @@ def test_ros_adapter_naming() -> None:
     assert is_ros_adapter("rosmc_rqt_command/node.py")
     assert not is_ros_adapter("rosmc_rqt_command/plugin.py")
     assert not is_ros_adapter("rosmc_rqt_command/widgets/tasks.py")
-    assert not is_ros_adapter("rosmc_rviz_markers/core/geometry.py")
+    assert not is_ros_adapter("rosmc_rviz_markers/core/labels.py")
     assert not is_ros_adapter("rosmc_server/core/mission.py")

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from rosmc_rviz_markers.core import geometry, labels
+from rosmc_rviz_markers.core import labels
 from rosmc_rviz_markers.core.icons import block_label, icon_levels, status_rows
 from rosmc_rviz_markers.core.labels import Box, Label, layout, overlapping
 from rosmc_rviz_markers.core.scene import Scene
@@ -25,6 +25,7 @@ from rosmc_server.core import (
     MissionState,
     Pose,
     TaskMarker,
+    geometry,
     load_library,
 )
 from rosmc_server.core.changes import Change

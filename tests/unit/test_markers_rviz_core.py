@@ -13,7 +13,6 @@ from typing import Any
 
 import pytest
 
-from rosmc_rviz_markers.core import areas, geometry
 from rosmc_rviz_markers.core.icons import (
     BAD,
     DIM,
@@ -50,6 +49,8 @@ from rosmc_server.core import (
     SkillStatus,
     TaskMarker,
     Transfer,
+    areas,
+    geometry,
     load_library,
 )
 from rosmc_server.core.changes import Change, PlacedSkill

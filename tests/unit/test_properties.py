@@ -74,6 +74,8 @@ ROBOT_NEXT = {
     S.PAUSED: [S.RUNNING, S.RUNNING, S.SYNCWAITING, S.IDLE_SYNCHRONIZED, S.FAILURE],
 }  # fmt: skip
 
+# A take-back during an unanswered upload cancels the upload (legality.take_back_refusal).
+ALSO = {"unsynchronize": (EventKind.UPLOAD_CANCELLED,)}
 # The event each operation emits when it is accepted.
 KIND = {
     "add_skill": EventKind.SKILL_ADDED,
@@ -205,7 +207,7 @@ class MissionMachine(RuleBasedStateMachine):
             return None
         assert isinstance(event, MissionEvent)
         assert self.mission.revision == revision + 1 == event.revision, name
-        assert event.kind is KIND[name], (name, event.kind)
+        assert event.kind is KIND[name] or event.kind in ALSO.get(name, ()), (name, event.kind)
         assert event.stamp == self.now
         assert event.summary.strip()
         self.events.append(event)

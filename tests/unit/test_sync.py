@@ -263,12 +263,20 @@ def test_unsync_refusals(mission: Any, drv: Any, rejected: Any) -> None:
     rejected(mission, RuleViolation, mission.unsynchronize, "alpha", s3, match="already awaits")
 
 
-def test_unsync_refused_while_upload_pending(mission: Any, drv: Any, rejected: Any) -> None:
-    s1, _ = drv.adds("alpha", 2)
+def test_take_back_during_an_upload_cancels_it(mission: Any, drv: Any, rejected: Any) -> None:
+    """One rule for the server and the GUIs: what the robot has not confirmed can always
+    be taken back (the upload is cancelled); what it has, once it has answered."""
+    s1, s2, s3 = drv.adds("alpha", 3)
     drv.sync("alpha", s1)
     mission.synchronize("alpha")
-    rejected(mission, RuleViolation, mission.unsynchronize, "alpha", match="upload")
     rejected(mission, RuleViolation, mission.unsynchronize, "alpha", s1, match="upload")
+    event = mission.unsynchronize("alpha", s3)
+    assert event.kind is EventKind.UPLOAD_CANCELLED
+    assert [p.skill.id for p in event.change.put_skills] == [s3]
+    event = mission.unsynchronize("alpha")
+    assert event.kind is EventKind.UPLOAD_CANCELLED
+    assert [p.skill.id for p in event.change.put_skills] == [s2]
+    assert not mission.state.pending("alpha", Transfer.UPLOADING)
 
 
 def test_unsync_refused_when_everything_started(mission: Any, drv: Any, rejected: Any) -> None:

@@ -12,8 +12,8 @@ from typing import Any
 import pytest
 
 from rosmc_rqt_command.core import presentation
-from rosmc_rviz_markers.core import geometry, icons
-from rosmc_server.core import EventKind, Mission, SkillInstance, SkillStatus
+from rosmc_rviz_markers.core import icons
+from rosmc_server.core import EventKind, Mission, SkillInstance, SkillStatus, geometry
 from rosmc_server.core.agent_status import AgentStatus
 from rosmc_server.core.vocabulary import (
     OPERATOR_EVENTS,

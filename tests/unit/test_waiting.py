@@ -13,6 +13,7 @@ from rosmc_server.core.waiting import (
     queued_note,
     queued_notes,
     refusal,
+    room_refusal,
     waiting_text,
     waiting_work,
 )
@@ -186,6 +187,18 @@ def test_commands_already_transmitted_are_never_touched() -> None:
         (CommandKind.UNSYNC, ["a"]),
         (CommandKind.STOP, []),
     ]
+
+
+def test_the_bound_is_a_core_rule_by_command_kind() -> None:
+    """The services only call it: work is bounded; controls, policies and a take-back that
+    cancels an upload (kind None) collapse with or withdraw what waits, never refused."""
+    full = MAX_WAITING
+    for kind in (CommandKind.UPLOAD, CommandKind.UNSYNC, CommandKind.RETRY, CommandKind.SKIP):
+        assert room_refusal("rover", kind, full - 1) == ""
+        assert room_refusal("rover", kind, full) == refusal("rover", full)
+    for kind in (CommandKind.START, CommandKind.PAUSE, CommandKind.STOP, CommandKind.SET_OPTIONS):
+        assert room_refusal("rover", kind, full) == ""
+    assert room_refusal("rover", None, full) == ""
 
 
 def test_the_bound_is_refused_with_one_sentence() -> None:

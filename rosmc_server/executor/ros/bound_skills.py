@@ -23,7 +23,7 @@ import actionlib
 import rospy
 from actionlib_msgs.msg import GoalStatus
 
-from ...ros.connections import publishers_count_me
+from ...common.ros.connections import publishers_count_me
 from ..core import Outcome, SkillContext, ThreadedSkill
 from ..core.skills import Cancelled
 from .message_fields import MessageRecipe, Template, read_field

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import rospy
 
-from rosmc_server.ros.station import launch_path
+from rosmc_server.common.ros.station import launch_path
 
 from ..core.pacing import IDLE_PERIOD
 

@@ -9,7 +9,7 @@ Publishes:
     ``~idle_snapshot_period`` but twice within the ground's link timeout
     (:mod:`..core.pacing`); the whole queue in the first and when the ground asks,
     its digest always), ``/rosmc/barriers`` (rosmc/BarrierSignal, a copy for observers).
-Radio side channel (UDP, :mod:`rosmc_server.ros.radio`, registered as
+Radio side channel (UDP, :mod:`rosmc_server.common.ros.radio`, registered as
     ``/rosmc/radio/<robot>``): barrier signals to and from the other robots, and beacons
     to and from the ground (:class:`~rosmc_server.core.radio.BeaconPlan`: seldom while it
     hears the ground); a ground beacon after a silence reconnects the link's topics.
@@ -58,9 +58,16 @@ import rosmc.msg as wire
 import rospy
 
 from rosmc_server import interface
-from rosmc_server.ros.logging_bridge import bridge_logging_to_rosout
-from rosmc_server.ros.station import launch_path
+from rosmc_server.common.ros.logging_bridge import bridge_logging_to_rosout
+from rosmc_server.common.ros.station import launch_path
 
+from ...common.ros.radio import (
+    GROUND,
+    Radio,
+    TopicListener,
+    node_radio_key,
+    reconnect_in_background,
+)
 from ...conversions.robot_link import (
     ack_to_msg,
     command_from_msg,
@@ -74,7 +81,6 @@ from ...core.drop_log import DropLog
 from ...core.errors import RadioKeyError
 from ...core.radio import BeaconPlan, ContactWatch
 from ...core.radio_key import RadioKey
-from ...ros.radio import GROUND, Radio, TopicListener, node_radio_key, reconnect_in_background
 from ..core import Command, Engine, Report, Signal, SkillType
 from ..core.lost_link import PoseSource, no_pose
 from ..core.pacing import SnapshotPacer

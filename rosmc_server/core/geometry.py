@@ -16,11 +16,12 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
-from rosmc_server.core.frames import IDENTITY, Quaternion
-from rosmc_server.core.frames import quaternion_from_rpy as quaternion
-from rosmc_server.core.vocabulary import PALETTE
+from .frames import IDENTITY, Quaternion
+from .frames import quaternion_from_rpy as quaternion
+from .vocabulary import PALETTE
 
 Point = tuple[float, float, float]
+CHAR_WIDTH = 0.62  # a character's width in letter heights (rviz's text font, generously)
 
 
 @dataclass(frozen=True)
@@ -343,7 +344,7 @@ def polygon(
     vertices: Sequence[tuple[float, float]], color: Color, z: float = 0.04
 ) -> tuple[Primitive, ...]:
     """A filled polygon with a bold outline; ``vertices`` relative to the marker origin."""
-    from .areas import triangulate  # areas imports nothing from here at module level
+    from .areas import triangulate  # areas imports nothing from here
 
     outline = tuple((x, y, z + 0.01) for x, y in (*vertices, vertices[0]))
     triangles = tuple((x, y, z) for tri in triangulate(vertices) for x, y in tri)

@@ -42,17 +42,17 @@ import rosgraph.network
 import rosmc.msg as wire
 import rospy
 
-from ..core import RosmcError
-from ..core.drop_log import DropLog
-from ..core.radio import (
+from ...core import RosmcError
+from ...core.drop_log import DropLog
+from ...core.radio import (
     DIRECTORY_PERIOD,
     DatagramKind,
     next_directory_period,
     parse_endpoint,
 )
-from ..core.radio_auth import DatagramRefused, Opener, Sealer
-from ..core.radio_key import RadioKey, obtain_key
-from ..interface import RADIO_DIRECTORY
+from ...core.radio_auth import DatagramRefused, Opener, Sealer
+from ...core.radio_key import RadioKey, obtain_key
+from ...interface import RADIO_DIRECTORY
 from .connections import TimeoutTransport
 
 _log = logging.getLogger(__name__)

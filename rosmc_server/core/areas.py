@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from rosmc_server.core.errors import InvalidRequest
+from .errors import InvalidRequest
 
 XY = tuple[float, float]
 MIN_SIDE = 1.0  # metres

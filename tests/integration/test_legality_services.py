@@ -1,0 +1,302 @@
+"""What the GUIs offer is exactly what the real mission server accepts.
+
+:mod:`rosmc_server.core.legality` decides which skill and robot actions the command GUI
+and rviz enable. This module checks it against the real server's operator services, not
+against the core (``tests/unit/test_legality.py`` does that): for a set of mission states,
+every action on every skill (and each robot's send / take back) is legal by the core
+exactly when the service accepts the request the GUI sends for it. The states include an
+upload waiting for a robot that was never heard (out of contact), where the server
+cancels the upload on a take-back: *Take back* must then be offered.
+
+One server for the module; the drone is played by a test robot that answers every
+command, the science rover is never heard. A refused request leaves the mission as it
+was; after an accepted one, the state is taken back to an empty mission and built again
+(what the robots hold is given back first: a new mission needs idle robots).
+Reordering and the controls are not covered here (see the unit test's docstring).
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from typing import Any
+
+import pytest
+import rosmc.msg as wire
+import rospy
+
+from rosmc_server import interface
+from rosmc_server.conversions import mission_from_msg
+from rosmc_server.core import MissionState, SkillStatus
+from rosmc_server.core.control import ExecutorState
+from rosmc_server.core.legality import (
+    RobotAction,
+    SkillAction,
+    StatePicture,
+    TaskView,
+    legal_robot_actions,
+    legal_skill_actions,
+)
+
+pytest.register_assert_rewrite("tests.integration.server_fixtures")
+from tests.integration.server_fixtures import (  # noqa: E402
+    Client,
+    FakeRobot,
+    ServerProcess,
+    _launcher,
+    _stop_all,
+)
+
+pytest_plugins = ["tests.integration.server_fixtures"]
+pytestmark = pytest.mark.integration
+
+S = SkillStatus
+A = SkillAction
+ANSWERING = "drone"  # in contact, answers every command
+SILENT = "science_rover"  # never heard: what is sent to it waits for contact
+SETTLE = 60.0  # how long the server may take to show a robot's answer (a generous bound)
+
+
+@dataclass
+class Robot:
+    """The drone's end of the link: acknowledges every command while ``answering``."""
+
+    fake: FakeRobot
+    answering: bool = True
+    held: list[Any] = field(default_factory=list)  # commands left unanswered
+    reports: int = 0
+    lock: threading.Lock = field(default_factory=threading.Lock)
+
+    def on_command(self, command: Any) -> None:
+        with self.lock:
+            if self.answering:
+                self.fake.ack(command)
+            else:
+                self.held.append(command)
+
+    def answer(self) -> None:
+        """Answer again, the commands held first."""
+        with self.lock:
+            self.answering = True
+            for command in self.held:
+                self.fake.ack(command)
+            self.held.clear()
+
+    def report(self, skill_id: str, status: S) -> None:
+        self.reports += 1
+        self.fake.report(self.reports, skill_id, int(status))
+
+
+@dataclass
+class Bench:
+    """The module's server, a client, and the drone."""
+
+    client: Client
+    robot: Robot
+
+    def state(self) -> MissionState:
+        content, revision = mission_from_msg(self.client.mission())
+        return MissionState(content, revision)
+
+    def call(self, operation: str, **fields: Any) -> Any:
+        return self.client.call(operation, base_revision=self.client.revision(), **fields)
+
+    def do(self, operation: str, **fields: Any) -> Any:
+        response = self.call(operation, **fields)
+        assert response.error_code == 0, (operation, fields, response.error)
+        return response
+
+    def settle(self, done: Callable[[MissionState], bool], what: str) -> None:
+        """Wait until the mission shows ``done`` (a robot's answer has arrived)."""
+        deadline = time.monotonic() + SETTLE
+        while not done(self.state()):
+            assert time.monotonic() < deadline, f"the server never showed {what}"
+            time.sleep(0.02)
+
+    def reset(self) -> None:
+        """An empty mission: what the robots hold comes back first."""
+        self.robot.answer()
+        deadline = time.monotonic() + SETTLE
+        while True:
+            state = self.state()
+            for skill in state.task(ANSWERING):
+                if skill.status.is_active:
+                    self.robot.report(skill.id, S.SUCCESS)
+            for agent in (ANSWERING, SILENT):
+                self.call("unsynchronize", agent=agent, from_id="")  # refused if nothing
+            if self.call("new_mission", keep_markers=False).error_code == 0:
+                return
+            assert time.monotonic() < deadline, "the robots never gave their skills back"
+            time.sleep(0.02)
+
+
+@pytest.fixture(scope="module")
+def bench(client_node: Any, tmp_path_factory: pytest.TempPathFactory) -> Iterator[Bench]:
+    start, started = _launcher(dict(client_node.env), tmp_path_factory.mktemp("legality"))
+    server: ServerProcess = start("legality", link_timeout=3600.0)
+    fake = FakeRobot(ANSWERING)
+    robot = Robot(fake)
+    topics = interface.ground_link(ANSWERING)
+    listener = rospy.Subscriber(topics.command, wire.RobotCommand, robot.on_command)
+    fake.announce()
+    with Client() as client:
+        yield Bench(client, robot)
+    listener.unregister()
+    fake.close()
+    assert server.alive, "the mission server died"
+    _stop_all(started)
+
+
+# -- the mission states (each built from an empty mission; skills named by role) -------------
+Roles = dict[str, str]
+
+
+def blueprint(bench: Bench) -> Roles:
+    """Three drone skills, two rover skills; a barrier between the last of each."""
+    roles = {}
+    for agent, skill, prefix, count in (
+        (ANSWERING, "take_off", "d", 3),
+        (SILENT, "explore", "r", 2),
+    ):
+        for n in range(count):
+            roles[f"{prefix}{n}"] = bench.do(
+                "add_skill", agent=agent, skill=skill, index=-1
+            ).skill_id
+    bench.do("add_barrier", skill_ids=[roles["d2"], roles["r1"]])
+    return roles
+
+
+def rover_upload_waits(bench: Bench) -> Roles:
+    """The rover's whole task is being uploaded to it: it was never heard."""
+    roles = blueprint(bench)
+    bench.do("synchronize", agent=SILENT, upto_id="")
+    return roles
+
+
+def drone_synced(bench: Bench) -> Roles:
+    """The drone stored its first two skills; the rover's upload waits."""
+    roles = rover_upload_waits(bench)
+    bench.do("synchronize", agent=ANSWERING, upto_id=roles["d1"])
+    bench.settle(
+        lambda s: s.task(ANSWERING)[1].status is S.IDLE_SYNCHRONIZED, "the drone's confirmation"
+    )
+    return roles
+
+
+def drone_uploading(bench: Bench) -> Roles:
+    """The drone stored one skill; the upload of the next awaits its answer."""
+    roles = rover_upload_waits(bench)
+    bench.do("synchronize", agent=ANSWERING, upto_id=roles["d0"])
+    bench.settle(lambda s: s.task(ANSWERING)[0].status is S.IDLE_SYNCHRONIZED, "the upload")
+    bench.robot.answering = False
+    bench.do("synchronize", agent=ANSWERING, upto_id=roles["d1"])
+    return roles
+
+
+def drone_running(bench: Bench) -> Roles:
+    """The drone runs its first skill."""
+    roles = drone_synced(bench)
+    bench.robot.report(roles["d0"], S.RUNNING)
+    bench.settle(lambda s: s.task(ANSWERING)[0].status is S.RUNNING, "the RUNNING report")
+    return roles
+
+
+def drone_failed(bench: Bench) -> Roles:
+    """The drone's first skill failed."""
+    roles = drone_running(bench)
+    bench.robot.report(roles["d0"], S.FAILURE)
+    bench.settle(lambda s: s.task(ANSWERING)[0].status is S.FAILURE, "the FAILURE report")
+    return roles
+
+
+def drone_removing(bench: Bench) -> Roles:
+    """A take-back of the drone's second skill awaits its answer."""
+    roles = drone_synced(bench)
+    bench.robot.answering = False
+    bench.do("unsynchronize", agent=ANSWERING, from_id=roles["d1"])
+    return roles
+
+
+STATES = [blueprint, rover_upload_waits, drone_synced, drone_uploading, drone_running]
+STATES += [drone_failed, drone_removing]
+
+
+# -- the requests each action sends, as the GUIs send them ----------------------------------
+Request = tuple[str, dict[str, Any]]
+
+
+def skill_requests(state: MissionState, skill_id: str) -> Iterator[tuple[A, Request]]:
+    """Each action on one skill with the request the command GUI sends for it."""
+    agent = state.locate(skill_id)[0]
+    yield A.DELETE, ("delete_skills", {"skill_ids": [skill_id]})
+    yield A.SYNC, ("synchronize", {"agent": agent, "upto_id": skill_id})
+    yield A.UNSYNC, ("unsynchronize", {"agent": agent, "from_id": skill_id})
+    yield A.RETRY, ("retry_skill", {"skill_id": skill_id})
+    yield A.SKIP, ("skip_skill", {"skill_id": skill_id})
+    barrier = state.barrier_of(skill_id)
+    if barrier is not None:
+        yield A.DELETE_BARRIER, ("delete_barrier", {"barrier_id": barrier.id})
+
+
+def robot_requests(agent: str) -> Iterator[tuple[RobotAction, Request]]:
+    """A robot's send and take-back of its whole task."""
+    yield RobotAction.SYNC_ALL, ("synchronize", {"agent": agent, "upto_id": ""})
+    yield RobotAction.UNSYNC_ALL, ("unsynchronize", {"agent": agent, "from_id": ""})
+
+
+def checks(state: MissionState, roles: Roles) -> Iterator[tuple[str, bool, Request]]:
+    """(what, legal by the core, request) for every action of the state."""
+    picture = StatePicture(state)
+    for role, skill_id in roles.items():
+        legal = legal_skill_actions(picture, [state.skill(skill_id)])
+        for action, request in skill_requests(state, skill_id):
+            yield f"{action.name} {role}", action in legal, request
+    pair = [roles["d0"], roles["r0"]]
+    legal = A.BARRIER in legal_skill_actions(picture, state_skills(state, pair))
+    yield "BARRIER d0+r0", legal, ("add_barrier", {"skill_ids": pair})
+    for agent in (ANSWERING, SILENT):
+        actions = legal_robot_actions(TaskView.of(state, agent), ExecutorState.UNKNOWN)
+        for action, request in robot_requests(agent):
+            yield f"{action.name} {agent}", action in actions, request
+
+
+def state_skills(state: MissionState, ids: list[str]) -> list[Any]:
+    return [state.skill(i) for i in ids]
+
+
+@pytest.mark.parametrize("build", STATES, ids=[build.__name__ for build in STATES])
+def test_the_gui_offers_exactly_what_the_server_accepts(
+    bench: Bench, build: Callable[[Bench], Roles]
+) -> None:
+    bench.reset()
+    roles = build(bench)
+    state = bench.state()
+    table = {what: (legal, request) for what, legal, request in checks(state, roles)}
+    accepted = []
+    for what in list(table):
+        legal, (operation, fields) = table[what]
+        response = bench.call(operation, **fields)
+        assert (response.error_code == 0) == legal, (what, legal, response.error)
+        if response.error_code == 0:  # the mission changed: build the state again
+            accepted.append(what)
+            bench.reset()
+            roles = build(bench)
+            state = bench.state()
+            table = {what: (legal, request) for what, legal, request in checks(state, roles)}
+        else:
+            assert bench.client.revision() == state.revision, f"{what} changed the mission"
+    assert accepted  # every state offers something
+
+
+def test_take_back_is_offered_for_an_upload_to_a_robot_out_of_contact(bench: Bench) -> None:
+    """The case that disagreed: the server cancels the waiting upload, so the GUIs offer it."""
+    bench.reset()
+    roles = rover_upload_waits(bench)
+    state = bench.state()
+    rover = state.skill(roles["r0"])
+    assert A.UNSYNC in legal_skill_actions(StatePicture(state), [rover])
+    response = bench.do("unsynchronize", agent=SILENT, from_id=roles["r0"])
+    assert list(response.skill_ids) == [roles["r0"], roles["r1"]]
+    assert all(skill.is_editable for skill in bench.state().task(SILENT))
