@@ -17,7 +17,7 @@ from rosmc_server.core import (
 )
 from rosmc_server.core.vocabulary import STATUS_COLOURS as STATUS_COLOURS
 from rosmc_server.core.vocabulary import STATUS_WORDS as STATUS_WORDS
-from rosmc_server.core.vocabulary import dbm, number, percent
+from rosmc_server.core.vocabulary import dbm, number, percent, wifi_words
 
 TRANSFER_COLOUR = "#dae6fa"  # uploading or removing: on its way, not settled (italic too)
 SETTLED_FAILURE_COLOUR = "#f9bbb0"  # a failure the operator retried or skipped
@@ -146,25 +146,6 @@ def link_summary(status: AgentStatus | None) -> str:
     if status.radio_dropped:
         parts.append(status.radio_text)
     return " · ".join(parts)
-
-
-# Wi-Fi signal bands (dBm), as rviz colours them: yellow below the first, red below the second.
-WIFI_FAIR_DBM = -60.0
-WIFI_WEAK_DBM = -68.0
-
-
-def wifi_words(signal: float, in_coverage: bool) -> str:
-    """A Wi-Fi signal for an operator: good, fair, weak or out of range (the dBm are in the
-    header's tooltip, :func:`link_details`)."""
-    if not in_coverage:
-        word = "out of range"
-    elif signal >= WIFI_FAIR_DBM:
-        word = "good"
-    elif signal >= WIFI_WEAK_DBM:
-        word = "fair"
-    else:
-        word = "weak"
-    return word
 
 
 def link_details(status: AgentStatus | None) -> str:

@@ -120,6 +120,20 @@ def dbm(signal: float) -> str:
     return f"{signal:.0f} dBm"
 
 
+# Wi-Fi signal bands (dBm), as rviz colours them: yellow below the first, red below the second.
+WIFI_FAIR_DBM = -60.0
+WIFI_WEAK_DBM = -68.0
+
+
+def wifi_words(signal: float, in_coverage: bool) -> str:
+    """A Wi-Fi signal in an operator's words: good, fair, weak or out of range."""
+    if not in_coverage:
+        return "out of range"
+    if signal >= WIFI_FAIR_DBM:
+        return "good"
+    return "fair" if signal >= WIFI_WEAK_DBM else "weak"
+
+
 def counted(count: int, noun: str, plural: str = "") -> str:
     """A count and its noun, plural unless the count is one: ``1 skill``, ``0 stones``.
 

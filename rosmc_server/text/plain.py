@@ -24,7 +24,7 @@ from ..core import (
     Value,
 )
 from ..core.agent_status import AgentStatus
-from ..core.vocabulary import STATUS_MARKS, counted, dbm, number, percent
+from ..core.vocabulary import STATUS_MARKS, counted, dbm, number, percent, wifi_words
 
 _RULE = "    " + "-" * 56
 
@@ -101,7 +101,8 @@ def format_agent_status(status: AgentStatus | None) -> str:
     if status.battery is not None:
         parts.append(f"battery {percent(status.battery)}")
     if status.wifi_signal is not None:
-        parts.append(f"Wi-Fi {dbm(status.wifi_signal)}")
+        words = wifi_words(status.wifi_signal, status.in_coverage)
+        parts.append(f"Wi-Fi {words} ({dbm(status.wifi_signal)})")
     if status.pose is not None:
         pose = status.pose
         parts.append(f"at ({number(pose.x, 3)}, {number(pose.y, 3)}, {number(pose.z, 3)})")

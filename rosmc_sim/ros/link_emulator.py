@@ -15,7 +15,7 @@ Subscribes ``/<agent>/link/blackout`` (std_msgs/Bool): true cuts the link (the
 simulator's coverage model, or a test, publishes it).
 
 Parameters (private): ``~agents`` (list of str), or ``~scenario`` (str, its robots; relative
-to ``~cwd``), ``~latency`` (float, s, 0),
+to ``~cwd``), ``~cwd`` (str, where roslaunch was typed), ``~latency`` (float, s, 0),
 ``~drop`` (float, 0..1, 0), ``~seed`` (int, for reproducible loss), ``~rate`` (Hz, 200).
 """
 

@@ -31,7 +31,7 @@ from pathlib import Path
 
 import rospy
 
-from rosmc_server.ros.logging_bridge import bridge_logging_to_rosout
+from rosmc_server.common.ros.logging_bridge import bridge_logging_to_rosout
 from rosmc_sim.core.scenario import RobotSpec, load_scenario
 
 _log = logging.getLogger(__name__)

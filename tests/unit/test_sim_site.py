@@ -32,7 +32,8 @@ def test_the_site_lists_every_obstacle_the_lander_and_the_rovers(sim: Simulation
     assert names == [*(o.name for o in sim.scenario.obstacles), "lander"]
     lander = site.obstacles[-1]
     assert (lander.shape, lander.size_x) == (Shape.BOX, 2 * sim.scenario.lander_radius)
-    assert [r.agent for r in site.robots] == ["science_rover", "manipulator_rover"]  # no drone
+    rovers = [r.name for r in sim.scenario.robots if r.kind != "drone"]
+    assert [r.agent for r in site.robots] == rovers  # no drone
     assert all(r.clearance > sim.clearance for r in site.robots)
 
 
@@ -40,13 +41,14 @@ def test_every_target_the_site_accepts_for_a_rover_is_free_ground_to_its_planner
     sim: Simulation,
 ) -> None:
     site = site_model(sim)
+    rover = next(r.name for r in sim.scenario.robots if r.kind == "science_rover")
     x_min, x_max, y_min, y_max = site.bounds
     step = 0.37  # off the planner's 0.5 m grid, so targets fall all over their cells
     accepted = refused = 0
     for i in range(int((x_max - x_min) / step) + 1):
         for j in range(int((y_max - y_min) / step) + 1):
             x, y = x_min + i * step, y_min + j * step
-            if site.problem(SiteCheck.REACHABLE_GROUND, "science_rover", x, y):
+            if site.problem(SiteCheck.REACHABLE_GROUND, rover, x, y):
                 refused += 1
                 continue
             accepted += 1

@@ -97,7 +97,7 @@ def test_agent_status_line_with_telemetry() -> None:
     )
     line = format_agent_status(status)
     assert line.startswith("link down (round trip 12 ms, 2 commands in flight)")
-    assert "Wi-Fi -61 dBm" in line and "at (1, 2.5, 0)" in line
+    assert "Wi-Fi out of range (-61 dBm)" in line and "at (1, 2.5, 0)" in line
     assert "out of coverage" in line and line.endswith("waiting on bravo")
     assert format_agent_status(None) == "link unknown"
 

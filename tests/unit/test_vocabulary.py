@@ -63,10 +63,11 @@ def test_every_status_has_a_distinct_word_mark_and_colour() -> None:
 
 
 def test_battery_and_wifi_read_the_same_in_the_gui_and_in_rosmc() -> None:
-    status = AgentStatus("drone", link="up", battery=0.973, wifi_signal=-54.4)
+    status = AgentStatus("drone", link="up", battery=0.973, wifi_signal=-54.4, in_coverage=True)
     gui, text = presentation.link_summary(status), format_agent_status(status)
-    for words in ("battery 97%", "Wi-Fi -54 dBm"):
+    for words in ("battery 97%", "Wi-Fi good"):
         assert words in gui and words in text
+    assert "Wi-Fi good (-54 dBm)" in text  # the number too, for whoever reads a terminal
     health = icons.status_rows(status)[1].text
     assert "97%" in health and "-54 dBm" in health
 
