@@ -20,7 +20,6 @@ import argparse
 import ctypes
 import logging
 import os
-import shutil
 import signal
 import subprocess
 import sys
@@ -29,6 +28,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+import roslib.packages
 import rospy
 
 from rosmc_server.common.ros.logging_bridge import bridge_logging_to_rosout
@@ -66,12 +66,9 @@ class TeamConfig:
 def executor_command(robot: RobotSpec, config: TeamConfig) -> list[str]:
     """The command line of one robot's executor node (private parameters as ``_name:=``)."""
     state_file = f"{config.state_dir}/{robot.name}_executor.json" if config.state_dir else ""
-    script = shutil.which("mission_executor") or str(
-        Path(__file__).resolve().parents[2] / "scripts" / "mission_executor"
-    )
     return [
         sys.executable,
-        script,
+        executor_script(),
         "__name:=mission_executor",
         f"__ns:=/{robot.name}",
         f"_agent:={robot.name}",
@@ -81,6 +78,15 @@ def executor_command(robot: RobotSpec, config: TeamConfig) -> list[str]:
         f"_cwd:={config.cwd}",
         f"_state_file:={state_file}",
     ]
+
+
+def executor_script() -> str:
+    """The ``mission_executor`` entry script, found as ``rosrun rosmc mission_executor`` finds
+    it (devel space, install space or checkout)."""
+    found = roslib.packages.find_node("rosmc", "mission_executor")
+    if not found:
+        raise RuntimeError("rosmc's mission_executor is not installed (rosrun cannot find it)")
+    return str(found[0])
 
 
 class Team:

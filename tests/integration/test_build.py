@@ -275,7 +275,8 @@ def test_install_space_runs_the_simulated_team(
     install = catkin_ws.install
     args = ["sim:=true", "rviz:=false", "command_gui:=false"]
     nodes = set(probe_launch(install, "operator.launch", args, tmp_path)["nodes"])
-    assert {"/rosmc/mission_server", "/rosmc/sim", "/drone/mission_executor"} <= nodes
+    assert {"/rosmc/mission_server", "/rosmc/sim", "/rosmc/team_executors"} <= nodes
+    nodes |= {f"/{robot}/mission_executor" for robot in ("drone", "science_rover")}
     port = free_port()
     uri = f"http://127.0.0.1:{port}/"
     env = {**install.env, "ROSMC_VENV": str(REPO_ROOT / ".venv"), "ROS_IP": "127.0.0.1"}
