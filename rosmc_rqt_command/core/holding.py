@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 from rosmc_server.core import SkillStatus
 from rosmc_server.core.control import ExecutorState
+from rosmc_server.core.link import LinkStatus
 
 from .mission_view import MissionView
 
@@ -62,7 +63,7 @@ def lost_link_hold(view: MissionView, agent: str) -> Hold | None:
         return None
     if not any(mark in status.policy for mark in HOLD_MARKS):
         return None
-    return Hold(agent, status.link == "up", barrier_partners(view, agent))
+    return Hold(agent, status.link is LinkStatus.UP, barrier_partners(view, agent))
 
 
 def barrier_partners(view: MissionView, agent: str) -> tuple[str, ...]:

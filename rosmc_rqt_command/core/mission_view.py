@@ -20,6 +20,7 @@ from rosmc_server.core import (
     TaskMarker,
 )
 from rosmc_server.core.legality import TaskView
+from rosmc_server.core.link import LinkStatus
 from rosmc_server.core.updates import SkillAdded, SkillChanged, SkillRemoved
 
 from . import presentation
@@ -146,7 +147,7 @@ class MissionView:
     def out_of_contact(self, agent: str) -> bool:
         """The ground cannot hear ``agent``'s robot (never heard, or its link is down)."""
         status = self.statuses.get(agent)
-        return status is not None and status.link != "up"
+        return status is not None and status.link is not LinkStatus.UP
 
     def status_text(self, skill: SkillInstance) -> str:
         """The skill's status cell, as every panel shows it."""

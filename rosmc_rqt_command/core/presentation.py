@@ -15,6 +15,7 @@ from rosmc_server.core import (
     Transfer,
     Value,
 )
+from rosmc_server.core.link import LinkStatus
 from rosmc_server.core.vocabulary import STATUS_COLOURS as STATUS_COLOURS
 from rosmc_server.core.vocabulary import STATUS_WORDS as STATUS_WORDS
 from rosmc_server.core.vocabulary import dbm, number, percent, wifi_words
@@ -126,11 +127,11 @@ def params_summary(skill: SkillInstance, limit: int = 3) -> str:
 
 def link_summary(status: AgentStatus | None) -> str:
     """A robot's header line: link, seconds since heard, battery, Wi-Fi, policy."""
-    if status is None or status.link == "unknown":
+    if status is None or status.link is LinkStatus.UNKNOWN:
         waiting = status.waiting_text if status is not None else ""
         return f"never heard · {waiting}" if waiting else "never heard"
-    link = "link up" if status.link == "up" else "LINK DOWN"
-    if status.last_heard >= 0 and (status.link != "up" or status.last_heard >= 2):
+    link = "link up" if status.link is LinkStatus.UP else "LINK DOWN"
+    if status.last_heard >= 0 and (status.link is not LinkStatus.UP or status.last_heard >= 2):
         link += f", heard {status.last_heard:.0f} s ago"
     parts = [link]
     if status.commands_waiting:

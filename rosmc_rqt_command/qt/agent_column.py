@@ -28,6 +28,7 @@ from python_qt_binding.QtWidgets import (
 
 from rosmc_server.core import AgentStatus, LostLinkPolicy, SkillStatus
 from rosmc_server.core.legality import TaskView
+from rosmc_server.core.link import LinkStatus
 from rosmc_server.core.updates import SkillAdded, SkillChanged, SkillRemoved
 from rosmc_server.core.waiting import duration_text
 
@@ -231,7 +232,7 @@ class AgentColumn(QFrame):  # type: ignore[misc]
     def show_status(self, status: AgentStatus | None) -> None:
         """Show the robot's link and telemetry in the header."""
         text = presentation.link_summary(status)
-        colour = "#a00000" if status is not None and status.link == "down" else "#333333"
+        colour = "#a00000" if status is not None and status.link is LinkStatus.DOWN else "#333333"
         self.status_label.setText(f"<span style='color:{colour}'>{text}</span>")
         self.status_label.setToolTip(presentation.link_details(status))
         out_of_contact = self._view.out_of_contact(self.agent)
@@ -288,9 +289,9 @@ class AgentColumn(QFrame):  # type: ignore[misc]
 
 def on_robot_caption(status: AgentStatus | None) -> str:
     """The caption over the robot's section: marked last known while it is not heard."""
-    if status is None or status.link == "up":
+    if status is None or status.link is LinkStatus.UP:
         return ON_ROBOT
-    if status.link == "unknown" or status.last_heard < 0:
+    if status.link is LinkStatus.UNKNOWN or status.last_heard < 0:
         return "<i>On the robot</i> <span style='color:#a00000'>(last known, not heard yet)</span>"
     age = duration_text(status.last_heard)
     return f"<i>On the robot</i> <span style='color:#a00000'>(last known, {age} ago)</span>"

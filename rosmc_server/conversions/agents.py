@@ -11,9 +11,19 @@ import math
 import rosmc.msg as wire
 
 from ..core import AgentStatus, SkillStatus
+from ..core.link import LinkStatus
 from .values import pose_from_msg
 
-_LINK_STATES = {wire.LinkState.UP: "up", wire.LinkState.DOWN: "down"}
+_LINK_STATES: dict[int, LinkStatus] = {
+    wire.LinkState.UNKNOWN: LinkStatus.UNKNOWN,
+    wire.LinkState.UP: LinkStatus.UP,
+    wire.LinkState.DOWN: LinkStatus.DOWN,
+}
+
+
+def link_state_to_msg(status: LinkStatus) -> int:
+    """A link's state as ``rosmc/LinkState.state``."""
+    return next(number for number, known in _LINK_STATES.items() if known is status)
 
 
 def agent_statuses_from_msg(msg: wire.AgentStates) -> dict[str, AgentStatus]:
@@ -28,7 +38,7 @@ def agent_status_from_msg(msg: wire.AgentState) -> AgentStatus:
     current = msg.current_skill_id
     return AgentStatus(
         agent=msg.agent,
-        link=_LINK_STATES.get(msg.link.state, "unknown"),
+        link=_LINK_STATES.get(msg.link.state, LinkStatus.UNKNOWN),
         last_heard=msg.link.last_heard,
         round_trip=msg.link.round_trip,
         commands_in_flight=msg.link.commands_in_flight,

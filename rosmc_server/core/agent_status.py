@@ -11,6 +11,7 @@ import math
 from dataclasses import dataclass
 
 from .control import ExecutorState
+from .link import LinkStatus
 from .model import SkillStatus
 from .params import Pose
 from .vocabulary import counted
@@ -24,7 +25,7 @@ AGES = ("last_heard", "waiting_for")
 class AgentStatus:
     """What the mission server reports about one agent's robot (``/rosmc/agent_states``).
 
-    ``link`` is ``"up"``, ``"down"`` or ``"unknown"`` (never heard); times are seconds,
+    ``link`` is a :class:`LinkStatus` (its words, ``"up"``..., are taken too); times are seconds,
     -1 if unknown. ``battery`` (0..1), ``wifi_signal`` (dBm) and ``pose`` are None without
     telemetry. ``queue_hash`` is the synchronized queue as the ground sees it and
     ``robot_queue_hash`` as the robot last reported it (``hash_mismatch``: a repair is under
@@ -38,7 +39,7 @@ class AgentStatus:
     """
 
     agent: str
-    link: str = "unknown"
+    link: LinkStatus = LinkStatus.UNKNOWN
     last_heard: float = -1.0
     round_trip: float = -1.0
     commands_in_flight: int = 0
@@ -58,6 +59,10 @@ class AgentStatus:
     waiting_for: float = -1.0
     coverage_warning: str = ""
     radio_dropped: int = 0
+
+    def __post_init__(self) -> None:
+        # Its words ("up", ...) are accepted and kept as the enum: one comparison everywhere.
+        object.__setattr__(self, "link", LinkStatus(self.link))
 
     def news_since(self, old: AgentStatus | None) -> bool:
         """Whether this status says something ``old`` did not, at the resolution shown.

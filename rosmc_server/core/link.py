@@ -27,12 +27,14 @@ from typing import Generic, TypeVar
 Payload = TypeVar("Payload")
 
 
-class LinkStatus(enum.IntEnum):
-    """Ground view of a link (numbers match ``rosmc/LinkState``)."""
+class LinkStatus(enum.StrEnum):
+    """Ground view of a link: heard lately, silent too long, or never heard. Its values are
+    the words the views print; ``conversions.agents`` maps them to ``rosmc/LinkState``'s
+    numbers."""
 
-    UNKNOWN = 0
-    UP = 1
-    DOWN = 2
+    UNKNOWN = "unknown"
+    UP = "up"
+    DOWN = "down"
 
 
 def queue_hash(skill_ids: Iterable[str]) -> str:

@@ -15,6 +15,7 @@ import rosmc.msg as wire
 import rospy
 
 from .. import interface
+from ..conversions.agents import link_state_to_msg
 from ..core import SkillStatus
 from ..core.advice import waiting_on_unsynced
 from .coverage_watch import CoverageWatch
@@ -88,7 +89,7 @@ class AgentStatePublisher:
             )
         state = wire.AgentState(agent=agent, telemetry=telemetry)
         state.link = wire.LinkState(
-            state=int(report.status),
+            state=link_state_to_msg(report.status),
             last_heard=report.last_heard,
             round_trip=report.round_trip,
             commands_in_flight=report.in_flight,

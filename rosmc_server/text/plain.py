@@ -24,6 +24,7 @@ from ..core import (
     Value,
 )
 from ..core.agent_status import AgentStatus
+from ..core.link import LinkStatus
 from ..core.vocabulary import STATUS_MARKS, counted, dbm, number, percent, wifi_words
 
 _RULE = "    " + "-" * 56
@@ -84,7 +85,7 @@ def format_agent_status(status: AgentStatus | None) -> str:
     if status is None:
         return "link unknown"
     link = f"link {status.link}"
-    if status.link == "unknown":
+    if status.link is LinkStatus.UNKNOWN:
         link = "link never heard since the server started (commands wait for it)"
     details = []
     if status.last_heard >= 0:

@@ -35,6 +35,7 @@ import rospy
 from rosmc_server.common.ros.station import launch_path
 from rosmc_server.core import MarkerType, Pose, RosmcError, SkillStatus, TaskMarker
 from rosmc_server.core.changes import EventKind
+from rosmc_server.core.link import LinkStatus
 from rosmc_server.core.vocabulary import OPERATOR_EVENTS, counted
 from rosmc_server.ros.client import ControlCommand, MissionClient, MissionWatch
 
@@ -131,7 +132,7 @@ class DemoOperator:
     # -- conditions -------------------------------------------------------------------
     def _links_up(self) -> bool:
         states = self.watch.take_agent_states() or {}
-        return bool(states) and all(s.link == "up" for s in states.values())
+        return bool(states) and all(s.link is LinkStatus.UP for s in states.values())
 
     def _nothing_uploading(self) -> bool:
         return not any(s.transfer for s in self.client.get_mission().skills())
