@@ -61,6 +61,10 @@ def window(client_node: Any) -> Iterator[Window]:
     app.processEvents()
 
 
+# A replay is a process of its own: on a busy machine it starts slowly, never wrongly.
+START = 120.0
+
+
 def statuses(window: Window) -> dict[str, tuple[float, float]]:
     """Where the window's robots are (x, y), by name."""
     return {
@@ -144,7 +148,7 @@ def test_open_a_recording_seek_to_an_event_play_to_the_end_and_return_to_live(
     answer_file_dialog(str(SAMPLE))
     mode.open_action.trigger()
     bar = mode.bar
-    wait_until(lambda: bar.isVisible() and bar.play_button.isEnabled(), 30, "the replay bar")
+    wait_until(lambda: bar.isVisible() and bar.play_button.isEnabled(), START, "the replay bar")
     assert mode.process is not None
     start = history.revision_at(0.0).revision
     wait_until(lambda: widget.view.revision == start, 20, f"the recording's r{start}")
@@ -229,7 +233,7 @@ def test_following_a_replay_greys_out_what_cannot_act(
         ],
         name="replay",
     )
-    rospy.wait_for_service("/following/rosmc/replay/control", timeout=30.0)
+    rospy.wait_for_service("/following/rosmc/replay/control", timeout=START)
     app = QApplication.instance() or QApplication([])
     from rosmc_rqt_command.standalone import build
 
@@ -237,7 +241,7 @@ def test_following_a_replay_greys_out_what_cannot_act(
     widget.resize(1400, 800)
     widget.show()
     try:
-        wait_until(lambda: widget.view.loaded and widget.tasks.columns, 30, "the replay shown")
+        wait_until(lambda: widget.view.loaded and widget.tasks.columns, START, "the replay shown")
         column = select_first_skill(widget)
         assert not widget.parameters.label_edit.isEnabled()
         assert not column.blueprint_table.dragEnabled()

@@ -40,6 +40,7 @@ KEPT_NODES = (
     "/rosmc/sim",
     "/rosmc/link_emulator",
     "/rosmc/markers",
+    "/rosmc/team_executors",
     "/drone/mission_executor",
     "/science_rover/mission_executor",
     "/manipulator_rover/mission_executor",
@@ -159,8 +160,9 @@ def test_a_killed_server_comes_back_on_its_journal_and_the_team_goes_on(
     station.rosmc("add", "drone", "land")
     station.rosmc("sync", "drone")
     station.rosmc("start", "drone")
+    # Started, or already done: a poll on a busy machine may miss the seconds it runs.
     wait_until(
-        lambda: statuses(station, "drone")[1] == "RUNNING",
+        lambda: statuses(station, "drone")[1] in ("RUNNING", "SUCCESS"),
         MISSION_TIMEOUT,
         "the drone flies to its target",
         period=0.5,
