@@ -106,39 +106,52 @@ def layout(
     pitch: float = VIEW_PITCH,
     step: float = 0.0,
     keep: Mapping[str, float] | None = None,
+    prefer: Mapping[str, float] | None = None,
 ) -> dict[str, float]:
     """How far south (map metres, >= 0) to move each of ``labels`` so no two boxes overlap.
 
     Labels are taken from the top of the screen down; each moves the least that clears
     every box placed before it and every ``fixed`` box (a column of labels at one place).
-    With a ``step``, moves are whole steps (so that a small change moves no label). A
-    label named in ``keep`` stays that far south if it is clear there: one label that
-    changes then moves the labels it now covers, not every label below it in its column.
+    With a ``step``, moves are whole steps (so that a small change moves no label).
+
+    Laying out again after a change: labels named in ``keep`` (those that did not change)
+    are placed first, that far south, wherever they are clear; the others then find room
+    around them, each at its ``prefer`` offset if that is clear. A label that changes
+    then moves itself, not the labels below it in its column.
     """
+    keep, prefer = keep or {}, prefer or {}
     placed = _Placed(fixed)
-    rise = math.sin(pitch)
     out: dict[str, float] = {}
     order = sorted(labels, key=lambda label: (-label.box(0.0, pitch).top, label.x, label.key))
+    rest = []
     for label in order:
-        kept = (keep or {}).get(label.key)
-        if kept is not None and not placed.hits(label.box(kept, pitch)):
-            out[label.key] = kept
-            placed.add(label.box(kept, pitch))
+        if label.key in keep and not placed.hits(box := label.box(keep[label.key], pitch)):
+            out[label.key] = keep[label.key]
+            placed.add(box)
+        else:
+            rest.append(label)
+    for label in rest:
+        wanted = prefer.get(label.key)
+        if wanted is not None and not placed.hits(box := label.box(wanted, pitch)):
+            out[label.key] = wanted
+            placed.add(box)
             continue
-        south = 0.0
-        while True:
-            box = label.box(south, pitch)
-            hits = placed.hits(box)
-            if not hits:
-                break
-            # just below the lowest box it hits (the label only moves down the screen)
-            lowest = min(other.bottom for other in hits)
-            south += (box.top - lowest + GAP) / rise
-            if step > 0:
-                south = math.ceil(south / step - 1e-9) * step
-        out[label.key] = south
-        placed.add(box)
+        out[label.key] = south = _clear_south(label, placed, pitch, step)
+        placed.add(label.box(south, pitch))
     return out
+
+
+def _clear_south(label: Label, placed: _Placed, pitch: float, step: float) -> float:
+    """The least move south that clears every placed box."""
+    rise = math.sin(pitch)
+    south = 0.0
+    while hits := placed.hits(box := label.box(south, pitch)):
+        # just below the lowest box it hits (the label only moves down the screen)
+        lowest = min(other.bottom for other in hits)
+        south += (box.top - lowest + GAP) / rise
+        if step > 0:
+            south = math.ceil(south / step - 1e-9) * step
+    return south
 
 
 def overlapping(boxes: Sequence[Box]) -> list[tuple[int, int]]:

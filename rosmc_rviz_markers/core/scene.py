@@ -187,18 +187,19 @@ class Scene:
         label moved (their specs changed).
 
         ``names``: the task markers that may have changed (None: any). Labels that did
-        not change keep their place while it stays clear, so an edit moves only the labels
-        it covers. The robots' status blocks are laid out after, clear of
+        not change keep their place, and the changed ones find room around them (where
+        they are drawn, if their marker did not move and it is still clear): an isolated
+        edit moves its own label only. The robots' status blocks are laid out after, clear of
         :attr:`label_boxes`.
         """
         if names is None:
             self._labels = {}
             names = [marker.name for marker in state.markers]
         changed = set()
-        keep = dict(self.label_south)
+        keep, prefer = dict(self.label_south), {}
         for name in names:
-            label, old = self._label(state, name), self._labels.get(name)
-            if label == old:
+            label, was = self._label(state, name), self._labels.get(name)
+            if label == was:
                 continue
             changed.add(name)
             keep.pop(name, None)
@@ -206,17 +207,17 @@ class Scene:
                 self._labels.pop(name, None)
                 continue
             self._labels[name] = label
-            if old is not None and old.x == label.x and name in self.label_south:
+            if was is not None and was.x == label.x and name in self.label_south:
                 # its marker did not move (new words, locked): the label stays where it is
                 # drawn if that is still clear, rather than push its neighbours about
-                south = self.label_south[name] + label.y - old.y
+                south = self.label_south[name] + label.y - was.y
                 if south >= 0:
-                    keep[name] = south
+                    prefer[name] = south
         if not changed:
             return set()  # no label changed its text or place: the layout stands
         labels = list(self._labels.values())
         # whole quarter metres, so that a marker dragged a little does not redraw its column
-        new = layout(labels, step=LABEL_STEP, keep=keep)
+        new = layout(labels, step=LABEL_STEP, keep=keep, prefer=prefer)
         old, self.label_south = self.label_south, new
         self.label_boxes = tuple(label.box(new[label.key]) for label in labels)
         return {name for name in old.keys() | new.keys() if old.get(name) != new.get(name)}
