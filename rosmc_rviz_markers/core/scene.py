@@ -34,7 +34,16 @@ from rosmc_server.interface import MAP_FRAME
 
 from . import geometry as geo
 from .labels import Box, Label, layout
-from .menus import UNDO_MENU, flatten, robot_menu, static_agent_menu, task_marker_menu
+from .menus import (
+    OBJECT_WORD,
+    ROBOT_WORD,
+    UNDO_MENU,
+    flatten,
+    robot_menu,
+    static_agent_menu,
+    task_marker_menu,
+    title_menu,
+)
 from .specs import MarkerSpec, agent_spec, describe, task_label, task_specs
 from .styling import is_locked, marker_use
 
@@ -154,9 +163,11 @@ class Scene:
         if self.read_only:
             menu = flatten(())
         elif robot:
-            menu = flatten((*robot_menu(self.library, agent), *UNDO_MENU))
+            title = title_menu(agent, ROBOT_WORD)
+            menu = flatten((title, *robot_menu(self.library, agent), *UNDO_MENU))
         else:
-            menu = flatten((*static_agent_menu(self.library, agent), *UNDO_MENU))
+            title = title_menu(agent, OBJECT_WORD)
+            menu = flatten((title, *static_agent_menu(self.library, agent), *UNDO_MENU))
         highlighted = state is not None and any(
             state.has_skill(s) and state.skill(s).agent == agent for s in self.selection.skill_ids
         )
@@ -242,7 +253,11 @@ class Scene:
         menu = flatten(
             ()
             if self.read_only
-            else (*task_marker_menu(self.library, state, marker, bound, locked), *UNDO_MENU)
+            else (
+                title_menu(name, marker.type.name.lower()),
+                *task_marker_menu(self.library, state, marker, bound, locked),
+                *UNDO_MENU,
+            )
         )
         return task_specs(
             marker,
