@@ -54,7 +54,11 @@ SEPARATOR = " | "
 # are lines of one camera-facing text (each row's marker blanks the others' lines), so
 # they stay apart on screen from every view; rows stacked in height would merge when seen
 # from above.
-ICON_BASE = 2.15  # above the robot's frame: the lower line's centre, clear of mast, arm, pin
+# Above the robot's frame: the lower line's centre, clear of mast, arm and pin as the
+# shipped views see them. Text faces the camera at full height while heights below it
+# shrink by cos(pitch) on screen: at 2.15 m the lower line covered the drone's pin (what
+# an operator clicks when the drone rests on the lander) from the first view (pitch 1.1).
+ICON_BASE = 3.1
 ICON_TEXT = 0.45  # letter height
 ICON_ROW = ICON_TEXT * LINE_SPACING  # from one line's centre to the next, on screen
 ICON_GAP = 0.2  # between two lifted blocks, as the view sees them
