@@ -148,7 +148,7 @@ class Screenshot:
             return None if box is None else (box[0] + left0, box[1] + top0, box[2], box[3])
         mask = self.near(background, tolerance)
         by_background = self._box(mask)
-        by_chrome = self._box(self.pixels.min(axis=2) <= CHROME_LEVEL, longest=True)
+        by_chrome = self._dark_box(self.pixels.min(axis=2) <= CHROME_LEVEL)
         if by_chrome is not None:
             top, bottom, left, right = by_chrome
             if not mask[top : bottom + 1, left : right + 1].mean() > 0.01:
@@ -161,6 +161,22 @@ class Screenshot:
             box = by_chrome
         top, bottom, left, right = box
         return left, top, right - left + 1, bottom - top + 1
+
+    @staticmethod
+    def _dark_box(mask: np.ndarray) -> tuple[int, int, int, int] | None:
+        """Top, bottom, left, right of the widest run of columns mostly in ``mask``, and of
+        the longest run of rows mostly in it across those columns (panels beside the view
+        do not thin its rows out)."""
+        columns = np.flatnonzero(mask.mean(axis=0) > 0.5)
+        if columns.size == 0:
+            return None
+        columns = _longest_run(columns)
+        left, right = int(columns[0]), int(columns[-1])
+        rows = np.flatnonzero(mask[:, left : right + 1].mean(axis=1) > 0.5)
+        if rows.size == 0:
+            return None
+        rows = _longest_run(rows)
+        return int(rows[0]), int(rows[-1]), left, right
 
     @staticmethod
     def _box(mask: np.ndarray, longest: bool = False) -> tuple[int, int, int, int] | None:
