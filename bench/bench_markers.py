@@ -1,35 +1,43 @@
-"""Benchmark of the rviz marker node; prints one JSON object.
+"""Benchmark of the rviz marker node: what rviz receives per mission event; prints one JSON object.
 
 Starts its own ``rosmaster``, a ``mission_server`` on a library of 20 robots (the Mars team's
-models), the marker node (``scripts/markers_node``) and, in this process, 20 robots that
-publish ``/<robot>/telemetry`` at 10 Hz (pose, battery, Wi-Fi changing every message).
-The mission gets 200 task markers (half of them bound to blueprint skills). Then:
+models) and the marker node (``scripts/markers_node``). In this process, 20 robots move as
+the simulator moves them: TF ``map -> <robot>/base_link`` and ``/<robot>/telemetry`` at
+10 Hz (pose, battery and Wi-Fi change in every message); ``robot_00``'s link end is played
+here (uploads acknowledged, status reports sent). The mission gets 200 task markers, half of
+them bound to blueprint skills
+(``robot_00`` has one per round). Then, subscribed to ``/rosmc/markers/update`` as rviz is:
 
-* latency: one ``move_task_marker`` at a time; from the moment this process receives the
-  server's ``/rosmc/mission_events`` message to the moment it receives the marker node's
-  ``/rosmc/markers/update`` carrying the moved marker (p50/p95/max, ms);
-* sustained: moves sent back to back for ``--burst`` moves; events per second the node
-  keeps up with (last update received after the last event) and the latency under load;
-* incremental: the mean number of interactive markers per update message (a full rebuild
-  would send all 200+ every time).
+* ``idle``: 5 s without mission events: what the robots' motion alone costs per second
+  (updates, interactive markers inserted, pose updates, status-icon markers);
+* ``per_event``: one event at a time, per kind (``add``, ``edit`` (rebinds to another
+  marker), ``delete``, ``marker_move``, ``sync``, ``status`` (a robot report)): from just
+  before the call to 0.3 s after the first update that carries a marker the event changes,
+  the updates, interactive markers (full inserts), pose updates and erases rviz received,
+  and the latency from the arrival here of the ``/rosmc/mission_events`` message to the
+  arrival of that update (p50/p95/max);
+* ``sustained``: ``--burst`` marker moves back to back: events per second the node keeps up
+  with and the latency under that load;
+* the load average before and after.
 
 Run from the repository root::
 
     source env.sh
-    python bench/bench_markers.py [--samples 200] [--burst 300]
+    python bench/bench_markers.py [--samples 30] [--burst 200]
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import math
+import os
 import statistics
 import subprocess
 import sys
 import tempfile
 import threading
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -38,6 +46,7 @@ import yaml
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from _marker_watch import FakeRobot, UpdateWatch, team_motion
 from _server_harness import REPO, Server, ros_master, stop_process
 
 ROBOTS = 20
@@ -69,94 +78,16 @@ def summary(values: list[float]) -> dict[str, float]:
     }
 
 
-class Watcher:
-    """Arrival times of mission events (by revision) and of marker updates (by marker)."""
-
-    def __init__(self) -> None:
-        import rosmc.msg as wire
-        import rospy
-        from visualization_msgs.msg import InteractiveMarkerUpdate
-
-        self.lock = threading.Condition()
-        self.events: dict[int, float] = {}
-        self.updates: dict[str, list[float]] = {}
-        self.sizes: list[int] = []
-        rospy.Subscriber(
-            "/rosmc/mission_events", wire.MissionEvent, self._on_event, queue_size=10000
-        )
-        rospy.Subscriber(
-            "/rosmc/markers/update", InteractiveMarkerUpdate, self._on_update, queue_size=10000
-        )
-
-    def _on_event(self, msg: Any) -> None:
-        with self.lock:
-            self.events[msg.revision] = time.monotonic()
-            self.lock.notify_all()
-
-    def _on_update(self, msg: Any) -> None:
-        now = time.monotonic()
-        names = [m.name for m in msg.markers] + [p.name for p in msg.poses]
-        if not names:
-            return  # keep-alive
-        with self.lock:
-            self.sizes.append(len(names))
-            for name in names:
-                self.updates.setdefault(name, []).append(now)
-            self.lock.notify_all()
-
-    def wait_update(self, name: str, count: int, timeout: float = 10.0) -> float:
-        """The arrival time of the ``count``-th update of ``name``."""
-        deadline = time.monotonic() + timeout
-        with self.lock:
-            while len(self.updates.get(name, [])) < count:
-                left = deadline - time.monotonic()
-                if left <= 0:
-                    raise RuntimeError(f"no update {count} of {name}")
-                self.lock.wait(left)
-            return self.updates[name][count - 1]
-
-    def event_time(self, revision: int, timeout: float = 10.0) -> float:
-        deadline = time.monotonic() + timeout
-        with self.lock:
-            while revision not in self.events:
-                left = deadline - time.monotonic()
-                if left <= 0:
-                    raise RuntimeError(f"no event {revision}")
-                self.lock.wait(left)
-            return self.events[revision]
-
-
-def telemetry(stop: threading.Event) -> None:
-    """20 robots reporting at 10 Hz."""
-    import rosmc.msg as wire
-    import rospy
-
-    publishers = [
-        rospy.Publisher(f"/robot_{i:02d}/telemetry", wire.Telemetry, queue_size=10)
-        for i in range(ROBOTS)
-    ]
-    tick = 0
-    while not stop.wait(0.1):
-        tick += 1
-        for i, pub in enumerate(publishers):
-            angle = tick * 0.05 + i
-            msg = wire.Telemetry(
-                agent=f"robot_{i:02d}",
-                stamp=rospy.Time.now(),
-                frame_id="map",
-                battery=0.5 + 0.4 * math.sin(angle),
-                wifi_signal=-60 + 10 * math.cos(angle),
-                in_coverage=True,
-            )
-            msg.pose.x, msg.pose.y, msg.pose.yaw = 10 * math.cos(angle), 10 * math.sin(angle), angle
-            pub.publish(msg)
+SETTLE = 0.3  # s after the event's update in which its other updates still count
+TASK = "task/"
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--samples", type=int, default=200)
-    parser.add_argument("--burst", type=int, default=300)
+    parser.add_argument("--samples", type=int, default=30, help="events per kind")
+    parser.add_argument("--burst", type=int, default=200)
     args = parser.parse_args()
+    load_before = os.getloadavg()[0]
     with tempfile.TemporaryDirectory(prefix="bench_markers_") as tmp:
         work = Path(tmp)
         (work / "home").mkdir()
@@ -174,13 +105,80 @@ def main() -> int:
                 start_new_session=True,
             )
             try:
-                return run(args, work)
+                figures = run(args, work)
+            except Exception:
+                for name in ("server.log", "markers.log"):  # what went wrong, said there
+                    text = (work / name).read_text(errors="replace")
+                    print(f"--- {name}\n{text[-3000:]}", file=sys.stderr)
+                raise
             finally:
-                stop_process(node)  # never raises: the figures are printed already
+                stop_process(node)
                 server.stop()
+    figures["load_average"] = {"before": round(load_before, 2), "after": os.getloadavg()[0]}
+    print(json.dumps(figures, indent=2))
+    return 0
 
 
-def run(args: argparse.Namespace, work: Path) -> int:
+class Events:
+    """Mission events made one at a time, each with what rviz received for it."""
+
+    def __init__(self, watch: UpdateWatch, client: Any) -> None:
+        self.watch = watch
+        self.client = client
+        self.by_kind: dict[str, list[dict[str, float]]] = {}
+
+    def measure(self, kind: str, names: set[str], call: Callable[[], int]) -> None:
+        """Run ``call`` (returns the event's revision); keep what ``names``' update cost."""
+        began = time.monotonic()
+        revision = call()
+        arrived = self.watch.event_time(revision)
+        expected = {TASK + n for n in names}
+        first = self.watch.first_carrying(expected, began)
+        time.sleep(max(0.0, first + SETTLE - time.monotonic()))
+        updates = self.watch.between(began, first + SETTLE)
+        arrays, icons = self.watch.icon_markers_between(began, first + SETTLE)
+        self.by_kind.setdefault(kind, []).append(
+            {
+                "latency": max(0.0, first - arrived),
+                "updates": len(updates),
+                "markers": sum(len(u.markers) for u in updates),
+                "poses": sum(len(u.poses) for u in updates),
+                "erases": sum(len(u.erases) for u in updates),
+                "icon_markers": icons,
+                "icon_arrays": arrays,
+            }
+        )
+
+    def figures(self) -> dict[str, Any]:
+        """Per kind: the means of the counts, their max, and the latency."""
+        out: dict[str, Any] = {}
+        for kind, samples in self.by_kind.items():
+            figure: dict[str, Any] = {"n": len(samples)}
+            for key in ("updates", "markers", "poses", "erases", "icon_markers"):
+                values = [s[key] for s in samples]
+                figure[f"{key}_mean"] = round(statistics.mean(values), 2)
+                figure[f"{key}_max"] = max(values)
+            figure["latency"] = summary([s["latency"] for s in samples])
+            out[kind] = figure
+        return out
+
+
+def idle(watch: UpdateWatch, seconds: float = 5.0) -> dict[str, float]:
+    """What the robots' motion alone costs per second."""
+    began = time.monotonic()
+    time.sleep(seconds)
+    updates = watch.between(began, began + seconds)
+    arrays, icons = watch.icon_markers_between(began, began + seconds)
+    return {
+        "updates_per_s": round(len(updates) / seconds, 2),
+        "markers_per_s": round(sum(len(u.markers) for u in updates) / seconds, 2),
+        "poses_per_s": round(sum(len(u.poses) for u in updates) / seconds, 2),
+        "icon_arrays_per_s": round(arrays / seconds, 2),
+        "icon_markers_per_s": round(icons / seconds, 2),
+    }
+
+
+def run(args: argparse.Namespace, work: Path) -> dict[str, Any]:
     import rospy
 
     from rosmc_server.core import MarkerType, Pose, TaskMarker
@@ -192,71 +190,141 @@ def run(args: argparse.Namespace, work: Path) -> int:
         if time.monotonic() > deadline:
             raise RuntimeError("the marker node did not start")
         time.sleep(0.05)
+    robots = [f"robot_{i:02d}" for i in range(ROBOTS)]
+    robot = FakeRobot(robots[0])
     client = MissionClient(10.0)
     client.get_mission()
     names = []
+    blueprint: list[tuple[str, str]] = []  # robots[0]'s blueprint: (skill, its marker)
     for i in range(MARKERS):
         name = client.add_task_marker(
             TaskMarker(f"m{i:03d}", MarkerType.POSE, Pose(i % 20, i // 20))
         ).name
         names.append(name)
         if i % 2 == 0:
-            client.add_skill(f"robot_{i % ROBOTS:02d}", "navigate_to", bindings={"target": name})
-    watcher = Watcher()
+            # robots[0] gets one skill per round to synchronize and run, the others the rest
+            half = i // 2
+            agent = robots[0] if half < args.samples else robots[1 + half % (ROBOTS - 1)]
+            added = client.add_skill(agent, "navigate_to", bindings={"target": name})
+            if agent == robots[0]:
+                blueprint.append((added.skill_id, name))
+    free = [n for i, n in enumerate(names) if i % 2 == 1]  # bound to nothing
+    bound = [n for i, n in enumerate(names) if i % 2 == 0]
+    watch = UpdateWatch()
+    watch.start()
     stop = threading.Event()
-    reporter = threading.Thread(target=telemetry, args=(stop,), daemon=True)
-    reporter.start()
-    time.sleep(2.0)  # telemetry flowing, subscriptions connected
-    latencies: list[float] = []
-    seen: dict[str, int] = {}
-    for k in range(args.samples):
-        name = names[k % MARKERS]
-        before = len(watcher.updates.get(f"task/{name}", []))
-        result = client.move_task_marker(name, Pose(k % 20 + 0.5, k // 20 % 10, yaw=0.1 * k))
-        arrived = watcher.wait_update(f"task/{name}", before + 1)
-        latencies.append(arrived - watcher.event_time(result.revision))
-        seen[name] = before + 1
-    # sustained: back to back
-    sizes_before = len(watcher.sizes)
-    started = time.monotonic()
-    last: tuple[str, int] | None = None
-    burst: list[tuple[str, int, int]] = []
-    for k in range(args.burst):
-        name = names[(k * 7) % MARKERS]
-        before = len(watcher.updates.get(f"task/{name}", []))
-        result = client.move_task_marker(name, Pose(k % 20 + 0.25, (k // 20) % 10, yaw=0.2 * k))
-        burst.append((name, result.revision, before))
-        last = (name, before)
-    assert last is not None
-    end = time.monotonic()
-    for name, _, before in burst:  # every moved marker's update must arrive
-        watcher.wait_update(f"task/{name}", before + 1, timeout=30.0)
-    finished = max(watcher.updates[f"task/{n}"][-1] for n, _, _ in burst)
-    under_load = []
-    for name, revision, before in burst:
-        times = watcher.updates[f"task/{name}"]
-        if len(times) > before:
-            under_load.append(times[before] - watcher.event_time(revision))
-    stop.set()
-    reporter.join()
-    sizes = watcher.sizes[:sizes_before]
-    result = {
+    motion = threading.Thread(target=team_motion, args=(robots, stop), daemon=True)
+    motion.start()
+    deadline = time.monotonic() + 30
+    while not robot.connected():
+        if time.monotonic() > deadline:
+            raise RuntimeError("the server does not hear robot_00's link")
+        time.sleep(0.05)
+    robot.hello()
+    time.sleep(3.0)  # telemetry and TF flowing, subscriptions connected
+    figures: dict[str, Any] = {
         "robots": ROBOTS,
         "task_markers": MARKERS,
-        "telemetry_hz_per_robot": 10,
-        "event_to_marker_update": summary(latencies),
-        "sustained": {
-            "moves": args.burst,
-            "send_seconds": round(end - started, 3),
-            "events_per_second": round(args.burst / (finished - started), 1),
-            "lag_after_last_event_ms": round((finished - end) * 1000, 1),
-            "latency_under_load": summary(under_load),
-        },
-        "markers_per_update_mean": round(statistics.mean(sizes), 2) if sizes else None,
-        "target_p95_ms": 50,
+        "telemetry_and_tf_hz_per_robot": 10,
+        "idle": idle(watch),
     }
-    print(json.dumps(result, indent=2))
-    return 0
+    events = Events(watch, client)
+    for k in range(args.samples):
+        one_round(events, robot, robots, k, free, bound, blueprint)
+    figures["per_event"] = events.figures()
+    figures["sustained"] = sustained(watch, client, bound, args.burst)
+    stop.set()
+    motion.join()
+    return figures
+
+
+def one_round(
+    events: Events,
+    robot: FakeRobot,
+    robots: list[str],
+    k: int,
+    free: list[str],
+    bound: list[str],
+    blueprint: list[tuple[str, str]],
+) -> None:
+    """One event of each kind: add, edit, delete and move elsewhere; sync and status on
+    ``robot`` (robots[0], whose link end this process plays, its ``blueprint`` in order)."""
+    from rosmc_server.core import Pose, SkillStatus
+
+    client = events.client
+    agent = robots[1 + k % (len(robots) - 1)]
+    first, second = free[(2 * k) % len(free)], free[(2 * k + 1) % len(free)]
+    added: list[str] = []
+
+    def add() -> int:
+        result = client.add_skill(agent, "navigate_to", bindings={"target": first})
+        added.append(result.skill_id)
+        return int(result.revision)
+
+    events.measure("add", {first}, add)
+    events.measure(
+        "edit",
+        {first, second},
+        lambda: client.edit_skill(added[-1], bindings={"target": second}).revision,
+    )
+    events.measure("delete", {second}, lambda: client.delete_skills([added[-1]]).revision)
+    moved = bound[(k * 7) % len(bound)]
+    pose = Pose(k % 20 + 0.5, k // 20 % 10, yaw=0.1 * k)
+    events.measure("marker_move", {moved}, lambda: client.move_task_marker(moved, pose).revision)
+    # robots[0]: the head of its blueprint synchronized and run to the end
+    skill, target = blueprint.pop(0)
+    events.measure("sync", {target}, lambda: client.synchronize(robots[0], skill).revision)
+    events.measure("status", {target}, lambda: report(robot, skill, int(SkillStatus.RUNNING)))
+    events.measure("status", {target}, lambda: report(robot, skill, int(SkillStatus.SUCCESS)))
+
+
+def report(robot: FakeRobot, skill: str, status: int) -> int:
+    """Report ``status`` of ``skill``; the revision of the event it makes."""
+    from rosmc_server.ros.client import MissionClient
+
+    client = MissionClient(10.0)
+    before = client.get_mission().revision
+    robot.report(skill, status)
+    deadline = time.monotonic() + 10
+    resend = time.monotonic() + 1.0
+    while time.monotonic() < deadline:
+        time.sleep(0.01)
+        if time.monotonic() > resend:
+            robot.resend()
+            resend += 1.0
+        mission = client.get_mission()
+        if mission.revision > before and mission.skill(skill).status.value == status:
+            return mission.revision
+    raise RuntimeError(
+        f"the server did not take report {status} of {skill} "
+        f"(it has {mission.skill(skill).status}, the robot holds {robot.queue})"
+    )
+
+
+def sustained(watch: UpdateWatch, client: Any, bound: list[str], burst: int) -> dict[str, Any]:
+    """Moves back to back: how fast the node keeps up, and the latency meanwhile."""
+    from rosmc_server.core import Pose
+
+    began = time.monotonic()
+    sent: list[tuple[str, int, float]] = []
+    for k in range(burst):
+        name = bound[(k * 7) % len(bound)]
+        result = client.move_task_marker(name, Pose(k % 20 + 0.25, (k // 20) % 10, yaw=0.2 * k))
+        sent.append((name, result.revision, time.monotonic()))
+    end = time.monotonic()
+    latencies, last = [], began
+    for name, revision, at in sent:
+        arrived = watch.event_time(revision, timeout=30.0)
+        update = watch.first_carrying({TASK + name}, at - 0.001, timeout=30.0)
+        latencies.append(max(0.0, update - arrived))
+        last = max(last, update)
+    return {
+        "moves": burst,
+        "send_seconds": round(end - began, 3),
+        "events_per_second": round(burst / (last - began), 1),
+        "lag_after_last_event_ms": round((last - end) * 1000, 1),
+        "latency_under_load": summary(latencies),
+    }
 
 
 if __name__ == "__main__":

@@ -133,7 +133,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--real-time-factor", type=float, default=5.0, help="sim speed (5)")
     parser.add_argument("--timeout", type=float, default=180.0, help="wall seconds (180)")
     parser.add_argument("--settle", type=float, default=2.0, help="wall seconds (2)")
-    parser.add_argument("--size", type=shots._size, default=shots.DEFAULT_SIZE)
+    parser.add_argument("--size", type=shots._size, default=shots.config_window(operator.CONFIG))
     args = parser.parse_args(argv)
     try:
         return take(args)

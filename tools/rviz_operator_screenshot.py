@@ -23,9 +23,14 @@ When the mission is in that state and rviz has drawn, it waits ``--settle`` seco
 writes the screenshot. Everything it started is stopped by process group at the end, also
 on Ctrl-C or SIGTERM.
 
+With ``--first-look`` it screenshots rviz as it opens instead (the team at the lander, no
+mission yet). The screen is as large as the config's window (900x1000: the left part of a
+1600x1000 screen beside the command GUI) unless ``--size`` says otherwise.
+
 Run after ``source env.sh``::
 
     python tools/rviz_operator_screenshot.py -o docs/rviz.png
+    python tools/rviz_operator_screenshot.py --first-look -o docs/rviz_first_look.png
 
 Exit status: 0 written; 1 the mission did not reach that state or rviz did not draw in
 ``--timeout`` (the last screenshot is still written, to show why); 2 a program is missing
@@ -229,6 +234,8 @@ def take(args: argparse.Namespace) -> int:
         rviz = stack.enter_context(started).process  # restarted if it dies at start-up
         client = MissionClient(timeout=30.0)
         stack.callback(client.close)
+        if args.first_look:
+            return first_look(args, display, check, home)
         ids = plan_mission(client)
         print("rviz_operator_screenshot: mission started; waiting for the pictured state")
         deadline = time.monotonic() + args.timeout
@@ -272,6 +279,25 @@ def take(args: argparse.Namespace) -> int:
             return 1
     shutil.rmtree(home, ignore_errors=True)  # kept (logs) only when something went wrong
     print(f"rviz_operator_screenshot: {args.output} written")
+    return 0
+
+
+def first_look(args: argparse.Namespace, display: str, check: Any, home: Path) -> int:
+    """The screenshot of rviz as it opens: the team at the lander, no mission yet."""
+    deadline = time.monotonic() + args.timeout
+    while check.problems(shot := shots.grab(display)) and time.monotonic() < deadline:
+        time.sleep(0.5)
+    time.sleep(args.settle)  # the markers' full update, TF and the site arrive
+    shot = shots.grab(display)
+    shot.write_png(args.output)
+    problems = check.problems(shot)
+    if problems:
+        print(
+            f"rviz_operator_screenshot: rviz did not draw ({'; '.join(problems)})", file=sys.stderr
+        )
+        return 1
+    shutil.rmtree(home, ignore_errors=True)
+    print(f"rviz_operator_screenshot: {args.output} written (first look)")
     return 0
 
 
@@ -326,8 +352,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--real-time-factor", type=float, default=1.0, help="sim speed (1)")
     parser.add_argument("--timeout", type=float, default=180.0, help="wall seconds (180)")
     parser.add_argument("--settle", type=float, default=3.0, help="wall seconds (3)")
-    parser.add_argument("--size", type=shots._size, default=shots.DEFAULT_SIZE)
+    parser.add_argument(
+        "--size",
+        type=shots._size,
+        default=shots.config_window(CONFIG),
+        help="screen size (default: the config's window, 900x1000)",
+    )
     parser.add_argument("-v", "--verbose", action="store_true", help="say what is missing")
+    parser.add_argument(
+        "--first-look", action="store_true", help="rviz as it opens: the team, no mission"
+    )
     parser.add_argument("--view", help="a saved view of operator.rviz (default: its current)")
     parser.add_argument("--out-of-contact", default="", help="a robot cut off, work waiting")
     parser.add_argument(

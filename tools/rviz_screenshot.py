@@ -132,17 +132,51 @@ class Screenshot:
 
         A layer that covers most of the view (the radio-coverage shading) hides the
         background: then the view is where rviz's light window chrome is not, provided
-        the background shows in it at all.
+        the background shows in it at all (in a narrow window the shading can fill every
+        column of the view, and only the sky beyond the site is background).
         """
-        by_background = self._box(self.near(background, tolerance))
-        if by_background is None:
+        # a window narrower than the screen: the bare screen beside it (pure black) is no
+        # part of it, and would thin every row out
+        lit_rows = np.flatnonzero(self.pixels.max(axis=(1, 2)) > 0)
+        lit_columns = np.flatnonzero(self.pixels.max(axis=(0, 2)) > 0)
+        if lit_rows.size == 0:
             return None
-        box = by_background
-        by_chrome = self._box(self.pixels.min(axis=2) <= CHROME_LEVEL, longest=True)
-        if by_chrome is not None and _area(by_chrome) * 0.9 > _area(by_background):
+        top0, left0 = int(lit_rows[0]), int(lit_columns[0])
+        window = self.pixels[top0 : int(lit_rows[-1]) + 1, left0 : int(lit_columns[-1]) + 1]
+        if window.shape != self.pixels.shape:
+            box = Screenshot(window).view_box(background, tolerance)
+            return None if box is None else (box[0] + left0, box[1] + top0, box[2], box[3])
+        mask = self.near(background, tolerance)
+        by_background = self._box(mask)
+        by_chrome = self._dark_box(self.pixels.min(axis=2) <= CHROME_LEVEL)
+        if by_chrome is not None:
+            top, bottom, left, right = by_chrome
+            if not mask[top : bottom + 1, left : right + 1].mean() > 0.01:
+                by_chrome = None  # dark, but no background in it: not the 3D view
+        if by_background is None and by_chrome is None:
+            return None
+        box = by_background or by_chrome
+        assert box is not None
+        if by_chrome is not None and _area(by_chrome) * 0.9 > _area(box):
             box = by_chrome
         top, bottom, left, right = box
         return left, top, right - left + 1, bottom - top + 1
+
+    @staticmethod
+    def _dark_box(mask: np.ndarray) -> tuple[int, int, int, int] | None:
+        """Top, bottom, left, right of the widest run of columns mostly in ``mask``, and of
+        the longest run of rows mostly in it across those columns (panels beside the view
+        do not thin its rows out)."""
+        columns = np.flatnonzero(mask.mean(axis=0) > 0.5)
+        if columns.size == 0:
+            return None
+        columns = _longest_run(columns)
+        left, right = int(columns[0]), int(columns[-1])
+        rows = np.flatnonzero(mask[:, left : right + 1].mean(axis=1) > 0.5)
+        if rows.size == 0:
+            return None
+        rows = _longest_run(rows)
+        return int(rows[0]), int(rows[-1]), left, right
 
     @staticmethod
     def _box(mask: np.ndarray, longest: bool = False) -> tuple[int, int, int, int] | None:
@@ -336,6 +370,17 @@ def config_background(config: Path) -> RGB | None:
         return None
     red, green, blue = (int(group) for group in match.groups())
     return red, green, blue
+
+
+def config_window(config: Path) -> tuple[int, int]:
+    """The width and height of the window ``config`` asks for (``Window Geometry``), so that
+    a screenshot holds rviz as an operator sees it and no empty screen beside it."""
+    document = yaml.safe_load(config.read_text())
+    geometry = document.get("Window Geometry", {})
+    width, height = geometry.get("Width"), geometry.get("Height")
+    if not isinstance(width, int) or not isinstance(height, int):
+        return DEFAULT_SIZE
+    return width, height
 
 
 def with_saved_view(config: Path, view: str, directory: Path) -> Path:

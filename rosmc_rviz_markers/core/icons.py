@@ -12,14 +12,14 @@ without covering the others:
   for contact follow the link (``LINK DOWN 40 s, 2 WAITING 1 min``).
 
 No data is shown as such (``?``, "never heard"), never left out. Robots whose blocks
-would cover each other from the shipped views (at the lander, at one region, a row of
-robots) get their blocks lifted by whole blocks (:func:`icon_levels`).
+would cover each other or a task marker's label from the shipped views (at the lander, at
+one region, a row of robots) get their blocks lifted by whole blocks (:func:`icon_levels`).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 from rosmc_server.core.agent_status import AgentStatus
@@ -54,7 +54,11 @@ SEPARATOR = " | "
 # are lines of one camera-facing text (each row's marker blanks the others' lines), so
 # they stay apart on screen from every view; rows stacked in height would merge when seen
 # from above.
-ICON_BASE = 2.15  # above the robot's frame: the lower line's centre, clear of mast, arm, pin
+# Above the robot's frame: the lower line's centre, clear of mast, arm and pin as the
+# shipped views see them. Text faces the camera at full height while heights below it
+# shrink by cos(pitch) on screen: at 2.15 m the lower line covered the drone's pin (what
+# an operator clicks when the drone rests on the lander) from the first view (pitch 1.1).
+ICON_BASE = 3.1
 ICON_TEXT = 0.45  # letter height
 ICON_ROW = ICON_TEXT * LINE_SPACING  # from one line's centre to the next, on screen
 ICON_GAP = 0.2  # between two lifted blocks, as the view sees them
@@ -183,18 +187,21 @@ def status_rows(
 
 
 def icon_levels(
-    positions: Mapping[str, Point | None], lines: Mapping[str, Sequence[str]] | None = None
+    positions: Mapping[str, Point | None],
+    lines: Mapping[str, Sequence[str]] | None = None,
+    fixed: Iterable[Box] = (),
 ) -> dict[str, int]:
     """How many whole blocks to lift each robot's block (0 = right above the robot).
 
     Robots are taken from south to north (the shipped views look north, so a robot further
     north stands higher on screen and its block goes higher still); each gets the lowest
     level at which its block, as the shipped views see it (:mod:`.labels`), covers no
-    block placed before. ``lines`` are each block's texts (default: two lines of
-    :data:`TYPICAL_LINE` characters). Robots without a known position come last, in the
+    block placed before and none of the ``fixed`` boxes (the task markers' labels, which
+    stay put while robots drive by). ``lines`` are each block's texts (default: two lines
+    of :data:`TYPICAL_LINE` characters). Robots without a known position come last, in the
     order given, and stack on each other as if together.
     """
-    placed: list[Box] = []
+    placed: list[Box] = list(fixed)
     unknown = 0
     out: dict[str, int] = {}
     order = sorted(positions.items(), key=lambda item: (item[1] is None, (item[1] or (0, 0))[1]))
@@ -203,12 +210,15 @@ def icon_levels(
             out[agent], unknown = unknown, unknown + 1
             continue
         texts = tuple((lines or {}).get(agent, ("x" * TYPICAL_LINE,) * 2))
+        box = _block(agent, position, 0, texts).box()
+        # only boxes beside it can be in its way as it is lifted (a field of labels is big)
+        beside = [b for b in placed if b.left < box.right and box.left < b.right]
         level = 0
-        while True:
+        while hits := [other for other in beside if box.overlaps(other)]:
+            # at least clear of the hit that ends lowest: no level in between can be free
+            rise = min(hit.top for hit in hits) - box.bottom
+            level += max(1, math.ceil(rise / _level_rise(len(texts)) - 1e-9))
             box = _block(agent, position, level, texts).box()
-            if not any(box.overlaps(other) for other in placed):
-                break
-            level += 1
         out[agent] = level
         placed.append(box)
     return out
@@ -219,14 +229,18 @@ def _block(agent: str, position: Point, level: int, texts: Sequence[str]) -> Lab
     return Label(agent, position[0], position[1], centre, tuple(texts), ICON_TEXT, ICON_ROW)
 
 
+def _level_rise(rows: int) -> float:
+    """How far one level lifts a block on the view plane (see :func:`block_centre`)."""
+    return ICON_ROW * (rows - 1) + ICON_TEXT + ICON_GAP
+
+
 def block_centre(level: int, rows: int = 2) -> float:
     """Height (m above the robot's frame) of the centre of a block of ``rows`` at ``level``.
 
     One level lifts a block just enough to clear the one below it as the steepest shipped
     view sees it (looking down, height shows foreshortened by ``cos(pitch)``).
     """
-    on_screen = ICON_ROW * (rows - 1) + ICON_TEXT + ICON_GAP
-    return ICON_BASE + ICON_ROW * (rows - 1) / 2 + level * on_screen / math.cos(VIEW_PITCH)
+    return ICON_BASE + ICON_ROW * (rows - 1) / 2 + level * _level_rise(rows) / math.cos(VIEW_PITCH)
 
 
 def block_label(agent: str, position: Point, level: int, rows: Sequence[IconRow]) -> Label:

@@ -10,7 +10,9 @@
 * Task marker: ``Add skill ▸ <robot> ▸ <skill>`` for skills with a parameter that accepts the
   marker's kind (the new skill is bound to the marker), ``Rename ▸ <suggestion>`` and
   ``Delete`` (only when no skill uses it; rename only while it is not locked).
-* Every one of them ends with ``Undo my last change`` and ``Redo`` (:data:`UNDO_MENU`).
+* Every one of them starts with an entry that names what was clicked, ``drone — robot``,
+  ``RSS North — area`` (:func:`title_menu`; choosing it selects the object), and ends with
+  ``Undo my last change`` and ``Redo`` (:data:`UNDO_MENU`).
 
 Entries are numbered depth first from 1, as ``visualization_msgs/MenuEntry`` wants.
 """
@@ -63,8 +65,13 @@ class UndoEdit:
     redo: bool = False
 
 
+@dataclass(frozen=True)
+class SelectObject:
+    """Select the clicked object (the menu's first entry, the one that names it)."""
+
+
 EditAction = AddSkill | RenameMarker | DeleteMarker
-MenuAction = EditAction | UndoEdit
+MenuAction = EditAction | UndoEdit | SelectObject
 
 
 @dataclass(frozen=True)
@@ -78,6 +85,18 @@ class Menu:
 
 UNDO_MENU = (Menu("Undo my last change", UndoEdit()), Menu("Redo", UndoEdit(redo=True)))
 """Every marker's menu ends with these (see :mod:`.edit_history`)."""
+
+ROBOT_WORD = "robot"
+OBJECT_WORD = "object"
+
+
+def title_menu(name: str, what: str) -> Menu:
+    """The first entry of a menu: which object it belongs to (``drone — robot``).
+
+    rviz opens a menu where the mouse is and shows no title: among robots, flags and
+    labels close together the operator could not tell whose menu opened.
+    """
+    return Menu(f"{name} \u2014 {what}", SelectObject())
 
 
 @dataclass(frozen=True)

@@ -5,12 +5,15 @@
 (:meth:`Scene.touched`). The node republishes only the touched ones whose spec changed,
 so an event costs what it changes, not the size of the mission. Laying the labels out
 (:meth:`Scene.relayout`) looks at every task marker, but is plain arithmetic, and only
-the markers whose label moved are republished.
+the markers whose label moved are republished. It depends on the task markers alone:
+robots move all the time, so their status blocks keep clear of the task labels
+(:attr:`Scene.label_boxes`), not the other way round; a robot driving by (and its
+telemetry at 10 Hz) then costs no task marker anything.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 
 from rosmc_server.core import geometry as geo
@@ -30,8 +33,17 @@ from rosmc_server.core.updates import (
 )
 from rosmc_server.interface import MAP_FRAME
 
-from .labels import Label, layout
-from .menus import UNDO_MENU, flatten, robot_menu, static_agent_menu, task_marker_menu
+from .labels import Box, Label, layout
+from .menus import (
+    OBJECT_WORD,
+    ROBOT_WORD,
+    UNDO_MENU,
+    flatten,
+    robot_menu,
+    static_agent_menu,
+    task_marker_menu,
+    title_menu,
+)
 from .specs import MarkerSpec, agent_spec, describe, task_label, task_specs
 from .styling import is_locked, marker_use
 
@@ -80,6 +92,8 @@ class Scene:
         self.follow_tf = follow_tf
         self.selection = Selection()
         self.label_south: dict[str, float] = {}  # task marker -> its label moved south (m)
+        self.label_boxes: tuple[Box, ...] = ()  # where the task labels are, as laid out
+        self._labels: dict[str, Label] = {}  # task marker -> its label before the layout
         self.tf_missing: frozenset[str] = frozenset()  # agents whose TF frame is not there
 
     def set_tf_missing(self, agents: Iterable[str]) -> Touched:
@@ -149,9 +163,11 @@ class Scene:
         if self.read_only:
             menu = flatten(())
         elif robot:
-            menu = flatten((*robot_menu(self.library, agent), *UNDO_MENU))
+            title = title_menu(agent, ROBOT_WORD)
+            menu = flatten((title, *robot_menu(self.library, agent), *UNDO_MENU))
         else:
-            menu = flatten((*static_agent_menu(self.library, agent), *UNDO_MENU))
+            title = title_menu(agent, OBJECT_WORD)
+            menu = flatten((title, *static_agent_menu(self.library, agent), *UNDO_MENU))
         highlighted = state is not None and any(
             state.has_skill(s) and state.skill(s).agent == agent for s in self.selection.skill_ids
         )
@@ -177,19 +193,55 @@ class Scene:
         )
         return replace(made, description=f"{agent}: not heard") if unheard else made
 
-    def relayout(self, state: MissionState, blocks: Sequence[Label] = ()) -> set[str]:
-        """Lay the task markers' labels out clear of each other and of the robots' status
-        ``blocks``; returns the markers whose label moved (their specs changed)."""
-        labels = []
-        for marker in state.markers:
-            bound = state.bound_to(marker.name)
-            locked = is_locked(bound)
-            text = describe(marker, marker_use(bound), locked)
-            labels.append(task_label(marker, text, movable=not locked and not self.read_only))
-        # whole quarter metres, so that a robot creeping past does not redraw labels
-        new = layout(labels, [block.box() for block in blocks], step=LABEL_STEP)
+    def relayout(self, state: MissionState, names: Iterable[str] | None = None) -> set[str]:
+        """Lay the task markers' labels out clear of each other; returns the markers whose
+        label moved (their specs changed).
+
+        ``names``: the task markers that may have changed (None: any). Labels that did
+        not change keep their place, and the changed ones find room around them (where
+        they are drawn, if their marker did not move and it is still clear): an isolated
+        edit moves its own label only. The robots' status blocks are laid out after, clear of
+        :attr:`label_boxes`.
+        """
+        if names is None:
+            self._labels = {}
+            names = [marker.name for marker in state.markers]
+        changed = set()
+        keep, prefer = dict(self.label_south), {}
+        for name in names:
+            label, was = self._label(state, name), self._labels.get(name)
+            if label == was:
+                continue
+            changed.add(name)
+            keep.pop(name, None)
+            if label is None:
+                self._labels.pop(name, None)
+                continue
+            self._labels[name] = label
+            if was is not None and was.x == label.x and name in self.label_south:
+                # its marker did not move (new words, locked): the label stays where it is
+                # drawn if that is still clear, rather than push its neighbours about
+                south = self.label_south[name] + label.y - was.y
+                if south >= 0:
+                    prefer[name] = south
+        if not changed:
+            return set()  # no label changed its text or place: the layout stands
+        labels = list(self._labels.values())
+        # whole quarter metres, so that a marker dragged a little does not redraw its column
+        new = layout(labels, step=LABEL_STEP, keep=keep, prefer=prefer)
         old, self.label_south = self.label_south, new
+        self.label_boxes = tuple(label.box(new[label.key]) for label in labels)
         return {name for name in old.keys() | new.keys() if old.get(name) != new.get(name)}
+
+    def _label(self, state: MissionState, name: str) -> Label | None:
+        """Task marker ``name``'s label where it stands before the layout (None: no marker)."""
+        if not state.has_marker(name):
+            return None
+        marker = state.marker(name)
+        bound = state.bound_to(name)
+        locked = is_locked(bound)
+        text = describe(marker, marker_use(bound), locked)
+        return task_label(marker, text, movable=not locked and not self.read_only)
 
     def marker_specs(self, state: MissionState, name: str) -> list[MarkerSpec]:
         """The interactive markers of task marker ``name`` (none if it does not exist)."""
@@ -201,7 +253,11 @@ class Scene:
         menu = flatten(
             ()
             if self.read_only
-            else (*task_marker_menu(self.library, state, marker, bound, locked), *UNDO_MENU)
+            else (
+                title_menu(name, marker.type.name.lower()),
+                *task_marker_menu(self.library, state, marker, bound, locked),
+                *UNDO_MENU,
+            )
         )
         return task_specs(
             marker,

@@ -37,6 +37,7 @@ from ..core.coverage import Cell, LastLink, last_links, measured_cells, model_ce
 
 PERIOD = 1.0
 POLE_HEIGHT = 1.6
+LABEL_SOUTH = 1.6  # the last-link label, this far south of its pole (m)
 
 
 class CoverageLayer:
@@ -130,7 +131,9 @@ def _last_link(index: int, mark: LastLink) -> list[Marker]:
     if not mark.label:  # rviz flags an empty text as an error: take the label away instead
         label.action = Marker.DELETE
         return [pole, label]
-    label.pose.position = Point(mark.x, mark.y, POLE_HEIGHT + 0.4)
+    # south of the pole's foot (below it on screen), not over its top: a robot standing
+    # at its last-link place (the drone on the lander) keeps its pin clear to click
+    label.pose.position = Point(mark.x, mark.y - LABEL_SOUTH, 0.3)
     label.scale.z = 0.5
     label.color = ColorRGBA(1.0, 1.0, 1.0, alpha)
     label.text = mark.label

@@ -37,7 +37,14 @@ from rosmc_server.ros.client import AsyncMissionClient, MissionClient, Outcome
 
 from .. import topics
 from ..core.edit_history import EditHistory
-from ..core.menus import AddSkill, DeleteMarker, EditAction, RenameMarker, UndoEdit
+from ..core.menus import (
+    AddSkill,
+    DeleteMarker,
+    EditAction,
+    RenameMarker,
+    SelectObject,
+    UndoEdit,
+)
 from ..core.requests import SkillPlan, moved_area, moved_pose, new_marker, robot_skill_plan
 from ..core.scene import Selection
 from ..core.specs import Parsed, parse_name
@@ -145,6 +152,9 @@ class Interaction:
             return
         if isinstance(action, UndoEdit):
             self._undo(action.redo)
+            return
+        if isinstance(action, SelectObject):
+            self._select(parsed)
             return
         mirror = self._node.mirror
         scene = self._node.scene

@@ -8,8 +8,9 @@ become mission server calls (see :mod:`.interaction`).
 ROS interface (every name behind ``~ns``):
     Publishes ``/rosmc/markers/update`` (visualization_msgs/InteractiveMarkerUpdate),
     ``/rosmc/markers/update_full`` (InteractiveMarkerInit, latched),
-    ``/rosmc/markers/icons`` (visualization_msgs/MarkerArray, latched: status icons, and
-    a text above the origin once the mission server restarted, naming its revision),
+    ``/rosmc/markers/icons`` (visualization_msgs/MarkerArray: status icons, and a text
+    above the origin once the mission server restarted, naming its revision; all of them
+    to a subscriber as it connects, then only what changed, see :mod:`.icon_layer`),
     ``/rosmc/selection`` (rosmc/Selection, latched: what the operator clicked),
     ``/rosmc/coverage`` (visualization_msgs/MarkerArray, latched: radio coverage, see
     :mod:`.coverage_layer`, which also subscribes ``/rosmc/sim/coverage``).
@@ -33,7 +34,7 @@ import time
 from collections.abc import Mapping, Sequence
 
 import rospy
-from visualization_msgs.msg import Marker, MarkerArray
+from visualization_msgs.msg import Marker
 
 from rosmc_server.common.ros.logging_bridge import bridge_logging_to_rosout
 from rosmc_server.core import AgentStatus, Library, MissionState, load_library
@@ -44,14 +45,14 @@ from rosmc_server.interface import MAP_FRAME, base_link
 from rosmc_server.ros.client import MissionFollower, Outcome
 
 from .. import topics
-from ..core.icons import WARN, IconRow, block_label, icon_levels, status_rows
-from ..core.labels import Label
+from ..core.icons import WARN, IconRow, icon_levels, status_rows
 from ..core.scene import Scene, Touched
 from ..core.specs import MarkerSpec
 from .adapter import MarkerServer
 from .config import MarkerNodeConfig
 from .convert import icon_markers, interactive_marker_msg, pose_msg
 from .coverage_layer import CoverageLayer
+from .icon_layer import IconLayer
 from .interaction import Interaction
 from .tf_presence import TfPresence
 
@@ -82,9 +83,7 @@ class MarkerNode:
         self._closed = False
         self._unsubscribe: list[object] = []
         self.server = MarkerServer(topics.topic(topics.MARKERS_NS, config.ns), self._on_feedback)
-        self._icons = rospy.Publisher(
-            topics.topic(topics.ICONS_TOPIC, config.ns), MarkerArray, queue_size=10, latch=True
-        )
+        self._icons = IconLayer(topics.topic(topics.ICONS_TOPIC, config.ns))
         self.interaction = Interaction(self, config)
         self.coverage = CoverageLayer(config.ns)  # radio coverage and last-link marks
         self._tf: TfPresence | None = None  # which agents have TF (follow_tf only)
@@ -237,8 +236,10 @@ class MarkerNode:
             # Agents touched under a previous library may be unknown to this one (the server
             # restarted with another library): they have nothing left to draw.
             agents = set(touched.agents) & set(scene.agents())
-            if touched.everything or touched.markers or touched.icons:
-                names |= scene.relayout(state, self._block_labels(scene, statuses, state))
+            boxes = scene.label_boxes
+            if touched.everything or touched.markers:
+                # task labels depend on task markers alone: a robot's status costs none
+                names |= scene.relayout(state, None if touched.everything else touched.markers)
             if touched.everything:
                 names |= {m.name for m in state.markers}
                 with self._lock:
@@ -247,7 +248,8 @@ class MarkerNode:
             specs = {name: scene.marker_specs(state, name) for name in names}
             agent_specs = [scene.agent_spec(a, state, statuses.get(a)) for a in agents]
             icons: list[Marker] | None = None
-            if touched.everything or touched.icons:
+            # status blocks keep clear of the task labels: they follow when a label moves
+            if touched.everything or touched.icons or scene.label_boxes != boxes:
                 icons = self._icon_markers(scene, statuses, state)
         with self._lock:
             for spec in agent_specs:
@@ -265,7 +267,7 @@ class MarkerNode:
                     self._groups.pop(name, None)
             self.server.apply()
         if icons is not None:
-            self._icons.publish(MarkerArray(markers=icons))
+            self._icons.show(icons)
 
     def _stage(self, spec: MarkerSpec) -> None:
         old = self._published.get(spec.name)
@@ -296,18 +298,9 @@ class MarkerNode:
             ):
                 label = state.skill(status.current_skill).label
             rows[agent] = status_rows(status, label, agent)
-        levels = icon_levels(points, {a: [row.text for row in r] for a, r in rows.items()})
+        texts = {a: [row.text for row in r] for a, r in rows.items()}
+        levels = icon_levels(points, texts, scene.label_boxes)
         return [(agent, rows[agent], points[agent], levels[agent]) for agent in agents]
-
-    def _block_labels(
-        self, scene: Scene, statuses: Mapping[str, AgentStatus], state: MissionState
-    ) -> list[Label]:
-        """The status blocks of robots with a known position, for the label layout."""
-        return [
-            block_label(agent, point, level, rows)
-            for agent, rows, point, level in self._blocks(scene, statuses, state)
-            if point is not None
-        ]
 
     def _icon_markers(
         self, scene: Scene, statuses: Mapping[str, AgentStatus], state: MissionState

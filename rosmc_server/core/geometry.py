@@ -291,6 +291,11 @@ def agent_body(kind: BodyKind) -> tuple[Primitive, ...]:
 
 # -- task markers ------------------------------------------------------------------------------
 FLAG_HEIGHT = 2.2
+# rviz picks what is drawn: the flag's whole footprint is there to be grabbed. A ground disc
+# of 1.2 m and a 10 cm pole were hard to hit from the shipped views (a few pixels wide).
+FLAG_DISC = 2.0  # diameter of the ground disc (m)
+FLAG_POLE = 0.22  # thickness of the pole (m)
+FLAG_CLOTH = (1.3, 0.9)  # length and height of the cloth (m)
 
 
 def flag(color: Color) -> tuple[Primitive, ...]:
@@ -299,10 +304,20 @@ def flag(color: Color) -> tuple[Primitive, ...]:
     The cloth is a thin box (lit from both sides; a triangle list has no normals in rviz
     and shows black).
     """
+    length, height = FLAG_CLOTH
+    pole = (FLAG_POLE, FLAG_POLE, FLAG_HEIGHT)
     return (
-        Primitive(Shape.CYLINDER, DARK, (0.0, 0.0, FLAG_HEIGHT / 2), (0.1, 0.1, FLAG_HEIGHT)),
-        _box(color.with_alpha(1.0), 0.55, 0.0, FLAG_HEIGHT - 0.35, 1.0, 0.05, 0.7),
-        Primitive(Shape.CYLINDER, color, (0.0, 0.0, 0.02), (1.2, 1.2, 0.04)),
+        Primitive(Shape.CYLINDER, DARK, (0.0, 0.0, FLAG_HEIGHT / 2), pole),
+        _box(
+            color.with_alpha(1.0),
+            length / 2 + 0.05,
+            0.0,
+            FLAG_HEIGHT - height / 2,
+            length,
+            0.06,
+            height,
+        ),
+        Primitive(Shape.CYLINDER, color, (0.0, 0.0, 0.02), (FLAG_DISC, FLAG_DISC, 0.04)),
     )
 
 

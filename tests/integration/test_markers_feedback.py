@@ -74,7 +74,13 @@ def test_robot_menu_area_skill_gets_an_area_in_front(mission: Any, rviz: Rviz) -
 
 def test_task_marker_menu_adds_a_skill_bound_to_it(mission: Any, rviz: Rviz) -> None:
     name = add_marker(mission, rviz, TaskMarker("drop", MarkerType.POSE, Pose(5.0, 6.0, yaw=0.5)))
-    assert rviz.titles(f"task/{name}") == ["Add skill", "Rename", "Delete", *UNDO_TITLES]
+    assert rviz.titles(f"task/{name}") == [
+        f"{name} \u2014 pose",  # the first entry names the object
+        "Add skill",
+        "Rename",
+        "Delete",
+        *UNDO_TITLES,
+    ]
     rviz.select_menu(f"task/{name}", "Add skill", "manipulator_rover", "place_box")
     (skill,) = wait_for(lambda: skills_of(mission, "manipulator_rover"), "place_box")
     assert skill.skill == "place_box" and skill.bindings == {"target": name}
@@ -273,3 +279,14 @@ def test_selection_both_ways(mission: Any, rviz: Rviz) -> None:
     )
     rviz.marker(f"task/{other}", highlighted)
     rviz.marker(f"task/{name}", lambda m: not highlighted(m))
+
+
+def test_the_menus_first_entry_names_the_object_and_selects_it(mission: Any, rviz: Rviz) -> None:
+    name = add_marker(mission, rviz, TaskMarker("RSS North", MarkerType.POSITION, Pose(3.0, 9.0)))
+    assert rviz.titles("robot/drone")[0] == "drone \u2014 robot"
+    assert rviz.titles("object/lander")[0] == "lander \u2014 object"
+    assert rviz.titles(f"task/{name}")[0] == "RSS North \u2014 position"
+    revision = current(mission).revision
+    rviz.select_menu(f"task/{name}", "RSS North \u2014 position")
+    wait_for(lambda: [s for s in rviz.selections if name in s.marker_names], "the selection")
+    assert current(mission).revision == revision, "naming the object changes nothing"

@@ -9,7 +9,10 @@ background colour fills rows and columns). Each test checks the outcome in the m
 * *Publish Point* on open ground (between the grid's lines) creates a position marker there;
 * dragging a pose marker by its heading arrow moves it without turning it, and dragging
   its ring's knob turns it without moving it;
-* right-clicking the drone where it rests on the lander opens the drone's own menu.
+* right-clicking the drone where it rests on the lander opens the drone's own menu, whose
+  first entry names it;
+* right-clicking a flag's ground disc near its rim (outside the 1.2 m disc flags had)
+  opens that marker's menu, and its first entry (the marker's name) selects it.
 """
 
 from __future__ import annotations
@@ -25,10 +28,12 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+import rosmc.msg as wire
 import rospy
 from visualization_msgs.msg import InteractiveMarkerFeedback
 
 from rosmc_rviz_markers import topics
+from rosmc_server import interface
 from rosmc_server.core import MarkerType, Pose, TaskMarker, geometry
 from rosmc_server.ros.client import MissionClient
 from tests.conftest import RosMaster
@@ -39,8 +44,9 @@ from tests.integration.test_rviz_operator import CONFIG, markers, project, serve
 pytest_plugins = ["tests.integration.server_fixtures"]
 
 Point3 = tuple[float, float, float]
-OPEN_GROUND = (-7.0, -7.0)  # between the grid's lines (every 10 m), nothing above it
-POSE_AT = (-6.0, -9.0)
+OPEN_GROUND = (3.0, -13.0)  # between the grid's lines (every 10 m), nothing above it
+POSE_AT = (-2.0, -14.0)
+FLAG_AT = (-3.0, -11.0)  # a position marker, clicked on the rim of its ground disc
 DRONE_AT = (0.0, 0.0)  # resting on the lander, inside the lander's clickable shell
 STEPS = 12  # mouse positions per drag
 SETTLE = 2.0  # seconds a dragged marker must hold still to count as put down
@@ -118,7 +124,9 @@ def screen(
         with tool.drawn_rviz(
             CONFIG, env, tmp_path / "rviz.log", check, timeout=60.0, attempts=3
         ) as started:
-            assert not started.problems, f"rviz did not draw the site: {started.problems}"
+            if started.problems:
+                started.shot.write_png(tmp_path / "start.png")
+            assert not started.problems, f"rviz did not draw: {started.problems} ({tmp_path})"
             time.sleep(3.0)  # the markers' full update and TF arrive
             shot = tool.grab(display)
             yield Screen(display, *view_box(shot, background), tool=tool)
@@ -216,7 +224,8 @@ def test_the_drone_on_the_lander_opens_its_own_menu(screen: Screen, tmp_path: Pa
         screen.click((*DRONE_AT, geometry.PIN_CENTRE), button=3)  # right click: the menu
         time.sleep(1.0)
         screen.save(tmp_path / "menu.png")
-        screen.xdotool("key", "Down", "Right", "Return")  # Add skill > its first skill
+        # the first entry names the drone; Add skill > its first skill is the second
+        screen.xdotool("key", "Down", "Down", "Right", "Return")
         what = f"a menu entry chosen ({tmp_path / 'menu.png'})"
         chosen = wait_for(lambda: list(selected), what)
     finally:
@@ -224,3 +233,40 @@ def test_the_drone_on_the_lander_opens_its_own_menu(screen: Screen, tmp_path: Pa
     assert chosen[0].marker_name == "robot/drone", f"the menu of {chosen[0].marker_name}"
     added = wait_for(lambda: client.get_mission().task("drone"), "the drone's new skill")
     assert len(added) == 1
+
+
+@pytest.mark.usefixtures("gui_programs", "sim")
+def test_a_flag_is_hit_near_its_rim_and_its_menu_names_it(screen: Screen, tmp_path: Path) -> None:
+    client = MissionClient(10.0)
+    client.get_mission()
+    marker = TaskMarker("RSS spot", MarkerType.POSITION, Pose(*FLAG_AT))
+    name = client.add_task_marker(marker).name
+    time.sleep(2.0)  # rviz shows the new marker
+    chosen: list[InteractiveMarkerFeedback] = []
+    selected: list[Any] = []
+
+    def on_feedback(feedback: InteractiveMarkerFeedback) -> None:
+        if feedback.event_type == InteractiveMarkerFeedback.MENU_SELECT:
+            chosen.append(feedback)
+
+    feedback_topic = topics.topic(topics.MARKERS_NS, "") + "/feedback"
+    subscribers = [
+        rospy.Subscriber(feedback_topic, InteractiveMarkerFeedback, on_feedback),
+        rospy.Subscriber(interface.SELECTION_TOPIC, wire.Selection, selected.append),
+    ]
+    try:
+        # 0.85 m east of the pole: on the 2 m disc, beyond the 1.2 m disc of before
+        rim = (FLAG_AT[0] + 0.85, FLAG_AT[1], 0.04)
+        screen.click(rim, button=3)
+        time.sleep(1.0)
+        screen.save(tmp_path / "flag_menu.png")
+        screen.xdotool("key", "Down", "Return")  # the first entry: the marker's name
+        what = f"a menu entry chosen ({tmp_path / 'flag_menu.png'})"
+        feedback = wait_for(lambda: list(chosen), what)[0]
+        assert feedback.marker_name == f"task/{name}", f"the menu of {feedback.marker_name}"
+        assert feedback.menu_entry_id == 1, "the first entry"
+        wait_for(lambda: [s for s in selected if name in s.marker_names], "the marker selected")
+    finally:
+        for subscriber in subscribers:
+            subscriber.unregister()
+    assert mission_markers(client)[name].pose == marker.pose, "naming it changed nothing"

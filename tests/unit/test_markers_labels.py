@@ -43,9 +43,12 @@ MARKERS = (
 ROBOTS = {"science_rover": (15.0, 8.0, 0.0), "manipulator_rover": (17.0, 8.5, 0.0)}
 
 
-def robot_blocks(robots: dict[str, tuple[float, float, float]]) -> list[Label]:
-    """The robots' status blocks as the node draws them (levels from icon_levels)."""
-    levels = icon_levels(dict(robots))
+def robot_blocks(
+    robots: dict[str, tuple[float, float, float]], labels: tuple[Box, ...] = ()
+) -> list[Label]:
+    """The robots' status blocks as the node draws them (levels from icon_levels, clear of
+    the task ``labels``)."""
+    levels = icon_levels(dict(robots), fixed=labels)
     out = []
     for agent, point in robots.items():
         status = AgentStatus(agent, link="up", last_heard=0.5, battery=0.9, wifi_signal=-55.0)
@@ -67,15 +70,51 @@ def test_labels_at_a_busy_region_do_not_overlap() -> None:
     state = MissionState(MissionContent.empty(LIBRARY))
     state.apply(Change(put_markers=MARKERS))
     scene = Scene(LIBRARY)
-    blocks = robot_blocks(ROBOTS)
     # as they would stand without a layout, the labels write over each other
-    assert overlapping(laid_out_boxes(scene, state, blocks))
+    assert overlapping(laid_out_boxes(scene, state, robot_blocks(ROBOTS)))
 
-    moved = scene.relayout(state, blocks)
+    moved = scene.relayout(state)
     assert moved, "some labels had to move"
+    # the task labels stay put; the robots' blocks keep clear of them
+    blocks = robot_blocks(ROBOTS, scene.label_boxes)
     assert not overlapping(laid_out_boxes(scene, state, blocks))
     # and a second layout of the same scene moves nothing (no redraw without a change)
-    assert scene.relayout(state, blocks) == set()
+    assert scene.relayout(state) == set()
+    assert scene.relayout(state, [m.name for m in MARKERS]) == set()
+
+
+def test_robots_driving_by_move_no_task_label() -> None:
+    """Robots' status blocks are laid out after the task labels: however robots stand,
+    the labels' layout (and so every task marker) is the same."""
+    state = MissionState(MissionContent.empty(LIBRARY))
+    state.apply(Change(put_markers=MARKERS))
+    scene = Scene(LIBRARY)
+    scene.relayout(state)
+    before = dict(scene.label_south)
+    for dx in (-3.0, -1.0, 0.0, 1.5):
+        robots = {a: (x + dx, y, z) for a, (x, y, z) in ROBOTS.items()}
+        blocks = robot_blocks(robots, scene.label_boxes)
+        assert not overlapping([b.box() for b in blocks] + list(scene.label_boxes))
+    assert scene.relayout(state) == set() and scene.label_south == before
+
+
+def test_a_changed_label_moves_only_the_labels_it_covers() -> None:
+    """A column of ten labels: the top one grows; only labels it now covers move (here
+    none: growing sideways at the top of a column clears the rest)."""
+    column = tuple(TaskMarker(f"c{i}", MarkerType.POSITION, Pose(0.0, -0.5 * i)) for i in range(10))
+    state = MissionState(MissionContent.empty(LIBRARY))
+    state.apply(Change(put_markers=column))
+    scene = Scene(LIBRARY)
+    scene.relayout(state)
+    before = dict(scene.label_south)
+    moved_top = TaskMarker("c0", MarkerType.POSITION, Pose(0.0, 0.5))
+    state.apply(Change(put_markers=(moved_top,)))
+    moved = scene.relayout(state, ["c0"])
+    assert moved <= {"c0"}
+    assert {k: v for k, v in scene.label_south.items() if k != "c0"} == {
+        k: v for k, v in before.items() if k != "c0"
+    }
+    assert not overlapping(list(scene.label_boxes))
 
 
 @pytest.mark.parametrize("read_only", [False, True])
@@ -83,7 +122,7 @@ def test_the_label_drawn_is_where_the_layout_put_it(read_only: bool) -> None:
     state = MissionState(MissionContent.empty(LIBRARY))
     state.apply(Change(put_markers=MARKERS))
     scene = Scene(LIBRARY, read_only=read_only)
-    scene.relayout(state, robot_blocks(ROBOTS))
+    scene.relayout(state)
     for marker in MARKERS:
         spec = scene.marker_specs(state, marker.name)[0]
         text = next(
@@ -126,3 +165,13 @@ def test_layout_stacks_labels_south_and_only_as_far_as_needed() -> None:
     tops = sorted((b.top for b in boxes[:3]), reverse=True)
     bottoms = sorted((b.bottom for b in boxes[:3]), reverse=True)
     assert all(math.isclose(bottoms[i] - tops[i + 1], labels.GAP, abs_tol=1e-9) for i in range(2))
+
+
+def test_a_status_block_lifts_clear_of_a_task_label() -> None:
+    label = task_label(MARKERS[0], "RSS A sample spot [blueprint]")
+    robot = {"rover": (MARKERS[0].pose.x, label.y - 1.5, 0.0)}
+    assert icon_levels(robot) == {"rover": 0}
+    lifted = icon_levels(robot, fixed=[label.box()])["rover"]
+    assert lifted > 0
+    block = robot_blocks(robot, (label.box(),))[0]
+    assert not block.box().overlaps(label.box())
