@@ -33,7 +33,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import rviz_operator_screenshot as operator  # the sibling tool: the team, waiting
 import rviz_screenshot as shots  # the sibling tool: Xvfb, rviz, grabbing
 
-OUT_THERE = (26.0, 4.0)  # beyond the Mars lander's 24 m, in the config's view
+OUT_THERE = (4.0, 26.0)  # beyond the Mars lander's 24 m, in the config's first view (north)
 AGE = 20.0  # sim seconds since the rover last had a link, in the picture
 ROBOT = "science_rover"
 

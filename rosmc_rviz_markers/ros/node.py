@@ -58,7 +58,7 @@ from .tf_presence import TfPresence
 
 _log = logging.getLogger(__name__)
 SERVER_ICON = "mission_server"  # the status text of the server itself (icons/mission_server)
-SERVER_NOTE_AT = (0.0, 0.0, 3.0)  # just above the lander (the map origin), below its score
+SERVER_NOTE_AT = (0.0, 0.0, 9.0)  # + ICON_BASE: over the lander (map origin), above its score
 SERVER_NOTE_TEXT = 0.8  # letter height (m): as large as the site's region labels
 
 
