@@ -24,6 +24,7 @@ Typical use::
 from rosmc_server.recording._mcap.files import default_journal_path
 from rosmc_server.recording.channels import JOURNAL_TOPICS
 from rosmc_server.recording.errors import JournalError
+from rosmc_server.recording.journal_options import JournalOptions
 from rosmc_server.recording.reader import (
     JournalRecord,
     JournalResult,
@@ -31,7 +32,7 @@ from rosmc_server.recording.reader import (
     latest_state,
     read_journal,
 )
-from rosmc_server.recording.writer import JournalOptions, JournalWriter
+from rosmc_server.recording.writer import JournalWriter
 
 __all__ = [
     "JOURNAL_TOPICS",

@@ -3,7 +3,7 @@
 A 10,000-skill snapshot takes genpy about 0.3 s to decode, and a journal holds one
 every 500 changes; a reader that decoded every record paid for every snapshot the
 journal ever took. A :class:`JournalRecord` read from a journal keeps its payload
-(a big one stays in the file, see :class:`~._mcap.scan.DeferredMessage`) and decodes
+(a big one stays in the file, see :class:`~._mcap.deferred.DeferredMessage`) and decodes
 it when :attr:`JournalRecord.message` is first asked for. Its leading fields (the
 ``revision``, ``stamp`` and ``kind`` that ``rosmc/Mission`` and ``rosmc/MissionEvent``
 begin with, an event's ``agent`` and ``summary``) are read straight from the bytes,
@@ -20,7 +20,7 @@ import genpy
 
 from rosmc_server.recording._mcap import records as fmt
 from rosmc_server.recording._mcap.codec import Decoder, RosMessage, installed_class
-from rosmc_server.recording._mcap.scan import DeferredMessage, payload_head
+from rosmc_server.recording._mcap.deferred import DeferredMessage, payload_head
 from rosmc_server.recording.errors import JournalError
 
 KEEP_DECODED = 65536

@@ -36,10 +36,11 @@ from rosmc_server.core.changes import EventKind
 from rosmc_server.recording._mcap.codec import RosMessage
 from rosmc_server.recording._mcap.files import journal_parts
 from rosmc_server.recording.high_water import RevisionMark, first_mark, resumed_mark
+from rosmc_server.recording.journal_options import JournalOptions
 from rosmc_server.recording.mark_recovery import recover_mark
 from rosmc_server.recording.reader import latest_state
 from rosmc_server.recording.recovery import ResumeReport
-from rosmc_server.recording.writer import JournalOptions, JournalWriter
+from rosmc_server.recording.writer import JournalWriter
 
 _log = logging.getLogger(__name__)
 

@@ -43,6 +43,11 @@ from rosmc_server.recording import (  # noqa: E402
 )
 from rosmc_server.recording._mcap import scan as _scan  # noqa: E402
 from rosmc_server.recording._mcap.codec import Decoder, serialize  # noqa: E402
+from rosmc_server.recording._mcap.deferred import (  # noqa: E402
+    HEAD_BYTES,
+    DeferredMessage,
+    payload_head,
+)
 from rosmc_server.recording.errors import JournalError  # noqa: E402
 from rosmc_server.recording.history import MissionHistory  # noqa: E402
 from rosmc_server.recording.lazy import Payload  # noqa: E402
@@ -232,7 +237,7 @@ def test_a_damaged_event_costs_the_revisions_to_the_next_snapshot_as_before(
     spans = [
         span
         for msg, span in zip(scan.messages, scan.spans, strict=True)
-        if msg.channel_id == events and int.from_bytes(_scan.payload_head(msg)[:8], "little") == 30
+        if msg.channel_id == events and int.from_bytes(payload_head(msg)[:8], "little") == 30
     ]
     data = bytearray(path.read_bytes())
     data[(spans[0][0] + spans[0][1]) // 2] ^= 0x20
@@ -255,14 +260,14 @@ def test_a_deferred_message_reads_as_the_kept_one(tmp_path: Path) -> None:
         deferred = _scan.scan(path)
     finally:
         _scan.DEFER_BYTES = original
-    assert all(isinstance(m, _scan.DeferredMessage) for m in deferred.messages)
+    assert all(isinstance(m, DeferredMessage) for m in deferred.messages)
     fields = [(m.channel_id, m.sequence, m.log_time, m.publish_time, m.data) for m in kept.messages]
     assert [
         (m.channel_id, m.sequence, m.log_time, m.publish_time, m.data) for m in deferred.messages
     ] == fields
     assert deferred.spans == kept.spans
-    assert [_scan.payload_head(m) for m in deferred.messages] == [
-        m.data[: _scan.HEAD_BYTES] for m in kept.messages
+    assert [payload_head(m) for m in deferred.messages] == [
+        m.data[:HEAD_BYTES] for m in kept.messages
     ]
     assert deferred.chunk_indexes == kept.chunk_indexes and deferred.data_end == kept.data_end
 

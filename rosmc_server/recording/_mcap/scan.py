@@ -28,6 +28,8 @@ from mcap.opcode import Opcode
 from rosmc_server.recording._mcap import head_mark
 from rosmc_server.recording._mcap import records as fmt
 from rosmc_server.recording._mcap.checks import Declarations, RecordDamage
+from rosmc_server.recording._mcap.deferred import DeferredMessage, PayloadSource
+from rosmc_server.recording._mcap.journal_head import damaged_journal_head, read_journal_header
 from rosmc_server.recording._mcap.resync import Resync
 from rosmc_server.recording.channels import LIBRARY, PROFILE
 from rosmc_server.recording.damage import Damage
@@ -36,8 +38,6 @@ from rosmc_server.recording.errors import JournalError
 _HEAD = fmt.RECORD_HEAD.size
 DEFER_BYTES = 65536
 """A message payload this big or bigger stays in the file (see :class:`DeferredMessage`)."""
-HEAD_BYTES = 64
-"""Bytes of a deferred payload kept in memory (its leading fields: revision, stamp, kind)."""
 _JOURNAL_OPCODES = frozenset(
     (
         Opcode.SCHEMA,
@@ -82,77 +82,6 @@ class ScanResult:
     """Where the revision mark's slots lie (:mod:`.head_mark`); None in older journals."""
 
 
-@dataclass(frozen=True)
-class PayloadSource:
-    """Where a deferred message's payload lies in its file.
-
-    Attributes:
-        path: The file.
-        record: Offset of the record that holds it (a chunk, or the message itself).
-        length: Bytes of that record, its opcode and length field included.
-        start: Offset of the payload in the chunk's records (in the file, when bare).
-        size: Bytes of the payload.
-        chunked: Whether the record is a chunk (read and checked against its CRC again).
-    """
-
-    path: Path
-    record: int
-    length: int
-    start: int
-    size: int
-    chunked: bool
-
-    def load(self) -> bytes:
-        """The payload's bytes; raise JournalError if the file no longer holds them."""
-        try:
-            with self.path.open("rb") as file:
-                if not self.chunked:
-                    file.seek(self.start)
-                    data = file.read(self.size)
-                else:
-                    file.seek(self.record)
-                    # By its own fields, as the scan kept it: its opcode or length may be
-                    # damaged (a chunk its CRC vouches for is kept whole).
-                    rec, _ = fmt.read_chunk(file.read(self.length), _HEAD)
-                    data = rec.data[self.start : self.start + self.size]
-        except (OSError, fmt.FormatError) as err:
-            raise JournalError(
-                f"journal {self.path} changed since it was read (byte {self.record}): {err}"
-            ) from err
-        if len(data) != self.size:
-            raise JournalError(f"journal {self.path} changed since it was read: it is shorter")
-        return data
-
-
-class DeferredMessage(fmt.MessageRecord):
-    """A Message record whose payload stays in the file until :attr:`data` is asked for.
-
-    Compares, hashes and reads like a :class:`~.records.MessageRecord`; :attr:`head`
-    holds the payload's first :data:`HEAD_BYTES` bytes, enough for a journal's reader
-    to learn a snapshot's or event's revision without reading the rest.
-    """
-
-    head: bytes
-    source: PayloadSource
-
-    def __init__(self, msg: fmt.MessageRecord, source: PayloadSource) -> None:
-        # Frozen fields, set as the dataclass's own __init__ sets them; data is not kept.
-        for name in ("channel_id", "sequence", "log_time", "publish_time"):
-            object.__setattr__(self, name, getattr(msg, name))
-        object.__setattr__(self, "head", msg.data[:HEAD_BYTES])
-        object.__setattr__(self, "source", source)
-
-    @property  # the frozen base's read-only field, read from the file
-    def data(self) -> bytes:
-        """The payload, read from the file (and checked against its chunk's CRC) each time."""
-        return self.source.load()
-
-
-def payload_head(msg: fmt.MessageRecord) -> bytes:
-    """The first bytes of a message's payload (at most :data:`HEAD_BYTES`), never from disk."""
-    return msg.head if isinstance(msg, DeferredMessage) else msg.data[:HEAD_BYTES]
-
-
 class _Short(Exception):
     """A record that runs past the end of the file."""
 
@@ -167,64 +96,17 @@ def scan(path: Path) -> ScanResult:
     size = len(data)
     if size == 0:
         raise JournalError(f"journal {path} is empty (0 bytes)")
-    damaged_head = _damaged_journal_head(path, data)
+    damaged_head = damaged_journal_head(path, data)
     if damaged_head is not None:
         profile, library, start, damage = PROFILE, LIBRARY, damaged_head.end, [damaged_head]
     elif data[: len(fmt.MAGIC)] != fmt.MAGIC[:size]:
         raise JournalError(f"{path} is not an MCAP file (it does not start with the MCAP magic)")
     else:
-        profile, library, start, damage = _header(path, data)
+        profile, library, start, damage = read_journal_header(path, data)
     result = ScanResult(path=path, size=size, profile=profile, library=library)
     result.damage += damage
     _Walker(result, data).walk(start)
     return result
-
-
-_JOURNAL_HEAD = fmt.MAGIC + fmt.header(PROFILE, LIBRARY)
-"""The bytes every journal file starts with."""
-
-
-def _damaged_journal_head(path: Path, data: bytes) -> Damage | None:
-    """The damage of a journal whose magic or header has a few wrong bytes (or is zeroed),
-    None if its head is intact or it is not a journal at all.
-
-    A journal's head is always the same bytes, so a damaged one is known for what it was
-    and costs nothing but itself: the records after it are read as usual.
-    """
-    head = data[: len(_JOURNAL_HEAD)]
-    if len(head) < len(_JOURNAL_HEAD) or head == _JOURNAL_HEAD:
-        return None
-    pairs = enumerate(zip(head, _JOURNAL_HEAD, strict=True))
-    wrong = [i for i, (have, want) in pairs if have != want]
-    if len(wrong) > len(_JOURNAL_HEAD) // 4 and head.strip(b"\0"):
-        return None  # another file, not a damaged journal
-    return Damage(path, wrong[0], len(_JOURNAL_HEAD), "a damaged MCAP magic or header", kept=True)
-
-
-def _header(path: Path, data: bytes) -> tuple[str, str, int, list[Damage]]:
-    """The header's profile and library, where the records after it start, and its damage."""
-    head = fmt.record_head(data, len(fmt.MAGIC))
-    if head is None:
-        raise JournalError(
-            f"journal {path} holds only {len(data)} bytes: it was cut short before its MCAP "
-            "header was complete, so it holds no records"
-        )
-    if head[0] != Opcode.HEADER:
-        raise JournalError(f"{path} is not a valid MCAP file (its first record is not a header)")
-    declared = len(fmt.MAGIC) + _HEAD + head[1]
-    try:
-        profile, library, end = fmt.read_header(data, len(fmt.MAGIC) + _HEAD)
-    except fmt.FormatError as err:
-        if declared > len(data):
-            return _header(path, data[: len(fmt.MAGIC) + 1])  # cut short: says so
-        raise JournalError(
-            f"{path} is not a valid MCAP file (its header is damaged: {err})"
-        ) from err
-    if end == declared or library != LIBRARY:
-        return profile, library, declared, []
-    # A journal's header ends where its two strings end, whatever its length field says.
-    where = len(fmt.MAGIC) + 1
-    return profile, library, end, [Damage(path, where, where + 8, "a damaged length field", True)]
 
 
 class _Walker:
