@@ -79,7 +79,7 @@ def test_forged_datagrams_do_not_start_a_barrier_member_and_are_counted(
 ) -> None:
     system, op = team
     early = op.add("r1", "wait", {"duration": 0.1})
-    busy = op.add("r2", "wait", {"duration": 6.0})
+    busy = op.add("r2", "wait", {"duration": 1.0})
     late = op.add("r2", "wait", {"duration": 0.1})
     barrier = op.add_barrier([early, late])
     op.sync("r1")
@@ -89,7 +89,9 @@ def test_forged_datagrams_do_not_start_a_barrier_member_and_are_counted(
         60.0,
         "every skill on its robot",
     )
-    op.start()
+    # r1 alone starts: it waits at the barrier for as long as r2 is not started (a state
+    # held, not one a poll on a busy machine could miss).
+    op.start("r1")
     op.wait_status([early], S.SYNCWAITING)
     before = dropped(op, "r1")
 
@@ -112,12 +114,13 @@ def test_forged_datagrams_do_not_start_a_barrier_member_and_are_counted(
     )
     state = op.mission()
     assert state.skill(early).status is S.SYNCWAITING, describe(state)
-    assert state.skill(busy).status is S.RUNNING, describe(state)
+    assert state.skill(busy).status is S.IDLE_SYNCHRONIZED, describe(state)
 
     status_line = format_agent_status(agent_status_from_msg(op.agent_state("r1")))
     assert "forged radio datagrams dropped" in status_line, status_line
 
     # The barrier goes on as if nothing happened: both start together once r2 arrives.
+    op.start("r2")
     op.wait_status([early, late], S.SUCCESS, timeout=60.0)
     system.stop("server")
     assert_released_together(system.journal, [early, late])
