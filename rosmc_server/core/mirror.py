@@ -259,4 +259,3 @@ class MissionMirror:
                 listener(update)
             except Exception:  # one broken view must not stop the others or the mirror
                 _log.exception("a mission mirror listener failed at revision %d", update.revision)
-

@@ -181,7 +181,9 @@ class _Described:
         self.changes.append(SkillRemoved(skill, index))
 
     def skill_put(self, old: SkillInstance | None, new: SkillInstance, index: int) -> None:
-        self.changes.append(SkillAdded(new, index) if old is None else SkillChanged(old, new, index))
+        self.changes.append(
+            SkillAdded(new, index) if old is None else SkillChanged(old, new, index)
+        )
 
     def skills_moved(self, agent: str, moves: Sequence[SkillMove]) -> None:
         self.changes.append(SkillsMoved(agent, moves))
