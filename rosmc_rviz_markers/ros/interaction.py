@@ -32,11 +32,11 @@ from visualization_msgs.msg import InteractiveMarkerFeedback as Feedback
 
 from rosmc_server import interface
 from rosmc_server.core import InvalidRequest, MarkerType, Pose, RosmcError, areas
+from rosmc_server.core.edit_history import EditHistory, EditKind, Step, failure_of
 from rosmc_server.core.params import value_to_data
 from rosmc_server.ros.client import AsyncMissionClient, MissionClient, Outcome
 
 from .. import topics
-from ..core.edit_history import EditHistory
 from ..core.menus import (
     AddSkill,
     DeleteMarker,
@@ -45,7 +45,14 @@ from ..core.menus import (
     SelectObject,
     UndoEdit,
 )
-from ..core.requests import SkillPlan, moved_area, moved_pose, new_marker, robot_skill_plan
+from ..core.requests import (
+    SkillPlan,
+    edit_kind,
+    moved_area,
+    moved_pose,
+    new_marker,
+    robot_skill_plan,
+)
 from ..core.scene import Selection
 from ..core.specs import Parsed, parse_name
 from ..core.styling import is_locked
@@ -169,7 +176,9 @@ class Interaction:
             status = mirror.agent_status(parsed.name) if parsed.kind == "robot" else None
             pose = status.pose if status is not None else None
         call = self._menu_call(action, parsed, scene.library, pose)
-        self._submit(call, f"{fb.marker_name}: {self._title(action)}", revision)
+        self._submit(
+            call, f"{fb.marker_name}: {self._title(action)}", revision, kind=edit_kind(action)
+        )
 
     @staticmethod
     def _title(action: EditAction) -> str:
@@ -194,19 +203,26 @@ class Interaction:
         return lambda c: _add_planned(c, plan)
 
     def _undo(self, redo: bool) -> None:
-        """Ask the server to undo this rviz's newest edit (``redo``: its newest undo)."""
-        entry = self.history.take_redo() if redo else self.history.take_undo()
-        word = "redo" if redo else "undo"
-        if entry is None:
-            _log.warning("nothing of this rviz's to %s", word)
+        """Ask the server to undo this rviz's newest edit (``redo``: its newest undo), against
+        the revision shown (the rule of :class:`EditHistory`, as in the command GUI)."""
+        step = self.history.begin(redo=redo, seen=self._node.mirror.revision)
+        if step is None:  # nothing to take back, or one step still on its way
+            _log.warning("nothing of this rviz's to %s now", "redo" if redo else "undo")
             return
-        revision, what = entry
-        keep = self.history.redone if redo else self.history.undone
-        self._submit(
-            lambda c: c.undo_edit(revision),
-            f"{word} {what}",
-            record=lambda result: keep(result.revision, what),
+        future = self._client.submit(
+            lambda c: c.undo_edit(step.entry.revision),
+            lambda outcome: self._undo_answered(step, outcome),
+            step.base_revision,
         )
+        future.add_done_callback(lambda f: f.exception())  # errors reach the callback
+
+    def _undo_answered(self, step: Step, outcome: Outcome[Any]) -> None:
+        if outcome.error is None:
+            self.history.accepted(step, int(getattr(outcome.value, "revision", 0)))
+            _log.info("%s: done", step.words)
+        else:  # kept (a conflict, no answer) or dropped (refused), as the sentence says
+            error = outcome.error
+            _log.warning("%s", self.history.failed(step, failure_of(error), str(error)))
 
     # -- drags ------------------------------------------------------------------------------------
     def _drag(self, fb: Any, parsed: Parsed) -> None:
@@ -266,6 +282,7 @@ class Interaction:
             f"move '{parsed.name}'",
             revision,
             on_error=lambda: self._node.snap_back(name),
+            kind=EditKind.MOVE_MARKER,
         )
 
     # -- selection --------------------------------------------------------------------------------
@@ -329,7 +346,8 @@ class Interaction:
             _log.warning("ignored a new %s marker: %s", what, error)
             return
         revision = self._node.mirror.revision
-        self._submit(lambda c: c.add_task_marker(marker), f"new {what} marker", revision)
+        call: Call = lambda c: c.add_task_marker(marker)  # noqa: E731
+        self._submit(call, f"new {what} marker", revision, kind=EditKind.ADD_MARKER)
 
     def on_reset(self, revision: int) -> None:
         """A snapshot came; one older than this node's last result means a new server."""
@@ -344,11 +362,10 @@ class Interaction:
         what: str,
         seen: int | None = None,
         on_error: Callable[[], None] | None = None,
-        record: Callable[[Any], None] | None = None,
+        kind: EditKind | None = None,
     ) -> None:
         """Run ``call`` on the client's thread against ``seen``, the revision the operator
-        saw; an accepted edit goes to the history (``record`` instead: how an undo or redo
-        is kept)."""
+        saw; an accepted edit (``kind``) goes to the history."""
 
         def done(outcome: Outcome[Any]) -> None:
             if outcome.error is not None:
@@ -357,10 +374,8 @@ class Interaction:
                     on_error()
                 return
             revision = getattr(outcome.value, "revision", None)
-            if record is not None:
-                record(outcome.value)
-            elif revision is not None:
-                self.history.done(revision, what)
+            if revision is not None:
+                self.history.done(kind, revision, what)
             _log.info("%s: done", what)
 
         future = self._client.submit(call, done, seen)
