@@ -363,7 +363,7 @@ class Mission:
         """Apply ``event`` with the one applier, keeping the undo history and the operator
         revision as it goes (the server's own changes and a resume's alike)."""
         inverse = self.history.inverse(self.state, event.kind, event.change)
-        apply_event(self.state, event)
+        apply_event(self.state, event, describe=False)
         if event.kind not in ROBOT_EVENTS:
             self.operator_revision = event.revision
         self.history.keep(self.state, event, inverse)

@@ -24,14 +24,18 @@ class SnapshotNeeded(RosmcError):
     """The event cannot be applied without a snapshot (it replaced the whole mission)."""
 
 
-def apply_event(state: MissionState, event: MissionEvent) -> tuple[MirrorChange, ...]:
+def apply_event(
+    state: MissionState, event: MissionEvent, *, describe: bool = True
+) -> tuple[MirrorChange, ...]:
     """Apply ``event`` to ``state``, which must be at the revision just before it, and say
     what it changed.
 
     The changes come in the order the state makes them (removals, skills put, moves,
     barriers and markers put), each index as it is at that moment: a view that applies
     them one after the other ends equal to ``state``. A replacement is one
-    :class:`MissionReset`. The cost is the change's, not the mission's.
+    :class:`MissionReset`. The cost is the change's, not the mission's. ``describe``
+    False: the same application, nothing described (the server, which has no view to
+    update, saves a value per skill of a synchronize of thousands).
 
     Raises:
         RuleViolation: the event does not follow the state's revision.
@@ -48,10 +52,10 @@ def apply_event(state: MissionState, event: MissionEvent) -> tuple[MirrorChange,
         state.apply(event.change)
         state.revision = event.revision
         return (MissionReset(state),)
-    described = _Described()
+    described = _Described() if describe else None
     state.apply(event.change, described)
     state.revision = event.revision
-    return tuple(described.changes)
+    return () if described is None else tuple(described.changes)
 
 
 def needs_snapshot(event: MissionEvent) -> bool:
