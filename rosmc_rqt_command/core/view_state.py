@@ -1,4 +1,4 @@
-"""What the GUI shows of the mission, as immutable values taken from the mirror.
+"""What the GUI shows of the mission, as values taken from the mirror for the GUI thread.
 
 The mirror calls its listeners on ROS threads with its lock held; :func:`view_update` runs
 there and forwards what the mirror said changed: the event it applied, its skill deltas
