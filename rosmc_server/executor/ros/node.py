@@ -11,7 +11,7 @@ Publishes:
     its digest always), ``/rosmc/barriers`` (rosmc/BarrierSignal, a copy for observers).
 Radio side channel (UDP, :mod:`rosmc_server.common.ros.radio`, registered as
     ``/rosmc/radio/<robot>``): barrier signals to and from the other robots, and beacons
-    to and from the ground (:class:`~rosmc_server.core.radio.BeaconPlan`: seldom while it
+    to and from the ground (:class:`~rosmc_server.core.robots.radio.BeaconPlan`: seldom while it
     hears the ground); a ground beacon after a silence reconnects the link's topics.
 
 ``<link>`` is ``/rosmc/link/<robot>`` (talking to the ground directly) or, with
@@ -34,7 +34,7 @@ Parameters (private):
     ``~tick_rate`` (float, Hz, 50), ``~robot_side`` (bool, false).
     ``~radio_key`` (str): the deployment's radio key file, which signs the radio side
         channel's datagrams (default ``$ROS_HOME/rosmc/radio.key``, made there if missing;
-        a key given here must exist: see :mod:`rosmc_server.core.radio_key`).
+        a key given here must exist: see :mod:`rosmc_server.core.robots.radio_key`).
     ``~cwd`` (str): a relative ``~state_file`` is taken from there (launch files pass the
     directory roslaunch was typed in).
 
@@ -77,10 +77,10 @@ from ...conversions.robot_link import (
     snapshot_to_msg,
 )
 from ...core import LibraryError, RosmcError, SkillSetupError
-from ...core.drop_log import DropLog
 from ...core.errors import RadioKeyError
-from ...core.radio import BeaconPlan, ContactWatch
-from ...core.radio_key import RadioKey
+from ...core.robots.drop_log import DropLog
+from ...core.robots.radio import BeaconPlan, ContactWatch
+from ...core.robots.radio_key import RadioKey
 from ..core import Command, Engine, Report, Signal, SkillType
 from ..core.lost_link import PoseSource, no_pose
 from ..core.pacing import SnapshotPacer
