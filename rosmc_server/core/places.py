@@ -143,7 +143,9 @@ def default_place(
     """
     if param.marker_type is None:
         return None
-    offered = places_for(param, agent, markers, around)
+    offered = [
+        p for p in places_for(param, agent, markers, around) if fits(param, agent, p, around)
+    ]
     latest = last_location(task)
     if latest is not None:
         skill, name = latest
@@ -156,12 +158,26 @@ def default_place(
         xy = location_xy(skill.params.get(name))
         if xy is not None:
             what = skill.label or skill.skill
-            return Place(what, PlaceKind.TASK, *xy, value_at(param, *xy))
+            earlier = Place(what, PlaceKind.TASK, *xy, value_at(param, *xy))
+            if fits(param, agent, earlier, around):
+                return earlier
     for kind, name in ((PlaceKind.ROBOT, agent), (PlaceKind.LANDER, LANDER)):
         chosen = next((p for p in offered if p.kind is kind and p.name == name), None)
         if chosen is not None:
             return chosen
     return None
+
+
+def fits(param: ParameterSpec, agent: str, place: Place, around: Surroundings) -> bool:
+    """Whether the site (if known) takes ``place`` as ``agent``'s ``param``: a default the
+    server would refuse is no default."""
+    site, check = around.site, param.check_target
+    if site is None or check is None:
+        return True
+    if isinstance(place.value, list):
+        corners = [location_xy(corner) for corner in place.value]
+        return all(xy is not None and not site.problem(check, agent, *xy) for xy in corners)
+    return not site.problem(check, agent, place.x, place.y)
 
 
 def last_location(

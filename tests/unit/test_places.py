@@ -208,3 +208,13 @@ def test_drive_first_not_offered_for_moves_or_skills_without_a_point(library: Li
     assert drive_first(library, move, 0, None) is None
     area = [skill(library, "science_rover", "explore", "a")]
     assert drive_first(library, area, 0, None) is None
+
+
+def test_default_skips_places_the_site_refuses(library: Library) -> None:
+    param = library.skill("science_rover", "navigate_to").parameter("target")
+    inside = Pose(0.5, 0.5)  # on the lander: no ground target
+    task = [skill(library, "science_rover", "navigate_to", "a", params={"target": inside})]
+    around = Surroundings(site=SITE, robots={"science_rover": Pose(0.2, 0.0)}, lander=(0.0, 0.0))
+    chosen = default_place(param, "science_rover", task, [], around)
+    assert chosen is not None and chosen.kind is PlaceKind.LANDER  # beside it, not on it
+    assert SITE.problem(param.check_target, "science_rover", chosen.x, chosen.y) == ""  # type: ignore[arg-type]
