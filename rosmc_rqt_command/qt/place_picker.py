@@ -67,6 +67,8 @@ class PlacePicker(QComboBox):  # type: ignore[misc]
         self.addItems([NEW_MARKER, PICK_IN_VIEW])
         self.setCurrentIndex(current + 1)
         self.blockSignals(False)
+        # the list as wide as its longest entry, even where the panel is narrow
+        self.view().setMinimumWidth(self.view().sizeHintForColumn(0) + 24)
 
     def showPopup(self) -> None:
         """Bring the places up to date (robots move), then open the list."""

@@ -57,7 +57,10 @@ class Place:
     @property
     def label(self) -> str:
         """How a picker lists it, e.g. ``RSS A — region (16, 9)``."""
-        return f"{self.name} \u2014 {self.kind.value} ({self.x:.0f}, {self.y:.0f})"
+        where = f"({self.x:.0f}, {self.y:.0f})"
+        if self.name == self.kind.value:  # the lander: no need to say it twice
+            return f"{self.name} {where}"
+        return f"{self.name} \u2014 {self.kind.value} {where}"
 
     def fill(self, param: str) -> tuple[dict[str, Value], dict[str, str]]:
         """The ``params`` and ``bindings`` that put this place into ``param``."""

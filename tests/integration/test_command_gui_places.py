@@ -55,7 +55,7 @@ def mars(ros_master: Any, tmp_path: Path) -> Iterator[tuple[Operator, Gui, Missi
     client = MissionClient(5.0)
     app = QApplication.instance() or QApplication([])
     widget, bridge = build(timeout=30.0)
-    widget.resize(1500, 900)
+    widget.resize(1500, 1000)
     widget.show()
     widget.activateWindow()  # shortcuts need an active window
     QTest.qWaitForWindowActive(widget, 2000)
@@ -113,14 +113,20 @@ def shown_picker(gui: Gui, skill_id: str, param: str) -> PlacePicker:
 
 def write_picture(gui: Gui, picker: PlacePicker, path: str) -> None:
     """The window with ``picker``'s list open, as the docs show it."""
+    gui.widget.splitter.setSizes([880, 620])  # the parameters wide enough to read
+    QApplication.processEvents()
+    gui.widget.parameters.ensureWidgetVisible(gui.widget.parameters.places.drive_button)
+    gui.widget.parameters.ensureWidgetVisible(picker)
     view = open_list(picker)
     shot = gui.widget.grab()
     popup = view.window()
     painter = QPainter(shot)
-    painter.drawPixmap(gui.widget.mapFromGlobal(popup.mapToGlobal(QPoint(0, 0))), popup.grab())
+    # Drawn under the picker, where a screen large enough shows it (the offscreen screen
+    # is smaller than the window and pushes the list inside it).
+    painter.drawPixmap(picker.mapTo(gui.widget, QPoint(0, picker.height())), popup.grab())
     painter.end()
     assert shot.save(path)
-    QTest.keyClick(view, Qt.Key_Escape)
+    picker.hidePopup()
 
 
 def test_places_are_picked_by_name_and_drive_there_first_is_offered(mars: Any) -> None:

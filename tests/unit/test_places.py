@@ -69,7 +69,7 @@ def test_a_point_parameter_offers_markers_area_centres_regions_lander_and_robots
     assert rock.fill("position") == ({}, {"position": "rock"})  # a marker binds
     assert centre.fill("position") == ({"position": Pose(10.0, 0.0)}, {})  # others fill
     assert region.value == Pose(16.0, 9.0) and region.label == "RSS A \u2014 region (16, 9)"
-    assert lander.value == Pose(0.0, 0.0)  # on_site: the lander itself
+    assert lander.value == Pose(0.0, 0.0) and lander.label == "lander (0, 0)"  # on_site: itself
     assert own.value == Pose(3.0, -4.0)  # a point has no heading
 
 
