@@ -22,7 +22,7 @@ from python_qt_binding.QtGui import QPainter
 from python_qt_binding.QtTest import QTest
 from python_qt_binding.QtWidgets import QApplication
 
-from rosmc_rqt_command.qt.place_picker import NEW_MARKER, PlacePicker
+from rosmc_rqt_command.qt.place_picker import NEW_MARKER, PICK_IN_VIEW, PlacePicker
 from rosmc_rqt_command.standalone import build
 from rosmc_server import interface
 from rosmc_server.conversions.science import science_to_msg
@@ -183,6 +183,15 @@ def test_places_are_picked_by_name_and_drive_there_first_is_offered(mars: Any) -
     choose(shown_picker(gui, drive, "target"), "Typed coordinates")
     wait_until(lambda: not operator.mission().skill(drive).bindings, 30, "unbound")
     assert operator.mission().skill(drive).params["target"].x == pytest.approx(7.0)
+
+    # Pick in 3D view: the next task marker made (rviz's 2D Nav Goal makes it) is bound.
+    choose(shown_picker(gui, drive, "target"), PICK_IN_VIEW)
+    gui.said("the new marker fills target")
+    client.add_task_marker(
+        TaskMarker("goal", MarkerType.POSE, Pose(3.0, 4.0)), retry_on_conflict=True
+    )
+    wait_until(lambda: operator.mission().skill(drive).bindings == {"target": "goal"}, 30, "goal")
+    assert operator.mission().skill(drive).params["target"].x == pytest.approx(3.0)
 
 
 def test_duplicate_copies_the_selection_after_it_with_its_bindings(mars: Any) -> None:
