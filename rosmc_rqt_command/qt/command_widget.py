@@ -98,6 +98,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
             self.send,
             self._select_soon,
             self.messages.say,
+            lambda: self.backend.read_only,
         )
         self._journal_alerting = False  # the server said its journal has a problem
         self.connected = False
@@ -235,6 +236,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.parameters.set_read_only(backend.read_only)
         self.enabling.read_only = backend.read_only
         self.enabling.update()
+        self.duplicate.update()
 
     # -- sending ------------------------------------------------------------------------------
     def send(self, request: Request) -> None:

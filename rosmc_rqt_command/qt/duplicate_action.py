@@ -31,6 +31,7 @@ class DuplicateAction(QObject):  # type: ignore[misc]
         send: Hands a request to the backend.
         select: Selects skills by id once they are shown.
         say: Puts a sentence in the message area (with its level).
+        read_only: Whether the window follows a replay (nothing can be duplicated).
     """
 
     def __init__(
@@ -41,6 +42,7 @@ class DuplicateAction(QObject):  # type: ignore[misc]
         send: Callable[[Request], None],
         select: Callable[[list[str]], None],
         say: Callable[[str, str], None],
+        read_only: Callable[[], bool],
     ) -> None:
         super().__init__(owner)
         self._view = view
@@ -48,6 +50,7 @@ class DuplicateAction(QObject):  # type: ignore[misc]
         self._send = send
         self._select = select
         self._say = say
+        self._read_only = read_only
         self.action = CommandActions.make(
             owner,
             "Duplicate",
@@ -60,6 +63,9 @@ class DuplicateAction(QObject):  # type: ignore[misc]
 
     def update(self) -> None:
         """Enable the action when the selection can be duplicated."""
+        if self._read_only():
+            self.action.setEnabled(False)
+            return
         try:
             copies(self._view, self._view.skills(self._selected()))
         except InvalidRequest:

@@ -57,8 +57,8 @@ class PlacePicker(QComboBox):  # type: ignore[misc]
         if current < 0 and not bound:
             current = next((i for i, p in enumerate(places) if p.value == value), -1)
         same = list(places) == self.places and (bound, current) == (self._bound, self._current)
-        if same and self.currentIndex() == current + 1:
-            return  # unchanged: leave what the operator may be typing alone
+        if (same and self.currentIndex() == current + 1) or self.view().isVisible():
+            return  # unchanged, or the list is open: leave what the operator is doing alone
         self.places, self._bound, self._current = list(places), bound, current
         self.blockSignals(True)
         self.clear()
@@ -96,7 +96,10 @@ class PlacePicker(QComboBox):  # type: ignore[misc]
     def _on_picker_return_pressed(self) -> None:
         text = self.currentText().strip()
         old = self._bound
-        if text and old and text != old and self.findText(text) < 0:
+        named = self.index_of(text)
+        if named > 0 and text != old:  # a place's name typed: as if chosen
+            self._on_picker_activated(named)
+        elif text and old and text != old and self.findText(text) < 0:
             self._bound = text  # asked once, even if Enter reaches here twice
             self.rename_requested.emit(old, text)
 
