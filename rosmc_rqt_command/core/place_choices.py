@@ -44,10 +44,12 @@ def surroundings(
 def task_specs(view: MissionView, agent: str) -> list[tuple[SkillInstance, SkillSpec]]:
     """``agent``'s task with each skill's spec (a skill the library lacks is left out)."""
     library = view.library
-    found = []
-    for skill in view.view(agent).skills if library is not None else ():
+    found: list[tuple[SkillInstance, SkillSpec]] = []
+    if library is None:
+        return found
+    for skill in view.view(agent).skills:
         try:
-            found.append((skill, library.skill(agent, skill.skill)))  # type: ignore[union-attr]
+            found.append((skill, library.skill(agent, skill.skill)))
         except RosmcError:
             continue
     return found

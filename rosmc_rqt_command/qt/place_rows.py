@@ -98,10 +98,13 @@ class PlaceRows(QObject):  # type: ignore[misc]
         self.pickers[name].show_places(places, bound, skill.params.get(name))
 
     def _take_picked(self, skill: SkillInstance) -> None:
-        waiting = self.waiting
-        if waiting is None or waiting.skill_id != skill.id or not skill.is_editable:
+        waiting, library = self.waiting, self._view.library
+        if waiting is not None and waiting.skill_id != skill.id:
+            self.waiting = None  # another skill shown: the pick is off
             return
-        accepts = self._view.library.skill(skill.agent, skill.skill).parameter(waiting.param)  # type: ignore[union-attr]
+        if waiting is None or not skill.is_editable or library is None:
+            return
+        accepts = library.skill(skill.agent, skill.skill).parameter(waiting.param)
         new = [
             m
             for m in self._view.markers.values()
