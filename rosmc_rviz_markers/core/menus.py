@@ -32,7 +32,7 @@ from rosmc_server.core.library import AgentKind, Library, SkillSpec
 from rosmc_server.core.markers import generated_name
 from rosmc_server.core.model import SkillInstance, TaskMarker
 from rosmc_server.core.params import MarkerType, ParamType, Value
-from rosmc_server.core.places import last_location, location_xy
+from rosmc_server.core.places import first_location, location_xy
 from rosmc_server.core.state import MissionState
 
 
@@ -219,35 +219,33 @@ def with_drives(
 ) -> list[tuple[AddSkill, str]]:
     """``pairs``, each skill that works at a point followed by its "driving there first"."""
     out: list[tuple[AddSkill, str]] = []
+    there: dict[str, bool] = {}  # per robot: its task already ends at the marker
     for action, title in pairs:
         out.append((action, title))
         move = move_skill(library, action.agent)
         param = library.skill(action.agent, action.skill).parameter(action.bind or "")
-        if (
-            move is not None
-            and action.skill != move[0]
-            and param.marker_type is not MarkerType.AREA
-            and not _ends_at(library, state, action.agent, marker)
-        ):
+        if move is None or action.skill == move[0] or param.marker_type is MarkerType.AREA:
+            continue
+        if action.agent not in there:
+            there[action.agent] = _ends_at(library, state, action.agent, marker)
+        if not there[action.agent]:
             out.append((replace(action, drive=move), title + DRIVING))
     return out
 
 
 def _ends_at(library: Library, state: MissionState, agent: str, marker: TaskMarker) -> bool:
     """Whether ``agent``'s task already takes it to ``marker`` (its latest place is there)."""
-    task = [
-        (s, library.skills_of(agent)[s.skill])
-        for s in state.task(agent)
-        if s.skill in library.skills_of(agent)
-    ]
-    latest = last_location(task)
-    if latest is None:
-        return False
-    skill, param = latest
-    xy = location_xy(skill.params.get(param))
-    if skill.bindings.get(param) == marker.name:
-        return True
-    return xy is not None and math.dist(xy, (marker.pose.x, marker.pose.y)) <= ARRIVED
+    skills = library.skills_of(agent)
+    for skill in reversed(state.task(agent)):  # from the end: the latest place is near it
+        spec = skills.get(skill.skill)
+        name = first_location(spec) if spec is not None else ""
+        if not name:
+            continue
+        if skill.bindings.get(name) == marker.name:
+            return True
+        xy = location_xy(skill.params.get(name))
+        return xy is not None and math.dist(xy, (marker.pose.x, marker.pose.y)) <= ARRIVED
+    return False
 
 
 def rename_suggestions(
