@@ -99,6 +99,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
             self._select_soon,
             self.messages.say,
             lambda: self.backend.read_only,
+            self.history.join,
         )
         self._journal_alerting = False  # the server said its journal has a problem
         self.connected = False

@@ -2,8 +2,9 @@
 
 The mission server adds one skill per request, so the copies are sent one after another,
 each once the one before was accepted (so each is made against the previous one's
-revision and lands right after it); a refusal stops the rest and is said. The copies are
-selected once shown, so Ctrl+D again copies them again.
+revision and lands right after it); a refusal stops the rest and is said. The window's
+undo history then holds them as one entry (one Ctrl+Z takes every copy back). The copies
+are selected once shown, so Ctrl+D again copies them again.
 """
 
 from __future__ import annotations
@@ -32,6 +33,7 @@ class DuplicateAction(QObject):  # type: ignore[misc]
         select: Selects skills by id once they are shown.
         say: Puts a sentence in the message area (with its level).
         read_only: Whether the window follows a replay (nothing can be duplicated).
+        join: Makes the edits that produced these revisions one undo entry.
     """
 
     def __init__(
@@ -43,6 +45,7 @@ class DuplicateAction(QObject):  # type: ignore[misc]
         select: Callable[[list[str]], None],
         say: Callable[[str, str], None],
         read_only: Callable[[], bool],
+        join: Callable[[list[int], str], None],
     ) -> None:
         super().__init__(owner)
         self._view = view
@@ -51,6 +54,7 @@ class DuplicateAction(QObject):  # type: ignore[misc]
         self._select = select
         self._say = say
         self._read_only = read_only
+        self._join = join
         self.action = CommandActions.make(
             owner,
             "Duplicate",
@@ -79,20 +83,26 @@ class DuplicateAction(QObject):  # type: ignore[misc]
         except InvalidRequest as error:
             self._say(f"Not duplicated: {error}.", "warning")
             return
-        self._next(planned, [], self._view.revision)
+        what = f"duplicate {len(planned)} skills on {planned[0].agent}"
+        self._next(planned, [], [], self._view.revision, what)
 
-    def _next(self, planned: list[Copy], made: list[str], seen: int) -> None:
+    def _next(
+        self, planned: list[Copy], made: list[str], revisions: list[int], seen: int, what: str
+    ) -> None:
         if not planned:
+            self._join(revisions, what)
             self._select(made)
             return
         copy, rest = planned[0], planned[1:]
 
         def sent(answer: Answer) -> None:
             if answer.ok:
-                self._next(rest, [*made, answer.value.skill_id], answer.value.revision)
+                revision = int(answer.value.revision)
+                ids = [*made, answer.value.skill_id]
+                self._next(rest, ids, [*revisions, revision], revision, what)
 
-        what = f"duplicate {copy.label or copy.skill} on {copy.agent}"
-        call = ask(lambda c: c.add_skill, what, seen, sent)
+        one = f"duplicate {copy.label or copy.skill} on {copy.agent}"
+        call = ask(lambda c: c.add_skill, one, seen, sent)
         self._send(
             call(
                 copy.agent,

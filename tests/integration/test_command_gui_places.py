@@ -220,6 +220,20 @@ def test_duplicate_copies_the_selection_after_it_with_its_bindings(mars: Any) ->
     copies = [s.id for s in task[3:]]
     wait_until(lambda: w.tasks.selected_ids == copies, 30, "the copies selected")
 
+    # One Ctrl+Z takes every copy back; redo brings them all again.
+    undo = w.history.undo_action
+    wait_until(lambda: undo.text() == "&Undo duplicate 3 skills on manipulator_rover", 30, "one")
+    table = gui.table("manipulator_rover", True)
+    QTest.keyClick(table, Qt.Key_Z, Qt.ControlModifier)
+    wait_until(lambda: len(operator.mission().task("manipulator_rover")) == 3, 30, "undone")
+    assert [s.id for s in operator.mission().task("manipulator_rover")] == [drive, pick, deposit]
+    wait_until(lambda: w.history.redo_action.isEnabled(), 30, "redo possible")
+    QTest.keyClick(table, Qt.Key_Z, Qt.ControlModifier | Qt.ShiftModifier)
+    wait_until(lambda: len(operator.mission().task("manipulator_rover")) == 6, 30, "redone")
+    task = operator.mission().task("manipulator_rover")
+    assert [s.skill for s in task] == ["navigate_to", "pick_stone", "deposit_at_lander"] * 2
+    assert task[4].bindings == {"position": "rock"}
+
     # The context menu's Duplicate copies one skill right after it.
     gui.click_row("manipulator_rover", True, 1)
     gui.context_menu_choose("manipulator_rover", True, 1, "Duplicate")
