@@ -49,6 +49,8 @@ class UndoHistory(QObject):  # type: ignore[misc]
         self._send = send
         self._undo: list[tuple[int, str]] = []  # (revision an edit produced, what it did)
         self._redo: list[tuple[int, str]] = []  # (revision an undo produced, what it undid)
+        # An entry made of several edits (see join): its revision -> the others', newest first.
+        self._joined: dict[int, list[int]] = {}
         self._waiting = False  # one undo or redo at a time: the next needs its answer
         self.read_only = False
         self.undo_action = CommandActions.make(
@@ -72,37 +74,65 @@ class UndoHistory(QObject):  # type: ignore[misc]
         self._update()
         return "Ctrl+Z undoes it"
 
+    def join(self, revisions: list[int], what: str) -> None:
+        """Make this window's newest edits, which produced ``revisions`` (oldest first), one
+        entry called ``what``: one undo takes them all back (the server still records each)."""
+        count = len(revisions)
+        if count < 2 or [r for r, _ in self._undo[-count:]] != revisions:
+            return  # another edit came in between: they stay separate
+        del self._undo[-count:]
+        self._push(self._undo, revisions[::-1], what)
+        self._update()
+
     def undo(self) -> None:
         """Ask the server to undo this window's newest edit."""
         if self._undo and not self._waiting and not self.read_only:
             revision, what = self._undo.pop()
-            self._ask(revision, f"undo {what}", self._redo, self._undo, what)
+            revisions = [revision, *self._joined.pop(revision, [])]
+            self._ask(revisions, f"undo {what}", self._redo, self._undo, what)
 
     def redo(self) -> None:
         """Ask the server to undo this window's newest undo (the edit comes back)."""
         if self._redo and not self._waiting and not self.read_only:
             revision, what = self._redo.pop()
-            self._ask(revision, f"redo {what}", self._undo, self._redo, what)
+            revisions = [revision, *self._joined.pop(revision, [])]
+            self._ask(revisions, f"redo {what}", self._undo, self._redo, what)
+
+    def _push(self, onto: list[tuple[int, str]], newest_first: list[int], what: str) -> None:
+        onto.append((newest_first[0], what))
+        if len(newest_first) > 1:
+            self._joined[newest_first[0]] = newest_first[1:]
 
     def _ask(
         self,
-        revision: int,
+        revisions: list[int],
         words: str,
         onto: list[tuple[int, str]],
         back: list[tuple[int, str]],
         what: str,
     ) -> None:
+        """Undo ``revisions`` (newest first) one after another."""
+        done: list[int] = []
+
         def answered(answer: Answer) -> None:
-            self._waiting = False
             if answer.ok:
-                onto.append((int(answer.value.revision), what))
+                done.append(int(answer.value.revision))
+                if len(done) < len(revisions):
+                    send(revisions[len(done)])
+                    return
             elif answer.conflict or answer.unreachable:
-                back.append((revision, what))  # not refused: it can be tried again
+                self._push(back, revisions[len(done) :], what)  # not refused: try again later
+            self._waiting = False
+            if done:
+                self._push(onto, done[::-1], what)
             self._update()
+
+        def send(revision: int) -> None:
+            self._send(ask(lambda c: c.undo_edit, words, self._view.revision, answered)(revision))
 
         self._waiting = True
         self._update()
-        self._send(ask(lambda c: c.undo_edit, words, self._view.revision, answered)(revision))
+        send(revisions[0])
 
     def set_read_only(self, read_only: bool) -> None:
         """A window that follows a replay undoes nothing."""

@@ -52,6 +52,7 @@ from ..core.specs import Parsed, parse_name
 from ..core.styling import is_locked
 from .config import MarkerHost, MarkerNodeConfig
 from .convert import pose_numbers
+from .menu_calls import add_driving_first
 
 _log = logging.getLogger(__name__)
 Call = Callable[[MissionClient], Any]
@@ -175,7 +176,8 @@ class Interaction:
     @staticmethod
     def _title(action: EditAction) -> str:
         if isinstance(action, AddSkill):
-            return f"add {action.skill} to {action.agent}"
+            driving = f"{action.drive[0]} and " if action.drive else ""
+            return f"add {driving}{action.skill} to {action.agent}"
         if isinstance(action, RenameMarker):
             return f"rename to '{action.new_name}'"
         return "delete"
@@ -187,6 +189,8 @@ class Interaction:
             return lambda c: c.rename_task_marker(name, action.new_name)
         if isinstance(action, DeleteMarker):
             return lambda c: c.delete_task_marker(name)
+        if action.drive is not None and parsed.kind == "task":
+            return lambda c: add_driving_first(c, action, name)
         if action.from_robot:
             plan = robot_skill_plan(library, action.agent, action.skill, pose)
         else:
