@@ -14,8 +14,8 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 from rosmc_server.core import SkillStatus
-from rosmc_server.core.control import ExecutorState
-from rosmc_server.core.link import LinkStatus
+from rosmc_server.core.model.control import ExecutorState
+from rosmc_server.core.robots.link import LinkStatus
 
 from .mission_view import MissionView
 

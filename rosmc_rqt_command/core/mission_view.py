@@ -2,7 +2,7 @@
 
 :class:`MissionView` takes :class:`~.view_state.ViewUpdate` values in order (a reset's copy
 of the mission, then each update's event applied to it with the one applier,
-:func:`~rosmc_server.core.updates.apply_event`) and answers the read-only questions panels
+:func:`~rosmc_server.core.live.updates.apply_event`) and answers the read-only questions panels
 ask (which skill has this id, which barrier holds it, what a robot reports). It lives on
 the GUI thread only, so nothing here needs a lock.
 """
@@ -20,9 +20,9 @@ from rosmc_server.core import (
     SkillStatus,
     TaskMarker,
 )
-from rosmc_server.core.legality import TaskView
-from rosmc_server.core.link import LinkStatus
-from rosmc_server.core.updates import apply_event
+from rosmc_server.core.live.updates import apply_event
+from rosmc_server.core.robots.link import LinkStatus
+from rosmc_server.core.rules.legality import TaskView
 
 from . import presentation
 from .view_state import ViewUpdate, barrier_tags

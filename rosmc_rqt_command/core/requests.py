@@ -15,7 +15,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, ParamSpec, Protocol
 
-from rosmc_server.core.edit_history import EditKind
+from rosmc_server.core.live.edit_history import EditKind
 
 if TYPE_CHECKING:  # for the type checker only: the widgets never load the client
     from rosmc_server.ros.client import MissionClient

@@ -6,7 +6,7 @@ there and forwards what the mirror said changed: the event it applied, its skill
 the barriers or markers if they changed and the robot statuses that changed, as a
 :class:`ViewUpdate`. Only a reset copies the mission (a state of the GUI's own). The
 value then crosses to the GUI thread, where the view applies the event to its state with
-the one applier (:func:`~rosmc_server.core.updates.apply_event`) and models change only
+the one applier (:func:`~rosmc_server.core.live.updates.apply_event`) and models change only
 the rows the deltas name. No Qt and no rospy here, so it is tested without either.
 """
 
@@ -23,9 +23,7 @@ from rosmc_server.core import (
     MissionState,
     TaskMarker,
 )
-from rosmc_server.core.legality import TaskView
-from rosmc_server.core.moves import move_columns
-from rosmc_server.core.updates import (
+from rosmc_server.core.live.updates import (
     AgentStatusChanged,
     BarrierPut,
     BarrierRemoved,
@@ -38,6 +36,8 @@ from rosmc_server.core.updates import (
     SkillRemoved,
     SkillsMoved,
 )
+from rosmc_server.core.model.moves import move_columns
+from rosmc_server.core.rules.legality import TaskView
 
 SkillDelta = SkillAdded | SkillChanged | SkillRemoved | SkillsMoved
 

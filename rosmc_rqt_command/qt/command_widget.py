@@ -17,20 +17,23 @@ from python_qt_binding.QtCore import QPoint
 from python_qt_binding.QtWidgets import QMenu, QWidget
 
 from rosmc_server.core import AgentStatus, Library, LostLinkPolicy
-from rosmc_server.core.edit_history import EditKind
+from rosmc_server.core.live.edit_history import EditKind
 
 from ..core.dispatch import Dispatcher
 from ..core.legality import Action, RobotAction
 from ..core.mission_view import MissionView
 from ..core.phrasing import answer_message
+from ..core.place_choices import surroundings
 from ..core.requests import Answer, Backend, Request, ask
 from ..core.view_state import ViewUpdate
 from .actions import CommandActions
 from .control_panel import ControlPanel
+from .duplicate_action import DuplicateAction
 from .enabling import Enabling
 from .file_menu import FileController
 from .message_area import MessageArea
 from .parameter_panel import ParameterPanel
+from .place_requests import PlaceRequests
 from .repaints import Repaints
 from .section_table import SectionTable
 from .task_widget import TaskWidget
@@ -82,6 +85,23 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.menu_bar, self.banner, self.splitter = layout.menu_bar, layout.banner, layout.splitter
         self.science, self.site, self.legend = layout.science, layout.site, layout.legend
         self._select_when_seen: list[str] = []
+        self.places = PlaceRequests(
+            view,
+            self.send,
+            lambda: surroundings(view, self.science.science, self.site.source),
+            self._select_soon,
+        )
+        self.places.connect_rows(self.parameters.places)
+        self.duplicate = DuplicateAction(
+            self,
+            view,
+            lambda: self.tasks.selected_ids,
+            self.send,
+            self._select_soon,
+            self.messages.say,
+            lambda: self.backend.read_only,
+            self.history.join,
+        )
         self._journal_alerting = False  # the server said its journal has a problem
         self.connected = False
         self._connect()
@@ -99,6 +119,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.parameters.edit_requested.connect(self._on_parameters_edit_requested)
         self.parameters.rename_marker_requested.connect(self._on_parameters_rename_requested)
         self.parameters.problem.connect(lambda text: self.messages.say(text, "warning"))
+        self.parameters.places.said.connect(lambda text: self.messages.say(text, "info"))
         for kind, action in self.actions_.skill.items():
             action.triggered.connect(lambda _=False, k=kind: self.do(k))
         for robot_action, action in self.actions_.all_robots.items():
@@ -139,6 +160,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
             self._select_when_seen = []
         self.repaints.checker.note(None if reset else changed)
         self.enabling.update(None if reset else agents)
+        self.duplicate.update()
         self.files.on_mission_shown()
         if first:
             self.files.mark_saved()
@@ -216,6 +238,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.parameters.set_read_only(backend.read_only)
         self.enabling.read_only = backend.read_only
         self.enabling.update()
+        self.duplicate.update()
 
     # -- sending ------------------------------------------------------------------------------
     def send(self, request: Request) -> None:
@@ -249,6 +272,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
     def _on_tasks_selection_changed(self, ids: list[str]) -> None:
         self.parameters.show_selection(ids)
         self.enabling.update()
+        self.duplicate.update()
         selected = self.view.skills(ids)
         self.backend.publish_selection(ids, self.view.bound_markers(selected))
 
@@ -261,6 +285,8 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         for action in self.actions_.skill.values():
             if action.isEnabled():
                 menu.addAction(action)
+        if self.duplicate.action.isEnabled():
+            menu.addAction(self.duplicate.action)
         agent = table.section.agent
         column = self.tasks.columns.get(agent)
         if table.section.blueprint and column is not None and column.add_button.isEnabled():
@@ -274,16 +300,14 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.do_robot(agent, kind)
 
     def _on_tasks_add_requested(self, agent: str, skill: str) -> None:
-        def select_new(answer: Answer) -> None:
-            if answer.ok:
-                self._select_when_seen = [answer.value.skill_id]
-                if self.view.skill(answer.value.skill_id) is not None:
-                    self.tasks.select_ids(self._select_when_seen)
-                    self._select_when_seen = []
+        self.places.add_skill(agent, skill)
 
-        what = f"add {skill} to {agent}"
-        call = ask(lambda c: c.add_skill, what, self.view.revision, select_new, EditKind.ADD_SKILL)
-        self.send(call(agent, skill))
+    def _select_soon(self, skill_ids: list[str]) -> None:
+        """Select ``skill_ids`` now, or as soon as the update that shows them arrives."""
+        self._select_when_seen = list(skill_ids)
+        if all(self.view.skill(i) is not None for i in skill_ids):
+            self.tasks.select_ids(self._select_when_seen)
+            self._select_when_seen = []
 
     def _on_tasks_policy_chosen(self, agent: str, policy: LostLinkPolicy) -> None:
         def forget_if_refused(answer: Answer) -> None:

@@ -1,11 +1,12 @@
 """Undo and redo of this window's own edits (Ctrl+Z, Ctrl+Shift+Z, Edit menu).
 
-The two actions over the shared :class:`~rosmc_server.core.edit_history.EditHistory`
+The two actions over the shared :class:`~rosmc_server.core.live.edit_history.EditHistory`
 (rviz keeps one too, by the same rule): an accepted request whose kind is an edit can be
-undone; undo asks the server to undo the newest (``undo_edit``, against the revision
-shown), redo undoes that undo. A refusal by the mission rules (the skills were sent since,
-someone changed them) drops the entry and the message area shows the server's sentence;
-a conflict or no answer keeps it, and the message area says so.
+undone, and a Duplicate's copies are joined into one entry; undo asks the server to undo
+the newest (``undo_edit``, against the revision shown), redo undoes that undo. A refusal
+by the mission rules (the skills were sent since, someone changed them) drops the entry
+and the message area shows the server's sentence; a conflict or no answer keeps it, and
+the message area says so.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from collections.abc import Callable
 from python_qt_binding.QtCore import QObject
 from python_qt_binding.QtWidgets import QWidget
 
-from rosmc_server.core.edit_history import EditHistory, Failure, Step
+from rosmc_server.core.live.edit_history import EditHistory, Failure, Step
 
 from ..core.mission_view import MissionView
 from ..core.requests import Answer, Request, ask
@@ -68,6 +69,12 @@ class UndoHistory(QObject):  # type: ignore[misc]
         self._update()
         return "Ctrl+Z undoes it"
 
+    def join(self, revisions: list[int], what: str) -> None:
+        """Make this window's newest edits, which produced ``revisions`` (oldest first), one
+        entry called ``what``: one undo takes them all back (the server still records each)."""
+        if self.edits.join(revisions, what):
+            self._update()
+
     def undo(self) -> None:
         """Ask the server to undo this window's newest edit."""
         self._ask(redo=False)
@@ -78,19 +85,23 @@ class UndoHistory(QObject):  # type: ignore[misc]
 
     def _ask(self, *, redo: bool) -> None:
         step = None if self.read_only else self.edits.begin(redo=redo, seen=self._view.revision)
-        if step is None:
-            return
+        if step is not None:
+            self._update()
+            self._send_undo(step, step.next_revision)
 
+    def _send_undo(self, step: Step, revision: int) -> None:
         def answered(answer: Answer) -> None:
             self._answered(step, answer)
 
-        self._update()
         pick = ask(lambda c: c.undo_edit, step.words, step.base_revision, answered)
-        self._send(pick(step.entry.revision))
+        self._send(pick(revision))
 
     def _answered(self, step: Step, answer: Answer) -> None:
         if answer.ok:
-            self.edits.accepted(step, int(answer.value.revision))
+            following = self.edits.accepted(step, int(answer.value.revision))
+            if following is not None:  # joined edits: the next one back
+                self._send_undo(step, following)
+                return
         else:
             failure = (
                 Failure.CONFLICT

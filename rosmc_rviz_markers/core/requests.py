@@ -11,12 +11,12 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from rosmc_server.core import areas
-from rosmc_server.core.edit_history import EditKind
 from rosmc_server.core.errors import InvalidRequest
-from rosmc_server.core.library import Library
-from rosmc_server.core.model import TaskMarker
-from rosmc_server.core.params import MarkerType, ParamType, Pose, Value
+from rosmc_server.core.live.edit_history import EditKind
+from rosmc_server.core.model.model import TaskMarker
+from rosmc_server.core.skills.library import Library
+from rosmc_server.core.skills.params import MarkerType, ParamType, Pose, Value
+from rosmc_server.core.world import areas
 
 from .menus import DeleteMarker, EditAction, RenameMarker
 

@@ -31,9 +31,10 @@ from geometry_msgs.msg import PointStamped, PoseStamped, PoseWithCovarianceStamp
 from visualization_msgs.msg import InteractiveMarkerFeedback as Feedback
 
 from rosmc_server import interface
-from rosmc_server.core import InvalidRequest, MarkerType, Pose, RosmcError, areas
-from rosmc_server.core.edit_history import EditHistory, EditKind, Step, failure_of
-from rosmc_server.core.params import value_to_data
+from rosmc_server.core import InvalidRequest, MarkerType, Pose, RosmcError
+from rosmc_server.core.live.edit_history import EditHistory, EditKind, Step, failure_of
+from rosmc_server.core.skills.params import value_to_data
+from rosmc_server.core.world import areas
 from rosmc_server.ros.client import AsyncMissionClient, MissionClient, Outcome
 
 from .. import topics
@@ -58,6 +59,7 @@ from ..core.specs import Parsed, parse_name
 from ..core.styling import is_locked
 from .config import MarkerHost, MarkerNodeConfig
 from .convert import pose_numbers
+from .menu_calls import add_driving_first
 
 _log = logging.getLogger(__name__)
 Call = Callable[[MissionClient], Any]
@@ -183,7 +185,8 @@ class Interaction:
     @staticmethod
     def _title(action: EditAction) -> str:
         if isinstance(action, AddSkill):
-            return f"add {action.skill} to {action.agent}"
+            driving = f"{action.drive[0]} and " if action.drive else ""
+            return f"add {driving}{action.skill} to {action.agent}"
         if isinstance(action, RenameMarker):
             return f"rename to '{action.new_name}'"
         return "delete"
@@ -195,6 +198,8 @@ class Interaction:
             return lambda c: c.rename_task_marker(name, action.new_name)
         if isinstance(action, DeleteMarker):
             return lambda c: c.delete_task_marker(name)
+        if action.drive is not None and parsed.kind == "task":
+            return lambda c: add_driving_first(c, action, name)
         if action.from_robot:
             plan = robot_skill_plan(library, action.agent, action.skill, pose)
         else:
@@ -209,8 +214,11 @@ class Interaction:
         if step is None:  # nothing to take back, or one step still on its way
             _log.warning("nothing of this rviz's to %s now", "redo" if redo else "undo")
             return
+        self._send_undo(step, step.next_revision)
+
+    def _send_undo(self, step: Step, revision: int) -> None:
         future = self._client.submit(
-            lambda c: c.undo_edit(step.entry.revision),
+            lambda c: c.undo_edit(revision),
             lambda outcome: self._undo_answered(step, outcome),
             step.base_revision,
         )
@@ -218,8 +226,11 @@ class Interaction:
 
     def _undo_answered(self, step: Step, outcome: Outcome[Any]) -> None:
         if outcome.error is None:
-            self.history.accepted(step, int(getattr(outcome.value, "revision", 0)))
-            _log.info("%s: done", step.words)
+            following = self.history.accepted(step, int(getattr(outcome.value, "revision", 0)))
+            if following is not None:  # several edits in one entry: the next one back
+                self._send_undo(step, following)
+            else:
+                _log.info("%s: done", step.words)
         else:  # kept (a conflict, no answer) or dropped (refused), as the sentence says
             error = outcome.error
             _log.warning("%s", self.history.failed(step, failure_of(error), str(error)))

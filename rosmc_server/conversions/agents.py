@@ -11,7 +11,7 @@ import math
 import rosmc.msg as wire
 
 from ..core import AgentStatus, SkillStatus
-from ..core.link import LinkStatus
+from ..core.robots.link import LinkStatus
 from .values import pose_from_msg
 
 _LINK_STATES: dict[int, LinkStatus] = {

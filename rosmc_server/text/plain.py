@@ -23,9 +23,9 @@ from ..core import (
     Transfer,
     Value,
 )
-from ..core.agent_status import AgentStatus
-from ..core.link import LinkStatus
-from ..core.vocabulary import STATUS_MARKS, counted, dbm, number, percent, wifi_words
+from ..core.robots.agent_status import AgentStatus
+from ..core.robots.link import LinkStatus
+from ..core.views.vocabulary import STATUS_MARKS, counted, dbm, number, percent, wifi_words
 
 _RULE = "    " + "-" * 56
 

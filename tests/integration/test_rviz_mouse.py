@@ -34,7 +34,8 @@ from visualization_msgs.msg import InteractiveMarkerFeedback
 
 from rosmc_rviz_markers import topics
 from rosmc_server import interface
-from rosmc_server.core import MarkerType, Pose, TaskMarker, geometry
+from rosmc_server.core import MarkerType, Pose, TaskMarker
+from rosmc_server.core.views import geometry
 from rosmc_server.ros.client import MissionClient
 from tests.conftest import RosMaster
 from tests.integration.markers_fixtures import wait_for
@@ -270,3 +271,31 @@ def test_a_flag_is_hit_near_its_rim_and_its_menu_names_it(screen: Screen, tmp_pa
         for subscriber in subscribers:
             subscriber.unregister()
     assert mission_markers(client)[name].pose == marker.pose, "naming it changed nothing"
+
+
+@pytest.mark.usefixtures("gui_programs", "sim")
+def test_a_flags_menu_adds_a_skill_there_driving_there_first(
+    screen: Screen, tmp_path: Path
+) -> None:
+    client = MissionClient(10.0)
+    client.get_mission()
+    name = client.add_task_marker(TaskMarker("stone", MarkerType.POSITION, Pose(*FLAG_AT))).name
+    time.sleep(2.0)  # rviz shows the new marker and its menu
+    screen.click((FLAG_AT[0] + 0.85, FLAG_AT[1], 0.04), button=3)  # its menu opens
+    time.sleep(1.0)
+    # Add skill here ▸ manipulator_rover ▸ "pick_stone, driving there first" (after
+    # identify_stones, its driving variant and navigate_to)
+    screen.xdotool("key", "Down", "Down", "Right", "Down", "Down", "Right")
+    screen.xdotool("key", "Down", "Down", "Down", "Down")
+    screen.save(tmp_path / "add_here.png")
+    screen.xdotool("key", "Return")
+
+    def added() -> list[Any]:
+        return list(client.get_mission().task("manipulator_rover"))
+
+    what = f"the skills added ({tmp_path / 'add_here.png'})"
+    drive, pick = wait_for(lambda: len(added()) == 2 and added(), what)
+    assert (drive.skill, drive.bindings) == ("navigate_to", {"target": name})
+    assert (pick.skill, pick.bindings) == ("pick_stone", {"position": name})
+    assert (pick.params["position"].x, pick.params["position"].y) == FLAG_AT
+    client.close()

@@ -1,6 +1,6 @@
 """A mission rebuilt from the applier's typed changes alone (a test helper, not a test).
 
-What a view that reacts to :data:`~rosmc_server.core.updates.MirrorChange` values sees:
+What a view that reacts to :data:`~rosmc_server.core.live.updates.MirrorChange` values sees:
 plain task lists and dicts, changed step by step as each value says, with no rule of the
 core. It checks each value against what it holds (the ``old`` of a change is what was
 there, at the index given), so a description that is wrong at any step fails there.
@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 from rosmc_server.core import Barrier, MissionState, SkillInstance, TaskMarker
-from rosmc_server.core.updates import (
+from rosmc_server.core.live.updates import (
     BarrierPut,
     BarrierRemoved,
     MarkerPut,

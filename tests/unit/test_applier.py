@@ -1,4 +1,4 @@
-"""The one event applier (rosmc_server.core.updates.apply_event), kind by kind.
+"""The one event applier (rosmc_server.core.live.updates.apply_event), kind by kind.
 
 A real :class:`Mission` makes an event of every :class:`EventKind`. Applied one after the
 other to a copy of the start, by :func:`apply_event`, they give the server's mission at
@@ -25,14 +25,14 @@ from rosmc_server.core import (
     TaskMarker,
     load_library,
 )
-from rosmc_server.core.changes import Change, SkillMove
-from rosmc_server.core.updates import (
+from rosmc_server.core.live.updates import (
     MissionReset,
     SkillChanged,
     SkillRemoved,
     SkillsMoved,
     apply_event,
 )
+from rosmc_server.core.model.changes import Change, SkillMove
 from tests.unit.conftest import make_mission
 from tests.unit.described_view import DescribedView
 

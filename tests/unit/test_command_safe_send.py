@@ -17,7 +17,7 @@ from rosmc_rqt_command.core.holding import lost_link_hold
 from rosmc_rqt_command.core.legality import RobotAction
 from rosmc_rqt_command.core.requests import Answer
 from rosmc_server.core import AgentStatus, Library, LostLinkKind, LostLinkPolicy, Mission
-from rosmc_server.core.control import ControlCommand
+from rosmc_server.core.model.control import ControlCommand
 from rosmc_server.executor.core.lost_link import LostLinkGuard
 from tests.team_gui import click, columns, settle, step_right
 from tests.team_twenty import stage, twenty_robot_library

@@ -19,7 +19,7 @@ import pytest
 from rosmc_rqt_command.core.legality import Action
 from rosmc_rqt_command.core.requests import Answer, Request
 from rosmc_server.core import Library, Mission
-from rosmc_server.core.edit_history import EditKind
+from rosmc_server.core.live.edit_history import EditKind
 from tests.unit.test_command_harness import Gui, open_gui
 
 SCREENSHOT = os.environ.get("ROSMC_UNDO_SCREENSHOT", "")

@@ -1,8 +1,9 @@
-"""The edit history both GUIs keep (rosmc_server.core.edit_history): its one rule.
+"""The edit history both GUIs keep (rosmc_server.core.live.edit_history): its one rule.
 
 Only requests whose kind is an edit are kept; undo and redo go one at a time, against the
 revision the operator saw; a conflict or no answer keeps the entry (and says so), a
-refusal by the mission rules drops it (and gives the server's reason).
+refusal by the mission rules drops it (and gives the server's reason). Joined edits (a
+Duplicate's copies) are one entry, undone one revision after the other.
 """
 
 from __future__ import annotations
@@ -10,8 +11,8 @@ from __future__ import annotations
 import pytest
 
 from rosmc_server.core import RuleViolation, StaleRevision
-from rosmc_server.core.edit_history import EditHistory, EditKind, Entry, Failure, failure_of
 from rosmc_server.core.errors import ServerUnavailable
+from rosmc_server.core.live.edit_history import EditHistory, EditKind, Entry, Failure, failure_of
 
 
 def test_only_edits_are_kept_and_a_new_edit_forgets_the_redo() -> None:
@@ -22,10 +23,10 @@ def test_only_edits_are_kept_and_a_new_edit_forgets_the_redo() -> None:
     step = history.begin(redo=False, seen=3)
     assert step is not None
     history.accepted(step, 4)
-    assert history.next_redo() == Entry(4, "add take_off to drone")
+    assert history.next_redo() == Entry((4,), "add take_off to drone")
     history.done(EditKind.MOVE_MARKER, 5, "move 'Pose 1'")
     assert history.next_redo() is None
-    assert history.next_undo() == Entry(5, "move 'Pose 1'")
+    assert history.next_undo() == Entry((5,), "move 'Pose 1'")
 
 
 def test_undo_takes_the_newest_edit_and_redo_takes_back_the_newest_undo() -> None:
@@ -33,14 +34,14 @@ def test_undo_takes_the_newest_edit_and_redo_takes_back_the_newest_undo() -> Non
     history.done(EditKind.ADD_SKILL, 3, "add take_off to drone")
     history.done(EditKind.MOVE_MARKER, 5, "move 'Pose 1'")
     undo = history.begin(redo=False, seen=5)
-    assert undo is not None and undo.entry == Entry(5, "move 'Pose 1'")
+    assert undo is not None and undo.entry == Entry((5,), "move 'Pose 1'")
     assert undo.words == "undo move 'Pose 1'" and undo.base_revision == 5
     history.accepted(undo, 6)
     redo = history.begin(redo=True, seen=6)
-    assert redo is not None and redo.entry == Entry(6, "move 'Pose 1'")
+    assert redo is not None and redo.entry == Entry((6,), "move 'Pose 1'")
     assert redo.words == "redo move 'Pose 1'"
     history.accepted(redo, 7)
-    assert history.next_undo() == Entry(7, "move 'Pose 1'")  # the redo can be undone again
+    assert history.next_undo() == Entry((7,), "move 'Pose 1'")  # the redo can be undone again
     assert history.next_redo() is None
 
 
@@ -64,7 +65,7 @@ def test_a_conflict_or_no_answer_keeps_the_entry_and_says_why(failure: Failure) 
     assert step is not None
     sentence = history.failed(step, failure)
     assert sentence == f"Could not undo delete 'take_off' ({failure.value}); it is kept: try again"
-    assert history.next_undo() == Entry(8, "delete 'take_off'") and not history.busy
+    assert history.next_undo() == Entry((8,), "delete 'take_off'") and not history.busy
     again = history.begin(redo=False, seen=9)  # tried again against what is shown now
     assert again is not None and again.base_revision == 9
 
@@ -78,7 +79,7 @@ def test_a_refusal_drops_the_entry_with_the_servers_reason() -> None:
     reason = "skill 'drone-1' has been sent to drone since revision 4"
     sentence = history.failed(step, Failure.REFUSED, reason)
     assert sentence == f"Could not undo change altitude of 'take_off': {reason}"
-    assert history.next_undo() == Entry(3, "add take_off to drone")
+    assert history.next_undo() == Entry((3,), "add take_off to drone")
 
 
 def test_a_failed_redo_goes_back_to_the_redo_stack() -> None:
@@ -90,7 +91,7 @@ def test_a_failed_redo_goes_back_to_the_redo_stack() -> None:
     redo = history.begin(redo=True, seen=4)
     assert redo is not None
     history.failed(redo, Failure.CONFLICT)
-    assert history.next_redo() == Entry(4, "rename") and history.next_undo() is None
+    assert history.next_redo() == Entry((4,), "rename") and history.next_undo() is None
 
 
 def test_errors_map_to_failures() -> None:
@@ -106,3 +107,33 @@ def test_a_new_server_shows_in_revisions_above_its_own_and_clear_forgets_all() -
     history.begin(redo=False, seen=12)
     history.clear()
     assert history.next_undo() is None and not history.busy
+
+
+def test_joined_edits_are_one_entry_undone_newest_first() -> None:
+    history = EditHistory()
+    history.done(EditKind.ADD_SKILL, 3, "add take_off to drone")
+    for revision in (5, 6, 7):
+        history.done(EditKind.ADD_SKILL, revision, "duplicate take_off")
+    assert not history.join([4, 6, 7], "duplicate 3 skills")  # not the newest edits
+    assert history.join([5, 6, 7], "duplicate 3 skills")
+    step = history.begin(redo=False, seen=7)
+    assert step is not None and step.next_revision == 7
+    assert history.accepted(step, 8) == 6 and history.busy  # the next copy back
+    assert history.accepted(step, 9) == 5
+    assert history.accepted(step, 10) is None and not history.busy
+    assert history.next_redo() == Entry((10, 9, 8), "duplicate 3 skills")
+    redo = history.begin(redo=True, seen=10)
+    assert redo is not None and redo.next_revision == 10
+
+
+def test_a_joined_undo_cut_short_keeps_what_is_left_and_what_was_undone() -> None:
+    history = EditHistory()
+    for revision in (5, 6, 7):
+        history.done(EditKind.ADD_SKILL, revision, "duplicate")
+    history.join([5, 6, 7], "duplicate 3 skills")
+    step = history.begin(redo=False, seen=7)
+    assert step is not None
+    assert history.accepted(step, 8) == 6
+    history.failed(step, Failure.CONFLICT)
+    assert history.next_undo() == Entry((6, 5), "duplicate 3 skills")  # tried again later
+    assert history.next_redo() == Entry((8,), "duplicate 3 skills")  # the copy taken back

@@ -24,8 +24,8 @@ from rosmc_server.core import (
     SkillStatus,
     Transfer,
 )
-from rosmc_server.core.commands import CommandKind
-from rosmc_server.core.link import queue_hash
+from rosmc_server.core.robots.commands import CommandKind
+from rosmc_server.core.robots.link import queue_hash
 from rosmc_server.executor.basic_skills import Count
 from rosmc_server.executor.core import (
     AckResult,

@@ -12,7 +12,7 @@ from rosmc_rviz_markers.core.menus import (
     flatten,
 )
 from rosmc_rviz_markers.core.requests import edit_kind
-from rosmc_server.core.edit_history import EditKind
+from rosmc_server.core.live.edit_history import EditKind
 
 
 def test_every_menu_can_end_with_undo_and_redo() -> None:

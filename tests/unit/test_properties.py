@@ -57,11 +57,11 @@ from rosmc_server.core import (
     mission_to_dict,
     parse_mission,
 )
-from rosmc_server.core.barriers import find_deadlock
-from rosmc_server.core.changes import SkillMove
-from rosmc_server.core.persistence import mission_from_dict
-from rosmc_server.core.state import MissionState
-from rosmc_server.core.updates import apply_event
+from rosmc_server.core.files.persistence import mission_from_dict
+from rosmc_server.core.live.updates import apply_event
+from rosmc_server.core.model.changes import SkillMove
+from rosmc_server.core.model.state import MissionState
+from rosmc_server.core.rules.barriers import find_deadlock
 from tests.unit.described_view import DescribedView
 
 S = SkillStatus

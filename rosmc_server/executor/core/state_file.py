@@ -22,7 +22,7 @@ from rosmc_server.core import (
     SkillStatus,
     Transfer,
 )
-from rosmc_server.core.protocol import (
+from rosmc_server.core.robots.protocol import (
     Ack,
     AckResult,
     BarrierInfo,
