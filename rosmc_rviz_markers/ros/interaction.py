@@ -32,7 +32,7 @@ from visualization_msgs.msg import InteractiveMarkerFeedback as Feedback
 
 from rosmc_server import interface
 from rosmc_server.core import InvalidRequest, MarkerType, Pose, RosmcError
-from rosmc_server.core.live.edit_history import EditHistory, EditKind, Step, failure_of
+from rosmc_server.core.live.edit_history import EditHistory, EditKind
 from rosmc_server.core.skills.params import value_to_data
 from rosmc_server.core.world import areas
 from rosmc_server.ros.client import AsyncMissionClient, MissionClient, Outcome
@@ -60,6 +60,7 @@ from ..core.styling import is_locked
 from .config import MarkerHost, MarkerNodeConfig
 from .convert import pose_numbers
 from .menu_calls import add_driving_first
+from .undo_calls import UndoCalls
 
 _log = logging.getLogger(__name__)
 Call = Callable[[MissionClient], Any]
@@ -73,6 +74,7 @@ class Interaction:
         self._config = config
         self._client = AsyncMissionClient(MissionClient(5.0, config.ns), "rosmc-markers-client")
         self.history = EditHistory()  # this rviz's own edits, for Undo / Redo
+        self.undo = UndoCalls(self.history, self._client, lambda: node.mirror.revision)
         self._drags: dict[str, tuple[float, float, float]] = {}
         self._timers: dict[str, threading.Timer] = {}
         self._lock = threading.Lock()
@@ -160,7 +162,7 @@ class Interaction:
             )
             return
         if isinstance(action, UndoEdit):
-            self._undo(action.redo)
+            self.undo.ask(action.redo)
             return
         if isinstance(action, SelectObject):
             self._select(parsed)
@@ -206,34 +208,6 @@ class Interaction:
             bindings = ((action.bind, name),) if action.bind and parsed.kind == "task" else ()
             plan = SkillPlan(action.agent, action.skill, dict(action.values), (), bindings)
         return lambda c: _add_planned(c, plan)
-
-    def _undo(self, redo: bool) -> None:
-        """Ask the server to undo this rviz's newest edit (``redo``: its newest undo), against
-        the revision shown (the rule of :class:`EditHistory`, as in the command GUI)."""
-        step = self.history.begin(redo=redo, seen=self._node.mirror.revision)
-        if step is None:  # nothing to take back, or one step still on its way
-            _log.warning("nothing of this rviz's to %s now", "redo" if redo else "undo")
-            return
-        self._send_undo(step, step.next_revision)
-
-    def _send_undo(self, step: Step, revision: int) -> None:
-        future = self._client.submit(
-            lambda c: c.undo_edit(revision),
-            lambda outcome: self._undo_answered(step, outcome),
-            step.base_revision,
-        )
-        future.add_done_callback(lambda f: f.exception())  # errors reach the callback
-
-    def _undo_answered(self, step: Step, outcome: Outcome[Any]) -> None:
-        if outcome.error is None:
-            following = self.history.accepted(step, int(getattr(outcome.value, "revision", 0)))
-            if following is not None:  # several edits in one entry: the next one back
-                self._send_undo(step, following)
-            else:
-                _log.info("%s: done", step.words)
-        else:  # kept (a conflict, no answer) or dropped (refused), as the sentence says
-            error = outcome.error
-            _log.warning("%s", self.history.failed(step, failure_of(error), str(error)))
 
     # -- drags ------------------------------------------------------------------------------------
     def _drag(self, fb: Any, parsed: Parsed) -> None:
