@@ -35,8 +35,8 @@ def apply_event(
     barriers and markers put), each index as it is at that moment: a view that applies
     them one after the other ends equal to ``state``. A replacement is one
     :class:`MissionReset`. The cost is the change's, not the mission's. ``describe``
-    False: the same application, nothing described (the server, which has no view to
-    update, saves a value per skill of a synchronize of thousands).
+    False: the same application, nothing described (the server and the history readers,
+    which have no view to update, save a value per skill of a synchronize of thousands).
 
     Raises:
         RuleViolation: the event does not follow the state's revision.
