@@ -57,3 +57,38 @@ _STARTED = frozenset(
         ExecutorState.CONTINGENCY,
     }
 )
+
+
+class HoldCause(enum.Enum):
+    """Why a robot holds on its own after its lost-link policy acted (``NONE``: it does not).
+
+    The executor reports it as a word (``ExecutorSnapshot.hold``, ``AgentState.hold``); a
+    holding robot starts no new work and its barrier partners wait for it until the
+    operator resumes it. :meth:`of` is the one place a reported word becomes a cause.
+    """
+
+    NONE = ""
+    LOST_LINK = "lost_link"
+    RETURN_POINT = "return_point"
+    SAFE_SKILL = "safe_skill"
+
+    @classmethod
+    def of(cls, word: str) -> HoldCause:
+        """The cause a reported word names (NONE for "" or a word this version does not know)."""
+        try:
+            return cls(word)
+        except ValueError:
+            return cls.NONE
+
+    @property
+    def where(self) -> str:
+        """Where the robot holds, in the operator's words ("" for NONE)."""
+        return _HOLD_WHERE[self]
+
+
+_HOLD_WHERE = {
+    HoldCause.NONE: "",
+    HoldCause.LOST_LINK: "where it lost the link",
+    HoldCause.RETURN_POINT: "at its lost-link return point",
+    HoldCause.SAFE_SKILL: "after its lost-link safe skill",
+}

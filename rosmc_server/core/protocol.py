@@ -12,6 +12,7 @@ import enum
 from dataclasses import dataclass
 
 from .commands import CommandKind
+from .control import HoldCause
 from .model import SkillInstance, SkillStatus
 
 
@@ -109,6 +110,8 @@ class Snapshot:
     policy: str
     full: bool = True  # ``queue`` holds every skill; False: it is left out (the digest stands)
     status_digest: str = ""
+    hold: HoldCause = HoldCause.NONE  # why the robot holds after its lost-link policy acted
+    waiting_since: float = 0.0  # robot clock when its barrier wait began; 0: not waiting
 
 
 class Mode(enum.Enum):
