@@ -33,7 +33,7 @@ from rosmc_server.core.updates import SkillAdded, SkillChanged, SkillRemoved
 from rosmc_server.core.waiting import duration_text
 
 from ..core import presentation
-from ..core.holding import lost_link_hold
+from ..core.holding import barrier_wait, lost_link_hold
 from ..core.legality import RobotAction
 from ..core.mission_view import MissionView
 from ..core.view_state import SkillDelta
@@ -103,6 +103,10 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         never_widen(self.status_label)
         self.status_label.setObjectName(f"status_{agent}")
         self.warning_label = coverage_warning_label(agent)
+        self.wait_label = never_widen(QLabel(""))  # what its barrier waits for, how long
+        self.wait_label.setObjectName(f"barrier_wait_{agent}")
+        self.wait_label.setStyleSheet("QLabel { color:#8a5a00; }")
+        self.wait_label.hide()
         self.hold_notice = HoldNotice(agent, self)
         self.hold_notice.resume_requested.connect(self._on_hold_notice_resume_requested)
         self.policy_in_force = ""
@@ -140,6 +144,7 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         header.addLayout(top)
         header.addWidget(self.status_label)
         header.addWidget(self.warning_label)
+        header.addWidget(self.wait_label)
         header.addWidget(self.hold_notice)
         # Adding and sending sit at opposite ends of their row, the controls on a row of
         # their own: a click meant for one never lands on the other.
@@ -251,6 +256,9 @@ class AgentColumn(QFrame):  # type: ignore[misc]
             )
         show_coverage_warning(self.warning_label, status)
         self.hold_notice.show_hold(lost_link_hold(self._view, self.agent))
+        wait = barrier_wait(self._view, self.agent)
+        self.wait_label.setText(wait)
+        self.wait_label.setVisible(bool(wait))
         self.synced_caption.setText(on_robot_caption(status))
 
     def set_skills(self, names: Sequence[str]) -> None:

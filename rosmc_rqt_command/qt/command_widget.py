@@ -91,6 +91,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.tasks.selection_changed.connect(self._on_tasks_selection_changed)
         self.tasks.context_menu_requested.connect(self._on_tasks_context_menu_requested)
         self.tasks.robot_action.connect(self._on_tasks_robot_action)
+        self.messages.resume_requested.connect(self._on_messages_resume_requested)
         self.tasks.add_requested.connect(self._on_tasks_add_requested)
         self.tasks.policy_chosen.connect(self._on_tasks_policy_chosen)
         self.tasks.reorder_requested.connect(self._on_tasks_reorder_requested)
@@ -271,6 +272,9 @@ class CommandWidget(QWidget):  # type: ignore[misc]
 
     def _on_tasks_robot_action(self, agent: str, kind: RobotAction) -> None:
         self.do_robot(agent, kind)
+
+    def _on_messages_resume_requested(self, agent: str) -> None:
+        self.do_robot(agent, RobotAction.RESUME)
 
     def _on_tasks_add_requested(self, agent: str, skill: str) -> None:
         def select_new(answer: Answer) -> None:

@@ -16,8 +16,15 @@ from python_qt_binding.QtWidgets import QApplication, QMessageBox
 from rosmc_rqt_command.core.holding import lost_link_hold
 from rosmc_rqt_command.core.legality import RobotAction
 from rosmc_rqt_command.core.requests import Answer
-from rosmc_server.core import AgentStatus, Library, LostLinkKind, LostLinkPolicy, Mission
-from rosmc_server.core.control import ControlCommand
+from rosmc_server.core import (
+    AgentStatus,
+    Library,
+    LostLinkKind,
+    LostLinkPolicy,
+    Mission,
+    SkillStatus,
+)
+from rosmc_server.core.control import ControlCommand, HoldCause
 from rosmc_server.executor.core.lost_link import LostLinkGuard
 from tests.team_gui import click, columns, settle, step_right
 from tests.team_twenty import stage, twenty_robot_library
@@ -162,17 +169,20 @@ def held(gui: Gui) -> tuple[str, str]:
     feed.sync("alpha")
     feed.sync("bravo")
     feed.statuses(
-        AgentStatus("alpha", link="up", executor_state="paused", policy=HELD_POLICY),
+        AgentStatus(
+            "alpha",
+            link="up",
+            executor_state="paused",
+            policy=HELD_POLICY,
+            hold=HoldCause.RETURN_POINT,
+        ),
         AgentStatus("bravo", link="up", last_heard=0.0, executor_state="waiting"),
     )
     settle(gui.widget)
     return member, partner
 
 
-SENTENCE = (
-    "alpha is holding after its link came back: it will not start new work; its barrier "
-    "partners bravo wait for it. Press Resume alpha."
-)
+SENTENCE = "alpha holds at its lost-link return point \u2014 its barrier partners bravo wait."
 
 
 def test_a_held_robot_and_whom_it_blocks_are_said_with_resume_one_click_away(gui: Gui) -> None:
@@ -187,6 +197,40 @@ def test_a_held_robot_and_whom_it_blocks_are_said_with_resume_one_click_away(gui
     assert gui.backend.requests[0].args == (ControlCommand.RESUME, "alpha")
 
 
+def test_the_warnings_area_resumes_a_held_robot_with_one_click(gui: Gui) -> None:
+    held(gui)
+    gui.widget.repaints.warn_now()
+    messages = gui.widget.messages
+    assert list(messages.hold_buttons) == ["alpha"]
+    button = messages.hold_buttons["alpha"]
+    assert button.isVisible() and button.text() == "Resume alpha"
+    QTest.mouseClick(button, Qt.LeftButton)
+    assert gui.backend.operations() == ["control"]
+    assert gui.backend.requests[0].args == (ControlCommand.RESUME, "alpha")
+    gui.feed.statuses(AgentStatus("alpha", link="up", executor_state="idle"))
+    settle(gui.widget)
+    gui.widget.repaints.warn_now()
+    assert not messages.hold_bar.isVisible() and not messages.hold_buttons
+
+
+def test_a_barrier_partner_says_whom_it_waits_for_and_since_when(gui: Gui) -> None:
+    _member, partner = held(gui)
+    gui.feed("report_status", partner, SkillStatus.SYNCWAITING)
+    gui.feed.statuses(
+        AgentStatus(
+            "bravo",
+            link="up",
+            executor_state="waiting",
+            current_skill=partner,
+            barrier_wait=92.0,
+        )
+    )
+    settle(gui.widget)
+    label = gui.widget.tasks.columns["bravo"].wait_label
+    assert label.isVisible()
+    assert label.text() == "bravo waits for alpha at barrier B1 since 1 min 32 s"
+
+
 def test_sending_work_to_a_held_robot_warns_that_it_will_not_start(gui: Gui) -> None:
     held(gui)
     gui.feed.add("alpha", "move")
@@ -196,20 +240,23 @@ def test_sending_work_to_a_held_robot_warns_that_it_will_not_start(gui: Gui) -> 
     assert "until you press Resume alpha" in asked.texts[0]
 
 
-def test_the_executors_own_words_for_a_hold_are_recognised(gui: Gui) -> None:
+def test_a_hold_is_read_from_the_typed_field_not_from_the_policy_words(gui: Gui) -> None:
     now = [100.0]
     guard = LostLinkGuard("alpha", lambda: now[0], {})
     guard.adopt(LostLinkPolicy(LostLinkKind.HOLD, 5.0), default=False)
     now[0] += 10.0
     guard.trigger(now[0], True, lambda _note: None)
     guard.contact()
+    assert guard.held is HoldCause.LOST_LINK
+    words = guard.describe()
     gui.feed.statuses(
-        AgentStatus("alpha", link="up", executor_state="paused", policy=guard.describe())
+        AgentStatus("alpha", link="up", executor_state="paused", policy=words, hold=guard.held)
     )
     settle(gui.widget)
     hold = lost_link_hold(gui.widget.view, "alpha")
     assert hold is not None and hold.link_back and hold.partners == ()
-    # Paused by the operator, not by the policy: no hold.
-    gui.feed.statuses(AgentStatus("alpha", link="up", executor_state="paused", policy=""))
+    assert hold.sentence() == "alpha holds where it lost the link."
+    # The same words without the field: not a hold (the wording is not read).
+    gui.feed.statuses(AgentStatus("alpha", link="up", executor_state="paused", policy=words))
     settle(gui.widget)
     assert lost_link_hold(gui.widget.view, "alpha") is None
