@@ -110,6 +110,7 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         self.hold_notice = HoldNotice(agent, self)
         self.hold_notice.resume_requested.connect(self._on_hold_notice_resume_requested)
         self.policy_in_force = ""
+        self.default_policy: LostLinkPolicy | None = None  # the library's, for its model
         self.pending_policy: LostLinkPolicy | None = None  # chosen here, not yet in force
         self.skill_names: list[str] = []
         self.ask_policy: AskPolicy = ask_policy  # tests answer the dialog through this
@@ -283,7 +284,10 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         self.add_requested.emit(self.agent, action.text())  # type: ignore[attr-defined]
 
     def _on_policy_button_clicked(self) -> None:
-        args = (self.agent, self.skill_names, self, self.policy_in_force)
+        in_force, default = self.policy_in_force, self.default_policy
+        if not in_force and default is not None:  # not reported yet: the server sends this
+            in_force = f"{default.describe()} (library default, not reported yet)"
+        args = (self.agent, self.skill_names, self, in_force)
         pending = self.pending_policy
         policy = self.ask_policy(*args) if pending is None else self.ask_policy(*args, pending)
         if policy is not None:
