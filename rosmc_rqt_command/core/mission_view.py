@@ -151,9 +151,10 @@ class MissionView:
 
     def status_text(self, skill: SkillInstance) -> str:
         """The skill's status cell, as every panel shows it."""
-        return presentation.status_text(
-            skill, self.waiting_on(skill), self.out_of_contact(skill.agent)
-        )
+        out = self.out_of_contact(skill.agent)
+        status = self.statuses.get(skill.agent)
+        heard = status.last_heard if out and status is not None else -1.0
+        return presentation.status_text(skill, self.waiting_on(skill), out, heard)
 
     def bound_markers(self, skills: Sequence[SkillInstance]) -> list[str]:
         """Names of the task markers bound to any of ``skills`` (each once)."""

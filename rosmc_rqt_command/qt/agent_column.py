@@ -246,6 +246,8 @@ class AgentColumn(QFrame):  # type: ignore[misc]
             self._out_of_contact = out_of_contact
             self.synced_model.refresh()
             self.blueprint_model.refresh()
+        elif out_of_contact:  # its rows say how long ago the robot was heard
+            self.synced_model.refresh()
         self.policy_in_force = status.policy if status is not None else ""
         pending = self.pending_policy
         if pending is not None and self.policy_in_force.startswith(pending.describe()):

@@ -1,4 +1,5 @@
-"""Nothing is sent to a robot by a slip of the mouse, and a held robot is said in words.
+"""Nothing is sent to a robot by a slip of the mouse; a held robot, a barrier wait and a robot
+out of contact are said in words.
 
 The real widget (offscreen Qt) follows a real mission through the unit harness; the
 operator's clicks are real mouse clicks, and the questions are the real message boxes.
@@ -15,7 +16,9 @@ from python_qt_binding.QtWidgets import QApplication, QMessageBox
 
 from rosmc_rqt_command.core.holding import lost_link_hold
 from rosmc_rqt_command.core.legality import RobotAction
+from rosmc_rqt_command.core.presentation import LAST_KNOWN_TEXT_COLOUR, last_known_colour
 from rosmc_rqt_command.core.requests import Answer
+from rosmc_rqt_command.qt.task_model import STATUS
 from rosmc_server.core import (
     AgentStatus,
     Library,
@@ -260,3 +263,29 @@ def test_a_hold_is_read_from_the_typed_field_not_from_the_policy_words(gui: Gui)
     gui.feed.statuses(AgentStatus("alpha", link="up", executor_state="paused", policy=words))
     settle(gui.widget)
     assert lost_link_hold(gui.widget.view, "alpha") is None
+
+
+def test_rows_of_a_robot_out_of_contact_read_last_known_with_their_age(gui: Gui) -> None:
+    gui.feed.add("alpha", "move")
+    (running,) = gui.feed.sync("alpha")
+    gui.feed("report_status", running, SkillStatus.RUNNING)
+    gui.feed.statuses(AgentStatus("alpha", link="up", last_heard=0.0))
+    settle(gui.widget)
+    model = gui.widget.tasks.columns["alpha"].synced_model
+    cell = model.index(0, STATUS)
+    assert model.data(cell) == "running"
+    current = model.data(cell, Qt.BackgroundRole).color().name()
+    gui.feed.statuses(AgentStatus("alpha", link="down", last_heard=40.0))
+    settle(gui.widget)
+    assert model.data(cell) == "running (last known, 40 s ago)"
+    greyed = model.data(cell, Qt.BackgroundRole).color().name()
+    assert greyed != current and greyed == last_known_colour(current)
+    assert model.data(cell, Qt.ForegroundRole).color().name() == LAST_KNOWN_TEXT_COLOUR
+    assert model.data(cell, Qt.FontRole).italic()
+    gui.feed.statuses(AgentStatus("alpha", link="down", last_heard=95.0))
+    settle(gui.widget)
+    assert model.data(cell) == "running (last known, 1 min ago)"
+    gui.feed.statuses(AgentStatus("alpha", link="up", last_heard=0.0))
+    settle(gui.widget)
+    assert model.data(cell) == "running"
+    assert model.data(cell, Qt.BackgroundRole).color().name() == current
