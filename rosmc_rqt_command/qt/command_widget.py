@@ -21,7 +21,7 @@ from rosmc_server.core import AgentStatus, Library, LostLinkPolicy
 from ..core.dispatch import Dispatcher
 from ..core.legality import Action, RobotAction
 from ..core.mission_view import MissionView
-from ..core.phrasing import answer_message
+from ..core.phrasing import answer_detail, answer_message
 from ..core.requests import Answer, Backend, Request, ask
 from ..core.view_state import ViewUpdate
 from .actions import CommandActions
@@ -142,7 +142,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.files.on_mission_shown()
         if first:
             self.files.mark_saved()
-            self.messages.say(f"Mission shown (revision {self.view.revision}).", "ok")
+            self.messages.say("Mission shown.", "ok", f"mission revision {self.view.revision}")
         if reset:
             self.banner.hide()
         self.team.refresh()
@@ -175,9 +175,10 @@ class CommandWidget(QWidget):  # type: ignore[misc]
     def on_server_restarted(self, revision: int) -> None:
         """A new mission server process took over (a restart); say from which revision."""
         self.messages.say(
-            f"The mission server restarted from revision {revision}; robot states are "
-            "shown again as it hears the robots.",
+            "The mission server restarted with the mission as it last recorded it; robot "
+            "states are shown again as it hears the robots.",
             "warning",
+            f"restarted from mission revision {revision}",
         )
 
     def on_journal_alert(self, alert: str) -> None:
@@ -194,7 +195,8 @@ class CommandWidget(QWidget):  # type: ignore[misc]
     def on_answer(self, answer: Answer) -> None:
         """Say how a request ended."""
         hint = self.history.note(answer) if answer.ok else ""  # "Ctrl+Z undoes it"
-        self.messages.say(*answer_message(answer, hint))
+        text, severity = answer_message(answer, hint)
+        self.messages.say(text, severity, answer_detail(answer))
         if answer.request.on_answer is not None:
             answer.request.on_answer(answer)
 

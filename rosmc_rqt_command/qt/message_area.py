@@ -85,9 +85,12 @@ class MessageArea(QWidget):  # type: ignore[misc]
                 self.hold_buttons[agent] = button
         self.hold_bar.setVisible(bool(agents))
 
-    def say(self, text: str, severity: str = "info") -> None:
-        """Add one message (``severity``: info, ok, warning or error)."""
+    def say(self, text: str, severity: str = "info", detail: str = "") -> None:
+        """Add one message (``severity``: info, ok, warning or error); ``detail`` (numbers
+        for roboticists, e.g. the mission revision) goes in its tooltip."""
         item = QListWidgetItem(f"{time.strftime('%H:%M:%S')}  {text}")
+        if detail:
+            item.setToolTip(detail)
         item.setForeground(QBrush(QColor(SEVERITY_COLOURS.get(severity, "#1d1d1d"))))
         item.setData(256, severity)  # Qt.UserRole
         self.log.insertItem(0, item)

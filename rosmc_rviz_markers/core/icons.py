@@ -27,12 +27,13 @@ from dataclasses import dataclass
 from rosmc_server.core.agent_status import AgentStatus
 from rosmc_server.core.control import HoldCause
 from rosmc_server.core.geometry import Color, Point
-from rosmc_server.core.holding import RVIZ_HOLD_LABEL, age_text
 from rosmc_server.core.model import SkillStatus
 from rosmc_server.core.vocabulary import (
+    HOLDING_LABEL,
     STATUS_COLOURS,
     STATUS_MARKS,
     STATUS_WORDS,
+    age_text,
     dbm,
     percent,
     rgb,
@@ -160,7 +161,7 @@ def status_parts(status: AgentStatus | None, skill_label: str = "") -> tuple[Ico
             battery_row(None),
         )
     if status.hold is not HoldCause.NONE:
-        skill = IconRow("skill", RVIZ_HOLD_LABEL, BAD)
+        skill = IconRow("skill", HOLDING_LABEL, BAD)
     else:
         name = skill_label or status.current_skill
         skill = skill_row(name, status.current_status, status.waiting_on, status.barrier_wait)

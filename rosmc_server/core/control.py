@@ -64,7 +64,8 @@ class HoldCause(enum.Enum):
 
     The executor reports it as a word (``ExecutorSnapshot.hold``, ``AgentState.hold``); a
     holding robot starts no new work and its barrier partners wait for it until the
-    operator resumes it. :meth:`of` is the one place a reported word becomes a cause.
+    operator resumes it. :meth:`of` is the one place a reported word becomes a cause; its
+    words for operators are :data:`~.vocabulary.HOLD_WHERE`.
     """
 
     NONE = ""
@@ -79,16 +80,3 @@ class HoldCause(enum.Enum):
             return cls(word)
         except ValueError:
             return cls.NONE
-
-    @property
-    def where(self) -> str:
-        """Where the robot holds, in the operator's words ("" for NONE)."""
-        return _HOLD_WHERE[self]
-
-
-_HOLD_WHERE = {
-    HoldCause.NONE: "",
-    HoldCause.LOST_LINK: "where it lost the link",
-    HoldCause.RETURN_POINT: "at its lost-link return point",
-    HoldCause.SAFE_SKILL: "after its lost-link safe skill",
-}

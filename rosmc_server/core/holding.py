@@ -4,7 +4,8 @@ A robot whose lost-link policy acted (hold where it was, or return to where it l
 link, then hold) reports why it holds (:class:`~.control.HoldCause`). It starts no new work
 and the partners of its barriers wait for it until the operator resumes it: the one action
 that frees it. The command GUI, rviz and ``rosmc status`` say it with these words, and say
-each barrier wait the same way: whom the robot waits for, where, and since how long.
+each barrier wait the same way: whom the robot waits for, where, and since how long
+(the words themselves are :mod:`.vocabulary`'s).
 """
 
 from __future__ import annotations
@@ -13,23 +14,9 @@ from collections.abc import Callable, Iterable, Sequence
 
 from .control import HoldCause
 from .model import Barrier, SkillInstance, SkillStatus
-
-RVIZ_HOLD_LABEL = "holding \u2014 Resume from its menu"
-"""What a holding robot's label in rviz says instead of its skill."""
+from .vocabulary import HOLD_WHERE, age_text
 
 _ARRIVED = frozenset({SkillStatus.SYNCWAITING, SkillStatus.RUNNING})
-
-
-def age_text(seconds: float) -> str:
-    """An age to the second, in the two largest units: ``45 s``, ``1 min 32 s``, ``2 h 5 min``."""
-    whole = max(0, int(seconds))
-    hours, rest = divmod(whole, 3600)
-    minutes, secs = divmod(rest, 60)
-    if hours:
-        return f"{hours} h {minutes} min"
-    if minutes:
-        return f"{minutes} min {secs} s"
-    return f"{secs} s"
 
 
 def hold_sentence(agent: str, cause: HoldCause, partners: Sequence[str], link_back: bool) -> str:
@@ -37,7 +24,7 @@ def hold_sentence(agent: str, cause: HoldCause, partners: Sequence[str], link_ba
 
     Out of contact it adds that a Resume goes out once the robot is heard again.
     """
-    text = f"{agent} holds {cause.where or 'after its lost-link policy acted'}"
+    text = f"{agent} holds {HOLD_WHERE[cause]}"
     if partners:
         text += f" \u2014 its barrier partners {', '.join(partners)} wait"
     text += "."

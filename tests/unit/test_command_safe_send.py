@@ -8,6 +8,7 @@ operator's clicks are real mouse clicks, and the questions are the real message 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
+from types import SimpleNamespace
 
 import pytest
 from python_qt_binding.QtCore import QPoint, Qt, QTimer
@@ -16,8 +17,9 @@ from python_qt_binding.QtWidgets import QApplication, QMessageBox
 
 from rosmc_rqt_command.core.holding import lost_link_hold
 from rosmc_rqt_command.core.legality import RobotAction
+from rosmc_rqt_command.core.phrasing import answer_detail, answer_message
 from rosmc_rqt_command.core.presentation import LAST_KNOWN_TEXT_COLOUR, last_known_colour
-from rosmc_rqt_command.core.requests import Answer
+from rosmc_rqt_command.core.requests import Answer, ask
 from rosmc_rqt_command.qt.task_model import STATUS
 from rosmc_server.core import (
     AgentStatus,
@@ -289,3 +291,17 @@ def test_rows_of_a_robot_out_of_contact_read_last_known_with_their_age(gui: Gui)
     settle(gui.widget)
     assert model.data(cell) == "running"
     assert model.data(cell, Qt.BackgroundRole).color().name() == current
+
+
+def test_answers_are_said_without_the_revision_which_stays_in_the_tooltip(gui: Gui) -> None:
+    request = ask(lambda c: c.delete_skills, "delete 'go'")(["s1"])
+    answer = Answer(request, SimpleNamespace(revision=626))
+    assert answer_message(answer, "Ctrl+Z undoes it") == (
+        "Done: delete 'go' (Ctrl+Z undoes it).",
+        "ok",
+    )
+    assert answer_detail(answer) == "mission revision 626"
+    assert answer_detail(Answer(request, error="no such skill")) == ""
+    gui.widget.messages.say(*answer_message(answer), answer_detail(answer))
+    item = gui.widget.messages.log.item(0)
+    assert "626" not in item.text() and item.toolTip() == "mission revision 626"

@@ -6,13 +6,13 @@ from rosmc_rviz_markers.core.icons import status_rows
 from rosmc_server.core import AgentStatus, Library, Mission, SkillStatus
 from rosmc_server.core.control import HoldCause
 from rosmc_server.core.holding import (
-    age_text,
     barrier_partners,
     hold_sentence,
     not_arrived,
     wait_sentence,
 )
 from rosmc_server.core.policy import LostLinkKind, LostLinkPolicy
+from rosmc_server.core.vocabulary import HOLD_WHERE, age_text
 from rosmc_server.executor.core.lost_link import LostLinkGuard
 from rosmc_server.executor.core.skills import Outcome, SkillBehavior, SkillContext, SkillType
 from rosmc_server.text.plain import format_tasks
@@ -23,7 +23,8 @@ def test_a_reported_word_becomes_a_cause_and_an_unknown_one_none() -> None:
     assert HoldCause.of("return_point") is HoldCause.RETURN_POINT
     assert HoldCause.of("") is HoldCause.NONE
     assert HoldCause.of("a word of a newer robot") is HoldCause.NONE
-    assert HoldCause.RETURN_POINT.where == "at its lost-link return point"
+    assert HOLD_WHERE[HoldCause.RETURN_POINT] == "at its lost-link return point"
+    assert set(HOLD_WHERE) == set(HoldCause), "every cause has its words"
 
 
 def test_ages_read_to_the_second() -> None:
