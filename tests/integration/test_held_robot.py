@@ -140,7 +140,7 @@ def test_a_held_robot_is_said_everywhere_and_resume_frees_its_partners(
     icons = Icons()
     widget, bridge = build(timeout=5.0)
     try:
-        widget.resize(1400, 800)
+        widget.resize(1600, 1000)  # as the other pictures of docs/
         widget.show()
         work, meet_r1, meet_r2 = hold_r1_before_its_barrier(op)
 
