@@ -1387,3 +1387,18 @@ def test_a_hold_after_the_policy_is_reported_until_the_operator_starts_it(robot:
     assert robot.engine.snapshot().hold is HoldCause.LOST_LINK
     robot.send(K.RESUME)
     assert robot.status("a") is S.RUNNING and robot.engine.snapshot().hold is HoldCause.NONE
+
+
+def test_a_hold_survives_an_executor_restart(robot: Robot, tmp_path: Path) -> None:
+    robot.send(K.SET_OPTIONS, argument=json.dumps({"lost_link": {"policy": "hold", "after": 5}}))
+    robot.upload(make_skill("a", params={"duration": 30.0}))
+    robot.send(K.START)
+    robot.run_for(6.0)
+    assert robot.engine.snapshot().hold is HoldCause.LOST_LINK
+    save_state(robot.engine, tmp_path / "r1.json")
+    fresh = Robot()
+    load_state(fresh.engine, tmp_path / "r1.json")
+    assert fresh.engine.snapshot().hold is HoldCause.LOST_LINK, "still paused: still held"
+    fresh.seq = robot.seq  # the ground numbers on
+    fresh.send(K.START)
+    assert fresh.engine.snapshot().hold is HoldCause.NONE
