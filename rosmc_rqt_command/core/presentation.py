@@ -70,12 +70,14 @@ def status_text(
     waiting_on: list[str] | None = None,
     out_of_contact: bool = False,
     heard_ago: float = -1.0,
+    holding: bool = False,
 ) -> str:
     """The status cell: a word, and what matters about it (pending transfer, wait, reason).
 
     ``out_of_contact``: the robot cannot be heard, so a transfer waits for contact, and
     what the robot last said of an unfinished skill may be old: it is marked last known,
     with how long ago the robot was heard (``heard_ago`` seconds; negative: never).
+    ``holding``: the robot holds after its lost-link policy; its paused skill says so.
     """
     if skill.transfer is Transfer.UPLOADING and out_of_contact:
         return "waiting for contact"
@@ -88,6 +90,8 @@ def status_text(
     word = STATUS_WORDS[skill.status]
     if skill.status is SkillStatus.SYNCWAITING and waiting_on:
         word = f"waiting on {', '.join(waiting_on)}"
+    if skill.status is SkillStatus.PAUSED and holding:
+        word = "holding (Resume frees it)"
     if skill.status is SkillStatus.FAILURE and skill.resolution is not Resolution.NONE:
         word += f" ({skill.resolution.name.lower()})"
     if skill.attempt > 1:

@@ -258,7 +258,10 @@ class AgentColumn(QFrame):  # type: ignore[misc]
                 f"for contact: {escape(self.pending_policy.describe())}</span>"
             )
         show_coverage_warning(self.warning_label, status)
-        self.hold_notice.show_hold(lost_link_hold(self._view, self.agent))
+        hold = lost_link_hold(self._view, self.agent)
+        if (hold is None) != (self.hold_notice.hold is None):
+            self.synced_model.refresh()  # its paused row says that it holds (or no more)
+        self.hold_notice.show_hold(hold)
         wait = barrier_wait(self._view, self.agent)
         self.wait_label.setText(wait)
         self.wait_label.setVisible(bool(wait))

@@ -27,6 +27,7 @@ from python_qt_binding.QtTest import QTest
 from python_qt_binding.QtWidgets import QApplication
 from visualization_msgs.msg import MarkerArray
 
+from rosmc_rqt_command.qt.task_model import STATUS
 from rosmc_rqt_command.standalone import build
 from rosmc_rviz_markers import topics
 from rosmc_server.core import LostLinkKind, LostLinkPolicy, SkillStatus
@@ -150,6 +151,8 @@ def test_a_held_robot_is_said_everywhere_and_resume_frees_its_partners(
         wait_until(lambda: notice.isVisible() and notice.text.text() == HELD, 30.0, "r1 held")
         widget.repaints.warn_now()
         assert HELD in widget.messages.warnings
+        rows = widget.tasks.columns["r1"].synced_model
+        assert rows.data(rows.index(0, STATUS)) == "holding (Resume frees it)"  # its work
         waits = widget.tasks.columns["r2"].wait_label
         wait_until(
             lambda: waits.text().startswith("r2 waits for r1 at barrier B1 since "),

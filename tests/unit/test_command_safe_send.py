@@ -305,3 +305,15 @@ def test_answers_are_said_without_the_revision_which_stays_in_the_tooltip(gui: G
     gui.widget.messages.say(*answer_message(answer), answer_detail(answer))
     item = gui.widget.messages.log.item(0)
     assert "626" not in item.text() and item.toolTip() == "mission revision 626"
+
+
+def test_the_status_cell_names_the_barrier_by_its_tag(gui: Gui) -> None:
+    _member, partner = held(gui)
+    gui.feed("report_status", partner, SkillStatus.SYNCWAITING)
+    barrier_id = gui.feed.mission.state.barriers[0].id
+    gui.feed.statuses(
+        AgentStatus("bravo", link="up", current_skill=partner, waiting_on=f"alpha at {barrier_id}")
+    )
+    settle(gui.widget)
+    model = gui.widget.tasks.columns["bravo"].synced_model
+    assert model.data(model.index(0, STATUS)) == "waiting on alpha at B1"
