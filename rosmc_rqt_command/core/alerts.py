@@ -18,8 +18,8 @@ import time
 from collections.abc import Iterable, Sequence
 
 from rosmc_server.core import Library, RosmcError, SkillInstance
-from rosmc_server.core.advice import stranded_barriers
-from rosmc_server.core.vocabulary import counted
+from rosmc_server.core.rules.advice import stranded_barriers
+from rosmc_server.core.views.vocabulary import counted
 
 from .mission_view import MissionView
 
@@ -28,7 +28,7 @@ WEAK_WIFI_DBM = -75.0  # below this a robot is about to lose the link
 
 def barrier_warnings(view: MissionView, sending: Sequence[SkillInstance] = ()) -> list[str]:
     """Barrier members on a robot (or being sent) whose partners are still planned (the
-    core's rule, :func:`~rosmc_server.core.advice.stranded_barriers`, worded here)."""
+    core's rule, :func:`~rosmc_server.core.rules.advice.stranded_barriers`, worded here)."""
     out = []
     for stranded in stranded_barriers(view, view.barriers, [s.id for s in sending]):
         robots = ", ".join(s.agent for s in stranded.going)

@@ -12,7 +12,7 @@ from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, ParamSpec
 
 from rosmc_server.core import SkillInstance
-from rosmc_server.core.control import ControlCommand
+from rosmc_server.core.model.control import ControlCommand
 
 from . import alerts
 from .legality import Action, RobotAction, legal_actions, legal_robot_actions, selection_agent

@@ -2,10 +2,10 @@
 
 When a robot's lost-link policy acts (hold, or return to where it last had a link, then
 hold) the robot reports why it holds (``AgentStatus.hold``, a
-:class:`~rosmc_server.core.control.HoldCause`). Work sent to it meanwhile waits on board,
+:class:`~rosmc_server.core.model.control.HoldCause`). Work sent to it meanwhile waits on board,
 and the partners of its barriers wait for it, until the operator presses Resume.
 :func:`lost_link_hold` finds such a robot in the view and :class:`Hold` says it in the
-operator's words (:mod:`rosmc_server.core.holding`, shared with rviz and ``rosmc``);
+operator's words (:mod:`rosmc_server.core.views.holding`, shared with rviz and ``rosmc``);
 :func:`barrier_wait` says what a robot waiting at a barrier waits for, and since how long.
 No Qt here.
 """
@@ -16,9 +16,9 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 from rosmc_server.core import SkillStatus
-from rosmc_server.core import holding as words
-from rosmc_server.core.control import HoldCause
-from rosmc_server.core.link import LinkStatus
+from rosmc_server.core.model.control import HoldCause
+from rosmc_server.core.robots.link import LinkStatus
+from rosmc_server.core.views import holding as words
 
 from .mission_view import MissionView
 

@@ -19,10 +19,10 @@ from rosmc_server.core import (
     SkillStatus,
     TaskMarker,
 )
-from rosmc_server.core.control import HoldCause
-from rosmc_server.core.legality import TaskView
-from rosmc_server.core.link import LinkStatus
-from rosmc_server.core.updates import SkillAdded, SkillChanged, SkillRemoved
+from rosmc_server.core.live.updates import SkillAdded, SkillChanged, SkillRemoved
+from rosmc_server.core.model.control import HoldCause
+from rosmc_server.core.robots.link import LinkStatus
+from rosmc_server.core.rules.legality import TaskView
 
 from . import presentation
 from .view_state import ViewUpdate, apply_delta, barrier_tags, delta_agent

@@ -15,11 +15,11 @@ from rosmc_server.core import (
     Transfer,
     Value,
 )
-from rosmc_server.core.link import LinkStatus
-from rosmc_server.core.vocabulary import STATUS_COLOURS as STATUS_COLOURS
-from rosmc_server.core.vocabulary import STATUS_WORDS as STATUS_WORDS
-from rosmc_server.core.vocabulary import dbm, number, percent, rgb, wifi_words
-from rosmc_server.core.waiting import duration_text
+from rosmc_server.core.robots.link import LinkStatus
+from rosmc_server.core.robots.waiting import duration_text
+from rosmc_server.core.views.vocabulary import STATUS_COLOURS as STATUS_COLOURS
+from rosmc_server.core.views.vocabulary import STATUS_WORDS as STATUS_WORDS
+from rosmc_server.core.views.vocabulary import dbm, number, percent, rgb, wifi_words
 
 TRANSFER_COLOUR = "#dae6fa"  # uploading or removing: on its way, not settled (italic too)
 SETTLED_FAILURE_COLOUR = "#f9bbb0"  # a failure the operator retried or skipped

@@ -16,10 +16,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 from rosmc_server.core import AgentStatus, Barrier, MissionState, SkillInstance, TaskMarker
-from rosmc_server.core.legality import TaskView
-from rosmc_server.core.moves import move_columns
-from rosmc_server.core.reorder import play_moves
-from rosmc_server.core.updates import (
+from rosmc_server.core.live.updates import (
     AgentStatusChanged,
     BarrierPut,
     BarrierRemoved,
@@ -32,6 +29,9 @@ from rosmc_server.core.updates import (
     SkillRemoved,
     SkillsMoved,
 )
+from rosmc_server.core.model.moves import move_columns
+from rosmc_server.core.model.reorder import play_moves
+from rosmc_server.core.rules.legality import TaskView
 
 SkillDelta = SkillAdded | SkillChanged | SkillRemoved | SkillsMoved
 

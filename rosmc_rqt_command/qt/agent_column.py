@@ -27,10 +27,10 @@ from python_qt_binding.QtWidgets import (
 )
 
 from rosmc_server.core import AgentStatus, LostLinkPolicy, SkillStatus
-from rosmc_server.core.legality import TaskView
-from rosmc_server.core.link import LinkStatus
-from rosmc_server.core.updates import SkillAdded, SkillChanged, SkillRemoved
-from rosmc_server.core.waiting import duration_text
+from rosmc_server.core.live.updates import SkillAdded, SkillChanged, SkillRemoved
+from rosmc_server.core.robots.link import LinkStatus
+from rosmc_server.core.robots.waiting import duration_text
+from rosmc_server.core.rules.legality import TaskView
 
 from ..core import presentation
 from ..core.holding import barrier_wait, lost_link_hold

@@ -34,7 +34,7 @@ from python_qt_binding.QtWidgets import (
 )
 
 from rosmc_server.core import InvalidRequest, MarkerType, ParameterSpec, ParamType, Pose, Value
-from rosmc_server.core.params import parse_text
+from rosmc_server.core.skills.params import parse_text
 
 BIG = 1e9
 INVALID_STYLE = "background:#ffd6d6"

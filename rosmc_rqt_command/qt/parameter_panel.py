@@ -26,7 +26,7 @@ from python_qt_binding.QtWidgets import (
 )
 
 from rosmc_server.core import InvalidRequest, RosmcError, SkillInstance, SkillSpec
-from rosmc_server.core.editing import check_retries, check_timeout
+from rosmc_server.core.rules.editing import check_retries, check_timeout
 from rosmc_server.core.validation import MAX_RETRIES
 
 from ..core.mission_view import MissionView

@@ -5,9 +5,9 @@ without covering the others:
 
 * the robot's name, its current skill and that skill's status
   (``science_rover: navigate_to >> running``), in the status's colour (the words, marks and
-  colours of :mod:`rosmc_server.core.vocabulary`, as in the command GUI and ``rosmc``); a
-  barrier wait says on whom and since how long; a robot holding after its lost-link policy
-  says so and what frees it instead (``r4: holding — Resume from its menu``, red);
+  colours of :mod:`rosmc_server.core.views.vocabulary`, as in the command GUI and ``rosmc``);
+  a barrier wait says on whom and since how long; a robot holding after its lost-link
+  policy says so and what frees it instead (``r4: holding — Resume from its menu``, red);
 * its health: battery, Wi-Fi and ground link
   (``BAT 97% | WiFi -54 dBm | link up``), coloured by the worst of the three (green,
   yellow, red; the part past its threshold is written in capitals). Commands waiting
@@ -24,11 +24,12 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
-from rosmc_server.core.agent_status import AgentStatus
-from rosmc_server.core.control import HoldCause
-from rosmc_server.core.geometry import Color, Point
-from rosmc_server.core.model import SkillStatus
-from rosmc_server.core.vocabulary import (
+from rosmc_server.core.model.control import HoldCause
+from rosmc_server.core.model.model import SkillStatus
+from rosmc_server.core.robots.agent_status import AgentStatus
+from rosmc_server.core.robots.waiting import duration_text
+from rosmc_server.core.views.geometry import Color, Point
+from rosmc_server.core.views.vocabulary import (
     HOLDING_LABEL,
     STATUS_COLOURS,
     STATUS_MARKS,
@@ -38,7 +39,6 @@ from rosmc_server.core.vocabulary import (
     percent,
     rgb,
 )
-from rosmc_server.core.waiting import duration_text
 
 from .labels import LINE_SPACING, VIEW_PITCH, Box, Label
 

@@ -24,11 +24,11 @@ import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
-from rosmc_server.core.library import AgentKind, Library, SkillSpec
-from rosmc_server.core.markers import generated_name
-from rosmc_server.core.model import SkillInstance, TaskMarker
-from rosmc_server.core.params import MarkerType, ParamType, Value
-from rosmc_server.core.state import MissionState
+from rosmc_server.core.model.model import SkillInstance, TaskMarker
+from rosmc_server.core.model.state import MissionState
+from rosmc_server.core.rules.markers import generated_name
+from rosmc_server.core.skills.library import AgentKind, Library, SkillSpec
+from rosmc_server.core.skills.params import MarkerType, ParamType, Value
 
 
 @dataclass(frozen=True)

@@ -11,11 +11,11 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from rosmc_server.core import areas
 from rosmc_server.core.errors import InvalidRequest
-from rosmc_server.core.library import Library
-from rosmc_server.core.model import TaskMarker
-from rosmc_server.core.params import MarkerType, ParamType, Pose, Value
+from rosmc_server.core.model.model import TaskMarker
+from rosmc_server.core.skills.library import Library
+from rosmc_server.core.skills.params import MarkerType, ParamType, Pose, Value
+from rosmc_server.core.world import areas
 
 AHEAD = 4.0  # metres in front of a robot where new task markers appear
 AREA_AHEAD = 7.0  # an area's centre in front of the robot (so the robot is outside it)

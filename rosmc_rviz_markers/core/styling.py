@@ -11,8 +11,8 @@ from __future__ import annotations
 import enum
 from collections.abc import Iterable
 
-from rosmc_server.core.geometry import Color
-from rosmc_server.core.model import SkillInstance, SkillStatus, Transfer
+from rosmc_server.core.model.model import SkillInstance, SkillStatus, Transfer
+from rosmc_server.core.views.geometry import Color
 
 
 class MarkerUse(enum.IntEnum):

@@ -31,9 +31,10 @@ from geometry_msgs.msg import PointStamped, PoseStamped, PoseWithCovarianceStamp
 from visualization_msgs.msg import InteractiveMarkerFeedback as Feedback
 
 from rosmc_server import interface
-from rosmc_server.core import InvalidRequest, MarkerType, Pose, RosmcError, areas
-from rosmc_server.core.control import ControlCommand
-from rosmc_server.core.params import value_to_data
+from rosmc_server.core import InvalidRequest, MarkerType, Pose, RosmcError
+from rosmc_server.core.model.control import ControlCommand
+from rosmc_server.core.skills.params import value_to_data
+from rosmc_server.core.world import areas
 from rosmc_server.ros.client import AsyncMissionClient, MissionClient, Outcome
 
 from .. import topics

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from collections.abc import Callable, Sequence
 
-from ..core.policy import DEFAULT_AFTER, LostLinkKind, LostLinkTrigger
+from ..core.skills.policy import DEFAULT_AFTER, LostLinkKind, LostLinkTrigger
 from .keys import add_commands as _add_keys
 from .replay import add_commands as _add_recording
 from .review import add_commands as _add_review

@@ -11,8 +11,8 @@ import math
 import rosmc.msg as wire
 
 from ..core import AgentStatus, SkillStatus
-from ..core.control import HoldCause
-from ..core.link import LinkStatus
+from ..core.model.control import HoldCause
+from ..core.robots.link import LinkStatus
 from .values import pose_from_msg
 
 _LINK_STATES: dict[int, LinkStatus] = {

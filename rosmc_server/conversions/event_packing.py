@@ -23,7 +23,7 @@ from typing import Any
 import rosmc.msg as wire
 
 from ..core import MissionEvent
-from ..core.changes import PlacedSkill
+from ..core.model.changes import PlacedSkill
 from .mission import event_to_msg
 from .packing import serialized, skill_bytes, string_bytes
 

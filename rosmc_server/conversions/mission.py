@@ -27,7 +27,7 @@ from ..core import (
     TaskMarker,
     Transfer,
 )
-from ..core.changes import SkillMove
+from ..core.model.changes import SkillMove
 from .move_fields import moves_from_fields, moves_to_fields
 from .values import (
     enum_from_number,

@@ -32,7 +32,7 @@ from rosmc_server.core import (
     NotFound,
     RosmcError,
 )
-from rosmc_server.core.updates import apply_event
+from rosmc_server.core.live.updates import apply_event
 from rosmc_server.interface import EVENTS_TOPIC, MISSION_TOPIC, ROBOT_REPORTS_TOPIC
 from rosmc_server.recording.damage import skipped_line
 from rosmc_server.recording.errors import JournalError

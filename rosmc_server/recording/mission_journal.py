@@ -32,7 +32,7 @@ from pathlib import Path
 from rosmc_server.conversions import event_from_msg, mission_from_msg, mission_to_msg
 from rosmc_server.conversions.event_packing import packed_event
 from rosmc_server.core import Library, Mission, MissionContent, MissionEvent
-from rosmc_server.core.changes import EventKind
+from rosmc_server.core.model.changes import EventKind
 from rosmc_server.recording._mcap.codec import RosMessage
 from rosmc_server.recording._mcap.files import journal_parts
 from rosmc_server.recording.high_water import RevisionMark, first_mark, resumed_mark

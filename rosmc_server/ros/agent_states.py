@@ -17,7 +17,7 @@ import rospy
 from .. import interface
 from ..conversions.agents import link_state_to_msg
 from ..core import SkillStatus
-from ..core.advice import waiting_on_unsynced
+from ..core.rules.advice import waiting_on_unsynced
 from .agent_link import AgentLink
 from .coverage_watch import CoverageWatch
 from .server_host import ServerHost

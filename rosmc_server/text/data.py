@@ -15,9 +15,9 @@ from ..core import (
     SkillSpec,
     TaskMarker,
 )
-from ..core.agent_status import AgentStatus
-from ..core.params import value_to_data
-from ..core.site_source import SiteInForce
+from ..core.robots.agent_status import AgentStatus
+from ..core.skills.params import value_to_data
+from ..core.world.site_source import SiteInForce
 
 
 def mission_to_json(

@@ -23,12 +23,12 @@ from ..core import (
     TaskMarker,
     Transfer,
     Value,
-    holding,
 )
-from ..core.agent_status import AgentStatus
-from ..core.control import HoldCause
-from ..core.link import LinkStatus
-from ..core.vocabulary import STATUS_MARKS, counted, dbm, number, percent, wifi_words
+from ..core.model.control import HoldCause
+from ..core.robots.agent_status import AgentStatus
+from ..core.robots.link import LinkStatus
+from ..core.views import holding
+from ..core.views.vocabulary import STATUS_MARKS, counted, dbm, number, percent, wifi_words
 
 _RULE = "    " + "-" * 56
 

@@ -38,10 +38,10 @@ from std_msgs.msg import Bool
 from rosmc_server import interface
 from rosmc_server.conversions import mission_from_msg, param_to_msg, skill_to_msg
 from rosmc_server.core import MissionState, SkillInstance, SkillStatus
-from rosmc_server.core.commands import CommandKind
-from rosmc_server.core.radio import DatagramKind, parse_endpoint
-from rosmc_server.core.radio_auth import Sealer
-from rosmc_server.core.radio_key import RadioKey, obtain_key
+from rosmc_server.core.robots.commands import CommandKind
+from rosmc_server.core.robots.radio import DatagramKind, parse_endpoint
+from rosmc_server.core.robots.radio_auth import Sealer
+from rosmc_server.core.robots.radio_key import RadioKey, obtain_key
 from rosmc_server.recording import read_journal
 from tests.conftest import wait_until
 

@@ -39,7 +39,7 @@ from rosmc_server.core import (
     load_library,
 )
 from rosmc_server.core.errors import ServerUnavailable
-from rosmc_server.core.science import RegionScience, Science
+from rosmc_server.core.views.science import RegionScience, Science
 from rosmc_server.interface import SCIENCE_TOPIC
 from rosmc_server.ros.client import MissionClient, RevisionConflict, library_from_msg
 from rosmc_server.ros.node_setup import init_node

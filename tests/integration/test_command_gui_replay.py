@@ -27,7 +27,7 @@ from python_qt_binding.QtWidgets import QApplication
 from rosmc_rqt_command.core.legality import RobotAction
 from rosmc_rqt_command.qt.science_strip import NO_REPLAY_SCORE
 from rosmc_rqt_command.replay_ticks import TickKind
-from rosmc_server.core.science import Science
+from rosmc_server.core.views.science import Science
 from rosmc_server.recording import read_journal
 from rosmc_server.recording.history import MissionHistory
 from rosmc_server.ros.client import agent_statuses_from_msg

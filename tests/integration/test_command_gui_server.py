@@ -43,8 +43,8 @@ from rosmc_rqt_command.standalone import build
 from rosmc_server.conversions.science import science_to_msg
 from rosmc_server.conversions.site import site_to_msg
 from rosmc_server.core import LostLinkKind, LostLinkPolicy
-from rosmc_server.core.science import RegionScience, Science
-from rosmc_server.core.site import Footprint, Shape, SiteModel
+from rosmc_server.core.views.science import RegionScience, Science
+from rosmc_server.core.world.site import Footprint, Shape, SiteModel
 from rosmc_server.interface import SCIENCE_TOPIC, SITE_TOPIC
 from rosmc_server.ros.client import MissionClient
 from tests import conftest

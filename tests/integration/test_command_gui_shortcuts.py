@@ -89,7 +89,7 @@ def drive() -> None:
     from rosmc_rqt_command.core.legality import RobotAction
     from rosmc_rqt_command.core.requests import Answer, ask
     from rosmc_server.core import AgentStatus, SkillStatus
-    from rosmc_server.core.library import library_from_dict
+    from rosmc_server.core.skills.library import library_from_dict
     from tests.unit.conftest import TEST_LIBRARY, make_mission
     from tests.unit.test_command_harness import Gui
 

@@ -33,8 +33,8 @@ from rosmc_server.core import (
     SkillStatus,
     Transfer,
 )
-from rosmc_server.core.commands import CommandKind
-from rosmc_server.core.link import queue_hash, status_digest
+from rosmc_server.core.robots.commands import CommandKind
+from rosmc_server.core.robots.link import queue_hash, status_digest
 from rosmc_server.recording import read_journal
 from rosmc_server.ros.client import MissionClient
 from tests.conftest import wait_until

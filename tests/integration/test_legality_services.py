@@ -1,6 +1,6 @@
 """What the GUIs offer is exactly what the real mission server accepts.
 
-:mod:`rosmc_server.core.legality` decides which skill and robot actions the command GUI
+:mod:`rosmc_server.core.rules.legality` decides which skill and robot actions the command GUI
 and rviz enable. This module checks it against the real server's operator services, not
 against the core (``tests/unit/test_legality.py`` does that): for a set of mission states,
 every action on every skill (and each robot's send / take back) is legal by the core
@@ -30,8 +30,8 @@ import rospy
 from rosmc_server import interface
 from rosmc_server.conversions import mission_from_msg
 from rosmc_server.core import MissionState, SkillStatus
-from rosmc_server.core.control import ExecutorState
-from rosmc_server.core.legality import (
+from rosmc_server.core.model.control import ExecutorState
+from rosmc_server.core.rules.legality import (
     RobotAction,
     SkillAction,
     StatePicture,

@@ -18,7 +18,7 @@ import pytest
 import rospy
 
 from rosmc_server.core import LostLinkKind, LostLinkPolicy, SkillStatus
-from rosmc_server.core.control import HoldCause
+from rosmc_server.core.model.control import HoldCause
 from rosmc_server.ros.client import ControlCommand
 from tests.conftest import wait_until
 from tests.integration.scenario_fixtures import Operator, Team, TeamSettings

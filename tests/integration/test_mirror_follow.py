@@ -20,7 +20,12 @@ import rospy
 from rosmc_server import interface
 from rosmc_server.core import MarkerType, NotFound, Pose, TaskMarker
 from rosmc_server.core.errors import ServerUnavailable
-from rosmc_server.core.updates import AgentStatusChanged, MirrorUpdate, MissionReset, SkillAdded
+from rosmc_server.core.live.updates import (
+    AgentStatusChanged,
+    MirrorUpdate,
+    MissionReset,
+    SkillAdded,
+)
 from rosmc_server.ros.client import AsyncMissionClient, MissionClient, MissionFollower, Outcome
 from tests.conftest import wait_until
 from tests.integration.server_fixtures import ServerProcess, StartServer

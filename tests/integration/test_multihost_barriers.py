@@ -22,7 +22,7 @@ import rosmc.msg as wire
 
 from rosmc_server import interface
 from rosmc_server.core import SkillStatus
-from rosmc_server.core.commands import CommandKind
+from rosmc_server.core.robots.commands import CommandKind
 from rosmc_server.recording import read_journal
 from tests.integration.barrier_cuts import (
     CutOutcome,

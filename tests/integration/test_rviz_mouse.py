@@ -35,7 +35,8 @@ from visualization_msgs.msg import InteractiveMarkerFeedback
 
 from rosmc_rviz_markers import topics
 from rosmc_server import interface
-from rosmc_server.core import MarkerType, Pose, TaskMarker, geometry
+from rosmc_server.core import MarkerType, Pose, TaskMarker
+from rosmc_server.core.views import geometry
 from rosmc_server.ros.client import MissionClient
 from tests.conftest import RosMaster
 from tests.integration.markers_fixtures import wait_for

@@ -33,8 +33,8 @@ from rosmc_server.core import (
     TaskMarker,
     Transfer,
 )
-from rosmc_server.core.changes import EventKind
-from rosmc_server.core.vocabulary import OPERATOR_EVENTS
+from rosmc_server.core.model.changes import EventKind
+from rosmc_server.core.views.vocabulary import OPERATOR_EVENTS
 from rosmc_server.interface import AGENT_STATES_TOPIC, EVENTS_TOPIC
 from rosmc_server.recording import read_journal
 from rosmc_server.ros.client import ControlCommand

@@ -77,14 +77,14 @@ from rosmc_server.core import (
     TaskMarker,
     Transfer,
 )
-from rosmc_server.core.changes import SkillMove
-from rosmc_server.core.commands import CommandKind
-from rosmc_server.core.control import HoldCause
-from rosmc_server.core.protocol import Signal, SignalKind
-from rosmc_server.core.radio_map import GridSpec, Prediction, Reading
-from rosmc_server.core.science import RegionScience, Science
-from rosmc_server.core.site import Footprint, GroundRobot, Shape, SiteCheck, SiteModel
-from rosmc_server.core.site_source import SiteInForce
+from rosmc_server.core.model.changes import SkillMove
+from rosmc_server.core.model.control import HoldCause
+from rosmc_server.core.robots.commands import CommandKind
+from rosmc_server.core.robots.protocol import Signal, SignalKind
+from rosmc_server.core.robots.radio_map import GridSpec, Prediction, Reading
+from rosmc_server.core.views.science import RegionScience, Science
+from rosmc_server.core.world.site import Footprint, GroundRobot, Shape, SiteCheck, SiteModel
+from rosmc_server.core.world.site_source import SiteInForce
 
 
 def over_the_wire(msg: Any) -> Any:

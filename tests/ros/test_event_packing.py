@@ -23,8 +23,8 @@ from rosmc_server.conversions.event_packing import (
 from rosmc_server.conversions.move_fields import order_from_field, order_to_field
 from rosmc_server.conversions.packing import serialized
 from rosmc_server.core import Barrier, EventKind, Library, MissionEvent
-from rosmc_server.core.changes import Change, PlacedSkill, SkillMove
-from rosmc_server.core.library import library_from_dict
+from rosmc_server.core.model.changes import Change, PlacedSkill, SkillMove
+from rosmc_server.core.skills.library import library_from_dict
 from tests.unit.conftest import TEST_LIBRARY
 from tests.unit.random_missions import random_content, text
 

@@ -37,7 +37,7 @@ from rosmc_server.core import (  # noqa: E402
     RuleViolation,
     load_library,
 )
-from rosmc_server.core.changes import SkillMove  # noqa: E402
+from rosmc_server.core.model.changes import SkillMove  # noqa: E402
 from rosmc_server.interface import EVENTS_TOPIC, MISSION_TOPIC  # noqa: E402
 from rosmc_server.recording import JournalWriter, latest_state, read_journal  # noqa: E402
 from rosmc_server.recording._mcap.codec import serialize  # noqa: E402

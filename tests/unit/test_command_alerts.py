@@ -12,7 +12,7 @@ import pytest
 from rosmc_rqt_command.core import alerts
 from rosmc_rqt_command.core.legality import Action
 from rosmc_server.core import AgentStatus, Library, Mission, SkillStatus
-from rosmc_server.core.library import library_from_dict
+from rosmc_server.core.skills.library import library_from_dict
 from tests.unit.test_command_harness import Gui, open_gui
 
 S = SkillStatus
@@ -222,9 +222,9 @@ def test_a_journal_alert_is_said_when_it_begins_and_when_it_clears(gui: Gui) -> 
 
 
 def test_the_gui_and_the_server_warn_of_the_same_barriers(gui: Gui, mission: Mission) -> None:
-    """One rule (rosmc_server.core.advice): a partner being uploaded is on its way, not
+    """One rule (rosmc_server.core.rules.advice): a partner being uploaded is on its way, not
     planned; the GUI's standing warning and the server's note on an upload agree."""
-    from rosmc_server.core.advice import unsynced_partners
+    from rosmc_server.core.rules.advice import unsynced_partners
 
     feed = gui.feed
     first, partner = feed.add("alpha", "wait"), feed.add("bravo", "wait")

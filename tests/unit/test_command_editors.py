@@ -27,7 +27,7 @@ from rosmc_rqt_command.qt.param_editors import (
     make_editor,
 )
 from rosmc_server.core import InvalidRequest, Library, Mission, ParamType, Pose
-from rosmc_server.core.library import ParameterSpec
+from rosmc_server.core.skills.library import ParameterSpec
 from tests.unit.test_command_harness import Gui, open_gui
 
 

@@ -18,7 +18,7 @@ from rosmc_rqt_command.core.policy_words import policy_in_force
 from rosmc_rqt_command.qt.policy_dialog import PolicyDialog
 from rosmc_server.core import AgentStatus, Library, LostLinkKind, LostLinkPolicy, Mission
 from rosmc_server.core import LostLinkTrigger as T
-from rosmc_server.core.library import library_from_dict
+from rosmc_server.core.skills.library import library_from_dict
 from tests.team_gui import settle
 from tests.unit.conftest import make_mission
 from tests.unit.test_command_harness import Gui, open_gui

@@ -29,7 +29,7 @@ from rosmc_server.core import (
     Mission,
     SkillStatus,
 )
-from rosmc_server.core.control import ControlCommand, HoldCause
+from rosmc_server.core.model.control import ControlCommand, HoldCause
 from rosmc_server.executor.core.lost_link import LostLinkGuard
 from tests.team_gui import click, columns, settle, step_right
 from tests.team_twenty import stage, twenty_robot_library

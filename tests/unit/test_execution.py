@@ -22,8 +22,13 @@ from rosmc_server.core import (
     TaskMarker,
     Transfer,
 )
-from rosmc_server.core.commands import CommandKind, commands_for_event
-from rosmc_server.core.updates import BarrierPut, BarrierRemoved, apply_and_describe, apply_event
+from rosmc_server.core.live.updates import (
+    BarrierPut,
+    BarrierRemoved,
+    apply_and_describe,
+    apply_event,
+)
+from rosmc_server.core.robots.commands import CommandKind, commands_for_event
 
 S = SkillStatus
 

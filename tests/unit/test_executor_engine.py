@@ -24,9 +24,9 @@ from rosmc_server.core import (
     SkillStatus,
     Transfer,
 )
-from rosmc_server.core.commands import CommandKind
-from rosmc_server.core.control import HoldCause
-from rosmc_server.core.link import queue_hash
+from rosmc_server.core.model.control import HoldCause
+from rosmc_server.core.robots.commands import CommandKind
+from rosmc_server.core.robots.link import queue_hash
 from rosmc_server.executor.basic_skills import Count
 from rosmc_server.executor.core import (
     AckResult,

@@ -4,15 +4,15 @@ from __future__ import annotations
 
 from rosmc_rviz_markers.core.icons import status_rows
 from rosmc_server.core import AgentStatus, Library, Mission, SkillStatus
-from rosmc_server.core.control import HoldCause
-from rosmc_server.core.holding import (
+from rosmc_server.core.model.control import HoldCause
+from rosmc_server.core.skills.policy import LostLinkKind, LostLinkPolicy
+from rosmc_server.core.views.holding import (
     barrier_partners,
     hold_sentence,
     not_arrived,
     wait_sentence,
 )
-from rosmc_server.core.policy import LostLinkKind, LostLinkPolicy
-from rosmc_server.core.vocabulary import HOLD_WHERE, age_text
+from rosmc_server.core.views.vocabulary import HOLD_WHERE, age_text
 from rosmc_server.executor.core.lost_link import LostLinkGuard
 from rosmc_server.executor.core.skills import Outcome, SkillBehavior, SkillContext, SkillType
 from rosmc_server.text.plain import format_tasks

@@ -19,9 +19,9 @@ from rosmc_server.core import (
     Pose,
     SkillStatus,
 )
-from rosmc_server.core.commands import CommandKind
-from rosmc_server.core.library import library_from_dict
-from rosmc_server.core.policy import options_argument, options_from_argument
+from rosmc_server.core.robots.commands import CommandKind
+from rosmc_server.core.skills.library import library_from_dict
+from rosmc_server.core.skills.policy import options_argument, options_from_argument
 from rosmc_server.executor.core import Engine, SkillType
 from rosmc_server.executor.core.engine import Mode
 from rosmc_server.executor.core.lost_link import LINK_MARGIN

@@ -50,12 +50,12 @@ from rosmc_server.core import (
     SkillStatus,
     TaskMarker,
     Transfer,
-    areas,
-    geometry,
     load_library,
 )
-from rosmc_server.core.changes import Change, PlacedSkill
-from rosmc_server.core.updates import AgentStatusChanged, MarkerPut, MirrorUpdate, SkillChanged
+from rosmc_server.core.live.updates import AgentStatusChanged, MarkerPut, MirrorUpdate, SkillChanged
+from rosmc_server.core.model.changes import Change, PlacedSkill
+from rosmc_server.core.views import geometry
+from rosmc_server.core.world import areas
 
 LIBRARY = load_library(
     Path(__file__).resolve().parents[2] / "rosmc_server" / "config" / "mars_team.yaml"

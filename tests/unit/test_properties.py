@@ -55,9 +55,9 @@ from rosmc_server.core import (
     mission_to_dict,
     parse_mission,
 )
-from rosmc_server.core.barriers import find_deadlock
-from rosmc_server.core.changes import SkillMove
-from rosmc_server.core.persistence import mission_from_dict
+from rosmc_server.core.files.persistence import mission_from_dict
+from rosmc_server.core.model.changes import SkillMove
+from rosmc_server.core.rules.barriers import find_deadlock
 
 S = SkillStatus
 REPO = Path(__file__).resolve().parents[2]

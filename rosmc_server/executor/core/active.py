@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from rosmc_server.core import SkillStatus
-from rosmc_server.core.protocol import BarrierInfo
+from rosmc_server.core.robots.protocol import BarrierInfo
 
 from .barrier_wait import Announcements
 from .skills import SkillBehavior

@@ -18,8 +18,8 @@ from collections.abc import Callable, Mapping
 from typing import Protocol
 
 from rosmc_server.core import SkillStatus
-from rosmc_server.core.control import ExecutorState, HoldCause
-from rosmc_server.core.protocol import (
+from rosmc_server.core.model.control import ExecutorState, HoldCause
+from rosmc_server.core.robots.protocol import (
     Ack,
     BarrierInfo,
     Command,

@@ -1,6 +1,6 @@
 """The lost-link policy at work on the robot: ground contact, the trigger, the safe skill.
 
-The policy itself (:class:`~rosmc_server.core.policy.LostLinkPolicy`) is the core's,
+The policy itself (:class:`~rosmc_server.core.skills.policy.LostLinkPolicy`) is the core's,
 shared with the server and the operators' tools; this module only runs it.
 
 Where the robot is comes from a :data:`PoseSource` that the robot's integration gives
@@ -21,8 +21,8 @@ from collections import deque
 from collections.abc import Callable, Mapping
 
 from rosmc_server.core import LostLinkKind, LostLinkPolicy, LostLinkTrigger, ParamType
-from rosmc_server.core.control import HoldCause
-from rosmc_server.core.params import Pose, value_to_data
+from rosmc_server.core.model.control import HoldCause
+from rosmc_server.core.skills.params import Pose, value_to_data
 
 from .skills import SkillBehavior, SkillContext, SkillType
 

@@ -22,8 +22,8 @@ from rosmc_server.core import (
     SkillStatus,
     Transfer,
 )
-from rosmc_server.core.control import HoldCause
-from rosmc_server.core.protocol import (
+from rosmc_server.core.model.control import HoldCause
+from rosmc_server.core.robots.protocol import (
     Ack,
     AckResult,
     BarrierInfo,
