@@ -280,6 +280,7 @@ class AgentColumn(QFrame):  # type: ignore[misc]
             button.setEnabled(not read_only and action in legal)
         self.add_button.setEnabled(not read_only and not self.add_menu.isEmpty())
         self.policy_button.setEnabled(not read_only and bool(self.skill_names))
+        self.hold_notice.resume_button.setEnabled(not read_only)
         self.blueprint_table.setDragEnabled(not read_only)  # no reordering a replay
 
     def _on_hold_notice_resume_requested(self) -> None:

@@ -217,6 +217,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.view.statuses = {}  # the robots as the new backend reports them
         self.parameters.set_read_only(backend.read_only)
         self.enabling.read_only = backend.read_only
+        self.messages.set_read_only(backend.read_only)
         self.enabling.update()
 
     # -- sending ------------------------------------------------------------------------------

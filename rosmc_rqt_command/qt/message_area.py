@@ -71,6 +71,10 @@ class MessageArea(QWidget):  # type: ignore[misc]
         self.warnings_label.setText("<br>".join(f"⚠ {w}" for w in warnings))
         self.warnings_label.setVisible(bool(warnings))
 
+    def set_read_only(self, read_only: bool) -> None:
+        """Follow a replay: a robot held in the recording cannot be resumed from here."""
+        self.hold_bar.setEnabled(not read_only)
+
     def show_holds(self, agents: Sequence[str]) -> None:
         """One *Resume <robot>* button per robot in ``agents`` (hidden when there is none)."""
         for agent in [a for a in self.hold_buttons if a not in agents]:

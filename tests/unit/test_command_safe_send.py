@@ -317,3 +317,15 @@ def test_the_status_cell_names_the_barrier_by_its_tag(gui: Gui) -> None:
     settle(gui.widget)
     model = gui.widget.tasks.columns["bravo"].synced_model
     assert model.data(model.index(0, STATUS)) == "waiting on alpha at B1"
+
+
+def test_a_replay_says_a_hold_but_offers_no_resume(mission: Mission, library: Library) -> None:
+    replay = Gui(mission, library, read_only=True)
+    try:
+        held(replay)
+        replay.widget.repaints.warn_now()
+        notice = replay.widget.tasks.columns["alpha"].hold_notice
+        assert notice.isVisible() and not notice.resume_button.isEnabled()
+        assert not replay.widget.messages.hold_buttons["alpha"].isEnabled()
+    finally:
+        replay.close()
