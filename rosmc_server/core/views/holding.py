@@ -1,7 +1,7 @@
 """A robot holding after its lost-link policy, and the barrier waits, in the operator's words.
 
 A robot whose lost-link policy acted (hold where it was, or return to where it last had a
-link, then hold) reports why it holds (:class:`~.control.HoldCause`). It starts no new work
+link, then hold) reports why it holds (:class:`~..model.control.HoldCause`). It starts no new work
 and the partners of its barriers wait for it until the operator resumes it: the one action
 that frees it. The command GUI, rviz and ``rosmc status`` say it with these words, and say
 each barrier wait the same way: whom the robot waits for, where, and since how long
