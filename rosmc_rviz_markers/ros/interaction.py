@@ -32,6 +32,7 @@ from visualization_msgs.msg import InteractiveMarkerFeedback as Feedback
 
 from rosmc_server import interface
 from rosmc_server.core import InvalidRequest, MarkerType, Pose, RosmcError
+from rosmc_server.core.model.control import ControlCommand
 from rosmc_server.core.skills.params import value_to_data
 from rosmc_server.core.world import areas
 from rosmc_server.ros.client import AsyncMissionClient, MissionClient, Outcome
@@ -43,6 +44,7 @@ from ..core.menus import (
     DeleteMarker,
     EditAction,
     RenameMarker,
+    ResumeRobot,
     SelectObject,
     UndoEdit,
 )
@@ -157,6 +159,14 @@ class Interaction:
             return
         if isinstance(action, SelectObject):
             self._select(parsed)
+            return
+        if isinstance(action, ResumeRobot):
+            agent = action.agent
+            self._submit(  # a control, not an edit: nothing for the undo history
+                lambda c: c.control(ControlCommand.RESUME, agent),
+                f"resume {agent}",
+                record=lambda _sent: None,
+            )
             return
         mirror = self._node.mirror
         scene = self._node.scene

@@ -138,6 +138,7 @@ def _methods(operator: Any) -> dict[str, Callable[..., Any]]:
         "started": lambda: {s.id: s.started for s in operator.mission().skills()},
         "links": links,
         "waiting_on": lambda agent: operator.agent_state(agent).waiting_on,
+        "barrier_wait": lambda agent: operator.agent_state(agent).barrier_wait,
         "revision": lambda: operator.mission().revision,
     }
 

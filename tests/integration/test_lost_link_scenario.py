@@ -18,6 +18,7 @@ import pytest
 import rospy
 
 from rosmc_server.core import LostLinkKind, LostLinkPolicy, SkillStatus
+from rosmc_server.core.model.control import HoldCause
 from rosmc_server.ros.client import ControlCommand
 from tests.conftest import wait_until
 from tests.integration.scenario_fixtures import Operator, Team, TeamSettings
@@ -90,6 +91,7 @@ def test_by_default_a_rover_left_out_of_coverage_returns_to_its_link_and_holds(
         "the robot holds after its return",
     )
     assert held.executor_state == "paused", held
+    assert held.hold is HoldCause.RETURN_POINT, held  # said as a field, not only in words
     where = re.search(r"returning to the last link position \((\S+), (\S+)\)", held.policy)
     assert where, held.policy
     goal = (float(where[1]), float(where[2]))

@@ -18,7 +18,7 @@ from collections.abc import Callable, Mapping
 from typing import Protocol
 
 from rosmc_server.core import SkillStatus
-from rosmc_server.core.model.control import ExecutorState
+from rosmc_server.core.model.control import ExecutorState, HoldCause
 from rosmc_server.core.robots.protocol import (
     Ack,
     BarrierInfo,
@@ -231,6 +231,7 @@ class Engine:
             return
         if upcoming.timeout > 0:  # the timeout bounds the wait too: partners may never come
             active.deadline = self.clock() + upcoming.timeout
+        active.waiting_since = self.clock()
         self.ledger.set(upcoming.id, S.SYNCWAITING, text=self.waits.text(active.barrier))
         self._announce_wait(active)
         self._try_release(active)
@@ -347,6 +348,7 @@ class Engine:
             if active.barrier is not None:
                 # Back to waiting at the barrier, not to PAUSED (and not straight to running).
                 waiting = self.waits.text(active.barrier)
+                active.waiting_since = self.clock()
                 self.ledger.set(active.skill_id, S.SYNCWAITING, text=waiting)
                 self._announce_wait(active)
             self._try_release(active)  # runs it if its barrier went away meanwhile
@@ -385,9 +387,11 @@ class Engine:
     def snapshot(self, full: bool = True) -> Snapshot:
         """The state for the periodic snapshot: the queue only if ``full``, its digest always."""
         active = self._active
-        waiting = ""
+        waiting, since = "", 0.0
         if active is not None and active.at_barrier and active.barrier is not None:
             waiting = self.waits.summary(active.barrier)
+            if self.ledger.status(active.skill_id) is S.SYNCWAITING:
+                since = active.waiting_since
         return Snapshot(
             self.clock(),
             self.commands.last_seq,
@@ -400,4 +404,13 @@ class Engine:
             self.lost_link.describe(),
             full,
             self.ledger.status_digest(),
+            self.hold(),
+            since,
         )
+
+    def hold(self) -> HoldCause:
+        """Why the robot holds after its lost-link policy acted (NONE: it does not).
+
+        Only while it stays paused: an operator's Start or Stop ends the hold.
+        """
+        return self.lost_link.held if self.mode is Mode.PAUSED else HoldCause.NONE

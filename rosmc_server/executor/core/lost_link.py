@@ -21,6 +21,7 @@ from collections import deque
 from collections.abc import Callable, Mapping
 
 from rosmc_server.core import LostLinkKind, LostLinkPolicy, LostLinkTrigger, ParamType
+from rosmc_server.core.model.control import HoldCause
 from rosmc_server.core.skills.params import Pose, value_to_data
 
 from .skills import SkillBehavior, SkillContext, SkillType
@@ -60,6 +61,8 @@ class LostLinkGuard:
         is_default: Whether ``policy`` is the library's default (no operator chose one).
         note: What the policy did last, for operators ("" until it acted).
         contingency: The safe skill while it runs (the robot is held meanwhile).
+        held: Why the policy left the robot holding (NONE until it did, and once the
+            operator started the robot again).
     """
 
     def __init__(
@@ -76,6 +79,7 @@ class LostLinkGuard:
         self.is_default = False
         self.note = ""
         self.contingency: SkillBehavior | None = None
+        self.held = HoldCause.NONE
         self._recent: deque[tuple[float, Pose]] = deque()  # poses within the margin
         self._link_pose: Pose | None = None
         self._pose_source = pose_source
@@ -116,6 +120,7 @@ class LostLinkGuard:
     def operator_took_over(self) -> None:
         """The robot was started again: what the policy did is over (its note would still
         say "holding"), unless its skill still runs (its note says so)."""
+        self.held = HoldCause.NONE
         if self.contingency is None:
             self.note = ""
 
@@ -184,6 +189,7 @@ class LostLinkGuard:
                 params.update(target)
         if just_hold:
             self.note = held
+            self.held = HoldCause.LOST_LINK
             pause(self.note)
         else:
             self.note = self._running_note(silent)
@@ -220,6 +226,8 @@ class LostLinkGuard:
         done = "done" if outcome.success else f"failed: {outcome.reason}"
         self.note += f" ({done}); holding"
         self.contingency = None
+        returned = self.policy.kind is LostLinkKind.RETURN_TO_LINK and outcome.success
+        self.held = HoldCause.RETURN_POINT if returned else HoldCause.SAFE_SKILL
         return True
 
     def describe(self) -> str:
