@@ -257,14 +257,9 @@ def test_collaborative_identification_scores_the_region_maximum(op: Operator) ->
         ).skill_id,
         c.add_skill(DRONE, "return_to_lander").skill_id,
     ]
-    # The rovers head out while the drone looks, then wait there, idle, for the sampling
-    # skills. Their library default (return_to_link once idle 60 s without the ground)
-    # counts robot (sim) seconds, 0.6 wall s at a factor of 100, while the ground is heard
-    # at wall-time intervals: on a loaded machine a gap that long sent the manipulator back
-    # towards the lander ("too far from RSS North: 8.4 m"). The test relies on the rovers
-    # staying put, so it says so.
-    for rover in (SCIENCE, ARM):
-        c.set_lost_link_policy(rover, LostLinkPolicy())
+    # The rovers head out while the drone looks, then wait there, idle and in coverage, for
+    # the sampling skills, under their library default (return_to_link once idle 60 s
+    # without the ground, wall seconds whatever the sim's speed).
     staging = [
         c.add_skill(SCIENCE, "navigate_to", target(-2.0, 6.5)).skill_id,
         c.add_skill(ARM, "navigate_to", target(2.0, 6.5)).skill_id,

@@ -201,7 +201,7 @@ def test_the_executors_own_words_for_a_hold_are_recognised(gui: Gui) -> None:
     guard = LostLinkGuard("alpha", lambda: now[0], {})
     guard.adopt(LostLinkPolicy(LostLinkKind.HOLD, 5.0), default=False)
     now[0] += 10.0
-    guard.trigger(now[0], True, lambda _note: None)
+    guard.trigger(True, lambda _note: None)
     guard.contact()
     gui.feed.statuses(
         AgentStatus("alpha", link="up", executor_state="paused", policy=guard.describe())

@@ -60,6 +60,10 @@ class Engine:
     The ground commands (:mod:`.commanding`) work through its public surface: the
     ``queue``, the barrier ``board``, :meth:`advance`, :meth:`start`, :meth:`pause`,
     :meth:`stop`, :meth:`set_barriers`, :attr:`active_skill_id` and ``lost_link.policy``.
+
+    ``clock`` is mission time (skills, timeouts, report stamps; sim time in simulation);
+    ``pace_clock`` paces progress texts and ``link_clock`` measures ground contact, both
+    steady wall clocks on a robot (each defaults to ``clock``).
     """
 
     def __init__(
@@ -70,6 +74,7 @@ class Engine:
         outputs: EngineOutputs,
         pose_source: PoseSource = no_pose,
         pace_clock: Callable[[], float] | None = None,
+        link_clock: Callable[[], float] | None = None,
     ) -> None:
         self.agent = agent
         self.skill_types = dict(skill_types)
@@ -80,7 +85,9 @@ class Engine:
         self.commands = CommandLog()
         self.board = BarrierBoard(agent)
         self.waits = BarrierWaits(agent, self.board, clock, outputs.signal)
-        self.lost_link = LostLinkGuard(agent, clock, self.skill_types, pose_source)
+        self.lost_link = LostLinkGuard(
+            agent, clock, self.skill_types, pose_source, link_clock
+        )
         self._active: ActiveSkill | None = None
         # Progress texts from skill threads, applied by tick() at most once a period.
         self._progress_box = ProgressBox(pace_clock or clock)
@@ -138,8 +145,8 @@ class Engine:
         self._apply_progress()
         idle = self.idle
         self.lost_link.observe(now)
-        if self.lost_link.due(now, idle):
-            self.lost_link.trigger(now, idle, self.pause)
+        if self.lost_link.due(idle):
+            self.lost_link.trigger(idle, self.pause)
             self.outputs.changed()
         if self.lost_link.step(now):
             self.outputs.changed()
