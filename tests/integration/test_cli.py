@@ -717,9 +717,9 @@ def test_client_reconnects_after_server_restart(server: Server, client: MissionC
     server.stop(signal.SIGKILL)  # connections break, the registrations stay behind
     with pytest.raises(ServerUnavailable):  # after its timeout, not a hang
         MissionClient(timeout=1.0).get_mission()
-    server.start()  # a new mission at revision 0, in a new journal
-    assert client.get_mission().revision == 0  # the broken connection was replaced
-    assert client.add_skill("drone", "land").revision == 1
+    server.start()  # a new mission at revision 1 (never 0: no check), in a new journal
+    assert client.get_mission().revision == 1  # the broken connection was replaced
+    assert client.add_skill("drone", "land").revision == 2
     server.stop()  # cleanly: the services are gone, the master stays
     (result,) = run_many(server.env, [["--timeout", "1", "add", "drone", "land"]])
     assert result.returncode == 3
