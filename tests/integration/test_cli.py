@@ -368,6 +368,11 @@ def test_every_error_class_exits_1_with_one_line(
     }
     for result, needle in zip(run_many(server.env, list(cases)), cases.values(), strict=True):
         assert_refused(result, needle)
+    # 0 would ask for no check at all: the command line takes only a mission's revisions.
+    before = fresh.get_mission().revision
+    (zero,) = run_many(server.env, [("--revision", "0", "add", "drone", "land")])
+    assert zero.returncode == 2 and "must be a mission revision (1 or more)" in zero.stderr
+    assert fresh.get_mission().revision == before
 
 
 def test_client_conflicts_and_local_checks(server: Server, fresh: MissionClient) -> None:
