@@ -8,8 +8,9 @@ parameters the launch files leave at their defaults (the sim step, the server's 
 timeout, the executors' snapshot period) so that minutes of sim time take seconds.
 
 :class:`Operator` is the only way the tests change anything: :class:`MissionClient` (the
-public operator services), :class:`MissionWatch` (``/rosmc/agent_states``), and the sim's
-public topics ``/rosmc/sim/science`` and ``/<robot>/telemetry``.
+public operator services), :class:`MissionWatch` (``/rosmc/agent_states``), the mission
+events (``/rosmc/mission_events``, kept: what a skill went through), and the sim's public
+topics ``/rosmc/sim/science`` and ``/<robot>/telemetry``.
 """
 
 from __future__ import annotations
@@ -34,9 +35,11 @@ import rospy
 from rosgraph_msgs.msg import Clock
 
 from rosmc_server.core import AgentStatus, MissionState, RosmcError, SkillStatus, Transfer
+from rosmc_server.interface import EVENTS_TOPIC
 from rosmc_server.ros.client import ControlCommand, MissionClient, MissionWatch
 from rosmc_sim.ros.topics import SCIENCE_TOPIC, blackout_topic
 from tests.conftest import wait_until
+from tests.integration.executor_fixtures import EventLog
 
 REPO = Path(__file__).resolve().parents[2]
 SCENARIO = REPO / "tests" / "data" / "scenario_team.yaml"
@@ -333,9 +336,14 @@ class Operator:
         self.science = Science()
         self.telemetry = {robot: Latest(f"/{robot}/telemetry", wire.Telemetry) for robot in ROBOTS}
         self.timings: list[Timed] = []
+        self.events = EventLog()
+        self._events = rospy.Subscriber(
+            EVENTS_TOPIC, wire.MissionEvent, self.events.on_event, queue_size=10000
+        )
 
     def close(self) -> None:
         """Unsubscribe and drop connections."""
+        self._events.unregister()
         self.watch.close()
         self.science.close()
         for latest in self.telemetry.values():
