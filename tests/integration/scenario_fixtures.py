@@ -485,13 +485,25 @@ class Operator:
         what: str,
         timeout: float = 30.0,
     ) -> wire.Telemetry:
-        """Wait until the robot's telemetry satisfies ``predicate``; that telemetry."""
+        """Wait until a telemetry message of the robot satisfies ``predicate``; that message.
 
-        def reached() -> wire.Telemetry | None:
-            telemetry = self.telemetry[robot].last
-            return telemetry if telemetry is not None and predicate(telemetry) else None
+        Every message is tested as it arrives (not only the latest at each look), so a
+        robot that passes where the predicate holds is seen there however busy the test is.
+        """
+        seen: list[wire.Telemetry] = []
+        last = self.telemetry[robot].last
+        if last is not None and predicate(last):
+            return last
 
-        return wait_until(reached, timeout, f"{robot}: {what}")
+        def keep(telemetry: wire.Telemetry) -> None:
+            if not seen and predicate(telemetry):
+                seen.append(telemetry)
+
+        subscriber = rospy.Subscriber(f"/{robot}/telemetry", wire.Telemetry, keep, queue_size=100)
+        try:
+            return wait_until(lambda: seen[0] if seen else None, timeout, f"{robot}: {what}")
+        finally:
+            subscriber.unregister()
 
 
 def describe(state: MissionState) -> str:
