@@ -35,7 +35,7 @@ from rosmc_server.core import (
 )
 from rosmc_server.core.changes import EventKind
 from rosmc_server.core.vocabulary import OPERATOR_EVENTS
-from rosmc_server.interface import AGENT_STATES_TOPIC, EVENTS_TOPIC
+from rosmc_server.interface import AGENT_STATES_TOPIC, EVENTS_TOPIC, MISSION_TOPIC
 from rosmc_server.recording import read_journal
 from rosmc_server.ros.client import ControlCommand
 from rosmc_sim.ros.demo_operator import WIFI_SPOT_ADAPTED
@@ -110,7 +110,8 @@ def test_the_demo_mission_completes_with_a_score_and_a_full_recording(tmp_path: 
     journal = read_journal(recording.group(1))
     assert journal.clean, journal.warnings
     events = journal.messages(EVENTS_TOPIC)
-    assert [e.revision for e in events] == list(range(1, len(events) + 1)), "revision gap"
+    assert journal.messages(MISSION_TOPIC)[0].revision == 1, "a fresh mission starts at 1"
+    assert [e.revision for e in events] == list(range(2, len(events) + 2)), "revision gap"
     assert events[-1].revision == int(changes.group(2))
     kinds = Counter(EventKind(e.kind) for e in events)
     made = {kind: n for kind, n in kinds.items() if kind in OPERATOR_EVENTS}
@@ -140,7 +141,7 @@ def _check_info(path: Path, score: float, revision: int) -> None:
         check=True,
     )
     info = json.loads(result.stdout)
-    assert info["revisions"] == [0, revision]
+    assert info["revisions"] == [1, revision]  # a fresh mission starts at 1
     assert info["final_score"] == pytest.approx(score, abs=0.01)
     outcomes = {robot["agent"]: robot for robot in info["robots"]}
     assert set(outcomes) == {DRONE, SCIENCE, ARM}
@@ -442,9 +443,17 @@ def test_with_20_minutes_of_latency_edits_answer_at_once_and_the_robot_goes_on(
     c = op.client
     legs = [c.add_skill(SCIENCE, "navigate_to", target(*LEGS[0])).skill_id]
     legs += [c.add_skill(SCIENCE, "navigate_to", target(*p, speed=SLOW)).skill_id for p in LEGS[1:]]
-    op.sync_and_start([SCIENCE])  # synchronized and started before the latency sets in
-    op.wait_mission(
-        lambda m: m.skill(legs[0]).status is not S.IDLE_SYNCHRONIZED, 30.0, "the rover starts"
+    # Twenty minutes of silence is an outage to the rover's default policy (a minute idle):
+    # this mission wants it to go on. Stored on the robot before the latency sets in, as the
+    # legs are; only the start travels under the latency, so the legs cannot run before it
+    # (restarting the link emulator takes seconds of a loaded machine, hundreds of sim s).
+    c.set_lost_link_policy(SCIENCE, LostLinkPolicy())
+    c.synchronize(SCIENCE)
+    op.wait_stored(SCIENCE)
+    wait_until(
+        lambda: (s := op.agent_state(SCIENCE)) and s.policy == "on link loss: continue",
+        30.0,
+        "the rover takes the continue policy",
     )
     try:
         team.start_emulator(LATENCY)
@@ -454,6 +463,7 @@ def test_with_20_minutes_of_latency_edits_answer_at_once_and_the_robot_goes_on(
         # the blueprint answers at once; a synchronize waits for contact, and can be taken
         # back before it ever leaves.
         op.wait_link(SCIENCE, "down", timeout=60.0)
+        c.control(ControlCommand.START, SCIENCE)  # waits for contact, then 20 minutes more
         edits_from = op.sim_now()
         _edit_under_latency(op)
         # Answered before a message could even reach the robot: none waited on it.
@@ -463,12 +473,12 @@ def test_with_20_minutes_of_latency_edits_answer_at_once_and_the_robot_goes_on(
         assert op.mission().skill(legs[-1]).transfer is Transfer.NONE
         # The robot goes on with what it holds; the server hears of it 20 minutes later.
         end = LEGS[-1]
-        op.wait_robot(SCIENCE, lambda t: near(t, end), f"the rover reaches {end}", timeout=120.0)
+        op.wait_robot(SCIENCE, lambda t: near(t, end), f"the rover reaches {end}", timeout=240.0)
         assert op.mission().skill(legs[-1]).status is not S.SUCCESS
         state = op.wait_status(legs, S.SUCCESS, timeout=120.0)
         heard_by = op.sim_now()
-        finished = state.skill(legs[-1]).finished
-        assert latency_from < finished, "the last leg ran under the latency"
+        started, finished = state.skill(legs[0]).started, state.skill(legs[-1]).finished
+        assert latency_from < started, "the legs ran under the latency"
         assert heard_by - finished >= LATENCY, (finished, heard_by)  # heard a latency later
     finally:
         team.start_emulator(0.0)
