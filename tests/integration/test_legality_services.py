@@ -318,8 +318,10 @@ def checks(state: MissionState, roles: Roles) -> Iterator[tuple[str, bool, Reque
             yield f"{marker_action.name} marker {name}", marker_action in legal_marker, request
     yield from whole_requests(state)
     pair = [roles["d0"], roles["r0"]]
-    legal = A.BARRIER in legal_skill_actions(picture, state_skills(state, pair))
-    yield "BARRIER d0+r0", legal, ("add_barrier", {"skill_ids": pair})
+    both = legal_skill_actions(picture, state_skills(state, pair))
+    yield "BARRIER d0+r0", A.BARRIER in both, ("add_barrier", {"skill_ids": pair})
+    team = {"agents": [ANSWERING, SILENT], "upto_ids": pair}  # one send of both robots
+    yield "SYNC d0+r0", A.SYNC in both, ("synchronize_team", team)
     for agent in (ANSWERING, SILENT):
         actions = legal_robot_actions(TaskView.of(state, agent), ExecutorState.UNKNOWN)
         for action, request in robot_requests(agent):
