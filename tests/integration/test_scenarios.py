@@ -447,14 +447,21 @@ def test_with_20_minutes_of_latency_edits_answer_at_once_and_the_robot_goes_on(
     # this mission wants it to go on. Stored on the robot before the latency sets in, as the
     # legs are; only the start travels under the latency, so the legs cannot run before it
     # (restarting the link emulator takes seconds of a loaded machine, hundreds of sim s).
+    # An earlier test left the rover started, and a started robot runs what it is sent: stop
+    # it first (it has nothing to do, so it only stops).
+    c.control(ControlCommand.STOP, SCIENCE)
     c.set_lost_link_policy(SCIENCE, LostLinkPolicy())
+    wait_until(
+        lambda: (
+            (s := op.agent_state(SCIENCE))
+            and s.executor_state == "stopped"
+            and s.policy == "on link loss: continue"
+        ),
+        30.0,
+        "the rover stopped, with the continue policy",
+    )
     c.synchronize(SCIENCE)
     op.wait_stored(SCIENCE)
-    wait_until(
-        lambda: (s := op.agent_state(SCIENCE)) and s.policy == "on link loss: continue",
-        30.0,
-        "the rover takes the continue policy",
-    )
     try:
         team.start_emulator(LATENCY)
         team.wait_emulator()
