@@ -35,7 +35,7 @@ from .skills import SkillBehavior, SkillContext, SkillType
 
 _log = logging.getLogger(__name__)
 LINK_MARGIN = 10.0
-"""Seconds before the last ground contact where the robot returns to."""
+"""Seconds of mission time before the last ground contact: where the robot returns to."""
 POSE_SAMPLE_PERIOD = 0.5
 """Seconds between the poses the guard remembers while the robot works."""
 
