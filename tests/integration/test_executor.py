@@ -507,7 +507,7 @@ def test_executor_restart_mid_mission_keeps_the_queue(rosmc: Start) -> None:
     op.sync("r1")
     wait_all_synced(op, ids)
     op.start("r1")
-    op.wait_status(ids[1:2], S.RUNNING)
+    op.events.wait_went(ids[1], S.RUNNING)
     system.stop("r1", signal.SIGKILL)
     system.start_executor("r1")
     # The robot's snapshot may show the skill back on the shelf before its report says why.
