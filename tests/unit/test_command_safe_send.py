@@ -250,7 +250,7 @@ def test_a_hold_is_read_from_the_typed_field_not_from_the_policy_words(gui: Gui)
     guard = LostLinkGuard("alpha", lambda: now[0], {})
     guard.adopt(LostLinkPolicy(LostLinkKind.HOLD, 5.0), default=False)
     now[0] += 10.0
-    guard.trigger(now[0], True, lambda _note: None)
+    guard.trigger(True, lambda _note: None)
     guard.contact()
     assert guard.held is HoldCause.LOST_LINK
     words = guard.describe()

@@ -131,8 +131,8 @@ def test_the_guard_says_why_it_holds_and_forgets_it_when_started_again() -> None
     guard = LostLinkGuard("r4", lambda: now[0], types)
     guard.adopt(LostLinkPolicy(LostLinkKind.SAFE_SKILL, 5.0, "go"), default=False)
     now[0] = 10.0
-    assert guard.due(now[0], idle=False)
-    guard.trigger(now[0], False, lambda _why: None)
+    assert guard.due(idle=False)
+    guard.trigger(False, lambda _why: None)
     assert guard.held is HoldCause.NONE  # on its way: not holding yet
     assert not guard.step(now[0]) and guard.step(now[0])
     assert guard.held is HoldCause.SAFE_SKILL

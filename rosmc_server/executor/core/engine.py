@@ -29,7 +29,7 @@ from rosmc_server.core.robots.protocol import (
     Snapshot,
 )
 
-from . import commanding, queueing
+from . import commanding, queueing, reporting
 from .active import ActiveSkill
 from .barrier_wait import ANNOUNCE_PERIOD, BarrierWaits
 from .barriers import BarrierBoard
@@ -60,6 +60,10 @@ class Engine:
     The ground commands (:mod:`.commanding`) work through its public surface: the
     ``queue``, the barrier ``board``, :meth:`advance`, :meth:`start`, :meth:`pause`,
     :meth:`stop`, :meth:`set_barriers`, :attr:`active_skill_id` and ``lost_link.policy``.
+
+    ``clock`` is mission time (skills, timeouts, report stamps; sim time in simulation);
+    ``pace_clock`` paces progress texts and ``link_clock`` measures ground contact, both
+    steady wall clocks on a robot (each defaults to ``clock``).
     """
 
     def __init__(
@@ -70,6 +74,7 @@ class Engine:
         outputs: EngineOutputs,
         pose_source: PoseSource = no_pose,
         pace_clock: Callable[[], float] | None = None,
+        link_clock: Callable[[], float] | None = None,
     ) -> None:
         self.agent = agent
         self.skill_types = dict(skill_types)
@@ -80,7 +85,7 @@ class Engine:
         self.commands = CommandLog()
         self.board = BarrierBoard(agent)
         self.waits = BarrierWaits(agent, self.board, clock, outputs.signal)
-        self.lost_link = LostLinkGuard(agent, clock, self.skill_types, pose_source)
+        self.lost_link = LostLinkGuard(agent, clock, self.skill_types, pose_source, link_clock)
         self._active: ActiveSkill | None = None
         # Progress texts from skill threads, applied by tick() at most once a period.
         self._progress_box = ProgressBox(pace_clock or clock)
@@ -138,8 +143,8 @@ class Engine:
         self._apply_progress()
         idle = self.idle
         self.lost_link.observe(now)
-        if self.lost_link.due(now, idle):
-            self.lost_link.trigger(now, idle, self.pause)
+        if self.lost_link.due(idle):
+            self.lost_link.trigger(idle, self.pause)
             self.outputs.changed()
         if self.lost_link.step(now):
             self.outputs.changed()
@@ -185,6 +190,11 @@ class Engine:
             return False
         upcoming = queueing.upcoming(self.ledger.queue)
         return upcoming is None or upcoming.status is S.FAILURE or self.mode is not Mode.STARTED
+
+    @property
+    def active(self) -> ActiveSkill | None:
+        """The skill being worked on (at its barrier, running or paused), if any."""
+        return self._active
 
     @property
     def active_skill_id(self) -> str:
@@ -373,40 +383,11 @@ class Engine:
 
     def state(self) -> ExecutorState:
         """What the executor is doing now."""
-        if self.lost_link.contingency is not None:
-            return ExecutorState.CONTINGENCY
-        if self.mode is not Mode.STARTED:
-            return ExecutorState(self.mode.value)
-        if queueing.holding(self.ledger.queue):
-            return ExecutorState.HOLDING
-        active = self._active
-        if active is None:
-            return ExecutorState.IDLE
-        return ExecutorState.WAITING if active.behavior is None else ExecutorState.RUNNING
+        return reporting.executor_state(self)
 
     def snapshot(self, full: bool = True) -> Snapshot:
         """The state for the periodic snapshot: the queue only if ``full``, its digest always."""
-        active = self._active
-        waiting, since = "", 0.0
-        if active is not None and active.at_barrier and active.barrier is not None:
-            waiting = self.waits.summary(active.barrier)
-            if self.ledger.status(active.skill_id) is S.SYNCWAITING:
-                since = active.waiting_since
-        return Snapshot(
-            self.clock(),
-            self.commands.last_seq,
-            self.ledger.last_report_seq,
-            self.queue_hash(),
-            tuple(self.ledger.queue) if full else (),
-            self.state_name(),
-            active.skill_id if active else "",
-            waiting,
-            self.lost_link.describe(),
-            full,
-            self.ledger.status_digest(),
-            self.hold(),
-            since,
-        )
+        return reporting.snapshot(self, full)
 
     def hold(self) -> HoldCause:
         """Why the robot holds after its lost-link policy acted (NONE: it does not).

@@ -12,6 +12,14 @@ after it went, so the very last contact can lie beyond the edge of coverage. The
 come from the robot's own steady sampling, not only from the moments the ground was
 heard: over a poor radio those are seconds apart, and a sim running many times faster
 than real time hears the ground once per many simulated seconds.
+
+Two clocks, each for its own purpose. Ground contact is link liveness, so the silence a
+policy counts (and the idleness it may add) is measured on the robot's ``link_clock``: a
+steady wall clock, as the ground measures a robot's silence and paces its heartbeat. A
+radio is silent for wall seconds whatever the simulation's speed; counted in sim seconds,
+a loaded machine that delays the heartbeat by half a wall second would look like a minute
+without the ground at a real-time factor of 100. Where the robot was is mission time: the
+poses are stamped with the engine's ``clock``, like the skills that move it.
 """
 
 from __future__ import annotations
@@ -28,7 +36,7 @@ from .skills import SkillBehavior, SkillContext, SkillType
 
 _log = logging.getLogger(__name__)
 LINK_MARGIN = 10.0
-"""Seconds before the last ground contact where the robot returns to."""
+"""Seconds of mission time before the last ground contact: where the robot returns to."""
 POSE_SAMPLE_PERIOD = 0.5
 """Seconds between the poses the guard remembers while the robot works."""
 
@@ -52,9 +60,10 @@ class LostLinkGuard:
 
     Args:
         agent: The robot.
-        clock: Seconds (the engine's clock).
+        clock: Seconds of mission time (the engine's clock): poses, the safe skill.
         skill_types: The skills the robot implements (the safe skill is one of them).
         pose_source: Where the robot is (remembered whenever the ground is heard).
+        link_clock: Steady wall seconds for ground contact (``clock`` if not given).
 
     Attributes:
         policy: The policy in force.
@@ -71,9 +80,11 @@ class LostLinkGuard:
         clock: Callable[[], float],
         skill_types: Mapping[str, SkillType],
         pose_source: PoseSource = no_pose,
+        link_clock: Callable[[], float] | None = None,
     ) -> None:
         self.agent = agent
         self.clock = clock
+        self.link_clock = link_clock or clock
         self.skill_types = skill_types
         self.policy = LostLinkPolicy()
         self.is_default = False
@@ -83,7 +94,7 @@ class LostLinkGuard:
         self._recent: deque[tuple[float, Pose]] = deque()  # poses within the margin
         self._link_pose: Pose | None = None
         self._pose_source = pose_source
-        self._last_contact = clock()
+        self._last_contact = self.link_clock()
         self._idle_since: float | None = None
         self._triggered = False
 
@@ -107,8 +118,8 @@ class LostLinkGuard:
 
     def contact(self) -> bool:
         """The ground was heard; True if that ends a triggered policy (the note changed)."""
-        now = self._last_contact = self.clock()
-        self._sample(now)
+        self._last_contact = self.link_clock()
+        self._sample(self.clock())
         if self._recent:
             self._link_pose = self._recent[0][1]
         if not self._triggered:
@@ -147,12 +158,14 @@ class LostLinkGuard:
         """
         return self._link_pose
 
-    def due(self, now: float, idle: bool) -> bool:
+    def due(self, idle: bool) -> bool:
         """Whether the policy acts now (``idle``: the robot has nothing left to do).
 
         A ``silent`` policy counts the seconds without the ground; an ``idle`` one the
-        seconds both idle and without the ground. It acts once per outage.
+        seconds both idle and without the ground, both on the link clock. It acts once per
+        outage.
         """
+        now = self.link_clock()
         if not idle:
             self._idle_since = None
         elif self._idle_since is None:
@@ -166,13 +179,13 @@ class LostLinkGuard:
             since = max(since, self._idle_since)
         return now - since >= self.policy.after
 
-    def trigger(self, now: float, idle: bool, pause: Callable[[str], None]) -> None:
+    def trigger(self, idle: bool, pause: Callable[[str], None]) -> None:
         """Act: hold the robot with ``pause``, then run the policy's skill.
 
         A ``silent`` safe_skill policy only holds a robot that is ``idle`` (it keeps its
         meaning from before idle triggers existed).
         """
-        silent = now - self._last_contact
+        silent = self.link_clock() - self._last_contact
         self._triggered = True
         policy = self.policy
         params: dict[str, object] = dict(policy.params)
