@@ -4,6 +4,7 @@
   wait at the barrier for ever unless the partner is sent too.
 * A robot about to leave Wi-Fi coverage (weak signal), or out of it, while it still has
   planned work not sent: once out of range, what is sent waits until it is heard again.
+  The signal is said in a word; its dBm are in the robot header's tooltip.
 * A skill whose parameter the library marks invalid (out of range, wrong type).
 * A robot whose radio link dropped forged datagrams (unsigned, wrong key, replayed).
 
@@ -56,7 +57,7 @@ def coverage_warnings(view: MissionView) -> list[str]:
             )
         elif status.wifi_signal < WEAK_WIFI_DBM:
             out.append(
-                f"{agent} is about to leave Wi-Fi range ({status.wifi_signal:.0f} dBm) "
+                f"{agent} is about to leave Wi-Fi range (weak signal) "
                 f"with {skills} not on board; send them now."
             )
     return out

@@ -21,6 +21,7 @@ from rosmc_server.core import (
     TaskMarker,
 )
 from rosmc_server.core.live.updates import apply_event
+from rosmc_server.core.model.control import HoldCause
 from rosmc_server.core.robots.link import LinkStatus
 from rosmc_server.core.rules.legality import TaskView
 
@@ -107,8 +108,8 @@ class MissionView:
         """Whom ``skill`` waits for at its barrier.
 
         As its robot reports it while it waits there (``r2 at B3 (arrived, not yet
-        confirmed)``: the robot knows what the ground cannot see during a cut), else the
-        robots whose partner skill has not started.
+        confirmed)``, the barrier named by its tag: the robot knows what the ground cannot
+        see during a cut), else the robots whose partner skill has not started.
         """
         status = self.statuses.get(skill.agent)
         if (
@@ -117,7 +118,12 @@ class MissionView:
             and status.current_skill == skill.id
             and skill.status is SkillStatus.SYNCWAITING
         ):
-            return [status.waiting_on]
+            barrier = self.barrier_of(skill.id)
+            if barrier is None:
+                return [status.waiting_on]
+            # the robot names the barrier by its id; the operator knows it by its tag
+            tag = f" at B{self.barrier_number(skill.id)}"
+            return [status.waiting_on.replace(f" at {barrier.id}", tag)]
         barrier = self.barrier_of(skill.id)
         if barrier is None:
             return []
@@ -134,9 +140,11 @@ class MissionView:
 
     def status_text(self, skill: SkillInstance) -> str:
         """The skill's status cell, as every panel shows it."""
-        return presentation.status_text(
-            skill, self.waiting_on(skill), self.out_of_contact(skill.agent)
-        )
+        out = self.out_of_contact(skill.agent)
+        status = self.statuses.get(skill.agent)
+        heard = status.last_heard if out and status is not None else -1.0
+        holding = status is not None and status.hold is not HoldCause.NONE
+        return presentation.status_text(skill, self.waiting_on(skill), out, heard, holding)
 
     def bound_markers(self, skills: Sequence[SkillInstance]) -> list[str]:
         """Names of the task markers bound to any of ``skills`` (each once)."""

@@ -22,7 +22,7 @@ from rosmc_server.core.live.edit_history import EditKind
 from ..core.dispatch import Dispatcher
 from ..core.legality import Action, RobotAction
 from ..core.mission_view import MissionView
-from ..core.phrasing import answer_message
+from ..core.phrasing import answer_detail, answer_message
 from ..core.place_choices import surroundings
 from ..core.requests import Answer, Backend, Request, ask
 from ..core.view_state import ViewUpdate
@@ -112,6 +112,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.tasks.selection_changed.connect(self._on_tasks_selection_changed)
         self.tasks.context_menu_requested.connect(self._on_tasks_context_menu_requested)
         self.tasks.robot_action.connect(self._on_tasks_robot_action)
+        self.messages.resume_requested.connect(self._on_messages_resume_requested)
         self.tasks.add_requested.connect(self._on_tasks_add_requested)
         self.tasks.policy_chosen.connect(self._on_tasks_policy_chosen)
         self.tasks.reorder_requested.connect(self._on_tasks_reorder_requested)
@@ -164,7 +165,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.files.on_mission_shown()
         if first:
             self.files.mark_saved()
-            self.messages.say(f"Mission shown (revision {self.view.revision}).", "ok")
+            self.messages.say("Mission shown.", "ok", f"mission revision {self.view.revision}")
         if reset:
             self.banner.hide()
         self.team.refresh()
@@ -197,9 +198,10 @@ class CommandWidget(QWidget):  # type: ignore[misc]
     def on_server_restarted(self, revision: int) -> None:
         """A new mission server process took over (a restart); say from which revision."""
         self.messages.say(
-            f"The mission server restarted from revision {revision}; robot states are "
-            "shown again as it hears the robots.",
+            "The mission server restarted with the mission as it last recorded it; robot "
+            "states are shown again as it hears the robots.",
             "warning",
+            f"restarted from mission revision {revision}",
         )
 
     def on_journal_alert(self, alert: str) -> None:
@@ -216,7 +218,8 @@ class CommandWidget(QWidget):  # type: ignore[misc]
     def on_answer(self, answer: Answer) -> None:
         """Say how a request ended."""
         hint = self.history.note(answer) if answer.ok else ""  # "Ctrl+Z undoes it"
-        self.messages.say(*answer_message(answer, hint))
+        text, severity = answer_message(answer, hint)
+        self.messages.say(text, severity, answer_detail(answer))
         if answer.request.on_answer is not None:
             answer.request.on_answer(answer)
 
@@ -237,6 +240,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.view.statuses = {}  # the robots as the new backend reports them
         self.parameters.set_read_only(backend.read_only)
         self.enabling.read_only = backend.read_only
+        self.messages.set_read_only(backend.read_only)
         self.enabling.update()
         self.duplicate.update()
 
@@ -298,6 +302,9 @@ class CommandWidget(QWidget):  # type: ignore[misc]
 
     def _on_tasks_robot_action(self, agent: str, kind: RobotAction) -> None:
         self.do_robot(agent, kind)
+
+    def _on_messages_resume_requested(self, agent: str) -> None:
+        self.do_robot(agent, RobotAction.RESUME)
 
     def _on_tasks_add_requested(self, agent: str, skill: str) -> None:
         self.places.add_skill(agent, skill)

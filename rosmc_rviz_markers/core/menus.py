@@ -2,7 +2,8 @@
 
 * Robot: ``Add skill ▸ <skill>`` (exactly that robot's skills). Pose parameters default to
   the robot's pose; a parameter that takes a task marker gets a new marker in front of the
-  robot, already bound.
+  robot, already bound. Then ``Resume`` (what frees a robot holding after its lost-link
+  policy acted).
 * Static agent (lander, payload box): ``Add skill ▸ <robot> ▸ <skill>`` for the skills that
   take that object: a text parameter whose choices name it (``pick_box box=wifi_box``), or a
   skill whose name or description mentions it (``return_to_lander``, ``recharge``: "at the
@@ -79,8 +80,15 @@ class SelectObject:
     """Select the clicked object (the menu's first entry, the one that names it)."""
 
 
+@dataclass(frozen=True)
+class ResumeRobot:
+    """Resume ``agent``: what frees a robot holding after its lost-link policy acted."""
+
+    agent: str
+
+
 EditAction = AddSkill | RenameMarker | DeleteMarker
-MenuAction = EditAction | UndoEdit | SelectObject
+MenuAction = EditAction | UndoEdit | SelectObject | ResumeRobot
 
 
 @dataclass(frozen=True)
@@ -146,12 +154,17 @@ def _skill_title(skill: str, param: str, several: bool) -> str:
 
 
 def robot_menu(library: Library, agent: str) -> tuple[Menu, ...]:
-    """``Add skill ▸ <skill>`` for every skill of ``agent``, alphabetical."""
+    """``Add skill ▸ <skill>`` for every skill of ``agent``, alphabetical, then ``Resume``.
+
+    ``Resume`` is always there (the menu does not change with the robot's state): a robot
+    holding after its lost-link policy says "Resume from its menu" on its label.
+    """
+    resume = Menu("Resume", ResumeRobot(agent))
     skills = sorted(library.skills_of(agent))
     if not skills:
-        return ()
+        return (resume,)
     children = tuple(Menu(s, AddSkill(agent, s, from_robot=True)) for s in skills)
-    return (Menu("Add skill", children=children),)
+    return (Menu("Add skill", children=children), resume)
 
 
 def _mentions(spec: SkillSpec, name: str) -> bool:

@@ -33,6 +33,7 @@ from visualization_msgs.msg import InteractiveMarkerFeedback as Feedback
 from rosmc_server import interface
 from rosmc_server.core import InvalidRequest, MarkerType, Pose, RosmcError
 from rosmc_server.core.live.edit_history import EditHistory, EditKind
+from rosmc_server.core.model.control import ControlCommand
 from rosmc_server.core.skills.params import value_to_data
 from rosmc_server.core.world import areas
 from rosmc_server.ros.client import AsyncMissionClient, MissionClient, Outcome
@@ -43,6 +44,7 @@ from ..core.menus import (
     DeleteMarker,
     EditAction,
     RenameMarker,
+    ResumeRobot,
     SelectObject,
     UndoEdit,
 )
@@ -166,6 +168,11 @@ class Interaction:
             return
         if isinstance(action, SelectObject):
             self._select(parsed)
+            return
+        if isinstance(action, ResumeRobot):
+            agent = action.agent
+            # a control, not an edit (no EditKind): nothing for the undo history
+            self._submit(lambda c: c.control(ControlCommand.RESUME, agent), f"resume {agent}")
             return
         mirror = self._node.mirror
         scene = self._node.scene

@@ -101,4 +101,6 @@ def snapshot_to_msg(agent: str, snapshot: Snapshot) -> wire.ExecutorSnapshot:
         policy=snapshot.policy,
         queue_omitted=not snapshot.full,
         status_digest=snapshot.status_digest,
+        hold=snapshot.hold.value,
+        waiting_since=snapshot.waiting_since,
     )

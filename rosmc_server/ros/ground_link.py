@@ -54,7 +54,7 @@ _log = logging.getLogger(__name__)
 
 # Seconds between stamped report acks to each robot: they refresh the round trip of a quiet
 # link (the robot echoes them). Ground contact for the robots' lost-link policies is the
-# server's Heartbeat (ROS time); the ground's asks for a whole queue go out when made.
+# server's Heartbeat (wall time, like this); the ground's asks for a whole queue go out when made.
 HEARTBEAT_PERIOD = 10.0
 
 

@@ -107,6 +107,8 @@ def agent_status_to_json(status: AgentStatus) -> dict[str, Any]:
         "policy": status.policy,
         "coverage_warning": status.coverage_warning,
         "radio_dropped": status.radio_dropped,
+        "hold": status.hold.value,
+        "barrier_wait": status.barrier_wait,
     }
 
 

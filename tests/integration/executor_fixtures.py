@@ -104,6 +104,27 @@ class EventLog:
         with self.lock:
             return len(self.events)
 
+    def statuses(self, skill_id: str) -> list[SkillStatus]:
+        """Every status the events carried for ``skill_id``, in order, repeats collapsed."""
+        went: list[SkillStatus] = []
+        for _, event in self.since(0):
+            for placed in event.put_skills:
+                status = SkillStatus(placed.skill.status.value)
+                if placed.skill.id == skill_id and went[-1:] != [status]:
+                    went.append(status)
+        return went
+
+    def wait_went(self, skill_id: str, status: SkillStatus, timeout: float = 60.0) -> None:
+        """Wait until an event showed ``skill_id`` at ``status``: a change that happened (and
+        is kept), never a passing state a look at the mission could miss."""
+        deadline = time.monotonic() + timeout
+        while status not in self.statuses(skill_id):
+            if time.monotonic() > deadline:
+                raise AssertionError(
+                    f"no event showed {skill_id} {status.name}: {self.statuses(skill_id)}"
+                )
+            time.sleep(0.02)
+
 
 class Operator:
     """An operator talking to the mission server through its services."""

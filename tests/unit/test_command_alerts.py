@@ -68,8 +68,8 @@ def test_a_member_on_the_robot_with_its_partner_planned_is_a_standing_warning(gu
     ("signal", "in_coverage", "planned", "expected"),
     [
         (-50.0, True, 2, None),
-        (-80.0, True, 2, "alpha is about to leave Wi-Fi range (-80 dBm) with 2 planned skills"),
-        (-80.0, True, 1, "alpha is about to leave Wi-Fi range (-80 dBm) with 1 planned skill "),
+        (-80.0, True, 2, "alpha is about to leave Wi-Fi range (weak signal) with 2 planned skills"),
+        (-80.0, True, 1, "alpha is about to leave Wi-Fi range (weak signal) with 1 planned skill "),
         (-95.0, False, 1, "alpha is out of Wi-Fi range with 1 planned skill not on board; what"),
         (-80.0, True, 0, None),  # nothing planned: nothing to lose
         (None, False, 2, None),  # no telemetry yet: no guess

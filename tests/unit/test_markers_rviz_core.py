@@ -29,6 +29,7 @@ from rosmc_rviz_markers.core.menus import (
     AddSkill,
     DeleteMarker,
     RenameMarker,
+    ResumeRobot,
     flatten,
     robot_menu,
     static_agent_menu,
@@ -256,9 +257,10 @@ def test_icon_levels_stack_only_robots_standing_together() -> None:
 
 
 # -- menus --------------------------------------------------------------------------------------
-def test_robot_menu_lists_exactly_its_skills() -> None:
-    (add,) = robot_menu(LIBRARY, "drone")
+def test_robot_menu_lists_exactly_its_skills_then_resume() -> None:
+    add, resume = robot_menu(LIBRARY, "drone")
     assert add.title == "Add skill"
+    assert resume.title == "Resume" and resume.action == ResumeRobot("drone")
     assert [c.title for c in add.children] == sorted(LIBRARY.skills_of("drone"))
     assert all(isinstance(c.action, AddSkill) and c.action.from_robot for c in add.children)
 

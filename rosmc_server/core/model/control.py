@@ -57,3 +57,26 @@ _STARTED = frozenset(
         ExecutorState.CONTINGENCY,
     }
 )
+
+
+class HoldCause(enum.Enum):
+    """Why a robot holds on its own after its lost-link policy acted (``NONE``: it does not).
+
+    The executor reports it as a word (``ExecutorSnapshot.hold``, ``AgentState.hold``); a
+    holding robot starts no new work and its barrier partners wait for it until the
+    operator resumes it. :meth:`of` is the one place a reported word becomes a cause; its
+    words for operators are :data:`~..views.vocabulary.HOLD_WHERE`.
+    """
+
+    NONE = ""
+    LOST_LINK = "lost_link"
+    RETURN_POINT = "return_point"
+    SAFE_SKILL = "safe_skill"
+
+    @classmethod
+    def of(cls, word: str) -> HoldCause:
+        """The cause a reported word names (NONE for "" or a word this version does not know)."""
+        try:
+            return cls(word)
+        except ValueError:
+            return cls.NONE

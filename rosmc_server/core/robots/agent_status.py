@@ -10,14 +10,14 @@ import dataclasses
 import math
 from dataclasses import dataclass
 
-from ..model.control import ExecutorState
+from ..model.control import ExecutorState, HoldCause
 from ..model.model import SkillStatus
 from ..skills.params import Pose
 from ..views.vocabulary import counted
 from .link import LinkStatus
 from .waiting import waiting_text
 
-AGES = ("last_heard", "waiting_for")
+AGES = ("last_heard", "waiting_for", "barrier_wait")
 """The fields of :class:`AgentStatus` that are ages in seconds, growing with the clock."""
 
 
@@ -36,6 +36,9 @@ class AgentStatus:
     out of coverage under a policy that would leave the robot there ("" if none).
     ``radio_dropped`` radio datagrams were dropped at either end of the robot's link since
     they started (unsigned, forged, replayed: never acted on; :attr:`radio_text`).
+    ``hold`` says why the robot holds after its lost-link policy acted (NONE: it does not):
+    it starts no new work and its barrier partners wait until the operator resumes it.
+    ``barrier_wait`` is how long the robot has waited at its barrier (-1: it does not).
     """
 
     agent: str
@@ -59,6 +62,8 @@ class AgentStatus:
     waiting_for: float = -1.0
     coverage_warning: str = ""
     radio_dropped: int = 0
+    hold: HoldCause = HoldCause.NONE
+    barrier_wait: float = -1.0
 
     def __post_init__(self) -> None:
         # Its words ("up", ...) are accepted and kept as the enum: one comparison everywhere.

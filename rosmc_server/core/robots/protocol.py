@@ -11,6 +11,7 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass
 
+from ..model.control import HoldCause
 from ..model.model import SkillInstance, SkillStatus
 from .commands import CommandKind
 
@@ -109,6 +110,8 @@ class Snapshot:
     policy: str
     full: bool = True  # ``queue`` holds every skill; False: it is left out (the digest stands)
     status_digest: str = ""
+    hold: HoldCause = HoldCause.NONE  # why the robot holds after its lost-link policy acted
+    waiting_since: float = 0.0  # robot clock when its barrier wait began; 0: not waiting
 
 
 class Mode(enum.Enum):

@@ -29,10 +29,12 @@ collapse as above, so they cannot pile up.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Any, Protocol, TypeVar
 
+from ..errors import RuleViolation, Unavailable
+from ..skills.library import Library
 from ..views.vocabulary import counted
 from .commands import CommandKind
 from .link import Outbox, Outgoing
@@ -153,6 +155,21 @@ def room_refusal(
     if kind is None or not is_work(kind):
         return ""
     return refusal(agent, waiting, limit)
+
+
+def check_link_command(
+    library: Library, agent: str, kind: CommandKind | None, waiting: Callable[[], int]
+) -> None:
+    """Refuse a command of ``kind`` for ``agent`` that its robot link cannot take: an unknown
+    agent (NotFound), a static one, which has no link (RuleViolation), or one whose bound
+    on waiting work is reached (Unavailable, :func:`room_refusal`; ``waiting`` counts its
+    unsent work). Out of contact is no reason: the command waits."""
+    if agent not in library.dynamic_agents:
+        library.agent(agent)
+        raise RuleViolation(f"'{agent}' is a static agent and has no robot link")
+    sentence = room_refusal(agent, kind, waiting())
+    if sentence:
+        raise Unavailable(sentence)
 
 
 def refusal(agent: str, waiting: int, limit: int = MAX_WAITING) -> str:

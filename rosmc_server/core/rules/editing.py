@@ -26,6 +26,7 @@ from ..validation import (
     finite_float,
 )
 from .barriers import barrier_without, check_moves
+from .edit_rules import edit_refusal
 
 
 def plan_add_skill(
@@ -194,10 +195,11 @@ def _reordered(state: MissionState, agent: str, moves: Sequence[SkillMove]) -> P
 
 
 def require_editable(skill: SkillInstance, verb: str) -> None:
-    """Raise RuleViolation unless the skill is in the editable blueprint."""
-    if not skill.is_editable:
-        state = "being uploaded" if skill.status.name == "IDLE" else skill.status.name
-        raise RuleViolation(f"skill '{skill.id}' is {state}; only blueprint skills can be {verb}")
+    """Raise RuleViolation unless the skill is in the editable blueprint (the rule:
+    :func:`~.edit_rules.edit_refusal`)."""
+    refusal = edit_refusal(skill, verb)
+    if refusal is not None:
+        raise RuleViolation(refusal)
 
 
 def check_params(spec: SkillSpec, params: Mapping[str, object]) -> dict[str, Value]:

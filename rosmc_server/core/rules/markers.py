@@ -15,12 +15,13 @@ from dataclasses import replace
 
 from ..errors import InvalidRequest, RuleViolation
 from ..model.changes import Change, EventKind, PlacedSkill, Proposal
-from ..model.model import SkillInstance, TaskMarker
+from ..model.model import TaskMarker
 from ..model.state import MissionState
 from ..skills.library import Library
 from ..skills.params import MarkerType, Pose
 from ..validation import MAX_NAME, check_corners, check_one_line
 from ..views.vocabulary import counted
+from .edit_rules import MarkerAction, marker_refusal
 from .editing import bound_values
 
 _NAME_NUMBER = re.compile(r"(\d+)$")
@@ -87,7 +88,7 @@ def plan_move_marker(
     old = state.marker(name)
     moved = check_marker(TaskMarker(name, old.type, pose, tuple(vertices)))
     bound = state.bound_to(name)
-    _require_unlocked(bound, name, "move")
+    _refuse(marker_refusal(name, bound, MarkerAction.MOVE))
 
     def find_marker(marker_name: str) -> TaskMarker:
         return moved if marker_name == name else state.marker(marker_name)
@@ -119,7 +120,7 @@ def plan_rename_marker(state: MissionState, name: str, new_name: str) -> Proposa
     if state.has_marker(renamed.name):
         raise RuleViolation(f"a task marker called '{renamed.name}' already exists")
     bound = state.bound_to(name)
-    _require_unlocked(bound, name, "be renamed")
+    _refuse(marker_refusal(name, bound, MarkerAction.RENAME))
     puts = tuple(
         PlacedSkill(
             state.locate(skill.id)[1],
@@ -144,11 +145,7 @@ def plan_rename_marker(state: MissionState, name: str, new_name: str) -> Proposa
 def plan_delete_marker(state: MissionState, name: str) -> Proposal:
     """Delete a marker that no skill is bound to."""
     state.marker(name)
-    bound = state.bound_to(name)
-    if bound:
-        raise RuleViolation(
-            f"marker '{name}' is in use by {', '.join(s.id for s in bound)}; unbind them first"
-        )
+    _refuse(marker_refusal(name, state.bound_to(name), MarkerAction.DELETE))
     return Proposal(
         EventKind.MARKER_DELETED,
         "",
@@ -157,10 +154,6 @@ def plan_delete_marker(state: MissionState, name: str) -> Proposal:
     )
 
 
-def _require_unlocked(bound: Sequence[SkillInstance], name: str, verb: str) -> None:
-    for skill in bound:
-        if not skill.is_editable and not skill.status.is_final:
-            raise RuleViolation(
-                f"marker '{name}' is bound to '{skill.id}', which has been synchronized, "
-                f"so it cannot {verb}"
-            )
+def _refuse(refusal: str | None) -> None:
+    if refusal is not None:
+        raise RuleViolation(refusal)

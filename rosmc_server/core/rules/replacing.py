@@ -45,16 +45,24 @@ def _kept(status: SkillStatus, transfer: Transfer) -> bool:
     return (status is SkillStatus.IDLE and transfer is Transfer.NONE) or status.is_final
 
 
-def require_robots_idle(tasks: Iterable[list[SkillInstance]], action: str) -> None:
-    """RuleViolation naming the first skill a robot holds (synchronized and not finished,
-    or in transfer), if any."""
+def robots_idle_refusal(tasks: Iterable[list[SkillInstance]], action: str) -> str | None:
+    """Why the mission cannot be replaced (``action``: "load a mission", ...): the first
+    skill a robot holds (synchronized and not finished, or in transfer); None if none."""
     for task in tasks:
         states = set(map(_STATE, task))
         if all(s not in _HELD_BY_ROBOT and t is Transfer.NONE for s, t in states):
             continue
         for skill in task:
             if skill.status in _HELD_BY_ROBOT or skill.transfer is not Transfer.NONE:
-                raise RuleViolation(
+                return (
                     f"cannot {action} while {skill.agent} holds unfinished skill '{skill.id}'; "
                     "unsynchronize or stop it first"
                 )
+    return None
+
+
+def require_robots_idle(tasks: Iterable[list[SkillInstance]], action: str) -> None:
+    """RuleViolation with :func:`robots_idle_refusal`'s sentence, if it has one."""
+    refusal = robots_idle_refusal(tasks, action)
+    if refusal is not None:
+        raise RuleViolation(refusal)

@@ -10,6 +10,12 @@ server checks it against the library and sends it, the robot's executor applies 
 * ``return_to_link``: after ``after`` seconds, run ``skill`` (say, ``navigate_to``) with its
   one pose parameter set to where the robot last heard the ground, then hold.
 
+After any kind but ``continue`` the robot holds until an operator resumes it; it reports so
+(:class:`~..model.control.HoldCause`). There is deliberately no "resume on contact": a robot
+that went on by itself once it heard the ground would follow the plan that took it out of
+coverage, lose the link again and come back, over and over; the plan usually needs a change
+first.
+
 ``when`` says which seconds count: ``silent`` (the robot has not heard the ground for
 ``after`` seconds, whatever it does) or ``idle`` (it has had nothing left to do *and* not
 heard the ground for ``after`` seconds). The library declares a default per robot model

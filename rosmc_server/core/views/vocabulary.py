@@ -15,6 +15,7 @@ from collections.abc import Mapping
 from types import MappingProxyType
 
 from ..model.changes import EventKind
+from ..model.control import HoldCause
 from ..model.model import SkillStatus
 
 STATUS_WORDS: Mapping[SkillStatus, str] = MappingProxyType(
@@ -140,3 +141,29 @@ def counted(count: int, noun: str, plural: str = "") -> str:
     ``plural`` is for nouns that do not just take an ``s``.
     """
     return f"{count} {noun if count == 1 else plural or noun + 's'}"
+
+
+def age_text(seconds: float) -> str:
+    """An age to the second, in the two largest units: ``45 s``, ``1 min 32 s``, ``2 h 5 min``."""
+    whole = max(0, int(seconds))
+    hours, rest = divmod(whole, 3600)
+    minutes, secs = divmod(rest, 60)
+    if hours:
+        return f"{hours} h {minutes} min"
+    if minutes:
+        return f"{minutes} min {secs} s"
+    return f"{secs} s"
+
+
+HOLD_WHERE: Mapping[HoldCause, str] = MappingProxyType(
+    {
+        HoldCause.NONE: "after its lost-link policy acted",
+        HoldCause.LOST_LINK: "where it lost the link",
+        HoldCause.RETURN_POINT: "at its lost-link return point",
+        HoldCause.SAFE_SKILL: "after its lost-link safe skill",
+    }
+)
+"""Where (and so why) a robot holds after its lost-link policy acted, for operators."""
+
+HOLDING_LABEL = "holding \u2014 Resume from its menu"
+"""What a holding robot's label in rviz says instead of its skill."""

@@ -143,8 +143,16 @@ class ExecutorNode:
         self._barrier_pub = rospy.Publisher(
             interface.BARRIER_TOPIC, wire.BarrierSignal, queue_size=100
         )
+        # Mission time is ROS time (sim time in simulation); ground contact is measured
+        # in wall seconds, as the ground measures the robot's silence.
         self.engine = Engine(
-            agent, skill_types, rospy.get_time, self, pose_source, pace_clock=time.monotonic
+            agent,
+            skill_types,
+            rospy.get_time,
+            self,
+            pose_source,
+            pace_clock=time.monotonic,
+            link_clock=time.monotonic,
         )
         if state_file is not None and state_file.exists():
             try:
