@@ -17,6 +17,7 @@ from python_qt_binding.QtCore import QPoint
 from python_qt_binding.QtWidgets import QMenu, QWidget
 
 from rosmc_server.core import AgentStatus, Library, LostLinkPolicy
+from rosmc_server.core.live.edit_history import EditKind
 
 from ..core.dispatch import Dispatcher
 from ..core.legality import Action, RobotAction
@@ -64,7 +65,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.control = ControlPanel(self.actions_)
         self.messages = MessageArea()
         self.files = FileController(self, self.actions_, view, self.messages, self.send)
-        self.history = UndoHistory(self, view, self.send)
+        self.history = UndoHistory(self, view, self.send, self.messages.say)
         self.team = TeamBar(self.tasks, view)
         self.enabling = Enabling(view, self.actions_, self.tasks, self.history)
         self.repaints = Repaints(view, self.messages, self._show_statuses)
@@ -326,7 +327,10 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.send(call(agent, policy))
 
     def _on_tasks_reorder_requested(self, agent: str, order: list[str]) -> None:
-        self.dispatcher.call(lambda c: c.reorder_skills, f"reorder {agent}'s task")(agent, order)
+        what = f"reorder {agent}'s task"
+        self.dispatcher.call(lambda c: c.reorder_skills, what, EditKind.REORDER_SKILLS)(
+            agent, order
+        )
 
     def _on_tasks_columns_added(self, agents: list[str]) -> None:
         self.team.refresh()
@@ -338,11 +342,12 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         changed = ", ".join(fields.get("params", {}) or fields.get("bindings", {}) or fields)
         revert = self.parameters.reverter(skill_id)  # a refused value leaves the field
         what = f"change {changed} of {name}"
-        self.send(ask(lambda c: c.edit_skill, what, self.view.revision, revert)(skill_id, **fields))
+        call = ask(lambda c: c.edit_skill, what, self.view.revision, revert, EditKind.EDIT_SKILL)
+        self.send(call(skill_id, **fields))
 
     def _on_parameters_rename_requested(self, old: str, new: str) -> None:
         what = f"rename marker {old} to {new}"
-        self.dispatcher.call(lambda c: c.rename_task_marker, what)(old, new)
+        self.dispatcher.call(lambda c: c.rename_task_marker, what, EditKind.RENAME_MARKER)(old, new)
 
     def _on_refresh_triggered(self) -> None:
         self.backend.refresh()

@@ -15,6 +15,7 @@ from python_qt_binding.QtCore import QObject
 from python_qt_binding.QtWidgets import QWidget
 
 from rosmc_server.core import InvalidRequest
+from rosmc_server.core.live.edit_history import EditKind
 
 from ..core.duplicating import Copy, copies
 from ..core.mission_view import MissionView
@@ -102,7 +103,7 @@ class DuplicateAction(QObject):  # type: ignore[misc]
                 self._next(rest, ids, [*revisions, revision], revision, what)
 
         one = f"duplicate {copy.label or copy.skill} on {copy.agent}"
-        call = ask(lambda c: c.add_skill, one, seen, sent)
+        call = ask(lambda c: c.add_skill, one, seen, sent, EditKind.ADD_SKILL)
         self._send(
             call(
                 copy.agent,

@@ -15,6 +15,7 @@ from collections.abc import Callable
 from python_qt_binding.QtCore import QObject
 
 from rosmc_server.core import TaskMarker
+from rosmc_server.core.live.edit_history import EditKind
 from rosmc_server.core.skills.params import value_to_data
 from rosmc_server.core.views.drive_first import DriveFirst
 from rosmc_server.core.views.places import Surroundings
@@ -23,6 +24,9 @@ from ..core.mission_view import MissionView
 from ..core.place_choices import new_skill_places
 from ..core.requests import Answer, Request, ask
 from .place_rows import PlaceRows
+
+# The edits this module's requests make (undo takes each back).
+ADD, EDIT, NEW_MARKER = EditKind.ADD_SKILL, EditKind.EDIT_SKILL, EditKind.ADD_MARKER
 
 
 class PlaceRequests(QObject):  # type: ignore[misc]
@@ -57,9 +61,8 @@ class PlaceRequests(QObject):  # type: ignore[misc]
     def add_skill(self, agent: str, skill: str) -> None:
         """Append ``skill`` to ``agent``'s blueprint at its default places; select it."""
         params, bindings = new_skill_places(self._view, self._around(), agent, skill)
-        call = ask(
-            lambda c: c.add_skill, f"add {skill} to {agent}", self._view.revision, self._chosen
-        )
+        what = f"add {skill} to {agent}"
+        call = ask(lambda c: c.add_skill, what, self._view.revision, self._chosen, ADD)
         self._send(call(agent, skill, params, bindings=bindings))
 
     def _chosen(self, answer: Answer) -> None:
@@ -70,15 +73,16 @@ class PlaceRequests(QObject):  # type: ignore[misc]
         def bind(answer: Answer) -> None:
             if answer.ok:
                 what = f"bind {param} to marker {answer.value.name}"
-                edit = ask(lambda c: c.edit_skill, what, answer.value.revision)
+                edit = ask(lambda c: c.edit_skill, what, answer.value.revision, kind=EDIT)
                 self._send(edit(skill_id, bindings={param: answer.value.name}))
 
         what = f"new {marker.type.name.lower()} marker for {param}"
-        self._send(ask(lambda c: c.add_task_marker, what, self._view.revision, bind)(marker))
+        made = ask(lambda c: c.add_task_marker, what, self._view.revision, bind, NEW_MARKER)
+        self._send(made(marker))
 
     def _on_rows_drive_requested(self, offer: DriveFirst) -> None:
         params = {name: value_to_data(value) for name, value in offer.params.items()}
-        call = ask(lambda c: c.add_skill, f"add {offer.words}", self._view.revision)
+        call = ask(lambda c: c.add_skill, f"add {offer.words}", self._view.revision, kind=ADD)
         self._send(
             call(offer.agent, offer.skill, params, bindings=offer.bindings, index=offer.index)
         )

@@ -101,7 +101,7 @@ class Menu:
 
 
 UNDO_MENU = (Menu("Undo my last change", UndoEdit()), Menu("Redo", UndoEdit(redo=True)))
-"""Every marker's menu ends with these (see :mod:`.edit_history`)."""
+"""Every marker's menu ends with these (see :mod:`rosmc_server.core.live.edit_history`)."""
 
 ROBOT_WORD = "robot"
 OBJECT_WORD = "object"

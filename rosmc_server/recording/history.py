@@ -259,7 +259,7 @@ def _timeline(history: MissionHistory, records: tuple[JournalRecord, ...]) -> Ti
         try:
             event = event_from_msg(record.message)
             builder.event(mission[0], event, record.log_time)
-            apply_event(mission[0], event)
+            apply_event(mission[0], event, describe=False)
         except RosmcError:
             return False
         return True

@@ -73,7 +73,7 @@ class StateBuilder:
                 state = MissionState(self._content(number), step.revision)
                 continue
             try:
-                apply_event(state, event_from_msg(step.event.message))
+                apply_event(state, event_from_msg(step.event.message), describe=False)
             except RosmcError as err:
                 self._break(number, str(err))
                 self._last = None

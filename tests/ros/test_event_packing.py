@@ -69,9 +69,9 @@ def random_events(library: Library, count: int, seed: int) -> list[MissionEvent]
         )
         kind = rng.choice(list(EventKind))
         stamp = rng.randrange(0, 2**31) + rng.randrange(0, 10**9) / 1e9
-        events.append(
-            MissionEvent(number, kind, text(rng, ALPHABET), text(rng, ALPHABET), stamp, change)
-        )
+        undoes = rng.choice((0, 0, rng.randrange(1, 2**40)))
+        agent, summary = text(rng, ALPHABET), text(rng, ALPHABET)
+        events.append(MissionEvent(number, kind, agent, summary, stamp, change, undoes))
     return events
 
 
@@ -92,6 +92,7 @@ def test_every_event_packs_as_genpy_serializes_it(library: Library) -> None:
         assert read == expected
         assert event_from_msg(read) == event_from_msg(expected)
         assert packed.revision == event.revision and packed.epoch == epoch
+        assert event_from_msg(read).undoes == event.undoes
 
 
 def test_a_whole_reorder_event_carries_every_move_in_order(library: Library) -> None:

@@ -108,10 +108,10 @@ def test_the_replayed_demo_ends_with_every_skill_done(history: MissionHistory) -
 def test_the_review_commands_read_the_sample(
     history: MissionHistory, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    last = history.revisions[-1].revision
+    first, last = history.revisions[0].revision, history.revisions[-1].revision
     assert rosmc(["--json", "info", str(SAMPLE)]) == 0
     info = json.loads(capsys.readouterr().out)
-    assert info["revisions"] == [0, last] and info["problems"] == []
+    assert info["revisions"] == [first, last] and info["problems"] == []
     assert {robot["agent"]: robot["failed"] for robot in info["robots"]} == {
         "drone": 0,
         "science_rover": 0,
@@ -121,7 +121,7 @@ def test_the_review_commands_read_the_sample(
     middle = history.revisions[len(history.revisions) // 2]
     assert rosmc(["at", str(SAMPLE), f"{history.seconds(middle.log_time):.9f}", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["revision"] == middle.revision
-    assert rosmc(["--json", "diff", str(SAMPLE), "r0", f"r{last}"]) == 0
+    assert rosmc(["--json", "diff", str(SAMPLE), f"r{first}", f"r{last}"]) == 0
     assert json.loads(capsys.readouterr().out)["to"]["revision"] == last
     assert rosmc(["timeline", str(SAMPLE), "-o", str(tmp_path / "t.svg")]) == 0
     assert "3 robots" in capsys.readouterr().out

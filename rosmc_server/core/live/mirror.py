@@ -2,7 +2,7 @@
 
 :class:`MissionMirror` is what both GUIs, ``rosmc watch`` and replay viewers hold. It takes
 snapshots, mission events and agent statuses as they arrive (from any thread, in any
-order), applies every event exactly once with :func:`~.updates.apply_and_describe`, asks for
+order), applies every event exactly once with :func:`~.updates.apply_event`, asks for
 one new snapshot when it sees a gap or a replaced mission, and tells its listeners what
 changed as one :class:`~.updates.MirrorUpdate` per snapshot, event or status change. No
 rospy or Qt: :class:`rosmc_server.ros.client.MissionFollower` feeds it from ROS.
@@ -15,7 +15,7 @@ import threading
 from collections import deque
 from collections.abc import Callable, Mapping
 
-from ..model.changes import EventKind, MissionEvent
+from ..model.changes import MissionEvent
 from ..model.state import MissionState
 from ..robots.agent_status import AgentStatus
 from .updates import (
@@ -23,7 +23,8 @@ from .updates import (
     Listener,
     MirrorUpdate,
     MissionReset,
-    apply_and_describe,
+    apply_event,
+    needs_snapshot,
 )
 
 _log = logging.getLogger(__name__)
@@ -211,10 +212,10 @@ class MissionMirror:
             for index, event in enumerate(ordered):
                 if event.revision <= state.revision:
                     continue  # seen already (in the snapshot or before)
-                if event.revision > state.revision + 1 or _replaces(event):
+                if event.revision > state.revision + 1 or needs_snapshot(event):
                     self._pending.extend(ordered[index:])
                     return self._claim_snapshot_request()
-                changes = apply_and_describe(state, event)
+                changes = apply_event(state, event)
                 self._notify(MirrorUpdate(event.revision, changes, event))
         return False
 
@@ -258,8 +259,3 @@ class MissionMirror:
                 listener(update)
             except Exception:  # one broken view must not stop the others or the mirror
                 _log.exception("a mission mirror listener failed at revision %d", update.revision)
-
-
-def _replaces(event: MissionEvent) -> bool:
-    # On the wire a replacement carries no content; a journal's may (then it applies).
-    return event.kind is EventKind.MISSION_REPLACED and event.change.replacement is None

@@ -1,10 +1,12 @@
-"""Events applied to a mission, and what they changed as typed values.
+"""The one way an event moves a mission to the next revision, and what it changed.
 
-:func:`apply_event` is the one way to move a mission from one revision to the next with an
-event: the server's resume, the recording history, replay and every client's
-:class:`~rosmc_server.core.live.mirror.MissionMirror` use it. :func:`apply_and_describe` also
-says what changed (skill added / changed / removed, order, barrier, marker), so views can
-update only what an event touched.
+:func:`apply_event` applies a :class:`MissionEvent` to a :class:`MissionState` and says
+what changed as typed values (skill added / changed / removed, moves, barrier, marker).
+Everything that moves a mission by an event uses it: the server's
+:class:`~rosmc_server.core.rules.mission.Mission` (its own changes and a resume's journaled
+ones), the recording history, replay, and every client's
+:class:`~rosmc_server.core.live.mirror.MissionMirror`, whose listeners (the command GUI,
+the rviz scene) update from the description instead of applying anything again.
 """
 
 from __future__ import annotations
@@ -12,8 +14,8 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from ..errors import NotFound, RosmcError, RuleViolation
-from ..model.changes import Change, EventKind, MissionEvent, SkillMove
+from ..errors import RosmcError, RuleViolation
+from ..model.changes import EventKind, MissionEvent, SkillMove
 from ..model.model import Barrier, SkillInstance, TaskMarker
 from ..model.state import MissionState
 from ..robots.agent_status import AgentStatus
@@ -23,8 +25,18 @@ class SnapshotNeeded(RosmcError):
     """The event cannot be applied without a snapshot (it replaced the whole mission)."""
 
 
-def apply_event(state: MissionState, event: MissionEvent) -> None:
-    """Apply ``event`` to ``state``, which must be at the revision just before it.
+def apply_event(
+    state: MissionState, event: MissionEvent, *, describe: bool = True
+) -> tuple[MirrorChange, ...]:
+    """Apply ``event`` to ``state``, which must be at the revision just before it, and say
+    what it changed.
+
+    The changes come in the order the state makes them (removals, skills put, moves,
+    barriers and markers put), each index as it is at that moment: a view that applies
+    them one after the other ends equal to ``state``. A replacement is one
+    :class:`MissionReset`. The cost is the change's, not the mission's. ``describe``
+    False: the same application, nothing described (the server and the history readers,
+    which have no view to update, save a value per skill of a synchronize of thousands).
 
     Raises:
         RuleViolation: the event does not follow the state's revision.
@@ -35,10 +47,22 @@ def apply_event(state: MissionState, event: MissionEvent) -> None:
         raise RuleViolation(
             f"event revision {event.revision} does not follow revision {state.revision}"
         )
-    if _needs_snapshot(event):
+    if needs_snapshot(event):
         raise SnapshotNeeded(f"revision {event.revision} replaced the mission; fetch it")
-    state.apply(event.change)
+    if event.change.replacement is not None:
+        state.apply(event.change)
+        state.revision = event.revision
+        return (MissionReset(state),)
+    described = _Described() if describe else None
+    state.apply(event.change, described)
     state.revision = event.revision
+    return () if described is None else tuple(described.changes)
+
+
+def needs_snapshot(event: MissionEvent) -> bool:
+    """Whether ``event`` replaced the mission without carrying it (as on the wire): only a
+    snapshot can follow it."""
+    return event.kind is EventKind.MISSION_REPLACED and event.change.replacement is None
 
 
 # -- what listeners hear ---------------------------------------------------------------------
@@ -152,62 +176,31 @@ class MirrorUpdate:
 Listener = Callable[[MirrorUpdate], None]
 
 
-def apply_and_describe(state: MissionState, event: MissionEvent) -> tuple[MirrorChange, ...]:
-    """Apply ``event`` to ``state`` (as :func:`apply_event`) and say what it changed.
+class _Described:
+    """Collects what :meth:`MissionState.apply` reports, as :data:`MirrorChange` values."""
 
-    The changes come in the order :meth:`MissionState.apply` makes them (removals, skills
-    put, a new order, barriers and markers put), each index as it is at that moment: a
-    view that applies them one after the other ends equal to ``state``. Only what the
-    event touches is looked at, so the cost is the change's, not the mission's.
-    """
-    if event.revision != state.revision + 1 or _needs_snapshot(event):
-        apply_event(state, event)  # raises the error that says why
-    change = event.change
-    if change.replacement is not None:
-        apply_event(state, event)
-        return (MissionReset(state),)
-    changes: list[MirrorChange] = []
-    for barrier_id in change.removed_barrier_ids:
-        barrier = _barrier_or_none(state, barrier_id)
-        if barrier is not None:
-            changes.append(BarrierRemoved(barrier))
-            state.apply(Change(removed_barrier_ids=(barrier_id,)))
-    for skill_id in change.removed_skill_ids:
-        agent, index = state.locate(skill_id)
-        changes.append(SkillRemoved(state.task(agent)[index], index))
-        state.apply(Change(removed_skill_ids=(skill_id,)))
-    for name in change.removed_marker_names:
-        changes.append(MarkerRemoved(state.marker(name)))
-        state.apply(Change(removed_marker_names=(name,)))
-    for placed in change.put_skills:
-        old = state.skill(placed.skill.id) if state.has_skill(placed.skill.id) else None
-        state.apply(Change(put_skills=(placed,)))
-        _, index = state.locate(placed.skill.id)
-        if old is None:
-            changes.append(SkillAdded(placed.skill, index))
-        else:
-            changes.append(SkillChanged(old, placed.skill, index))
-    if change.order_agent:
-        moves = change.moves or state.moves_for_order(change.order_agent, change.blueprint_order)
-        state.apply(Change(order_agent=change.order_agent, moves=moves))
-        changes.append(SkillsMoved(change.order_agent, moves))
-    for barrier in change.put_barriers:
-        changes.append(BarrierPut(_barrier_or_none(state, barrier.id), barrier))
-        state.apply(Change(put_barriers=(barrier,)))
-    for marker in change.put_markers:
-        old_marker = state.marker(marker.name) if state.has_marker(marker.name) else None
-        changes.append(MarkerPut(old_marker, marker))
-        state.apply(Change(put_markers=(marker,)))
-    state.revision = event.revision
-    return tuple(changes)
+    def __init__(self) -> None:
+        self.changes: list[MirrorChange] = []
 
+    def skill_removed(self, skill: SkillInstance, index: int) -> None:
+        self.changes.append(SkillRemoved(skill, index))
 
-def _needs_snapshot(event: MissionEvent) -> bool:
-    return event.kind is EventKind.MISSION_REPLACED and event.change.replacement is None
+    def skill_put(self, old: SkillInstance | None, new: SkillInstance, index: int) -> None:
+        self.changes.append(
+            SkillAdded(new, index) if old is None else SkillChanged(old, new, index)
+        )
 
+    def skills_moved(self, agent: str, moves: Sequence[SkillMove]) -> None:
+        self.changes.append(SkillsMoved(agent, moves))
 
-def _barrier_or_none(state: MissionState, barrier_id: str) -> Barrier | None:
-    try:
-        return state.barrier(barrier_id)
-    except NotFound:
-        return None
+    def barrier_removed(self, barrier: Barrier) -> None:
+        self.changes.append(BarrierRemoved(barrier))
+
+    def barrier_put(self, old: Barrier | None, new: Barrier) -> None:
+        self.changes.append(BarrierPut(old, new))
+
+    def marker_removed(self, marker: TaskMarker) -> None:
+        self.changes.append(MarkerRemoved(marker))
+
+    def marker_put(self, old: TaskMarker | None, new: TaskMarker) -> None:
+        self.changes.append(MarkerPut(old, new))

@@ -11,6 +11,7 @@ from __future__ import annotations
 import enum
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Protocol
 
 from .content import MissionContent
 from .model import Barrier, SkillInstance, TaskMarker
@@ -80,7 +81,11 @@ class Change:
 
 @dataclass(frozen=True)
 class MissionEvent:
-    """One accepted change: the revision it produced, what it was, and the patch."""
+    """One accepted change: the revision it produced, what it was, and the patch.
+
+    ``undoes``: the revision of the edit this event takes back (an undo, or a redo that
+    takes back an undo), 0 if it takes none back.
+    """
 
     revision: int
     kind: EventKind
@@ -88,6 +93,7 @@ class MissionEvent:
     summary: str
     stamp: float
     change: Change
+    undoes: int = 0
 
 
 @dataclass(frozen=True)
@@ -98,6 +104,34 @@ class Proposal:
     agent: str
     summary: str
     change: Change
+    undoes: int = 0  # as MissionEvent.undoes
+
+
+class ChangeObserver(Protocol):
+    """Told each step of a :class:`Change` as the state makes it, with indexes as they
+    are at that moment (:func:`~rosmc_server.core.live.updates.apply_event` describes
+    an event so)."""
+
+    def skill_removed(self, skill: SkillInstance, index: int) -> None:
+        """``skill`` left its agent's task; it was at ``index``."""
+
+    def skill_put(self, old: SkillInstance | None, new: SkillInstance, index: int) -> None:
+        """``new`` was inserted (``old`` None) or replaced ``old``, at ``index``."""
+
+    def skills_moved(self, agent: str, moves: Sequence[SkillMove]) -> None:
+        """``agent``'s skills moved, one move after the other."""
+
+    def barrier_removed(self, barrier: Barrier) -> None:
+        """``barrier`` was deleted."""
+
+    def barrier_put(self, old: Barrier | None, new: Barrier) -> None:
+        """``new`` was added (``old`` None) or replaced ``old``."""
+
+    def marker_removed(self, marker: TaskMarker) -> None:
+        """``marker`` was deleted."""
+
+    def marker_put(self, old: TaskMarker | None, new: TaskMarker) -> None:
+        """``new`` was added (``old`` None) or replaced ``old``."""
 
 
 def moves_between(current: Sequence[str], order: Sequence[str], offset: int = 0) -> MoveList:

@@ -11,7 +11,7 @@ from collections.abc import Iterator, Sequence
 
 from ..errors import NotFound
 from ..validation import excerpt
-from .changes import Change, SkillMove, moves_between
+from .changes import Change, ChangeObserver, SkillMove, moves_between
 from .content import MissionContent as MissionContent
 from .content import Sections as Sections
 from .model import (
@@ -165,56 +165,79 @@ class MissionState(TaskOrder):
         return moves_between([skill.id for skill in task[start:]], order, start)
 
     # -- the one way to change -------------------------------------------
-    def apply(self, change: Change) -> None:
-        """Apply a change that the operations have validated (see :class:`Change`)."""
+    def apply(self, change: Change, observer: ChangeObserver | None = None) -> None:
+        """Apply a change that the operations have validated (see :class:`Change`).
+
+        ``observer`` hears each step as it is made (nothing of a replacement: it is
+        the whole mission).
+        """
         try:
-            self._apply(change)
+            self._apply(change, observer)
         finally:
             self._played = None
 
-    def _apply(self, change: Change) -> None:
+    def _apply(self, change: Change, observer: ChangeObserver | None) -> None:
         if change.replacement is not None:
             self._content = change.replacement.copy()
             self._reindex()
             return
         content = self._content
         for barrier_id in change.removed_barrier_ids:
-            self._drop_barrier(barrier_id)
+            dropped = self._drop_barrier(barrier_id)
+            if observer is not None and dropped is not None:
+                observer.barrier_removed(dropped)
         for skill_id in change.removed_skill_ids:
+            if observer is not None:
+                observer.skill_removed(self.skill(skill_id), self.locate(skill_id)[1])
             self._remove_skill(skill_id)
         for name in change.removed_marker_names:
-            del content.markers[name]
+            removed = content.markers.pop(name)
+            if observer is not None:
+                observer.marker_removed(removed)
         for placed in change.put_skills:
-            self._put_skill(placed.index, placed.skill)
+            old, index = self._put_skill(placed.index, placed.skill)
+            if observer is not None:
+                observer.skill_put(old, placed.skill, index)
         if change.order_agent:
             moves = change.moves
             if not moves and change.blueprint_order:  # old journals: the whole new order
                 moves = self.moves_for_order(change.order_agent, change.blueprint_order)
             self._move_skills(change.order_agent, moves)
+            if observer is not None:
+                observer.skills_moved(change.order_agent, moves)
         for barrier in change.put_barriers:
-            self._drop_barrier(barrier.id)
+            replaced = self._drop_barrier(barrier.id)
             content.barriers[barrier.id] = barrier
             for skill_id in barrier.skill_ids:
                 self._barrier_of[skill_id] = barrier.id
                 self._add_member(skill_id)
+            if observer is not None:
+                observer.barrier_put(replaced, barrier)
         for marker in change.put_markers:
+            replaced_marker = content.markers.get(marker.name)
             content.markers[marker.name] = marker
+            if observer is not None:
+                observer.marker_put(replaced_marker, marker)
 
-    def _put_skill(self, index: int, skill: SkillInstance) -> None:
+    def _put_skill(self, index: int, skill: SkillInstance) -> tuple[SkillInstance | None, int]:
+        """Insert or replace ``skill``; the skill it replaced (None) and where it is now."""
         task = self._content.tasks[skill.agent]
+        old = None
         if skill.id in self._agent_of:
             # Most puts replace the skill at the place they name (a synchronize of
             # thousands): only a stale place needs the binary search.
             fits = 0 <= index < len(task) and task[index].id == skill.id
-            current = index if fits else self.locate(skill.id)[1]
-            self._unbind(task[current])
-            task[current] = skill
+            index = index if fits else self.locate(skill.id)[1]
+            old = task[index]
+            self._unbind(old)
+            task[index] = skill
             self._note_transfer(skill)
         else:
-            self._insert(skill.agent, index, skill)
+            index = self._insert(skill.agent, index, skill)
         self._bind(skill)
+        return old, index
 
-    def _insert(self, agent: str, index: int, skill: SkillInstance) -> None:
+    def _insert(self, agent: str, index: int, skill: SkillInstance) -> int:
         task, keys = self._content.tasks[agent], self._keys[agent]
         index = min(max(index, 0), len(task))
         low = keys[index - 1] if index else 0
@@ -229,6 +252,7 @@ class MissionState(TaskOrder):
         self._key_of[skill.id] = key
         self._agent_of[skill.id] = agent
         self._note_transfer(skill)
+        return index
 
     def _remove_skill(self, skill_id: str) -> SkillInstance:
         agent, index = self.locate(skill_id)
@@ -257,12 +281,13 @@ class MissionState(TaskOrder):
         else:
             self._reorder_stretch(agent, *played)
 
-    def _drop_barrier(self, barrier_id: str) -> None:
+    def _drop_barrier(self, barrier_id: str) -> Barrier | None:
         old = self._content.barriers.pop(barrier_id, None)
         if old is not None:
             for skill_id in old.skill_ids:
                 self._remove_member(skill_id)
                 self._barrier_of.pop(skill_id, None)
+        return old
 
     def _note_transfer(self, skill: SkillInstance) -> None:
         waiting = self._in_transfer.setdefault(skill.agent, set())

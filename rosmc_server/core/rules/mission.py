@@ -343,29 +343,30 @@ class Mission:
 
     def replay(self, event: MissionEvent) -> None:
         """Apply a journaled event; it must be the next revision (see :func:`apply_event`)."""
-        inverse = self.history.inverse(self.state, event.kind, event.change)
-        apply_event(self.state, event)
-        self.history.keep(self.state, event, inverse)
-        if event.kind not in ROBOT_EVENTS:
-            self.operator_revision = event.revision
+        self._take(event)
 
-    # -- internals ---------------------------------------------------------------
+    # -- internals ---------------------------------------------------------------------------
     def _commit(self, proposal: Proposal) -> MissionEvent:
-        inverse = self.history.inverse(self.state, proposal.kind, proposal.change)
-        self.state.apply(proposal.change)
-        self.state.revision += 1
-        if proposal.kind not in ROBOT_EVENTS:
-            self.operator_revision = self.state.revision
         event = MissionEvent(
-            self.state.revision,
+            self.state.revision + 1,
             proposal.kind,
             proposal.agent,
             proposal.summary,
             self._clock(),
             proposal.change,
+            proposal.undoes,
         )
-        self.history.keep(self.state, event, inverse)
+        self._take(event)
         return event
+
+    def _take(self, event: MissionEvent) -> None:
+        """Apply ``event`` with the one applier, keeping the undo history and the operator
+        revision as it goes (the server's own changes and a resume's alike)."""
+        inverse = self.history.inverse(self.state, event.kind, event.change)
+        apply_event(self.state, event, describe=False)
+        if event.kind not in ROBOT_EVENTS:
+            self.operator_revision = event.revision
+        self.history.keep(self.state, event, inverse)
 
     def _on_site(self, proposal: Proposal) -> Proposal:
         """``proposal`` if the targets it sets suit the known site; RuleViolation if not."""

@@ -11,7 +11,6 @@ the edit produced. An undo is itself undoable: undoing it is the redo.
 from __future__ import annotations
 
 import collections
-import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
@@ -42,9 +41,6 @@ _INVERSE_KIND = {
     EventKind.MARKER_MOVED: EventKind.MARKER_MOVED,
     EventKind.MARKER_RENAMED: EventKind.MARKER_RENAMED,
 }
-
-# An undo's summary names the revision it undid; journals replay it from there.
-_UNDO_OF = re.compile(r"undo of revision (\d+) ")
 
 UNDO_DEPTH = 200
 """How many of the latest edits can be undone (older ones are forgotten)."""
@@ -128,14 +124,19 @@ class UndoHistory:
             self._stretch = None
         else:
             left = _left_by(state, event.change)
-        match = _UNDO_OF.match(event.summary)
-        undoes = int(match.group(1)) if match else 0
-        undone = self._entries.get(undoes)
+        undone = self._entries.get(event.undoes)
         if undone is not None:
-            self._undone.add(undoes)
+            self._undone.add(event.undoes)
         is_undo = undone is not None and not undone.is_undo
         self._entries[event.revision] = UndoEntry(
-            event.revision, event.kind, event.agent, event.summary, inverse, left, undoes, is_undo
+            event.revision,
+            event.kind,
+            event.agent,
+            event.summary,
+            inverse,
+            left,
+            event.undoes,
+            is_undo,
         )
         while len(self._entries) > self._depth:
             self._undone.discard(self._entries.popitem(last=False)[0])
@@ -191,6 +192,7 @@ class UndoHistory:
             entry.agent,
             f"undo of revision {revision} ({entry.summary})",
             inverse,
+            undoes=revision,
         )
 
 
