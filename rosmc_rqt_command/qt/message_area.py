@@ -104,3 +104,12 @@ class MessageArea(QWidget):  # type: ignore[misc]
     def messages(self) -> list[str]:
         """Every message text, newest first (for tests and copy-paste)."""
         return [self.log.item(row).text() for row in range(self.log.count())]
+
+    def entries(self) -> list[tuple[str, str]]:
+        """Every message as its text and its detail (tooltip), newest first."""
+        items = (self.log.item(row) for row in range(self.log.count()))
+        return [(item.text(), item.toolTip()) for item in items]
+
+    def detail_of(self, text: str) -> str:
+        """The detail of the newest message whose text holds ``text`` ("" if none)."""
+        return next((detail for said, detail in self.entries() if text in said), "")

@@ -132,7 +132,8 @@ def write_picture(gui: Gui, picker: PlacePicker, path: str) -> None:
 def test_places_are_picked_by_name_and_drive_there_first_is_offered(mars: Any) -> None:
     operator, gui, client = mars
     w = gui.widget
-    client.add_task_marker(TaskMarker("rock", MarkerType.POSITION, Pose(7.0, 8.0)))  # as rviz
+    rock = client.add_task_marker(TaskMarker("rock", MarkerType.POSITION, Pose(7.0, 8.0)))  # rviz
+    wait_until(lambda: w.view.revision >= rock.revision, 30, "the rock shown")
 
     # A move, then a place picked by name with the mouse: bound to the marker.
     drive = gui.add("science_rover", "navigate_to")
@@ -197,7 +198,8 @@ def test_places_are_picked_by_name_and_drive_there_first_is_offered(mars: Any) -
 def test_duplicate_copies_the_selection_after_it_with_its_bindings(mars: Any) -> None:
     operator, gui, client = mars
     w = gui.widget
-    client.add_task_marker(TaskMarker("rock", MarkerType.POSITION, Pose(7.0, 8.0)))
+    rock = client.add_task_marker(TaskMarker("rock", MarkerType.POSITION, Pose(7.0, 8.0)))
+    wait_until(lambda: w.view.revision >= rock.revision, 30, "the rock shown")
     drive = gui.add("manipulator_rover", "navigate_to")
     choose(shown_picker(gui, drive, "target"), "rock")
     wait_until(lambda: w.view.skill(drive).bindings.get("target"), 30, "bound")

@@ -344,7 +344,8 @@ def test_a_two_robot_barrier_plan_goes_out_with_one_click_and_one_question(
     team = questions.asked[1]
     assert "drone: 2 skills, its whole task" in team and "science_rover: 2 skills" in team
     assert "Warnings" not in team, team
-    assert f"(revision {before + 1})" in message, message
+    detail = window.w.messages.detail_of(message)
+    assert detail == f"mission revision {before + 1}", (message, detail)
     wait_until(
         lambda: all(
             window.w.view.view(agent).editable == () for agent in ("drone", "science_rover")
