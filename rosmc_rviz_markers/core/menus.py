@@ -30,6 +30,7 @@ from dataclasses import dataclass, field, replace
 
 from rosmc_server.core.model.model import SkillInstance, TaskMarker
 from rosmc_server.core.model.state import MissionState
+from rosmc_server.core.rules.edit_rules import MarkerAction, marker_refusal
 from rosmc_server.core.rules.markers import generated_name
 from rosmc_server.core.skills.library import AgentKind, Library, SkillSpec
 from rosmc_server.core.skills.params import MarkerType, ParamType, Value
@@ -293,7 +294,7 @@ def task_marker_menu(
         names = rename_suggestions(state, marker, bound)
         if names:
             menus.append(Menu("Rename", children=tuple(Menu(n, RenameMarker(n)) for n in names)))
-    if not bound:
+    if marker_refusal(marker.name, bound, MarkerAction.DELETE) is None:  # the server's rule
         menus.append(Menu("Delete", DeleteMarker()))
     return tuple(menus)
 
