@@ -27,6 +27,7 @@ from dataclasses import dataclass
 from rosmc_server.core.model.control import HoldCause
 from rosmc_server.core.model.model import SkillStatus
 from rosmc_server.core.robots.agent_status import AgentStatus
+from rosmc_server.core.robots.link import LinkStatus
 from rosmc_server.core.robots.waiting import duration_text
 from rosmc_server.core.views.geometry import Color, Point
 from rosmc_server.core.views.vocabulary import (
@@ -101,7 +102,11 @@ def wifi_row(signal: float | None) -> IconRow:
 
 
 def link_row(
-    link: str, last_heard: float, waiting: int = 0, waiting_for: float = -1.0, forged: int = 0
+    link: LinkStatus,
+    last_heard: float,
+    waiting: int = 0,
+    waiting_for: float = -1.0,
+    forged: int = 0,
 ) -> IconRow:
     """Ground link: up / down / never heard, with seconds since the robot was heard, how
     many commands wait for contact (for how long), and how many forged radio datagrams its
@@ -109,16 +114,16 @@ def link_row(
     row = _link_only(link, last_heard)
     if forged > 0:
         row = IconRow("link", f"{row.text}, {forged} FORGED DROPPED", worst([row.color, WARN]))
-    if waiting <= 0 or link == "up":
+    if waiting <= 0 or link is LinkStatus.UP:
         return row
     age = f" {duration_text(waiting_for)}" if waiting_for >= 0 else ""
     return IconRow("link", f"{row.text}, {waiting} WAITING{age}", worst([row.color, WARN]))
 
 
-def _link_only(link: str, last_heard: float) -> IconRow:
-    if link == "unknown" or last_heard < 0:
-        return IconRow("link", "link never heard", DIM if link == "unknown" else BAD)
-    if link == "up":
+def _link_only(link: LinkStatus, last_heard: float) -> IconRow:
+    if link is LinkStatus.UNKNOWN or last_heard < 0:
+        return IconRow("link", "link never heard", DIM if link is LinkStatus.UNKNOWN else BAD)
+    if link is LinkStatus.UP:
         if last_heard > LINK_STALE:
             return IconRow("link", f"link up, {last_heard:.0f} s ago", WARN)
         return IconRow("link", "link up", GOOD)
@@ -156,7 +161,7 @@ def status_parts(status: AgentStatus | None, skill_label: str = "") -> tuple[Ico
     if status is None:
         return (
             IconRow("skill", "no status yet", DIM),
-            link_row("unknown", -1.0),
+            link_row(LinkStatus.UNKNOWN, -1.0),
             wifi_row(None),
             battery_row(None),
         )

@@ -12,6 +12,7 @@ import pytest
 from rosmc_rqt_command.core import alerts
 from rosmc_rqt_command.core.legality import Action
 from rosmc_server.core import AgentStatus, Library, Mission, SkillStatus
+from rosmc_server.core.robots.link import LinkStatus
 from rosmc_server.core.skills.library import library_from_dict
 from tests.unit.test_command_harness import Gui, open_gui
 
@@ -136,8 +137,9 @@ def test_forged_radio_datagrams_on_a_robots_link_are_a_warning_and_in_its_header
     assert link_summary(attacked).endswith("212 forged radio datagrams dropped")
     assert "WARNING: 212 forged radio datagrams dropped" in format_agent_status(attacked)
     assert AgentStatus("alpha", radio_dropped=1).radio_text == "1 forged radio datagram dropped"
-    row = link_row("up", 0.1, forged=212)
-    assert row.text == "link up, 212 FORGED DROPPED" and row.color != link_row("up", 0.1).color
+    row = link_row(LinkStatus.UP, 0.1, forged=212)
+    up = link_row(LinkStatus.UP, 0.1)
+    assert row.text == "link up, 212 FORGED DROPPED" and row.color != up.color
 
 
 def stricter(library_data: dict[str, Any]) -> Library:
