@@ -73,3 +73,22 @@ def clock_text(seconds: float | None, label: str = MISSION) -> str:
     whole = max(0, int(seconds))
     hours, rest = divmod(whole, 3600)
     return f"{label} {hours % 24 if label == UTC else hours}:{rest // 60:02d}:{rest % 60:02d}"
+
+
+def rviz_config_at(text: str, place: Rect) -> str:
+    """An rviz config (its text) whose window starts at ``place``; nothing else changes.
+
+    Only the four numbers of the top-level ``Window Geometry`` block are replaced (the file
+    is rewritten as text, so rviz reads everything else exactly as written).
+    """
+    wanted = {"Height": place.height, "Width": place.width, "X": place.x, "Y": place.y}
+    lines = text.splitlines(keepends=True)
+    inside = False
+    for index, line in enumerate(lines):
+        if not line.startswith(" "):
+            inside = line.rstrip() == "Window Geometry:"
+            continue
+        key = line.strip().split(":", 1)[0]
+        if inside and line.startswith("  ") and not line.startswith("   ") and key in wanted:
+            lines[index] = f"  {key}: {wanted[key]}\n"
+    return "".join(lines)

@@ -11,7 +11,9 @@ ROS interface (every name behind ``~ns``):
     ``/rosmc/markers/icons`` (visualization_msgs/MarkerArray: status icons, and a text
     above the origin once the mission server restarted, naming its revision; all of them
     to a subscriber as it connects, then only what changed, see :mod:`.icon_layer`),
-    ``/rosmc/selection`` (rosmc/Selection, latched: what the operator clicked),
+    ``/rosmc/selection`` (rosmc/Selection, latched: what the operator clicked), the
+    ``station`` interactive marker (the mission clock; its menu opens the command window,
+    see :mod:`.station_layer`),
     ``/rosmc/coverage`` (visualization_msgs/MarkerArray, latched: radio coverage, see
     :mod:`.coverage_layer`, which also subscribes ``/rosmc/sim/coverage``).
     Subscribes ``/rosmc/markers/feedback`` (InteractiveMarkerFeedback), ``/rosmc/selection``,
@@ -54,6 +56,7 @@ from .convert import icon_markers, interactive_marker_msg, pose_msg
 from .coverage_layer import CoverageLayer
 from .icon_layer import IconLayer
 from .interaction import Interaction
+from .station_layer import STATION_MARKER, StationLayer
 from .tf_presence import TfPresence
 
 _log = logging.getLogger(__name__)
@@ -86,6 +89,8 @@ class MarkerNode:
         self._icons = IconLayer(topics.topic(topics.ICONS_TOPIC, config.ns))
         self.interaction = Interaction(self, config)
         self.coverage = CoverageLayer(config.ns)  # radio coverage and last-link marks
+        # the mission clock over the lander, whose menu opens the command window
+        self.station = StationLayer(self.server, self._lock, config.ns)
         self._tf: TfPresence | None = None  # which agents have TF (follow_tf only)
         self._worker = threading.Thread(target=self._run, name="rosmc-markers", daemon=True)
 
@@ -126,6 +131,7 @@ class MarkerNode:
     def start(self) -> None:
         """Fetch the library, follow the mission and start publishing."""
         self._worker.start()
+        self.station.start()
         self.follower.start()
         if self.config.library:
             self._take_library(load_library(self.config.library))
@@ -138,6 +144,7 @@ class MarkerNode:
             self._closed = True
             self._wake.notify()
         self.interaction.close()
+        self.station.close()
         self.follower.close()
         if self._tf is not None:
             self._tf.close()
@@ -322,7 +329,10 @@ class MarkerNode:
 
     # -- feedback ---------------------------------------------------------------------------------
     def _on_feedback(self, feedback: object) -> None:
-        self.interaction.on_feedback(feedback)
+        if getattr(feedback, "marker_name", "") == STATION_MARKER:
+            self.station.on_feedback(feedback)
+        else:
+            self.interaction.on_feedback(feedback)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
