@@ -71,7 +71,7 @@ class FlowLayout(QLayout):  # type: ignore[misc]
         area = rect.adjusted(margins.left(), margins.top(), -margins.right(), -margins.bottom())
         x, y, row_height = area.x(), area.y(), 0
         for item in self._items:
-            hint = item.sizeHint()
+            hint = _hint(item)
             if x + hint.width() > area.right() + 1 and row_height > 0:
                 x, y, row_height = area.x(), y + row_height + self._gap, 0
             if move:
@@ -79,3 +79,14 @@ class FlowLayout(QLayout):  # type: ignore[misc]
             x += hint.width() + self._gap
             row_height = max(row_height, hint.height())
         return int(y + row_height - rect.y() + margins.bottom())
+
+
+def _hint(item: QLayoutItem) -> QSize:
+    """The size ``item`` asks for: a widget's own hint, even if it ignores its hint in a row.
+
+    (A label made with :func:`~.labels.never_widen` has an ``Ignored`` width, which Qt's
+    item reports as 0; in a flow its text must still fit, or it is cut.)
+    """
+    widget = item.widget()
+    hint = widget.sizeHint() if widget is not None else item.sizeHint()
+    return hint.expandedTo(item.minimumSize()).boundedTo(item.maximumSize())

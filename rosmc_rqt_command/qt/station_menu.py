@@ -61,6 +61,9 @@ class StationMenu:
         self.clock = QLabel(clock_text(None))
         self.clock.setObjectName("mission_clock")
         self.clock.setToolTip("Mission time: the simulation's time since it started")
+        # as wide as its longest reading, so that the menu bar's corner never cuts it
+        widest = self.clock.fontMetrics().horizontalAdvance(clock_text(359999, "mission time"))
+        self.clock.setMinimumWidth(widest + 4)
         button = QToolButton()
         button.setObjectName("show_3d_button")
         button.setDefaultAction(self.show_3d)
