@@ -174,17 +174,9 @@ class _Live:
         self.widget.set_backend(bridge)
         follow(self.widget, bridge)
         if self.menu is not None and not follows_replay(self.prefix):
-            self._join_station(self.menu)
+            self.station = join_station(self.widget, self.menu)
         if isinstance(pending, PendingBackend):
             pending.hand_over(bridge)
-
-    def _join_station(self, menu: StationMenu) -> None:
-        from .ros_station import StationLink
-
-        self.station = station = StationLink()
-        menu.hooks = station.hooks()
-        self.widget.replay.show_source = station.show_source
-        station.raise_requested.connect(lambda: bring_to_front(self.widget.window()))
 
     def close(self) -> None:
         """Stop following (if the node ever started)."""
@@ -193,6 +185,23 @@ class _Live:
             self.bridge.close()
         if self.station is not None:
             self.station.close()
+
+
+def join_station(widget: CommandWidget, menu: StationMenu) -> Any:
+    """Connect ``widget`` (following the live mission) to rviz; returns the StationLink.
+
+    Show 3D view and the clock go through the link; Open recording… makes rviz show the
+    replay, Return to live the live mission; rviz's Open command window brings the
+    window to the front.
+    """
+    from .ros_station import StationLink
+
+    station = StationLink()
+    menu.hooks = station.hooks()
+    menu.tick()
+    widget.replay.show_source = station.show_source
+    station.raise_requested.connect(lambda: bring_to_front(widget.window()))
+    return station
 
 
 def bring_to_front(window: QWidget) -> None:
