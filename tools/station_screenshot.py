@@ -31,7 +31,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-import rviz_screenshot as shots  # noqa: E402 (the sibling tool: Xvfb, grab, rviz's env)
+import rviz_screenshot as shots
 
 COMMAND_TITLE = "ROSMC command"
 START_TIMEOUT = 180.0
@@ -93,8 +93,8 @@ def command_window(display: str) -> Box | None:
 
 
 def rviz_window(display: str) -> Box | None:
-    """rviz's main window, if one is shown (the largest window of class rviz)."""
-    found = windows(display, "--class", "rviz")
+    """rviz's main window, if one is shown (not its splash screen: 400 px wide)."""
+    found = [box for box in windows(display, "--class", "rviz") if box.width > 500]
     return max(found, key=lambda b: b.width * b.height) if found else None
 
 
