@@ -9,7 +9,9 @@ started is stopped afterwards.
 
 Example, after ``source env.sh``::
 
-    python tools/station_screenshot.py -o docs/station.png
+    python tools/station_screenshot.py --demo --settle 60 -o docs/station.png
+    python tools/station_screenshot.py --team twenty --view "Whole site" --settle 120 \
+        -o docs/rviz_twenty.png
 
 The functions here also serve ``tests/integration/test_station_screen.py``.
 Exit status: 0 when written, 1 when the station did not come up in time, 130 when
@@ -114,11 +116,13 @@ class Station:
     env: Mapping[str, str]
     home: Path
 
-    def launch(self, *args: str, log: Path) -> subprocess.Popen[bytes]:
-        """``roslaunch rosmc operator.launch ARGS`` on this master and screen."""
+    def launch(
+        self, *args: str, log: Path, file: str = "operator.launch"
+    ) -> subprocess.Popen[bytes]:
+        """``roslaunch rosmc FILE ARGS`` on this master and screen."""
         with log.open("wb") as out:
             return subprocess.Popen(
-                ["roslaunch", "-p", str(self.port), "rosmc", "operator.launch", *args],
+                ["roslaunch", "-p", str(self.port), "rosmc", file, *args],
                 env=dict(self.env),
                 cwd=self.home,
                 stdout=out,
@@ -167,10 +171,24 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--size", type=shots._size, default=shots.DEFAULT_SIZE)
     parser.add_argument("--settle", type=float, default=15.0, help="seconds after both show")
     parser.add_argument("--team", default="three", help="three or twenty (operator.launch)")
+    parser.add_argument("--view", help="a saved view of rviz/operator.rviz to look from")
+    parser.add_argument(
+        "--demo",
+        action="store_true",
+        help="the scripted demo mission (demo.launch gui:=true) instead of an idle team",
+    )
     args = parser.parse_args(argv)
     home = Path(tempfile.mkdtemp(prefix="rosmc_station_"))
     with station_screen(args.size, home) as station:
-        launch = station.launch("sim:=true", f"team:={args.team}", log=home / "launch.log")
+        log = home / "launch.log"
+        if args.demo:
+            launch = station.launch("gui:=true", "real_time_factor:=2", log=log, file="demo.launch")
+        else:
+            extra = []
+            if args.view:
+                config = shots.REPO_ROOT / "rviz" / "operator.rviz"
+                extra.append(f"rviz_config:={shots.with_saved_view(config, args.view, home)}")
+            launch = station.launch("sim:=true", f"team:={args.team}", *extra, log=log)
         try:
             wait_for(
                 lambda: command_window(station.display) and rviz_window(station.display),

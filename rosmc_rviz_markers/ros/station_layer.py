@@ -38,7 +38,7 @@ from .adapter import MarkerServer
 
 _log = logging.getLogger(__name__)
 STATION_MARKER = "station"
-STATION_AT = (0.0, 0.0, 10.2)  # over the lander, between its score (8 m) and server notes
+STATION_AT = (0.0, 0.0, 10.9)  # over the lander, between its score (8 m) and server notes
 CLOCK_TEXT = 0.8  # letter height (m), as the server notes
 OPEN_COMMAND = 1  # the menu entry's id
 OPEN_COMMAND_TITLE = "Open command window"

@@ -6,12 +6,15 @@ as the standalone window is. The recording is opened with the mouse (File > Open
 recording…, the path typed into the dialog): rviz is started again on the replay's topics
 and the replay's marker node shows the replayed time; *Return to live* puts rviz back on the
 live topics. The window's clock shows the replayed time and then the mission time again.
+rviz killed with SIGKILL comes back (``respawn``) on the live topics.
 """
 
 from __future__ import annotations
 
 import os
 import re
+import signal
+import xmlrpc.client
 from collections.abc import Iterator
 from typing import Any
 
@@ -45,6 +48,15 @@ def subscribed(node: str) -> set[str]:
     """The topics ``node`` subscribes to now."""
     _pubs, subscribers, _services = rosgraph.Master("/station_test").getSystemState()
     return {topic for topic, nodes in subscribers if node in nodes}
+
+
+def view_pid() -> int | None:
+    """The process id of the rviz that rviz_station runs (None while there is none)."""
+    try:
+        uri = rosgraph.Master("/station_test").lookupNode(VIEW)
+        return int(xmlrpc.client.ServerProxy(uri).getPid("/station_test")[2])
+    except (rosgraph.MasterError, OSError, xmlrpc.client.Error):
+        return None
 
 
 def station_text(prefix: str) -> str | None:
@@ -146,3 +158,10 @@ def test_open_recording_shows_the_replay_in_rviz_and_return_to_live_brings_it_ba
     assert not widget.backend.read_only
     qt_wait(lambda: menu.clock.text().startswith("UTC "), 10, "the live clock again")
     assert station_text("")  # the live marker node's station marker is still there
+
+    # rviz killed (-9): roslaunch's respawn starts it again, on the live mission.
+    first = view_pid()
+    assert first is not None
+    os.kill(first, signal.SIGKILL)
+    qt_wait(lambda: view_pid() not in (None, first), START, "rviz back")
+    qt_wait(on_live, START, "rviz back on the live topics")

@@ -38,7 +38,7 @@ REPO = Path(__file__).resolve().parents[2]
 TOOL = REPO / "tools" / "station_screenshot.py"
 SIZE = (1600, 1000)
 START = 180.0  # the simulated team, rviz under software OpenGL, on two busy cores
-STATION_AT = (0.0, 0.0, 10.2)  # rosmc_rviz_markers/ros/station_layer.py
+STATION_AT = (0.0, 0.0, 10.9)  # rosmc_rviz_markers/ros/station_layer.py
 RVIZ_VIEW = "/rviz_operator_view"
 
 
