@@ -39,7 +39,7 @@ from tools.rviz_screenshot import (  # noqa: E402
     virtual_screen,
 )
 
-TIMEOUT = 60.0  # wall seconds for each step
+TIMEOUT = 120.0  # wall seconds for each step (rviz and a replay start on a busy machine)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -62,21 +62,35 @@ def main(argv: Sequence[str] | None = None) -> int:
         os.environ.update(env, DISPLAY=display, QT_QPA_PLATFORM="xcb")
         server_launch = str(REPO / "launch" / "mission_server.launch")
         server = launch(env, Path(tmp) / "server.log", server_launch, f"journal_dir:={tmp}")
-        rviz_env = rviz_environment(display, env)
-        views = [
-            launch(env, Path(tmp) / "markers.log", str(REPO / "launch" / "markers.launch")),
-            launch(
-                rviz_env,
-                Path(tmp) / "rviz.log",
-                str(REPO / "launch" / "rviz.launch"),
-                "respawn:=true",
-            ),
-        ]
+        # One roslaunch after the other: launches started together on a new master each
+        # declare their own run id, and all but the first end.
+        node_up("/rosmc/mission_server")
+        views = [launch(env, Path(tmp) / "markers.log", str(REPO / "launch" / "markers.launch"))]
+        node_up("/rosmc/markers")
+        rviz_launch = (str(REPO / "launch" / "rviz.launch"), "respawn:=true")
+        views.append(launch(rviz_environment(display, env), Path(tmp) / "rviz.log", *rviz_launch))
         try:
-            return run(args, display, (width, height))
+            status = run(args, display, (width, height))
         finally:
             for process in (*views, server):
                 stop_group(process, signal.SIGINT)
+        if status:  # what the server said, to show why
+            print((Path(tmp) / "server.log").read_text()[-3000:], file=sys.stderr)
+        return status
+
+
+def node_up(name: str) -> None:
+    """Wait until the master (``ROS_MASTER_URI``) knows node ``name``."""
+    import rosgraph
+
+    deadline = time.monotonic() + TIMEOUT
+    while time.monotonic() < deadline:
+        try:
+            rosgraph.Master("/shot").lookupNode(name)
+            return
+        except (rosgraph.MasterError, OSError):
+            time.sleep(0.5)
+    raise TimeoutError(f"{name} did not start")
 
 
 def run(args: argparse.Namespace, display: str, size: tuple[int, int]) -> int:

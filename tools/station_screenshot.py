@@ -181,14 +181,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     home = Path(tempfile.mkdtemp(prefix="rosmc_station_"))
     with station_screen(args.size, home) as station:
         log = home / "launch.log"
+        journal = f"journal_dir:={home}"  # the mission journal, not into the checkout's bags/
         if args.demo:
-            launch = station.launch("gui:=true", "real_time_factor:=2", log=log, file="demo.launch")
+            demo = ("gui:=true", "real_time_factor:=2", journal)
+            launch = station.launch(*demo, log=log, file="demo.launch")
         else:
             extra = []
             if args.view:
                 config = shots.REPO_ROOT / "rviz" / "operator.rviz"
                 extra.append(f"rviz_config:={shots.with_saved_view(config, args.view, home)}")
-            launch = station.launch("sim:=true", f"team:={args.team}", *extra, log=log)
+            launch = station.launch("sim:=true", f"team:={args.team}", journal, *extra, log=log)
         try:
             wait_for(
                 lambda: command_window(station.display) and rviz_window(station.display),

@@ -24,6 +24,7 @@ from rosmc_rqt_command.core.station_layout import (
     rviz_config_at,
     split_screen,
 )
+from rosmc_rqt_command.qt.replay_bar import ReplayBar
 from rosmc_rqt_command.qt.station_menu import StationHooks, StationMenu
 from rosmc_server.core import Library
 from rosmc_server.core.library import load_library
@@ -122,6 +123,12 @@ def test_the_command_window_is_whole_in_its_share_of_the_screen(
     for child in (team.text, team.robots_button, team.compact, team.count):
         assert team.rect().contains(inside(team, child)), child.objectName()
     assert team.count.width() >= team.count.sizeHint().width(), team.count.text()
+    bar = widget.findChild(ReplayBar)  # every_warning opened a recording's bar
+    for button in (bar.play_button, bar.slower_button, bar.faster_button, bar.live_button):
+        assert button.isVisible() and button.width() >= button.sizeHint().width(), button.text()
+        assert main.rect().contains(inside(main, button)), button.text()
+    assert bar.slider.width() >= 100, "the timeline has room"
+    assert bar.title.width() >= 200, "the recording's name is not squeezed to a letter"
     assert menu.clock.text() == "mission time 1:02:03"
     assert menu.clock.isVisible() and menu.clock.width() >= menu.clock.sizeHint().width()
     assert main.rect().contains(inside(main, menu.clock))
