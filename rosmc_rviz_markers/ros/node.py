@@ -11,9 +11,10 @@ ROS interface (every name behind ``~ns``):
     ``/rosmc/markers/icons`` (visualization_msgs/MarkerArray: status icons, and a text
     above the origin once the mission server restarted, naming its revision; all of them
     to a subscriber as it connects, then only what changed, see :mod:`.icon_layer`),
-    ``/rosmc/selection`` (rosmc/Selection, latched: what the operator clicked), the
-    ``station`` interactive marker (the mission clock; its menu opens the command window,
-    see :mod:`.station_layer`),
+    ``/rosmc/selection`` (rosmc/Selection, latched: what the operator clicked),
+    ``/rosmc/markers/clock`` (visualization_msgs/MarkerArray, latched: the mission clock)
+    and the ``station`` interactive marker (its menu opens the command window), see
+    :mod:`.station_layer`,
     ``/rosmc/coverage`` (visualization_msgs/MarkerArray, latched: radio coverage, see
     :mod:`.coverage_layer`, which also subscribes ``/rosmc/sim/coverage``).
     Subscribes ``/rosmc/markers/feedback`` (InteractiveMarkerFeedback), ``/rosmc/selection``,
@@ -61,7 +62,7 @@ from .tf_presence import TfPresence
 
 _log = logging.getLogger(__name__)
 SERVER_ICON = "mission_server"  # the status text of the server itself (icons/mission_server)
-SERVER_NOTE_AT = (0.0, 0.0, 9.0)  # + ICON_BASE: over the lander (map origin), above its score
+SERVER_NOTE_AT = (0.0, 0.0, 9.3)  # + ICON_BASE: over the lander, above its score and clock
 SERVER_NOTE_TEXT = 0.8  # letter height (m): as large as the site's region labels
 
 

@@ -49,6 +49,7 @@ FOLLOWED = (
     *(topics.topic(topics.MARKERS_NS, "") + f"/{leaf}" for leaf in ("update", "update_full")),
     topics.topic(topics.MARKERS_NS, "") + "/feedback",
     topics.topic(topics.ICONS_TOPIC, ""),
+    topics.topic(topics.CLOCK_TOPIC, ""),
     interface.TF_TOPIC,
     interface.WORLD_TOPIC,
 )

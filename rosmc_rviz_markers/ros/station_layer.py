@@ -1,12 +1,16 @@
-"""The station marker in rviz: the mission clock over the lander, and *Open command window*.
+"""The station in rviz: the mission clock over the lander, and *Open command window*.
 
-One interactive marker, ``station``, floats above the science score: its text is the mission
-clock (the simulation's time since it started; in a replay the replayed time; UTC without
-a simulation), and its menu (right click) holds *Open command window*, which brings the
-command window to the front, or starts one when none is running.
+The clock floats above the science score: the simulation's time since it started (in a
+replay the replayed time; UTC without a simulation), a text marker on a topic of its own,
+so that its tick every second costs one small message and never an interactive-marker
+update. Just above it, the interactive marker ``station`` reads *command window ▾*; a click
+(or right click) opens its menu, whose *Open command window* brings the command window to
+the front, or starts one when none is running.
 
-ROS interface:
-    Publishes ``/rosmc/station/show_command`` (std_msgs/Empty; the command window listens).
+ROS interface (behind ``~ns``):
+    Publishes ``/rosmc/markers/clock`` (visualization_msgs/MarkerArray, latched: the clock)
+    and ``/rosmc/station/show_command`` (std_msgs/Empty, never prefixed: the command window
+    listens).
     Subscribes ``<ns>/rosmc/replay/state`` (rosmc/ReplayState) when the node follows a
     replay (``~ns`` set): the replayed time.
 """
@@ -28,18 +32,23 @@ from visualization_msgs.msg import (
     InteractiveMarkerControl,
     InteractiveMarkerFeedback,
     Marker,
+    MarkerArray,
     MenuEntry,
 )
 
 from rosmc_rqt_command.core.station_layout import MISSION, REPLAY, UTC, clock_text
 from rosmc_server import interface
 
+from .. import topics
 from .adapter import MarkerServer
 
 _log = logging.getLogger(__name__)
 STATION_MARKER = "station"
-STATION_AT = (0.0, 0.0, 10.9)  # over the lander, between its score (8 m) and server notes
+CLOCK_AT = (0.0, 0.0, 10.4)  # over the lander, above its score (8 m)
+STATION_AT = (0.0, 0.0, 11.4)  # the menu's label, above the clock, below the server notes
 CLOCK_TEXT = 0.8  # letter height (m), as the server notes
+LABEL_TEXT = 0.6
+LABEL = "command window ▾"
 OPEN_COMMAND = 1  # the menu entry's id
 OPEN_COMMAND_TITLE = "Open command window"
 COMMAND_WINDOW = ["rosrun", "rosmc", "rosmc_command"]
@@ -84,8 +93,19 @@ def live_clock() -> tuple[float | None, str]:
     return time.time() % 86400, UTC
 
 
-def station_marker(text: str) -> InteractiveMarker:
-    """The station marker showing ``text``, with its menu."""
+def clock_marker(text: str) -> Marker:
+    """The clock's text marker."""
+    marker = Marker(type=Marker.TEXT_VIEW_FACING, action=Marker.ADD, text=text, ns="clock")
+    marker.header.frame_id = interface.MAP_FRAME
+    marker.pose.position.x, marker.pose.position.y, marker.pose.position.z = CLOCK_AT
+    marker.pose.orientation.w = 1.0
+    marker.scale.z = CLOCK_TEXT
+    marker.color = ColorRGBA(0.85, 0.92, 1.0, 1.0)
+    return marker
+
+
+def station_marker() -> InteractiveMarker:
+    """The station marker: a label whose menu opens the command window."""
     marker = InteractiveMarker()
     marker.header.frame_id = interface.MAP_FRAME
     marker.name = STATION_MARKER
@@ -93,11 +113,11 @@ def station_marker(text: str) -> InteractiveMarker:
     marker.scale = 1.0
     marker.pose.position.x, marker.pose.position.y, marker.pose.position.z = STATION_AT
     marker.pose.orientation.w = 1.0
-    label = Marker(type=Marker.TEXT_VIEW_FACING, text=text)
-    label.scale.z = CLOCK_TEXT
-    label.color = ColorRGBA(0.85, 0.92, 1.0, 1.0)
+    label = Marker(type=Marker.TEXT_VIEW_FACING, text=LABEL)
+    label.scale.z = LABEL_TEXT
+    label.color = ColorRGBA(0.55, 0.75, 1.0, 1.0)
     control = InteractiveMarkerControl(
-        name="clock", interaction_mode=InteractiveMarkerControl.MENU, always_visible=True
+        name="menu", interaction_mode=InteractiveMarkerControl.MENU, always_visible=True
     )
     control.orientation.w = 1.0
     control.markers.append(label)
@@ -124,6 +144,9 @@ class StationLayer:
             self._replay.read if self._replay is not None else live_clock
         )
         self._show = rospy.Publisher(interface.SHOW_COMMAND_TOPIC, Empty, queue_size=1)
+        self._clock_pub = rospy.Publisher(
+            topics.topic(topics.CLOCK_TOPIC, prefix), MarkerArray, queue_size=1, latch=True
+        )
         self._started: subprocess.Popen[bytes] | None = None
         self._shown = ""
         self._stop = threading.Event()
@@ -140,12 +163,13 @@ class StationLayer:
             self._replay.close()
 
     def _run(self) -> None:
+        with self._lock:
+            self._server.insert(station_marker())
+            self._server.apply()
         while not self._stop.is_set():
             text = clock_text(*self._clock())
             if text != self._shown:
-                with self._lock:
-                    self._server.insert(station_marker(text))
-                    self._server.apply()
+                self._clock_pub.publish(MarkerArray(markers=[clock_marker(text)]))
                 self._shown = text
             self._stop.wait(TICK)
 

@@ -5,7 +5,7 @@ A real master, mission server and live marker node; real rviz started by ``rviz.
 as the standalone window is. The recording is opened with the mouse (File > Open
 recording…, the path typed into the dialog): rviz is started again on the replay's topics
 and the replay's marker node shows the replayed time; *Return to live* puts rviz back on the
-live topics. The window's clock shows the replayed time and then the mission time again.
+live topics. The window's clock shows the replayed time and then the live clock again.
 rviz killed with SIGKILL comes back (``respawn``) on the live topics.
 """
 
@@ -21,7 +21,7 @@ from typing import Any
 import pytest
 import rosgraph
 import rospy
-from visualization_msgs.msg import InteractiveMarkerInit
+from visualization_msgs.msg import MarkerArray
 
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
@@ -50,6 +50,12 @@ def subscribed(node: str) -> set[str]:
     return {topic for topic, nodes in subscribers if node in nodes}
 
 
+def subscribers_of(topic: str) -> set[str]:
+    """The nodes that subscribe to ``topic`` now."""
+    _pubs, subscribers, _services = rosgraph.Master("/station_test").getSystemState()
+    return {node for name, nodes in subscribers if name == topic for node in nodes}
+
+
 def view_pid() -> int | None:
     """The process id of the rviz that rviz_station runs (None while there is none)."""
     try:
@@ -60,16 +66,13 @@ def view_pid() -> int | None:
 
 
 def station_text(prefix: str) -> str | None:
-    """The station marker's text as the marker node under ``prefix`` publishes it."""
-    topic = f"{prefix}/rosmc/markers/update_full"
+    """The mission clock's text as the marker node under ``prefix`` publishes it."""
+    topic = f"{prefix}/rosmc/markers/clock"
     try:
-        init = rospy.wait_for_message(topic, InteractiveMarkerInit, timeout=5.0)
+        clock = rospy.wait_for_message(topic, MarkerArray, timeout=5.0)
     except rospy.ROSException:
         return None
-    for marker in init.markers:
-        if marker.name == "station":
-            return str(marker.controls[0].markers[0].text)
-    return None
+    return str(clock.markers[0].text) if clock.markers else None
 
 
 @pytest.fixture
@@ -79,6 +82,8 @@ def rviz(
     """A server, the live marker node and the operator's rviz on a virtual screen."""
     start_server()
     launch_process(["roslaunch", "rosmc", "markers.launch"], env=ros_master.env, name="markers")
+    # one roslaunch after the other: two starting together on a new master clash on its run id
+    qt_wait(lambda: "/rosmc/markers" in subscribers_of("/rosmc/markers/feedback"), START, "markers")
     tool = load_tool()
     with tool.virtual_screen(1600, 1000) as display:
         env = tool.rviz_environment(display, ros_master.env)
@@ -137,7 +142,7 @@ def test_open_recording_shows_the_replay_in_rviz_and_return_to_live_brings_it_ba
     qt_wait(on_replay, START, "rviz on the replay's topics")
     assert "/rosmc/markers/update" not in subscribed(VIEW)
     # ... where the replay's marker node shows the replayed time over the lander.
-    text = qt_wait(lambda: station_text("/replay"), START, "the replay's station marker")
+    text = qt_wait(lambda: station_text("/replay"), START, "the replay's clock")
     assert text.startswith("replay time "), text
     assert menu.clock.text().startswith("replay time "), menu.clock.text()
 
@@ -157,7 +162,7 @@ def test_open_recording_shows_the_replay_in_rviz_and_return_to_live_brings_it_ba
     qt_wait(on_live, START, "rviz on the live topics")
     assert not widget.backend.read_only
     qt_wait(lambda: menu.clock.text().startswith("UTC "), 10, "the live clock again")
-    assert station_text("")  # the live marker node's station marker is still there
+    assert station_text("")  # the live marker node's clock is still there
 
     # rviz killed (-9): roslaunch's respawn starts it again, on the live mission.
     first = view_pid()

@@ -8,8 +8,9 @@ as an operator starts it (``rosmc_command``). Driven with the mouse through ``xd
 * its *Show 3D view* button starts rviz, which opens on the left part, beside it: both
   inside the screen, no overlap;
 * the mission clock over the lander in rviz advances with the simulation;
-* with the command window closed, rviz's station marker (right click, *Open command
-  window*) starts a command window again, in its place beside rviz;
+* with the command window closed, rviz's station marker (*command window ▾* over the
+  clock, right click, *Open command window*) starts a command window again, in its place
+  beside rviz;
 * *Show 3D view* with rviz running brings rviz forward and starts no second rviz.
 """
 
@@ -38,7 +39,7 @@ REPO = Path(__file__).resolve().parents[2]
 TOOL = REPO / "tools" / "station_screenshot.py"
 SIZE = (1600, 1000)
 START = 180.0  # the simulated team, rviz under software OpenGL, on two busy cores
-STATION_AT = (0.0, 0.0, 10.9)  # rosmc_rviz_markers/ros/station_layer.py
+STATION_AT = (0.0, 0.0, 11.4)  # the menu's label: rosmc_rviz_markers/ros/station_layer.py
 RVIZ_VIEW = "/rviz_operator_view"
 
 
@@ -72,9 +73,9 @@ def pid(uri: str, node: str) -> int | None:
 
 
 def clock_seconds(env: dict[str, str]) -> int | None:
-    """The seconds the station marker in rviz shows (None before it shows a time)."""
+    """The seconds the mission clock in rviz shows (None before it shows a time)."""
     result = subprocess.run(
-        ["rostopic", "echo", "-n", "1", "/rosmc/markers/update_full"],
+        ["rostopic", "echo", "-n", "1", "/rosmc/markers/clock"],
         env=env,
         capture_output=True,
         text=True,
