@@ -3,7 +3,7 @@
 The clock floats above the science score: the simulation's time since it started (in a
 replay the replayed time; UTC without a simulation), a text marker on a topic of its own,
 so that its tick every second costs one small message and never an interactive-marker
-update. Just above it, the interactive marker ``station`` reads *command window ▾*; a click
+update. Just above it, the interactive marker ``station`` reads *[ command window ]*; a click
 (or right click) opens its menu, whose *Open command window* brings the command window to
 the front, or starts one when none is running.
 
@@ -48,7 +48,7 @@ CLOCK_AT = (0.0, 0.0, 10.4)  # over the lander, above its score (8 m)
 STATION_AT = (0.0, 0.0, 11.4)  # the menu's label, above the clock, below the server notes
 CLOCK_TEXT = 0.8  # letter height (m), as the server notes
 LABEL_TEXT = 0.6
-LABEL = "command window ▾"
+LABEL = "[ command window ]"  # ASCII: rviz's font has no arrows
 OPEN_COMMAND = 1  # the menu entry's id
 OPEN_COMMAND_TITLE = "Open command window"
 COMMAND_WINDOW = ["rosrun", "rosmc", "rosmc_command"]

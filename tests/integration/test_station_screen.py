@@ -8,9 +8,9 @@ as an operator starts it (``rosmc_command``). Driven with the mouse through ``xd
 * its *Show 3D view* button starts rviz, which opens on the left part, beside it: both
   inside the screen, no overlap;
 * the mission clock over the lander in rviz advances with the simulation;
-* with the command window closed, rviz's station marker (*command window ▾* over the
-  clock, right click, *Open command window*) starts a command window again, in its place
-  beside rviz;
+* with the command window closed, rviz's station marker (*[ command window ]* over the
+  clock: a click opens its menu, then *Open command window*) starts a command window
+  again, in its place beside rviz;
 * *Show 3D view* with rviz running brings rviz forward and starts no second rviz.
 """
 
@@ -150,7 +150,7 @@ def test_the_station_fits_one_screen_and_its_windows_open_each_other(
         assert box is not None, f"no 3D view on the screen ({shot('no_view')})"
         left, top, width, height = box
         col, row = project(STATION_AT, width, height)
-        click(left + round(col), top + round(row), button=3)  # right click: the menu
+        click(left + round(col), top + round(row))  # a click on the label: its menu
         time.sleep(1.0)
         menu_shot = shot("menu")
         tool.xdotool(display, "key", "Down", "Return")  # its entry: Open command window
