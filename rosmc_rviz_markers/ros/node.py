@@ -91,7 +91,7 @@ class MarkerNode:
         self.interaction = Interaction(self, config)
         self.coverage = CoverageLayer(config.ns)  # radio coverage and last-link marks
         # the mission clock over the lander, whose menu opens the command window
-        self.station = StationLayer(self.server, self._lock, config.ns)
+        self.station = StationLayer(self.server, self._lock, config.ns, menu=not config.read_only)
         self._tf: TfPresence | None = None  # which agents have TF (follow_tf only)
         self._worker = threading.Thread(target=self._run, name="rosmc-markers", daemon=True)
 

@@ -5,7 +5,8 @@ replay the replayed time; UTC without a simulation), a text marker on a topic of
 so that its tick every second costs one small message and never an interactive-marker
 update. Just above it, the interactive marker ``station`` reads *[ command window ]*; a click
 (or right click) opens its menu, whose *Open command window* brings the command window to
-the front, or starts one when none is running.
+the front, or starts one when none is running. A read-only view (a replay) shows the clock
+only: it has no menus.
 
 ROS interface (behind ``~ns``):
     Publishes ``/rosmc/markers/clock`` (visualization_msgs/MarkerArray, latched: the clock)
@@ -137,8 +138,11 @@ def station_marker() -> InteractiveMarker:
 class StationLayer:
     """Keeps the station marker's clock current and answers its menu (see the module)."""
 
-    def __init__(self, server: MarkerServer, lock: threading.Lock, prefix: str) -> None:
+    def __init__(
+        self, server: MarkerServer, lock: threading.Lock, prefix: str, menu: bool = True
+    ) -> None:
         self._server, self._lock = server, lock
+        self._menu = menu  # a read-only view (a replay) has no menus at all
         self._replay = ReplayClock(prefix) if prefix else None
         self._clock: Callable[[], tuple[float | None, str]] = (
             self._replay.read if self._replay is not None else live_clock
@@ -163,9 +167,10 @@ class StationLayer:
             self._replay.close()
 
     def _run(self) -> None:
-        with self._lock:
-            self._server.insert(station_marker())
-            self._server.apply()
+        if self._menu:
+            with self._lock:
+                self._server.insert(station_marker())
+                self._server.apply()
         while not self._stop.is_set():
             text = clock_text(*self._clock())
             if text != self._shown:
