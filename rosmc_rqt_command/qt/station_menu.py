@@ -51,7 +51,7 @@ class StationMenu:
         self.show_3d.triggered.connect(self._on_show_3d_triggered)
         self.quit = QAction("&Quit", widget)
         self.quit.setObjectName("quit")
-        self.quit.setShortcut(QKeySequence.Quit)
+        self.quit.setShortcut(QKeySequence("Ctrl+Q"))  # the standard key is empty on some platforms
         self.quit.triggered.connect(lambda _=False: quit_())
         menu_bar = widget.menu_bar
         file_menu = menu_bar.actions()[0].menu()

@@ -132,3 +132,20 @@ def test_the_command_window_is_whole_in_its_share_of_the_screen(
     assert menu.clock.text() == "mission time 1:02:03"
     assert menu.clock.isVisible() and menu.clock.width() >= menu.clock.sizeHint().width()
     assert main.rect().contains(inside(main, menu.clock))
+
+
+def test_file_quit_closes_the_window_and_show_3d_view_says_what_it_did(
+    station_window: tuple[Gui, QMainWindow, StationMenu],
+) -> None:
+    gui, main, menu = station_window
+    said: list[str] = []
+    menu.hooks = StationHooks(
+        lambda: said.append("asked") or "Starting the 3D view (rviz).", menu.hooks.clock
+    )
+    file_menu = gui.widget.menu_bar.actions()[0].menu()
+    assert menu.quit in file_menu.actions() and menu.quit.shortcut().toString() == "Ctrl+Q"
+    menu.show_3d.trigger()
+    assert said == ["asked"]
+    assert any(m.endswith("Starting the 3D view (rviz).") for m in gui.widget.messages.messages())
+    menu.quit.trigger()
+    assert not main.isVisible()
