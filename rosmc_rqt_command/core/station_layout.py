@@ -50,11 +50,18 @@ class Station:
 
 
 def split_screen(screen: Rect) -> Station:
-    """rviz left, the command window right, both inside ``screen`` (its available area)."""
-    wanted = round(screen.width * COMMAND_SHARE)
-    command_width = max(min(wanted, COMMAND_MAX_WIDTH), min(COMMAND_MIN_WIDTH, screen.width // 2))
-    rviz_width = screen.width - command_width - GAP
+    """rviz left, the command window right, both inside ``screen`` (its available area).
+
+    A screen narrower than two command windows (under 1120 px) is not split: each window
+    takes all of it, one over the other.
+    """
     top, height = screen.y + TITLE_BAR, screen.height - TITLE_BAR
+    if screen.width < 2 * COMMAND_MIN_WIDTH:
+        whole = Rect(screen.x, top, screen.width, height)
+        return Station(rviz=whole, command=whole)
+    wanted = round(screen.width * COMMAND_SHARE)
+    command_width = min(max(wanted, COMMAND_MIN_WIDTH), COMMAND_MAX_WIDTH)
+    rviz_width = screen.width - command_width - GAP
     return Station(
         rviz=Rect(screen.x, top, rviz_width, height),
         command=Rect(screen.x + rviz_width + GAP, top, command_width, height),

@@ -50,6 +50,11 @@ def test_the_two_windows_share_the_screen_without_overlap(size: tuple[int, int])
     assert 560 <= station.command.width <= station.rviz.width
 
 
+def test_a_screen_too_narrow_for_two_windows_gives_each_all_of_it() -> None:
+    station = split_screen(Rect(0, 0, 800, 600))
+    assert station.rviz == station.command == Rect(0, 32, 800, 568)
+
+
 def test_a_panel_on_the_left_moves_both_windows() -> None:
     station = split_screen(Rect(64, 0, 1536, 1000))  # a dock 64 px wide on the left
     assert station.rviz.x == 64 and station.command.right == 1600
