@@ -23,6 +23,7 @@ from python_qt_binding.QtWidgets import QApplication, QMainWindow, QWidget
 from rosmc_server.ros.client import init_node
 
 from .core.pending_backend import PendingBackend, follows_replay
+from .core.station_layout import MISSION
 from .core.view_state import ViewUpdate
 from .qt.command_widget import CommandWidget
 from .qt.replay_mode import ReplayHooks, ReplayMode, ReplaySteering
@@ -241,9 +242,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     replay = follows_replay(options.ns)
     title = "ROSMC command" + (f" — following {options.ns} (read-only)" if replay else "")
     window = CommandWindow(widget, title)
-    live.menu = StationMenu(
-        widget, StationHooks(_not_yet, lambda: (None, "mission time")), window.close
-    )
+    live.menu = StationMenu(widget, StationHooks(_not_yet, lambda: (None, MISSION)), window.close)
     if report is not None:
         report.watch(window)
     window.show()

@@ -16,7 +16,7 @@ from python_qt_binding.QtCore import QTimer
 from python_qt_binding.QtGui import QKeySequence
 from python_qt_binding.QtWidgets import QAction, QHBoxLayout, QLabel, QToolButton, QWidget
 
-from ..core.station_layout import clock_text
+from ..core.station_layout import MISSION, clock_text
 
 if TYPE_CHECKING:
     from .command_widget import CommandWidget
@@ -62,7 +62,7 @@ class StationMenu:
         self.clock.setObjectName("mission_clock")
         self.clock.setToolTip("Mission time: the simulation's time since it started")
         # as wide as its longest reading, so that the menu bar's corner never cuts it
-        widest = self.clock.fontMetrics().horizontalAdvance(clock_text(359999, "mission time"))
+        widest = self.clock.fontMetrics().horizontalAdvance(clock_text(359999, MISSION))
         self.clock.setMinimumWidth(widest + 4)
         button = QToolButton()
         button.setObjectName("show_3d_button")
