@@ -133,7 +133,11 @@ class Station:
 
 @contextlib.contextmanager
 def station_screen(size: tuple[int, int], home: Path) -> Iterator[Station]:
-    """Xvfb of ``size`` and a ROS environment for a master on a free port in ``home``."""
+    """Xvfb of ``size`` and a master of its own on a free port, with ``home`` as ROS_HOME.
+
+    The master is started and stopped here: one that roslaunch started could outlive a
+    launch that had to be killed.
+    """
     (home / "log").mkdir(parents=True, exist_ok=True)
     with shots.virtual_screen(*size) as display:
         port = free_port()
@@ -145,7 +149,24 @@ def station_screen(size: tuple[int, int], home: Path) -> Iterator[Station]:
             ROS_HOME=str(home),
             ROS_LOG_DIR=str(home / "log"),
         )
-        yield Station(display, port, env, home)
+        with (home / "master.log").open("wb") as log:
+            master = subprocess.Popen(
+                ["rosmaster", "--core", "-p", str(port)],
+                env=env,
+                stdout=log,
+                stderr=subprocess.STDOUT,
+                start_new_session=True,
+            )
+        try:
+            wait_for(lambda: _listening(port), 30.0, "the master")
+            yield Station(display, port, env, home)
+        finally:
+            shots.stop_group(master, shots.signal.SIGTERM)
+
+
+def _listening(port: int) -> bool:
+    with socket.socket() as probe:
+        return probe.connect_ex(("127.0.0.1", port)) == 0
 
 
 def stop(process: subprocess.Popen[bytes]) -> None:
@@ -160,7 +181,7 @@ def wait_for(check: object, timeout: float, what: str) -> object:
         value = check()  # type: ignore[operator]
         if value:
             return value
-        time.sleep(1.0)
+        time.sleep(0.2)
     raise TimeoutError(f"{what}: not within {timeout:g} s")
 
 
