@@ -12,6 +12,9 @@ as an operator starts it (``rosmc_command``). Driven with the mouse through ``xd
   clock: a click opens its menu, then *Open command window*) starts a command window
   again, in its place beside rviz;
 * *Show 3D view* with rviz running brings rviz forward and starts no second rviz.
+
+At 1280x800 and 1920x1080 the whole ``operator.launch`` opens both windows side by side,
+inside the screen, without overlap (rviz's own minimum width fits its part).
 """
 
 from __future__ import annotations
@@ -25,6 +28,7 @@ import time
 import xmlrpc.client
 from pathlib import Path
 from types import ModuleType
+from typing import Any
 
 import pytest
 import rosgraph
@@ -169,3 +173,33 @@ def test_the_station_fits_one_screen_and_its_windows_open_each_other(
         view_nodes = [n for n in nodes(uri) if n.startswith("/rviz_operator")]
         assert sorted(view_nodes) == ["/rviz_operator", RVIZ_VIEW], view_nodes
         shot("station")
+
+
+@pytest.mark.usefixtures("gui_programs")
+@pytest.mark.parametrize("size", [(1280, 800), (1920, 1080)], ids=lambda s: f"{s[0]}x{s[1]}")
+def test_the_station_fits_smaller_and_larger_screens(
+    launch_process: LaunchProcess, tmp_path: Path, size: tuple[int, int]
+) -> None:
+    if shutil.which("xdotool") is None:
+        pytest.fail("xdotool is not installed (make setup installs it)")
+    tool = load_tool()
+    with tool.station_screen(size, tmp_path / "home") as station:
+        args = ["sim:=true", f"journal_dir:={tmp_path}"]
+        launch = ["roslaunch", "-p", str(station.port), "rosmc", "operator.launch", *args]
+        launch_process(launch, env=dict(station.env), name="station", cwd=tmp_path)
+        display = station.display
+
+        def both() -> tuple[Any, Any] | None:
+            command, rviz = tool.command_window(display), tool.rviz_window(display)
+            return (command, rviz) if command and rviz else None
+
+        command, rviz = wait_until(both, START, "both windows")
+        time.sleep(3.0)  # rviz has laid out its panels: a minimum width would show now
+        command, rviz = both() or (command, rviz)
+        shot = tmp_path / "station.png"
+        tool.shots.grab(display).write_png(shot)
+        assert not rviz.overlaps(command), f"{rviz} overlaps {command} ({shot})"
+        for box in (rviz, command):
+            assert box.x >= 0 and box.x + box.width <= size[0], f"{box} ({shot})"
+            assert box.y >= 0 and box.y + box.height <= size[1], f"{box} ({shot})"
+        assert rviz.x == 0 and command.x + command.width == size[0]
