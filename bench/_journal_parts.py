@@ -21,8 +21,8 @@ import yaml
 from _missions import library_yaml, mission_yaml
 
 from rosmc_server.conversions import mission_to_msg
-from rosmc_server.core.library import library_from_dict
-from rosmc_server.core.persistence import parse_mission
+from rosmc_server.core.files.persistence import parse_mission
+from rosmc_server.core.skills.library import library_from_dict
 from rosmc_server.recording import JournalOptions
 from rosmc_server.recording.mission_journal import MissionJournal
 

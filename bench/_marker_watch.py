@@ -183,14 +183,14 @@ class FakeRobot:
 
     def hello(self) -> None:
         """Send an empty snapshot, so that the server learns the report numbering."""
-        from rosmc_server.core.link import queue_hash
+        from rosmc_server.core.robots.link import queue_hash
 
         self._snapshot.publish(
             self._wire.ExecutorSnapshot(agent=self.agent, queue_hash=queue_hash([]), state="idle")
         )
 
     def _on_command(self, msg: Any) -> None:
-        from rosmc_server.core.link import queue_hash
+        from rosmc_server.core.robots.link import queue_hash
 
         ids = [skill.id for skill in msg.skills]
         if msg.type == self._wire.RobotCommand.UPLOAD:

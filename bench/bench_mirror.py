@@ -51,10 +51,10 @@ from rosmc_server.core import (  # noqa: E402
     SkillStatus,
     TaskMarker,
 )
-from rosmc_server.core.library import library_from_dict  # noqa: E402
-from rosmc_server.core.mirror import MissionMirror  # noqa: E402
-from rosmc_server.core.persistence import parse_mission  # noqa: E402
-from rosmc_server.core.updates import MirrorUpdate  # noqa: E402
+from rosmc_server.core.files.persistence import parse_mission  # noqa: E402
+from rosmc_server.core.live.mirror import MissionMirror  # noqa: E402
+from rosmc_server.core.live.updates import MirrorUpdate  # noqa: E402
+from rosmc_server.core.skills.library import library_from_dict  # noqa: E402
 
 TARGET = {"apply_p95_ms": 1.0, "callback_after_reply_p95_ms": 5.0}
 

@@ -62,8 +62,8 @@ def write_journal(path: Path, edits: int, closed: bool, agents: int, skills: int
     from rosmc_server.conversions.event_packing import packed_event
     from rosmc_server.conversions.packing import SnapshotPacker
     from rosmc_server.core import Mission
-    from rosmc_server.core.library import library_from_dict
-    from rosmc_server.core.persistence import parse_mission
+    from rosmc_server.core.files.persistence import parse_mission
+    from rosmc_server.core.skills.library import library_from_dict
     from rosmc_server.recording import JournalOptions, JournalWriter
 
     library = library_from_dict(yaml.safe_load(library_yaml(agents)))
@@ -124,7 +124,7 @@ def measure_resume(path: Path) -> dict[str, Any]:
     """The server's resume: reopen a copy, pick the latest state, rebuild the mission."""
     from rosmc_server.conversions import event_from_msg, mission_from_msg
     from rosmc_server.core import Mission
-    from rosmc_server.core.library import Library  # noqa: F401  (import cost before timing)
+    from rosmc_server.core.skills.library import Library  # noqa: F401  (import cost before timing)
     from rosmc_server.recording import JournalOptions, JournalWriter, latest_state
     from rosmc_server.recording._mcap.files import journal_parts, part_path
 
@@ -163,7 +163,7 @@ def _library() -> Any:
     import yaml
     from _missions import library_yaml
 
-    from rosmc_server.core.library import library_from_dict
+    from rosmc_server.core.skills.library import library_from_dict
 
     return library_from_dict(yaml.safe_load(library_yaml(2)))
 

@@ -31,7 +31,7 @@ from python_qt_binding.QtCore import QObject, Signal
 
 from rosmc_server import interface
 from rosmc_server.core import Library, RosmcError
-from rosmc_server.core.updates import MirrorUpdate
+from rosmc_server.core.live.updates import MirrorUpdate
 from rosmc_server.ros.client import (
     AsyncMissionClient,
     MissionClient,
@@ -69,8 +69,8 @@ class RosBridge(QObject):  # type: ignore[misc]
     server_restarted = Signal(int)  # the revision a new server process resumed at
     journal_alert = Signal(str)  # the server's journal alert ("" once it clears)
     selection_received = Signal(list, list)  # skill ids, marker names
-    science_received = Signal(object)  # rosmc_server.core.science.Science
-    site_received = Signal(object)  # rosmc_server.core.site_source.SiteInForce | None
+    science_received = Signal(object)  # rosmc_server.core.views.science.Science
+    site_received = Signal(object)  # rosmc_server.core.world.site_source.SiteInForce | None
 
     def __init__(self, prefix: str = "", timeout: float = 5.0) -> None:
         super().__init__()

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from .core import Mission, MissionEvent, Pose, SkillStatus, TaskMarker, load_library
-from .core.params import MarkerType
+from .core.skills.params import MarkerType
 from .text import format_tasks
 
 LIBRARY = Path(__file__).resolve().parent / "config" / "mars_team.yaml"

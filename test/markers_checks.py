@@ -18,7 +18,7 @@ from visualization_msgs.msg import InteractiveMarkerInit, InteractiveMarkerUpdat
 from rosmc_rviz_markers.core.specs import robot_name, task_name  # noqa: E402
 from rosmc_rviz_markers.topics import MARKERS_NS  # noqa: E402
 from rosmc_server.core import Pose, TaskMarker  # noqa: E402
-from rosmc_server.core.params import MarkerType  # noqa: E402
+from rosmc_server.core.skills.params import MarkerType  # noqa: E402
 from rosmc_server.ros.client import MissionClient  # noqa: E402
 
 ROBOTS = ("drone", "science_rover", "manipulator_rover")

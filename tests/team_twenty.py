@@ -17,7 +17,7 @@ from typing import Any
 import yaml
 
 from rosmc_server.core import AgentStatus, Library, SkillStatus
-from rosmc_server.core.library import library_from_dict
+from rosmc_server.core.skills.library import library_from_dict
 from rosmc_sim.core.scenario import load_scenario
 
 REPO = Path(__file__).resolve().parents[1]

@@ -11,7 +11,8 @@ The generated part sits in docs/reference.md between ``<!-- BEGIN MSG REFERENCE 
 Messages and services come from rosmc_msgs/msg and rosmc_msgs/srv: each type gets its
 leading comment as a description, a table of constants and a table of fields (type, name,
 the field's comment). Comment lines between definitions are attached to the definition below
-them. Field types that are rosmc types link to their own section.
+them, but an indented one right after a commented definition goes on with that comment.
+Field types that are rosmc types link to their own section.
 
 Node parameters come from each node's module: every private parameter the
 code reads with ``rospy.get_param("~name", default)``, its default when it is a literal, and
@@ -78,18 +79,24 @@ def parse_section(lines: list[str], leading_description: bool) -> Section:
     """Parse the lines of a .msg file (or of one side of a .srv file)."""
     section = Section()
     pending: list[str] = []  # comment lines waiting for the definition below them
+    previous: Field | Constant | None = None  # the commented definition just above
     in_header = leading_description
     for raw in lines:
         line = raw.rstrip()
         stripped = line.strip()
         if not stripped:
+            previous = None
             if in_header and pending:
                 section.description.extend(pending)
                 pending = []
             in_header = False
             continue
         if stripped.startswith("#"):
-            pending.append(_comment_text(stripped))
+            if previous is not None and not pending and raw[:1].isspace():
+                # an indented comment line goes on with the comment of the line above
+                previous.comment = _join(previous.comment, _comment_text(stripped).strip())
+            else:
+                pending.append(_comment_text(stripped))
             continue
         if in_header:
             # A last header line ending in ':' heads the definitions below it instead.
@@ -112,6 +119,7 @@ def parse_section(lines: list[str], leading_description: bool) -> Section:
                     constant.group("type"), constant.group("name"), value, _join(note, comment)
                 )
             )
+            previous = section.constants[-1] if comment else None
             continue
         parsed = _FIELD.match(stripped)
         if not parsed:
@@ -120,6 +128,7 @@ def parse_section(lines: list[str], leading_description: bool) -> Section:
         section.fields.append(
             Field(parsed.group("type"), parsed.group("name"), _join(note, comment))
         )
+        previous = section.fields[-1] if comment else None
     if in_header:
         section.description.extend(pending)
     return section

@@ -4,6 +4,7 @@
   wait at the barrier for ever unless the partner is sent too.
 * A robot about to leave Wi-Fi coverage (weak signal), or out of it, while it still has
   planned work not sent: once out of range, what is sent waits until it is heard again.
+  The signal is said in a word; its dBm are in the robot header's tooltip.
 * A skill whose parameter the library marks invalid (out of range, wrong type).
 * A robot whose radio link dropped forged datagrams (unsigned, wrong key, replayed).
 
@@ -17,8 +18,8 @@ import time
 from collections.abc import Iterable, Sequence
 
 from rosmc_server.core import Library, RosmcError, SkillInstance
-from rosmc_server.core.advice import stranded_barriers
-from rosmc_server.core.vocabulary import counted
+from rosmc_server.core.rules.advice import stranded_barriers
+from rosmc_server.core.views.vocabulary import counted
 
 from .mission_view import MissionView
 
@@ -27,7 +28,7 @@ WEAK_WIFI_DBM = -75.0  # below this a robot is about to lose the link
 
 def barrier_warnings(view: MissionView, sending: Sequence[SkillInstance] = ()) -> list[str]:
     """Barrier members on a robot (or being sent) whose partners are still planned (the
-    core's rule, :func:`~rosmc_server.core.advice.stranded_barriers`, worded here)."""
+    core's rule, :func:`~rosmc_server.core.rules.advice.stranded_barriers`, worded here)."""
     out = []
     for stranded in stranded_barriers(view, view.barriers, [s.id for s in sending]):
         robots = ", ".join(s.agent for s in stranded.going)
@@ -56,7 +57,7 @@ def coverage_warnings(view: MissionView) -> list[str]:
             )
         elif status.wifi_signal < WEAK_WIFI_DBM:
             out.append(
-                f"{agent} is about to leave Wi-Fi range ({status.wifi_signal:.0f} dBm) "
+                f"{agent} is about to leave Wi-Fi range (weak signal) "
                 f"with {skills} not on board; send them now."
             )
     return out

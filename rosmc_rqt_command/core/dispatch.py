@@ -12,7 +12,8 @@ from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, ParamSpec
 
 from rosmc_server.core import SkillInstance
-from rosmc_server.core.control import ControlCommand
+from rosmc_server.core.live.edit_history import EditKind
+from rosmc_server.core.model.control import ControlCommand
 
 from . import alerts
 from .legality import Action, RobotAction, legal_actions, legal_robot_actions, selection_agent
@@ -60,11 +61,15 @@ class Dispatcher:
         self._legal_for_all = legal_for_all
 
     def call(
-        self, pick: Callable[[MissionClient], Callable[P, object]], what: str
+        self,
+        pick: Callable[[MissionClient], Callable[P, object]],
+        what: str,
+        kind: EditKind | None = None,
     ) -> Callable[P, None]:
         """A sender of one call of the client method ``pick`` chooses, against the revision
-        shown: ``call(lambda c: c.retry_skill, "retry 'go'")(skill_id)``."""
-        make = ask(pick, what, self._view.revision)
+        shown: ``call(lambda c: c.retry_skill, "retry 'go'")(skill_id)``; ``kind``: the
+        edit it makes (undo can take it back)."""
+        make = ask(pick, what, self._view.revision, kind=kind)
 
         def send(*args: P.args, **kwargs: P.kwargs) -> None:
             self._send(make(*args, **kwargs))
@@ -90,12 +95,16 @@ class Dispatcher:
         handlers[kind](kind, selected, names)
 
     def _delete(self, _: Action, selected: Sequence[SkillInstance], names: str) -> None:
-        self.call(lambda c: c.delete_skills, f"delete {names}")([s.id for s in selected])
+        self.call(lambda c: c.delete_skills, f"delete {names}", EditKind.DELETE_SKILLS)(
+            [s.id for s in selected]
+        )
 
     def _move(self, kind: Action, selected: Sequence[SkillInstance], names: str) -> None:
         agent = selected[0].agent
         order = moved([s.id for s in self._view.view(agent).editable], selected, kind)
-        self.call(lambda c: c.reorder_skills, f"move {names}")(agent, order)
+        self.call(lambda c: c.reorder_skills, f"move {names}", EditKind.REORDER_SKILLS)(
+            agent, order
+        )
 
     def _sync(self, _: Action, selected: Sequence[SkillInstance], names: str) -> None:
         view = self._view
@@ -121,12 +130,16 @@ class Dispatcher:
             self.call(lambda c: c.skip_skill, f"skip {names}")(selected[0].id)
 
     def _barrier(self, _: Action, selected: Sequence[SkillInstance], names: str) -> None:
-        self.call(lambda c: c.add_barrier, f"start {names} together")([s.id for s in selected])
+        self.call(lambda c: c.add_barrier, f"start {names} together", EditKind.ADD_BARRIER)(
+            [s.id for s in selected]
+        )
 
     def _delete_barrier(self, _: Action, selected: Sequence[SkillInstance], names: str) -> None:
         barriers = {b.id for s in selected if (b := self._view.barrier_of(s.id)) is not None}
         for barrier_id in sorted(barriers):
-            self.call(lambda c: c.delete_barrier, f"remove barrier of {names}")(barrier_id)
+            self.call(
+                lambda c: c.delete_barrier, f"remove barrier of {names}", EditKind.DELETE_BARRIER
+            )(barrier_id)
 
     def robot_action(self, agent: str | None, kind: RobotAction) -> None:
         """Run ``kind`` on ``agent`` (None: every robot), if it is legal now."""

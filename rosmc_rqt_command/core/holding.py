@@ -1,11 +1,13 @@
-"""A robot holding after its lost-link policy acted: it starts no new work until resumed.
+"""A robot holding after its lost-link policy acted, and every barrier wait, for the GUI.
 
 When a robot's lost-link policy acts (hold, or return to where it last had a link, then
-hold) the executor pauses itself, and its policy line ends "…; holding" or says "held after
-N s without ground contact" (the words of ``rosmc_server/executor/core/lost_link.py``).
-Work sent to it meanwhile waits on board, and the partners of its barriers wait for it,
-until the operator presses Resume. :func:`lost_link_hold` finds such a robot in the view
-and :class:`Hold` says it in the operator's words. No Qt here.
+hold) the robot reports why it holds (``AgentStatus.hold``, a
+:class:`~rosmc_server.core.model.control.HoldCause`). Work sent to it meanwhile waits on board,
+and the partners of its barriers wait for it, until the operator presses Resume.
+:func:`lost_link_hold` finds such a robot in the view and :class:`Hold` says it in the
+operator's words (:mod:`rosmc_server.core.views.holding`, shared with rviz and ``rosmc``);
+:func:`barrier_wait` says what a robot waiting at a barrier waits for, and since how long.
+No Qt here.
 """
 
 from __future__ import annotations
@@ -14,13 +16,11 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 from rosmc_server.core import SkillStatus
-from rosmc_server.core.control import ExecutorState
-from rosmc_server.core.link import LinkStatus
+from rosmc_server.core.model.control import HoldCause
+from rosmc_server.core.robots.link import LinkStatus
+from rosmc_server.core.views import holding as words
 
 from .mission_view import MissionView
-
-# How the executor's lost-link note says that the robot holds (see lost_link.py).
-HOLD_MARKS = ("; holding", "held after")
 
 
 @dataclass(frozen=True)
@@ -31,22 +31,17 @@ class Hold:
         agent: The robot.
         link_back: The ground hears it again (a Resume reaches it at once).
         partners: Robots with a barrier member that waits for this robot, in order.
+        cause: Why (and so where) it holds.
     """
 
     agent: str
     link_back: bool
     partners: tuple[str, ...]
+    cause: HoldCause = HoldCause.LOST_LINK
 
     def sentence(self) -> str:
-        """What the robot's header and the warnings say, ending with what frees it."""
-        agent = self.agent
-        when = "after its link came back" if self.link_back else "out of contact"
-        text = f"{agent} is holding {when}: it will not start new work"
-        if self.partners:
-            text += f"; its barrier partners {', '.join(self.partners)} wait for it"
-        if self.link_back:
-            return f"{text}. Press Resume {agent}."
-        return f"{text}. Resume {agent} goes out when it is heard again."
+        """What the robot's header and the warnings say; the Resume button follows it."""
+        return words.hold_sentence(self.agent, self.cause, self.partners, self.link_back)
 
     def sending_warning(self) -> str:
         """The warning in the question before work is sent to the robot."""
@@ -59,25 +54,15 @@ class Hold:
 def lost_link_hold(view: MissionView, agent: str) -> Hold | None:
     """``agent``'s hold, or None when it is not holding after its lost-link policy."""
     status = view.statuses.get(agent)
-    if status is None or status.executor is not ExecutorState.PAUSED:
+    if status is None or status.hold is HoldCause.NONE:
         return None
-    if not any(mark in status.policy for mark in HOLD_MARKS):
-        return None
-    return Hold(agent, status.link is LinkStatus.UP, barrier_partners(view, agent))
+    partners = barrier_partners(view, agent)
+    return Hold(agent, status.link is LinkStatus.UP, partners, status.hold)
 
 
 def barrier_partners(view: MissionView, agent: str) -> tuple[str, ...]:
     """Robots whose barrier member waits for a member of ``agent`` that has not run yet."""
-    partners: dict[str, None] = {}
-    for barrier in view.barriers:
-        members = view.skills(barrier.skill_ids)
-        own = [s for s in members if s.agent == agent]
-        if not own or any(s.status.is_final or s.status is SkillStatus.RUNNING for s in own):
-            continue  # this robot's member already ran (or runs): nobody waits for it
-        for skill in members:
-            if skill.agent != agent and not skill.status.is_final:
-                partners[skill.agent] = None
-    return tuple(partners)
+    return words.barrier_partners(view.barriers, view.skill, agent)
 
 
 def holds(view: MissionView) -> list[Hold]:
@@ -88,3 +73,21 @@ def holds(view: MissionView) -> list[Hold]:
 def hold_warnings(view: MissionView, agents: Iterable[str]) -> list[str]:
     """The warnings for sending work to ``agents``: those holding will not start it."""
     return [hold.sending_warning() for a in agents if (hold := lost_link_hold(view, a))]
+
+
+def barrier_wait(view: MissionView, agent: str) -> str:
+    """``waits for r4 at barrier B2 since 1 min 32 s``; "" if ``agent`` waits at none.
+
+    The names are the partners whose member has not arrived at the barrier (as the
+    mission shows it); the age is the robot's own (``AgentStatus.barrier_wait``).
+    """
+    status = view.statuses.get(agent)
+    if status is None or not status.current_skill:
+        return ""
+    skill = view.skill(status.current_skill)
+    barrier = view.barrier_of(status.current_skill)
+    if skill is None or barrier is None or skill.status is not SkillStatus.SYNCWAITING:
+        return ""
+    missing = words.not_arrived(view.skills(barrier.skill_ids), agent)
+    name = f"B{view.barrier_number(skill.id)}"
+    return f"{agent} {words.wait_sentence(missing, name, status.barrier_wait)}"

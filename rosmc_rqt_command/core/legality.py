@@ -1,6 +1,6 @@
 """Which operator actions make sense for the current selection (so buttons can be enabled).
 
-The rules live in :mod:`rosmc_server.core.legality`, where the server's own checks use
+The rules live in :mod:`rosmc_server.core.rules.legality`, where the server's own checks use
 them: a button is enabled exactly when the server would accept its request against the
 mission shown. This module applies them to the GUI's :class:`~.mission_view.MissionView`
 and keeps each robot's result between updates. No Qt here.
@@ -11,10 +11,10 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 
 from rosmc_server.core import SkillInstance
-from rosmc_server.core.control import ExecutorState
-from rosmc_server.core.legality import RobotAction, legal_skill_actions, selection_agent
-from rosmc_server.core.legality import SkillAction as Action
-from rosmc_server.core.legality import legal_robot_actions as robot_rules
+from rosmc_server.core.model.control import ExecutorState
+from rosmc_server.core.rules.legality import RobotAction, legal_skill_actions, selection_agent
+from rosmc_server.core.rules.legality import SkillAction as Action
+from rosmc_server.core.rules.legality import legal_robot_actions as robot_rules
 
 from .mission_view import MissionView
 

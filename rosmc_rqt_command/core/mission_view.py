@@ -1,7 +1,8 @@
 """The GUI thread's picture of the mission: the latest :class:`TaskView` of every robot.
 
-:class:`MissionView` takes :class:`~.view_state.ViewUpdate` values in order (applying each
-update's skill deltas to its own task lists) and answers the read-only questions panels
+:class:`MissionView` takes :class:`~.view_state.ViewUpdate` values in order (a reset's copy
+of the mission, then each update's event applied to it with the one applier,
+:func:`~rosmc_server.core.live.updates.apply_event`) and answers the read-only questions panels
 ask (which skill has this id, which barrier holds it, what a robot reports). It lives on
 the GUI thread only, so nothing here needs a lock.
 """
@@ -9,22 +10,23 @@ the GUI thread only, so nothing here needs a lock.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import replace
 
 from rosmc_server.core import (
     AgentStatus,
     Barrier,
     Library,
+    MissionState,
     SkillInstance,
     SkillStatus,
     TaskMarker,
 )
-from rosmc_server.core.legality import TaskView
-from rosmc_server.core.link import LinkStatus
-from rosmc_server.core.updates import SkillAdded, SkillChanged, SkillRemoved
+from rosmc_server.core.live.updates import apply_event
+from rosmc_server.core.model.control import HoldCause
+from rosmc_server.core.robots.link import LinkStatus
+from rosmc_server.core.rules.legality import TaskView
 
 from . import presentation
-from .view_state import ViewUpdate, apply_delta, barrier_tags, delta_agent
+from .view_state import ViewUpdate, barrier_tags
 
 
 class MissionView:
@@ -34,12 +36,11 @@ class MissionView:
         self.revision = -1
         self.library: Library | None = None
         self.library_name = ""
-        self.agents: dict[str, TaskView] = {}  # each over its task list in _tasks
-        self._tasks: dict[str, list[SkillInstance]] = {}
+        self.agents: dict[str, TaskView] = {}  # each over its task in _state
+        self._state: MissionState | None = None  # the GUI thread's own copy
         self.barriers: tuple[Barrier, ...] = ()
         self.markers: dict[str, TaskMarker] = {}
         self.statuses: dict[str, AgentStatus] = {}
-        self._skills: dict[str, SkillInstance] = {}
         self._tags: dict[str, tuple[int, Barrier]] = {}
 
     @property
@@ -48,16 +49,18 @@ class MissionView:
         return self.revision >= 0
 
     def apply(self, update: ViewUpdate) -> None:
-        """Take one update (in revision order): a reset's tasks, or the skill deltas."""
-        if update.reset:
-            self._tasks = {view.agent: list(view.skills) for view in update.agents}
-            self._skills = {skill.id: skill for view in update.agents for skill in view.skills}
+        """Take one update (in revision order): a reset's mission, or the event it applied."""
+        if update.reset and update.state is not None:
+            self._state = update.state
             self.agents = {
-                view.agent: replace(view, skills=self._tasks[view.agent]) for view in update.agents
+                agent: TaskView.live(update.state, agent) for agent in update.state.agents
             }
             self.library_name = update.library
-        elif self.loaded:  # before the first snapshot there is nothing to change
-            self._apply_deltas(update)
+        elif self._state is not None and update.event is not None:
+            # before the first snapshot there is nothing to change
+            apply_event(self._state, update.event)
+            for agent in update.touched:
+                self.agents[agent] = TaskView.live(self._state, agent)
         if update.barriers is not None:
             self.barriers = update.barriers
             self._tags = barrier_tags(update.barriers)
@@ -70,34 +73,15 @@ class MissionView:
         elif self.loaded:
             self.revision = max(self.revision, update.revision)
 
-    def _apply_deltas(self, update: ViewUpdate) -> None:
-        for delta in update.deltas:
-            apply_delta(self._tasks.setdefault(delta_agent(delta), []), delta)
-            if isinstance(delta, SkillRemoved):
-                self._skills.pop(delta.skill.id, None)
-            elif isinstance(delta, SkillChanged):
-                self._skills[delta.new.id] = delta.new
-            elif isinstance(delta, SkillAdded):
-                self._skills[delta.skill.id] = delta.skill
-        for bounds in update.bounds:
-            agent = bounds.agent
-            self.agents[agent] = TaskView(
-                agent,
-                self._tasks.setdefault(agent, []),
-                bounds.synced_end,
-                bounds.editable_start,
-                bounds.uploading,
-                bounds.removing,
-            )
-
     # -- queries ---------------------------------------------------------------------------
     def skill(self, skill_id: str) -> SkillInstance | None:
         """The skill with this id, if it exists."""
-        return self._skills.get(skill_id)
+        state = self._state
+        return state.skill(skill_id) if state is not None and state.has_skill(skill_id) else None
 
     def skills(self, skill_ids: Sequence[str]) -> list[SkillInstance]:
         """The skills with these ids that exist, in the given order."""
-        return [s for i in skill_ids if (s := self._skills.get(i)) is not None]
+        return [s for i in skill_ids if (s := self.skill(i)) is not None]
 
     def barrier_of(self, skill_id: str) -> Barrier | None:
         """The barrier ``skill_id`` belongs to, if any."""
@@ -124,8 +108,8 @@ class MissionView:
         """Whom ``skill`` waits for at its barrier.
 
         As its robot reports it while it waits there (``r2 at B3 (arrived, not yet
-        confirmed)``: the robot knows what the ground cannot see during a cut), else the
-        robots whose partner skill has not started.
+        confirmed)``, the barrier named by its tag: the robot knows what the ground cannot
+        see during a cut), else the robots whose partner skill has not started.
         """
         status = self.statuses.get(skill.agent)
         if (
@@ -134,7 +118,12 @@ class MissionView:
             and status.current_skill == skill.id
             and skill.status is SkillStatus.SYNCWAITING
         ):
-            return [status.waiting_on]
+            barrier = self.barrier_of(skill.id)
+            if barrier is None:
+                return [status.waiting_on]
+            # the robot names the barrier by its id; the operator knows it by its tag
+            tag = f" at B{self.barrier_number(skill.id)}"
+            return [status.waiting_on.replace(f" at {barrier.id}", tag)]
         barrier = self.barrier_of(skill.id)
         if barrier is None:
             return []
@@ -151,9 +140,11 @@ class MissionView:
 
     def status_text(self, skill: SkillInstance) -> str:
         """The skill's status cell, as every panel shows it."""
-        return presentation.status_text(
-            skill, self.waiting_on(skill), self.out_of_contact(skill.agent)
-        )
+        out = self.out_of_contact(skill.agent)
+        status = self.statuses.get(skill.agent)
+        heard = status.last_heard if out and status is not None else -1.0
+        holding = status is not None and status.hold is not HoldCause.NONE
+        return presentation.status_text(skill, self.waiting_on(skill), out, heard, holding)
 
     def bound_markers(self, skills: Sequence[SkillInstance]) -> list[str]:
         """Names of the task markers bound to any of ``skills`` (each once)."""

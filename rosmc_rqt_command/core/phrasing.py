@@ -10,13 +10,11 @@ from .requests import Answer
 
 
 def answer_message(answer: Answer, hint: str = "") -> tuple[str, str]:
-    """The sentence for ``answer`` and its level; ``hint`` follows an accepted edit's
-    revision ("Ctrl+Z undoes it")."""
+    """The sentence for ``answer`` and its level; ``hint`` follows an accepted edit
+    ("Ctrl+Z undoes it"). The revision is no word of an operator's: see :func:`answer_detail`."""
     what = answer.request.what or answer.request.operation.replace("_", " ")
     if answer.ok:
-        revision = getattr(answer.value, "revision", None)
-        extra = f"; {hint}" if hint else ""
-        suffix = f" (revision {revision}{extra})" if revision is not None else ""
+        suffix = f" ({hint})" if hint else ""
         note = getattr(answer.value, "note", "")
         if note:  # accepted, but the operator should know (queued, a barrier partner)
             return f"Done: {what}{suffix}; {note}.", "warning"
@@ -30,3 +28,10 @@ def answer_message(answer: Answer, hint: str = "") -> tuple[str, str]:
     if answer.unreachable:
         return f"Could not {what}: the mission server did not answer ({answer.error}).", "error"
     return f"Could not {what}: {answer.error}.", "error"
+
+
+def answer_detail(answer: Answer) -> str:
+    """What a roboticist may want of ``answer`` beyond its sentence: ``revision 626`` ("" if
+    none); the message area keeps it in the message's tooltip."""
+    revision = getattr(answer.value, "revision", None) if answer.ok else None
+    return f"mission revision {revision}" if revision is not None else ""

@@ -11,7 +11,7 @@ import re
 
 from rosmc_server.core import LostLinkKind, LostLinkPolicy, LostLinkTrigger
 
-# The words of LostLinkPolicy.describe() (rosmc_server/core/policy.py), in order.
+# The words of LostLinkPolicy.describe() (rosmc_server/core/skills/policy.py), in order.
 _DESCRIBED = re.compile(
     r"^on link loss: (?:"
     r"(?P<continue>continue)"

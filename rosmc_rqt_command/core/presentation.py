@@ -15,16 +15,18 @@ from rosmc_server.core import (
     Transfer,
     Value,
 )
-from rosmc_server.core.link import LinkStatus
-from rosmc_server.core.vocabulary import STATUS_COLOURS as STATUS_COLOURS
-from rosmc_server.core.vocabulary import STATUS_WORDS as STATUS_WORDS
-from rosmc_server.core.vocabulary import dbm, number, percent, wifi_words
+from rosmc_server.core.robots.link import LinkStatus
+from rosmc_server.core.robots.waiting import duration_text
+from rosmc_server.core.views.vocabulary import STATUS_COLOURS as STATUS_COLOURS
+from rosmc_server.core.views.vocabulary import STATUS_WORDS as STATUS_WORDS
+from rosmc_server.core.views.vocabulary import dbm, number, percent, rgb, wifi_words
 
 TRANSFER_COLOUR = "#dae6fa"  # uploading or removing: on its way, not settled (italic too)
 SETTLED_FAILURE_COLOUR = "#f9bbb0"  # a failure the operator retried or skipped
 TEXT_COLOUR = "#1d1d1d"
 DONE_TEXT_COLOUR = "#55524c"  # finished work reads as the past
 ALARM_TEXT_COLOUR = "#ffffff"  # on the failure red
+LAST_KNOWN_TEXT_COLOUR = "#5c5c5c"  # a robot out of contact: what it last said, greyed
 # Barrier tags: saturated colours that stay apart from the status colours.
 BARRIER_COLOURS = (
     "#7b3fa0",
@@ -64,12 +66,18 @@ def barrier_colour(number: int) -> str:
 
 
 def status_text(
-    skill: SkillInstance, waiting_on: list[str] | None = None, out_of_contact: bool = False
+    skill: SkillInstance,
+    waiting_on: list[str] | None = None,
+    out_of_contact: bool = False,
+    heard_ago: float = -1.0,
+    holding: bool = False,
 ) -> str:
     """The status cell: a word, and what matters about it (pending transfer, wait, reason).
 
     ``out_of_contact``: the robot cannot be heard, so a transfer waits for contact, and
-    what the robot last said of an unfinished skill may be old: it is marked last known.
+    what the robot last said of an unfinished skill may be old: it is marked last known,
+    with how long ago the robot was heard (``heard_ago`` seconds; negative: never).
+    ``holding``: the robot holds after its lost-link policy; its paused skill says so.
     """
     if skill.transfer is Transfer.UPLOADING and out_of_contact:
         return "waiting for contact"
@@ -82,13 +90,25 @@ def status_text(
     word = STATUS_WORDS[skill.status]
     if skill.status is SkillStatus.SYNCWAITING and waiting_on:
         word = f"waiting on {', '.join(waiting_on)}"
+    if skill.status is SkillStatus.PAUSED and holding:
+        word = "holding (Resume frees it)"
     if skill.status is SkillStatus.FAILURE and skill.resolution is not Resolution.NONE:
         word += f" ({skill.resolution.name.lower()})"
     if skill.attempt > 1:
         word += f", try {skill.attempt}"
     if is_last_known(skill, out_of_contact):
-        word += " (last known)"
+        word += (
+            f" (last known, {duration_text(heard_ago)} ago)"
+            if heard_ago >= 0
+            else (" (last known)")
+        )
     return word
+
+
+def last_known_colour(colour: str) -> str:
+    """``colour`` greyed: the row of a robot out of contact shows the past, not the present."""
+    mixed = (round((part * 255 + 0xC8) / 2) for part in rgb(colour))
+    return "#" + "".join(f"{part:02x}" for part in mixed)
 
 
 def is_last_known(skill: SkillInstance, out_of_contact: bool) -> bool:

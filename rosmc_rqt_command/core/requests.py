@@ -15,6 +15,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, ParamSpec, Protocol
 
+from rosmc_server.core.live.edit_history import EditKind
+
 if TYPE_CHECKING:  # for the type checker only: the widgets never load the client
     from rosmc_server.ros.client import MissionClient
 
@@ -35,6 +37,7 @@ class Request:
         what: What the operator asked for, as words ("add take_off to drone").
         seen: The revision the operator saw (None: the client's own).
         on_answer: Called on the GUI thread with the answer (besides the message area).
+        kind: The edit it makes, which undo can take back (None: not an edit).
     """
 
     pick: Pick = field(compare=False)
@@ -43,6 +46,7 @@ class Request:
     what: str = ""
     seen: int | None = None
     on_answer: Callable[[Answer], None] | None = field(default=None, compare=False)
+    kind: EditKind | None = None
     operation: str = field(init=False)
 
     def __post_init__(self) -> None:
@@ -58,14 +62,16 @@ def ask(
     what: str = "",
     seen: int | None = None,
     on_answer: Callable[[Answer], None] | None = None,
+    kind: EditKind | None = None,
 ) -> Callable[P, Request]:
     """A request maker taking exactly the arguments of the method ``pick`` chooses.
 
-    ``ask(lambda c: c.delete_skills, "delete 'go'", revision)(["s1"])``.
+    ``ask(lambda c: c.delete_skills, "delete 'go'", revision)(["s1"])``; ``kind``: the
+    edit the call makes (:class:`EditKind`), so that undo can take it back.
     """
 
     def make(*args: P.args, **kwargs: P.kwargs) -> Request:
-        return Request(pick, args, kwargs, what, seen, on_answer)
+        return Request(pick, args, kwargs, what, seen, on_answer, kind)
 
     return make
 

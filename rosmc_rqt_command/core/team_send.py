@@ -13,7 +13,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from rosmc_server.core import SkillInstance
-from rosmc_server.core.vocabulary import counted
+from rosmc_server.core.views.vocabulary import counted
 
 from . import alerts
 from .holding import hold_warnings

@@ -1,12 +1,13 @@
-"""What the GUI shows of the mission, as immutable values taken from the mirror.
+"""What the GUI shows of the mission, as values taken from the mirror for the GUI thread.
 
 The mirror calls its listeners on ROS threads with its lock held; :func:`view_update` runs
-there and forwards what the mirror said changed (its skill deltas, with indexes as the
-mirror applied them), the section bounds of the robots they touched, the barriers or
-markers if they changed and the robot statuses that changed, as a :class:`ViewUpdate`.
-Only a reset copies whole tasks. The value then crosses to the GUI thread, where the
-view applies the deltas in order and models change only the rows they name. No Qt and no
-rospy here, so it is tested without either.
+there and forwards what the mirror said changed: the event it applied, its skill deltas
+(with indexes as the mirror applied them), the section bounds of the robots they touched,
+the barriers or markers if they changed and the robot statuses that changed, as a
+:class:`ViewUpdate`. Only a reset copies the mission (a state of the GUI's own). The
+value then crosses to the GUI thread, where the view applies the event to its state with
+the one applier (:func:`~rosmc_server.core.live.updates.apply_event`) and models change only
+the rows the deltas name. No Qt and no rospy here, so it is tested without either.
 """
 
 from __future__ import annotations
@@ -15,11 +16,14 @@ import time
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
-from rosmc_server.core import AgentStatus, Barrier, MissionState, SkillInstance, TaskMarker
-from rosmc_server.core.legality import TaskView
-from rosmc_server.core.moves import move_columns
-from rosmc_server.core.reorder import play_moves
-from rosmc_server.core.updates import (
+from rosmc_server.core import (
+    AgentStatus,
+    Barrier,
+    MissionEvent,
+    MissionState,
+    TaskMarker,
+)
+from rosmc_server.core.live.updates import (
     AgentStatusChanged,
     BarrierPut,
     BarrierRemoved,
@@ -32,6 +36,8 @@ from rosmc_server.core.updates import (
     SkillRemoved,
     SkillsMoved,
 )
+from rosmc_server.core.model.moves import move_columns
+from rosmc_server.core.rules.legality import TaskView
 
 SkillDelta = SkillAdded | SkillChanged | SkillRemoved | SkillsMoved
 
@@ -57,13 +63,13 @@ class TaskBounds:
 class ViewUpdate:
     """What one mirror update changed, ready for the GUI thread.
 
-    ``reset``: the whole mission was replaced; ``agents`` then holds every robot's task in
-    order. Otherwise ``deltas`` are the skill changes in the order the mirror made them (a
-    view that applies them one after the other ends equal to the mission) and ``bounds``
-    the sections of each robot they touched. ``barriers`` / ``markers`` are every barrier /
-    marker, or None if none changed. ``statuses`` are robot statuses that changed.
-    ``changed_ids`` are the skills this update added, changed or moved. ``received`` is
-    when the update reached this process (monotonic seconds).
+    ``reset``: the whole mission was replaced; ``state`` is then a copy of it for the GUI
+    thread alone and ``agents`` every robot's task in it. Otherwise ``event`` is the event
+    the mirror applied (None: robot statuses only), ``deltas`` the skill changes it made,
+    in order, and ``bounds`` the sections of each robot they touched. ``barriers`` /
+    ``markers`` are every barrier / marker, or None if none changed. ``statuses`` are
+    robot statuses that changed. ``changed_ids`` are the skills this update added, changed
+    or moved. ``received`` is when the update reached this process (monotonic seconds).
     """
 
     revision: int
@@ -78,6 +84,8 @@ class ViewUpdate:
     changed_ids: frozenset[str] = frozenset()
     summary: str = ""
     received: float = field(default_factory=time.monotonic)
+    state: MissionState | None = field(default=None, compare=False)
+    event: MissionEvent | None = None
 
     @property
     def touched(self) -> tuple[str, ...]:
@@ -94,15 +102,17 @@ def view_update(update: MirrorUpdate, state: MissionState | None) -> ViewUpdate:
     if state is None:
         return ViewUpdate(update.revision, statuses=statuses)
     if any(isinstance(c, MissionReset) for c in update.changes):
+        own = MissionState(state.content(), state.revision)
         return ViewUpdate(
             update.revision,
             reset=True,
-            library=state.library,
-            agents=tuple(TaskView.of(state, agent) for agent in state.agents),
-            barriers=tuple(state.barriers),
-            markers=tuple(state.markers),
+            library=own.library,
+            agents=tuple(TaskView.live(own, agent) for agent in own.agents),
+            barriers=tuple(own.barriers),
+            markers=tuple(own.markers),
             statuses=statuses,
             summary=summary,
+            state=own,
         )
     deltas = tuple(c for c in update.changes if isinstance(c, SkillDelta))
     agents: list[str] = []
@@ -121,6 +131,7 @@ def view_update(update: MirrorUpdate, state: MissionState | None) -> ViewUpdate:
         statuses=statuses,
         changed_ids=frozenset(changed),
         summary=summary,
+        event=update.event,
     )
 
 
@@ -136,27 +147,6 @@ def delta_ids(delta: SkillDelta) -> tuple[str, ...]:
     if isinstance(delta, SkillsMoved):
         return tuple(move_columns(delta.moves)[0])
     return (delta.new.id,) if isinstance(delta, SkillChanged) else (delta.skill.id,)
-
-
-def apply_delta(task: list[SkillInstance], delta: SkillDelta) -> None:
-    """Apply one delta to a robot's task list, as the mirror applied it."""
-    if isinstance(delta, SkillAdded):
-        task.insert(delta.index, delta.skill)
-    elif isinstance(delta, SkillChanged):
-        task[delta.index] = delta.new
-    elif isinstance(delta, SkillRemoved):
-        del task[delta.index]
-    else:
-        # A whole new order is thousands of moves: decoded in one pass, not played one
-        # by one (each a search and a shift of the task).
-        order = play_moves([skill.id for skill in task], delta.moves)
-        if order is not None:
-            by_id = {skill.id: skill for skill in task}
-            task[:] = [by_id[skill_id] for skill_id in order]
-            return
-        for move in delta.moves:
-            at = next(i for i, skill in enumerate(task) if skill.id == move.skill_id)
-            task.insert(move.index, task.pop(at))
 
 
 def _add_once(items: list[str], item: str) -> None:

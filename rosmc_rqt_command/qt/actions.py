@@ -21,12 +21,12 @@ SKILL_ACTIONS: dict[Action, tuple[str, str, str]] = {
     Action.SYNC: (
         "Send to robot",
         "Ctrl+Return",
-        "Synchronize: send the blueprint up to the selected skill to the robot",
+        "Send the planned skills up to the selected one to the robot",
     ),
     Action.UNSYNC: (
         "Take back",
         "Ctrl+Backspace",
-        "Unsynchronize: take the selected skill and the ones after it back to the blueprint",
+        "Take the selected skill and the ones after it back from the robot into the plan",
     ),
     Action.RETRY: ("Retry", "Ctrl+R", "Run the failed skill again"),
     Action.SKIP: ("Skip", "Ctrl+K", "Leave the failed skill and go on with the next one"),
@@ -46,7 +46,7 @@ ALL_ROBOT_ACTIONS: dict[RobotAction, tuple[str, str, str]] = {
     RobotAction.SYNC_ALL: (
         "Send all robots",
         "F4",
-        "Synchronize every robot's whole task in one step (one question, all or nothing)",
+        "Send every robot its whole plan in one step (one question, all or nothing)",
     ),
     RobotAction.START: ("Start all", "F6", "Start every robot"),
     RobotAction.PAUSE: ("Pause all", "F7", "Pause every robot"),

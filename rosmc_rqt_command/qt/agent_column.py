@@ -27,13 +27,13 @@ from python_qt_binding.QtWidgets import (
 )
 
 from rosmc_server.core import AgentStatus, LostLinkPolicy, SkillStatus
-from rosmc_server.core.legality import TaskView
-from rosmc_server.core.link import LinkStatus
-from rosmc_server.core.updates import SkillAdded, SkillChanged, SkillRemoved
-from rosmc_server.core.waiting import duration_text
+from rosmc_server.core.live.updates import SkillAdded, SkillChanged, SkillRemoved
+from rosmc_server.core.robots.link import LinkStatus
+from rosmc_server.core.robots.waiting import duration_text
+from rosmc_server.core.rules.legality import TaskView
 
 from ..core import presentation
-from ..core.holding import lost_link_hold
+from ..core.holding import barrier_wait, lost_link_hold
 from ..core.legality import RobotAction
 from ..core.mission_view import MissionView
 from ..core.view_state import SkillDelta
@@ -103,9 +103,14 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         never_widen(self.status_label)
         self.status_label.setObjectName(f"status_{agent}")
         self.warning_label = coverage_warning_label(agent)
+        self.wait_label = never_widen(QLabel(""))  # what its barrier waits for, how long
+        self.wait_label.setObjectName(f"barrier_wait_{agent}")
+        self.wait_label.setStyleSheet("QLabel { color:#8a5a00; }")
+        self.wait_label.hide()
         self.hold_notice = HoldNotice(agent, self)
         self.hold_notice.resume_requested.connect(self._on_hold_notice_resume_requested)
         self.policy_in_force = ""
+        self.default_policy: LostLinkPolicy | None = None  # the library's, for its model
         self.pending_policy: LostLinkPolicy | None = None  # chosen here, not yet in force
         self.skill_names: list[str] = []
         self.ask_policy: AskPolicy = ask_policy  # tests answer the dialog through this
@@ -140,6 +145,7 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         header.addLayout(top)
         header.addWidget(self.status_label)
         header.addWidget(self.warning_label)
+        header.addWidget(self.wait_label)
         header.addWidget(self.hold_notice)
         # Adding and sending sit at opposite ends of their row, the controls on a row of
         # their own: a click meant for one never lands on the other.
@@ -240,6 +246,8 @@ class AgentColumn(QFrame):  # type: ignore[misc]
             self._out_of_contact = out_of_contact
             self.synced_model.refresh()
             self.blueprint_model.refresh()
+        elif out_of_contact:  # its rows say how long ago the robot was heard
+            self.synced_model.refresh()
         self.policy_in_force = status.policy if status is not None else ""
         pending = self.pending_policy
         if pending is not None and self.policy_in_force.startswith(pending.describe()):
@@ -250,7 +258,13 @@ class AgentColumn(QFrame):  # type: ignore[misc]
                 f"for contact: {escape(self.pending_policy.describe())}</span>"
             )
         show_coverage_warning(self.warning_label, status)
-        self.hold_notice.show_hold(lost_link_hold(self._view, self.agent))
+        hold = lost_link_hold(self._view, self.agent)
+        if (hold is None) != (self.hold_notice.hold is None):
+            self.synced_model.refresh()  # its paused row says that it holds (or no more)
+        self.hold_notice.show_hold(hold)
+        wait = barrier_wait(self._view, self.agent)
+        self.wait_label.setText(wait)
+        self.wait_label.setVisible(bool(wait))
         self.synced_caption.setText(on_robot_caption(status))
 
     def set_skills(self, names: Sequence[str]) -> None:
@@ -266,6 +280,7 @@ class AgentColumn(QFrame):  # type: ignore[misc]
             button.setEnabled(not read_only and action in legal)
         self.add_button.setEnabled(not read_only and not self.add_menu.isEmpty())
         self.policy_button.setEnabled(not read_only and bool(self.skill_names))
+        self.hold_notice.resume_button.setEnabled(not read_only)
         self.blueprint_table.setDragEnabled(not read_only)  # no reordering a replay
 
     def _on_hold_notice_resume_requested(self) -> None:
@@ -275,7 +290,10 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         self.add_requested.emit(self.agent, action.text())  # type: ignore[attr-defined]
 
     def _on_policy_button_clicked(self) -> None:
-        args = (self.agent, self.skill_names, self, self.policy_in_force)
+        in_force, default = self.policy_in_force, self.default_policy
+        if not in_force and default is not None:  # not reported yet: the server sends this
+            in_force = f"{default.describe()} (library default, not reported yet)"
+        args = (self.agent, self.skill_names, self, in_force)
         pending = self.pending_policy
         policy = self.ask_policy(*args) if pending is None else self.ask_policy(*args, pending)
         if policy is not None:

@@ -17,19 +17,23 @@ from python_qt_binding.QtCore import QPoint
 from python_qt_binding.QtWidgets import QMenu, QWidget
 
 from rosmc_server.core import AgentStatus, Library, LostLinkPolicy
+from rosmc_server.core.live.edit_history import EditKind
 
 from ..core.dispatch import Dispatcher
 from ..core.legality import Action, RobotAction
 from ..core.mission_view import MissionView
-from ..core.phrasing import answer_message
+from ..core.phrasing import answer_detail, answer_message
+from ..core.place_choices import surroundings
 from ..core.requests import Answer, Backend, Request, ask
 from ..core.view_state import ViewUpdate
 from .actions import CommandActions
 from .control_panel import ControlPanel
+from .duplicate_action import DuplicateAction
 from .enabling import Enabling
 from .file_menu import FileController
 from .message_area import MessageArea
 from .parameter_panel import ParameterPanel
+from .place_requests import PlaceRequests
 from .repaints import Repaints
 from .section_table import SectionTable
 from .task_widget import TaskWidget
@@ -61,7 +65,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.control = ControlPanel(self.actions_)
         self.messages = MessageArea()
         self.files = FileController(self, self.actions_, view, self.messages, self.send)
-        self.history = UndoHistory(self, view, self.send)
+        self.history = UndoHistory(self, view, self.send, self.messages.say)
         self.team = TeamBar(self.tasks, view)
         self.enabling = Enabling(view, self.actions_, self.tasks, self.history)
         self.repaints = Repaints(view, self.messages, self._show_statuses)
@@ -81,6 +85,23 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.menu_bar, self.banner, self.splitter = layout.menu_bar, layout.banner, layout.splitter
         self.science, self.site, self.legend = layout.science, layout.site, layout.legend
         self._select_when_seen: list[str] = []
+        self.places = PlaceRequests(
+            view,
+            self.send,
+            lambda: surroundings(view, self.science.science, self.site.source),
+            self._select_soon,
+        )
+        self.places.connect_rows(self.parameters.places)
+        self.duplicate = DuplicateAction(
+            self,
+            view,
+            lambda: self.tasks.selected_ids,
+            self.send,
+            self._select_soon,
+            self.messages.say,
+            lambda: self.backend.read_only,
+            self.history.join,
+        )
         self._journal_alerting = False  # the server said its journal has a problem
         self.connected = False
         self._connect()
@@ -91,6 +112,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.tasks.selection_changed.connect(self._on_tasks_selection_changed)
         self.tasks.context_menu_requested.connect(self._on_tasks_context_menu_requested)
         self.tasks.robot_action.connect(self._on_tasks_robot_action)
+        self.messages.resume_requested.connect(self._on_messages_resume_requested)
         self.tasks.add_requested.connect(self._on_tasks_add_requested)
         self.tasks.policy_chosen.connect(self._on_tasks_policy_chosen)
         self.tasks.reorder_requested.connect(self._on_tasks_reorder_requested)
@@ -98,6 +120,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.parameters.edit_requested.connect(self._on_parameters_edit_requested)
         self.parameters.rename_marker_requested.connect(self._on_parameters_rename_requested)
         self.parameters.problem.connect(lambda text: self.messages.say(text, "warning"))
+        self.parameters.places.said.connect(lambda text: self.messages.say(text, "info"))
         for kind, action in self.actions_.skill.items():
             action.triggered.connect(lambda _=False, k=kind: self.do(k))
         for robot_action, action in self.actions_.all_robots.items():
@@ -138,10 +161,11 @@ class CommandWidget(QWidget):  # type: ignore[misc]
             self._select_when_seen = []
         self.repaints.checker.note(None if reset else changed)
         self.enabling.update(None if reset else agents)
+        self.duplicate.update()
         self.files.on_mission_shown()
         if first:
             self.files.mark_saved()
-            self.messages.say(f"Mission shown (revision {self.view.revision}).", "ok")
+            self.messages.say("Mission shown.", "ok", f"mission revision {self.view.revision}")
         if reset:
             self.banner.hide()
         self.team.refresh()
@@ -174,9 +198,10 @@ class CommandWidget(QWidget):  # type: ignore[misc]
     def on_server_restarted(self, revision: int) -> None:
         """A new mission server process took over (a restart); say from which revision."""
         self.messages.say(
-            f"The mission server restarted from revision {revision}; robot states are "
-            "shown again as it hears the robots.",
+            "The mission server restarted with the mission as it last recorded it; robot "
+            "states are shown again as it hears the robots.",
             "warning",
+            f"restarted from mission revision {revision}",
         )
 
     def on_journal_alert(self, alert: str) -> None:
@@ -193,7 +218,8 @@ class CommandWidget(QWidget):  # type: ignore[misc]
     def on_answer(self, answer: Answer) -> None:
         """Say how a request ended."""
         hint = self.history.note(answer) if answer.ok else ""  # "Ctrl+Z undoes it"
-        self.messages.say(*answer_message(answer, hint))
+        text, severity = answer_message(answer, hint)
+        self.messages.say(text, severity, answer_detail(answer))
         if answer.request.on_answer is not None:
             answer.request.on_answer(answer)
 
@@ -214,7 +240,9 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.view.statuses = {}  # the robots as the new backend reports them
         self.parameters.set_read_only(backend.read_only)
         self.enabling.read_only = backend.read_only
+        self.messages.set_read_only(backend.read_only)
         self.enabling.update()
+        self.duplicate.update()
 
     # -- sending ------------------------------------------------------------------------------
     def send(self, request: Request) -> None:
@@ -248,6 +276,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
     def _on_tasks_selection_changed(self, ids: list[str]) -> None:
         self.parameters.show_selection(ids)
         self.enabling.update()
+        self.duplicate.update()
         selected = self.view.skills(ids)
         self.backend.publish_selection(ids, self.view.bound_markers(selected))
 
@@ -260,6 +289,8 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         for action in self.actions_.skill.values():
             if action.isEnabled():
                 menu.addAction(action)
+        if self.duplicate.action.isEnabled():
+            menu.addAction(self.duplicate.action)
         agent = table.section.agent
         column = self.tasks.columns.get(agent)
         if table.section.blueprint and column is not None and column.add_button.isEnabled():
@@ -272,16 +303,18 @@ class CommandWidget(QWidget):  # type: ignore[misc]
     def _on_tasks_robot_action(self, agent: str, kind: RobotAction) -> None:
         self.do_robot(agent, kind)
 
-    def _on_tasks_add_requested(self, agent: str, skill: str) -> None:
-        def select_new(answer: Answer) -> None:
-            if answer.ok:
-                self._select_when_seen = [answer.value.skill_id]
-                if self.view.skill(answer.value.skill_id) is not None:
-                    self.tasks.select_ids(self._select_when_seen)
-                    self._select_when_seen = []
+    def _on_messages_resume_requested(self, agent: str) -> None:
+        self.do_robot(agent, RobotAction.RESUME)
 
-        what = f"add {skill} to {agent}"
-        self.send(ask(lambda c: c.add_skill, what, self.view.revision, select_new)(agent, skill))
+    def _on_tasks_add_requested(self, agent: str, skill: str) -> None:
+        self.places.add_skill(agent, skill)
+
+    def _select_soon(self, skill_ids: list[str]) -> None:
+        """Select ``skill_ids`` now, or as soon as the update that shows them arrives."""
+        self._select_when_seen = list(skill_ids)
+        if all(self.view.skill(i) is not None for i in skill_ids):
+            self.tasks.select_ids(self._select_when_seen)
+            self._select_when_seen = []
 
     def _on_tasks_policy_chosen(self, agent: str, policy: LostLinkPolicy) -> None:
         def forget_if_refused(answer: Answer) -> None:
@@ -294,7 +327,10 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.send(call(agent, policy))
 
     def _on_tasks_reorder_requested(self, agent: str, order: list[str]) -> None:
-        self.dispatcher.call(lambda c: c.reorder_skills, f"reorder {agent}'s task")(agent, order)
+        what = f"reorder {agent}'s task"
+        self.dispatcher.call(lambda c: c.reorder_skills, what, EditKind.REORDER_SKILLS)(
+            agent, order
+        )
 
     def _on_tasks_columns_added(self, agents: list[str]) -> None:
         self.team.refresh()
@@ -306,11 +342,12 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         changed = ", ".join(fields.get("params", {}) or fields.get("bindings", {}) or fields)
         revert = self.parameters.reverter(skill_id)  # a refused value leaves the field
         what = f"change {changed} of {name}"
-        self.send(ask(lambda c: c.edit_skill, what, self.view.revision, revert)(skill_id, **fields))
+        call = ask(lambda c: c.edit_skill, what, self.view.revision, revert, EditKind.EDIT_SKILL)
+        self.send(call(skill_id, **fields))
 
     def _on_parameters_rename_requested(self, old: str, new: str) -> None:
         what = f"rename marker {old} to {new}"
-        self.dispatcher.call(lambda c: c.rename_task_marker, what)(old, new)
+        self.dispatcher.call(lambda c: c.rename_task_marker, what, EditKind.RENAME_MARKER)(old, new)
 
     def _on_refresh_triggered(self) -> None:
         self.backend.refresh()

@@ -1,6 +1,6 @@
 """Which of the window's actions are enabled: what the server would accept now.
 
-The rules are the core's (:mod:`rosmc_server.core.legality`, through
+The rules are the core's (:mod:`rosmc_server.core.rules.legality`, through
 :mod:`..core.legality`); this part only applies them to the actions, the undo history and
 each robot's column, and keeps each robot's result between updates so a live report
 recomputes only its robot.

@@ -21,7 +21,8 @@ STYLE = (
 
 
 class HoldNotice(QFrame):  # type: ignore[misc]
-    """ "r4 is holding after its link came back: …" and a *Resume r4* button."""
+    """ "r4 holds at its lost-link return point — its barrier partners r1, r2 wait." and a
+    *Resume r4* button."""
 
     resume_requested = Signal()
 

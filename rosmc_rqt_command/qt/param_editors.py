@@ -1,4 +1,4 @@
-"""Typed editors for skill parameters, one per parameter type, and the task-marker picker.
+"""Typed editors for skill parameters, one per parameter type.
 
 Every editor has ``value()`` (raw data, checked by the parameter's spec before it is
 sent), ``set_value(value)``, ``set_read_only(flag)`` and a ``committed`` signal fired when
@@ -34,7 +34,7 @@ from python_qt_binding.QtWidgets import (
 )
 
 from rosmc_server.core import InvalidRequest, MarkerType, ParameterSpec, ParamType, Pose, Value
-from rosmc_server.core.params import parse_text
+from rosmc_server.core.skills.params import parse_text
 
 BIG = 1e9
 INVALID_STYLE = "background:#ffd6d6"
@@ -304,51 +304,6 @@ class VertexEditor(Editor):
         except InvalidRequest:
             return []
         return value if isinstance(value, list) else []
-
-
-class MarkerPicker(QComboBox):  # type: ignore[misc]
-    """Which task marker fills a parameter: choosing one binds it; typing a new name renames.
-
-    The first entry, "(no marker)", unbinds the parameter.
-    """
-
-    NONE = "(no marker)"
-    bind_requested = Signal(str)  # marker name, "" to unbind
-    rename_requested = Signal(str, str)  # old name, new name
-
-    def __init__(self) -> None:
-        super().__init__()
-        self.setEditable(True)
-        self.setInsertPolicy(QComboBox.NoInsert)
-        self.setToolTip("Pick a task marker to fill this parameter; type a new name to rename it")
-        self._bound = ""
-        self.activated.connect(self._on_picker_activated)
-        self.lineEdit().returnPressed.connect(self._on_picker_return_pressed)
-
-    def show_markers(self, names: Sequence[str], bound: str) -> None:
-        """Offer ``names``; ``bound`` is the marker bound now ("" if none)."""
-        offered = [self.itemText(i) for i in range(1, self.count())]
-        if offered == list(names) and bound == self._bound and self.count():
-            return  # unchanged: leave what the operator may be typing alone
-        self._bound = bound
-        self.blockSignals(True)
-        self.clear()
-        self.addItem(self.NONE)
-        self.addItems(list(names))
-        self.setCurrentIndex(self.findText(bound) if bound else 0)
-        self.blockSignals(False)
-
-    def _on_picker_activated(self, index: int) -> None:
-        name = "" if index <= 0 else self.itemText(index)
-        if name != self._bound:
-            self.bind_requested.emit(name)
-
-    def _on_picker_return_pressed(self) -> None:
-        text = self.currentText().strip()
-        old = self._bound
-        if text and old and text != old and self.findText(text) < 0:
-            self._bound = text  # asked once, even if Enter reaches here twice
-            self.rename_requested.emit(old, text)
 
 
 def make_editor(spec: ParameterSpec) -> Editor:

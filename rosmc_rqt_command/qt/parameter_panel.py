@@ -26,12 +26,14 @@ from python_qt_binding.QtWidgets import (
 )
 
 from rosmc_server.core import InvalidRequest, RosmcError, SkillInstance, SkillSpec
-from rosmc_server.core.editing import check_retries, check_timeout
+from rosmc_server.core.rules.editing import check_retries, check_timeout
 from rosmc_server.core.validation import MAX_RETRIES
 
 from ..core.mission_view import MissionView
 from ..core.requests import Answer
-from .param_editors import INVALID_STYLE, Editor, MarkerPicker, make_editor, wide_range
+from .param_editors import INVALID_STYLE, Editor, make_editor, wide_range
+from .place_picker import PlacePicker
+from .place_rows import PlaceRows
 
 
 class ParameterPanel(QScrollArea):  # type: ignore[misc]
@@ -46,7 +48,9 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
         self._view = view
         self.skill: SkillInstance | None = None
         self.editors: dict[str, Editor] = {}
-        self.pickers: dict[str, MarkerPicker] = {}
+        self.places = PlaceRows(view)  # the Place pickers and "Drive there first"
+        self.places.edit_requested.connect(self.edit_requested)
+        self.places.rename_requested.connect(self.rename_marker_requested)
         self._shown: dict[str, object] = {}  # what each editor showed of the skill
         self._spec: SkillSpec | None = None
         self.setWidgetResizable(True)
@@ -93,6 +97,11 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
         self.timeout_spin.editingFinished.connect(self._on_options_editing_finished)
         self.retries_spin.editingFinished.connect(self._on_options_editing_finished)
         self.show_skill(None)
+
+    @property
+    def pickers(self) -> dict[str, PlacePicker]:
+        """The Place picker of each location parameter of the shown skill."""
+        return self.places.pickers
 
     # -- showing ------------------------------------------------------------------------------
     @property
@@ -154,6 +163,8 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
             newest = self._view.skill(self.skill.id)
             if force or newest is not self.skill:
                 self.show_skill(newest)
+            elif newest is not None:  # its robot's task changed: places and drive offer
+                self.places.fill(newest, self.editable)
 
     def _show_options(self, skill: SkillInstance | None, force: bool = False) -> None:
         """The label, time limit and retries of ``skill``; blank for none (not the last
@@ -182,7 +193,7 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
         while self.params_form.rowCount():
             self.params_form.removeRow(0)
         self.editors = {}
-        self.pickers = {}
+        self.places.clear()
 
     def _build_editors(self) -> None:
         self._clear_editors()
@@ -198,12 +209,8 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
             self.params_form.addRow(label, editor)
             self.editors[spec.name] = editor
             if spec.marker_type is not None:
-                picker = MarkerPicker()
-                picker.setObjectName(f"marker_{spec.name}")
-                picker.bind_requested.connect(lambda m, n=spec.name: self._on_picker_bind(n, m))
-                picker.rename_requested.connect(self.rename_marker_requested)
-                self.params_form.addRow("   marker", picker)
-                self.pickers[spec.name] = picker
+                self.places.add_picker(self.params_form, spec)
+        self.places.add_drive_button(self.params_form)
 
     def _fill_editors(self, force: bool = False) -> None:
         """Show the skill's values (``force``: also in the editor being typed in)."""
@@ -217,18 +224,14 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
                 editor.mark_invalid(False)
                 editor.blockSignals(False)
                 self._shown[name] = _typed(editor)
-        for name, picker in self.pickers.items():
-            param = spec.parameter(name)
-            names = [m.name for m in self._view.markers.values() if param.accepts_marker(m.type)]
-            picker.show_markers(names, skill.bindings.get(name, ""))
+        self.places.fill(skill, self.editable)
 
     def _enable(self, editable: bool) -> None:
         for widget in (self.label_edit, self.timeout_spin, self.retries_spin):
             widget.setEnabled(editable)
         for editor in self.editors.values():
             editor.set_read_only(not editable)
-        for picker in self.pickers.values():
-            picker.setEnabled(editable)
+        self.places.enable(editable)
 
     # -- editing ------------------------------------------------------------------------------
     def _on_editor_committed(self, name: str) -> None:
@@ -251,10 +254,6 @@ class ParameterPanel(QScrollArea):  # type: ignore[misc]
         editor.mark_invalid(False)
         if skill.params.get(name) != value or name in skill.bindings:
             self._send({"params": {name: _data(value)}})
-
-    def _on_picker_bind(self, name: str, marker: str) -> None:
-        if self.editable:
-            self._send({"bindings": {name: marker or None}})
 
     def _on_label_edit_editing_finished(self) -> None:
         skill = self.skill

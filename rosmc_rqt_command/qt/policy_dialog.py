@@ -24,7 +24,7 @@ from python_qt_binding.QtWidgets import (
 )
 
 from rosmc_server.core import InvalidRequest, LostLinkKind, LostLinkPolicy, LostLinkTrigger
-from rosmc_server.core.policy import DEFAULT_AFTER
+from rosmc_server.core.skills.policy import DEFAULT_AFTER
 
 from ..core.policy_words import policy_in_force
 

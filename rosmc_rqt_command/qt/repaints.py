@@ -74,13 +74,15 @@ class Repaints(QObject):  # type: ignore[misc]
     def warn_now(self) -> None:
         """Show every warning now (the warning timer's slot)."""
         view = self._view
+        holds = holding.holds(view)
         warnings = [
-            *(hold.sentence() for hold in holding.holds(view)),
+            *(hold.sentence() for hold in holds),
             *alerts.barrier_warnings(view),
             *alerts.coverage_warnings(view),
             *alerts.radio_warnings(view),
             *self.checker.warnings(view),
         ]
         self._messages.show_warnings(warnings)
+        self._messages.show_holds([hold.agent for hold in holds])
         if self.checker.incomplete:
             self.warn_timer.start(WARN_SLICE_MS)

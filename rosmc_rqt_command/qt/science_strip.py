@@ -1,7 +1,7 @@
 """The science strip above the task panel: the score, the stones delivered, the regions.
 
 Fed from ``/rosmc/sim/science`` by the ROS bridge (as a core
-:class:`~rosmc_server.core.science.Science`); says "no score published" until the
+:class:`~rosmc_server.core.views.science.Science`); says "no score published" until the
 simulator (or a real science tally) publishes one.
 """
 
@@ -11,8 +11,8 @@ from html import escape
 
 from python_qt_binding.QtWidgets import QLabel, QWidget
 
-from rosmc_server.core.science import IDENTIFIED_WORDS, Science
-from rosmc_server.core.vocabulary import counted
+from rosmc_server.core.views.science import IDENTIFIED_WORDS, Science
+from rosmc_server.core.views.vocabulary import counted
 
 from .labels import never_widen
 

@@ -1,7 +1,7 @@
 """The site line under the science strip: which site map the mission checks targets against.
 
 Fed from ``/rosmc/site_in_force`` by the ROS bridge (as a core
-:class:`~rosmc_server.core.site_source.SiteInForce`, None before a map is in force): the
+:class:`~rosmc_server.core.world.site_source.SiteInForce`, None before a map is in force): the
 map's name, the node that sent it and when. ROS 1 lets any node publish a map, so the
 operator should see whose map is in force.
 """
@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from python_qt_binding.QtWidgets import QLabel, QWidget
 
-from rosmc_server.core.site_source import NO_SITE, SiteInForce, site_line
+from rosmc_server.core.world.site_source import NO_SITE, SiteInForce, site_line
 
 from .labels import never_widen
 

@@ -162,14 +162,18 @@ class TaskModel(QAbstractTableModel):  # type: ignore[misc]
             number = self._view.barrier_number(skill.id)
             if column == TAG and number:
                 return self._brush(presentation.barrier_colour(number))
-            return self._brush(presentation.row_colour(skill))
+            colour = presentation.row_colour(skill)
+            if self._last_known(skill):
+                colour = presentation.last_known_colour(colour)
+            return self._brush(colour)
         if role == Qt.ForegroundRole:
             if column == TAG and self._view.barrier_number(skill.id):
                 return self._brush("#ffffff")
+            if self._last_known(skill):
+                return self._brush(presentation.LAST_KNOWN_TEXT_COLOUR)
             return self._brush(presentation.text_colour(skill))
         if role == Qt.FontRole:
-            out = self._view.out_of_contact(skill.agent)
-            if skill.transfer.value or presentation.is_last_known(skill, out):
+            if skill.transfer.value or self._last_known(skill):
                 return self._italic
             if column == TAG or (column == STATUS and presentation.is_alarm(skill)):
                 return self._bold
@@ -181,6 +185,9 @@ class TaskModel(QAbstractTableModel):  # type: ignore[misc]
         if role == SKILL_ID_ROLE:
             return skill.id
         return None
+
+    def _last_known(self, skill: SkillInstance) -> bool:
+        return presentation.is_last_known(skill, self._view.out_of_contact(skill.agent))
 
     def flags(self, index: QModelIndex) -> Any:
         base = Qt.ItemIsEnabled | Qt.ItemIsSelectable

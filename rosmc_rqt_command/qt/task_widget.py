@@ -220,6 +220,7 @@ class TaskWidget(QScrollArea):  # type: ignore[misc]
     def _offer_skills(self, agent: str, column: AgentColumn) -> None:
         if self._library is not None and agent in self._library.dynamic_agents:
             column.set_skills(list(self._library.skills_of(agent)))
+            column.default_policy = self._library.default_policy(agent)
 
     # -- selection ------------------------------------------------------------------------
     def _on_table_plain_clicked(self, table: SectionTable) -> None:

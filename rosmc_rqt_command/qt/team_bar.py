@@ -20,7 +20,7 @@ from python_qt_binding.QtWidgets import (
     QWidget,
 )
 
-from rosmc_server.core.vocabulary import counted
+from rosmc_server.core.views.vocabulary import counted
 
 from ..core.mission_view import MissionView
 from ..core.team_filter import StatusFilter, TeamFilter, visible_agents

@@ -1,9 +1,12 @@
 """Undo and redo of this window's own edits (Ctrl+Z, Ctrl+Shift+Z, Edit menu).
 
-The window keeps the revisions its accepted edits produced. Undo asks the server
-to undo the newest (``undo_edit``: the inverse as a new revision); redo undoes that
-undo. The server refuses, in one sentence, an edit whose skills were sent since or
-that someone changed; the message area shows the sentence and the entry is dropped.
+The two actions over the shared :class:`~rosmc_server.core.live.edit_history.EditHistory`
+(rviz keeps one too, by the same rule): an accepted request whose kind is an edit can be
+undone, and a Duplicate's copies are joined into one entry; undo asks the server to undo
+the newest (``undo_edit``, against the revision shown), redo undoes that undo. A refusal
+by the mission rules (the skills were sent since, someone changed them) drops the entry
+and the message area shows the server's sentence; a conflict or no answer keeps it, and
+the message area says so.
 """
 
 from __future__ import annotations
@@ -13,43 +16,37 @@ from collections.abc import Callable
 from python_qt_binding.QtCore import QObject
 from python_qt_binding.QtWidgets import QWidget
 
+from rosmc_server.core.live.edit_history import EditHistory, Failure, Step
+
 from ..core.mission_view import MissionView
 from ..core.requests import Answer, Request, ask
 from .actions import CommandActions
 
-# The window's requests whose effect undo can take back.
-UNDOABLE = frozenset(
-    {
-        "add_skill",
-        "edit_skill",
-        "delete_skills",
-        "reorder_skills",
-        "add_barrier",
-        "delete_barrier",
-        "add_task_marker",
-        "move_task_marker",
-        "rename_task_marker",
-        "delete_task_marker",
-    }
-)
+Say = Callable[[str, str], None]  # (sentence, level) to the message area
 
 
 class UndoHistory(QObject):  # type: ignore[misc]
-    """The undo and redo stacks of one command window, and their two actions.
+    """The undo and redo actions of one command window.
 
     Args:
         owner: The command widget (the actions' shortcuts work inside it).
         view: The mission as shown (for the base revision).
         send: Hands a request to the backend.
+        say: Shows a sentence in the message area (why an entry is kept).
     """
 
-    def __init__(self, owner: QWidget, view: MissionView, send: Callable[[Request], None]) -> None:
+    def __init__(
+        self,
+        owner: QWidget,
+        view: MissionView,
+        send: Callable[[Request], None],
+        say: Say | None = None,
+    ) -> None:
         super().__init__(owner)
         self._view = view
         self._send = send
-        self._undo: list[tuple[int, str]] = []  # (revision an edit produced, what it did)
-        self._redo: list[tuple[int, str]] = []  # (revision an undo produced, what it undid)
-        self._waiting = False  # one undo or redo at a time: the next needs its answer
+        self._say = say
+        self.edits = EditHistory()
         self.read_only = False
         self.undo_action = CommandActions.make(
             owner, "&Undo", "Ctrl+Z", "Undo your last edit", "undo"
@@ -63,46 +60,60 @@ class UndoHistory(QObject):  # type: ignore[misc]
 
     def note(self, answer: Answer) -> str:
         """Remember an accepted edit of this window; a hint for its message ("" if none)."""
-        operation = answer.request.operation
         revision = getattr(answer.value, "revision", None)
-        if not answer.ok or operation not in UNDOABLE or revision is None:
+        if not answer.ok or revision is None:
             return ""
-        self._undo.append((int(revision), answer.request.what or operation.replace("_", " ")))
-        self._redo.clear()
+        what = answer.request.what or answer.request.operation.replace("_", " ")
+        if not self.edits.done(answer.request.kind, int(revision), what):
+            return ""
         self._update()
         return "Ctrl+Z undoes it"
 
+    def join(self, revisions: list[int], what: str) -> None:
+        """Make this window's newest edits, which produced ``revisions`` (oldest first), one
+        entry called ``what``: one undo takes them all back (the server still records each)."""
+        if self.edits.join(revisions, what):
+            self._update()
+
     def undo(self) -> None:
         """Ask the server to undo this window's newest edit."""
-        if self._undo and not self._waiting and not self.read_only:
-            revision, what = self._undo.pop()
-            self._ask(revision, f"undo {what}", self._redo, self._undo, what)
+        self._ask(redo=False)
 
     def redo(self) -> None:
         """Ask the server to undo this window's newest undo (the edit comes back)."""
-        if self._redo and not self._waiting and not self.read_only:
-            revision, what = self._redo.pop()
-            self._ask(revision, f"redo {what}", self._undo, self._redo, what)
+        self._ask(redo=True)
 
-    def _ask(
-        self,
-        revision: int,
-        words: str,
-        onto: list[tuple[int, str]],
-        back: list[tuple[int, str]],
-        what: str,
-    ) -> None:
-        def answered(answer: Answer) -> None:
-            self._waiting = False
-            if answer.ok:
-                onto.append((int(answer.value.revision), what))
-            elif answer.conflict or answer.unreachable:
-                back.append((revision, what))  # not refused: it can be tried again
+    def _ask(self, *, redo: bool) -> None:
+        step = None if self.read_only else self.edits.begin(redo=redo, seen=self._view.revision)
+        if step is not None:
             self._update()
+            self._send_undo(step, step.next_revision)
 
-        self._waiting = True
+    def _send_undo(self, step: Step, revision: int) -> None:
+        def answered(answer: Answer) -> None:
+            self._answered(step, answer)
+
+        pick = ask(lambda c: c.undo_edit, step.words, step.base_revision, answered)
+        self._send(pick(revision))
+
+    def _answered(self, step: Step, answer: Answer) -> None:
+        if answer.ok:
+            following = self.edits.accepted(step, int(answer.value.revision))
+            if following is not None:  # joined edits: the next one back
+                self._send_undo(step, following)
+                return
+        else:
+            failure = (
+                Failure.CONFLICT
+                if answer.conflict
+                else Failure.UNREACHABLE
+                if answer.unreachable
+                else Failure.REFUSED
+            )
+            sentence = self.edits.failed(step, failure, answer.error)
+            if failure is not Failure.REFUSED and self._say is not None:
+                self._say(sentence, "error")  # the refusal's own sentence is said already
         self._update()
-        self._send(ask(lambda c: c.undo_edit, words, self._view.revision, answered)(revision))
 
     def set_read_only(self, read_only: bool) -> None:
         """A window that follows a replay undoes nothing."""
@@ -110,8 +121,9 @@ class UndoHistory(QObject):  # type: ignore[misc]
         self._update()
 
     def _update(self) -> None:
-        free = not self._waiting and not self.read_only
-        self.undo_action.setEnabled(free and bool(self._undo))
-        self.redo_action.setEnabled(free and bool(self._redo))
-        self.undo_action.setText(f"&Undo {self._undo[-1][1]}" if self._undo else "&Undo")
-        self.redo_action.setText(f"&Redo {self._redo[-1][1]}" if self._redo else "&Redo")
+        free = not self.edits.busy and not self.read_only
+        undo, redo = self.edits.next_undo(), self.edits.next_redo()
+        self.undo_action.setEnabled(free and undo is not None)
+        self.redo_action.setEnabled(free and redo is not None)
+        self.undo_action.setText(f"&Undo {undo.what}" if undo else "&Undo")
+        self.redo_action.setText(f"&Redo {redo.what}" if redo else "&Redo")

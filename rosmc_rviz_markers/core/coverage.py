@@ -1,6 +1,6 @@
 """How rviz shows radio coverage: cells shaded by signal, and each robot's last-link mark.
 
-Pure geometry and colour over a :class:`~rosmc_server.core.radio_map.RadioMap`: the radio
+Pure geometry and colour over a :class:`~rosmc_server.core.robots.radio_map.RadioMap`: the radio
 model's prediction (faint, flat, only where it reaches), the robots' own readings (stronger,
 a little higher, faded once older than :data:`OLD_AFTER`), and where each robot last had a
 link, labelled with its reading and age ("-72 dBm 26 s ago").
@@ -10,8 +10,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from rosmc_server.core.geometry import Color
-from rosmc_server.core.radio_map import RadioMap, reading_text
+from rosmc_server.core.robots.radio_map import RadioMap, reading_text
+from rosmc_server.core.views.geometry import Color
 
 STRONG, WEAK = -50.0, -90.0  # dBm shaded full green and full red
 OLD_AFTER = 10.0  # seconds: a reading older than this is shown as old

@@ -5,7 +5,9 @@ without covering the others:
 
 * the robot's name, its current skill and that skill's status
   (``science_rover: navigate_to >> running``), in the status's colour (the words, marks and
-  colours of :mod:`rosmc_server.core.vocabulary`, as in the command GUI and ``rosmc``);
+  colours of :mod:`rosmc_server.core.views.vocabulary`, as in the command GUI and ``rosmc``);
+  a barrier wait says on whom and since how long; a robot holding after its lost-link
+  policy says so and what frees it instead (``r4: holding — Resume from its menu``, red);
 * its health: battery, Wi-Fi and ground link
   (``BAT 97% | WiFi -54 dBm | link up``), coloured by the worst of the three (green,
   yellow, red; the part past its threshold is written in capitals). Commands waiting
@@ -22,18 +24,21 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
-from rosmc_server.core.agent_status import AgentStatus
-from rosmc_server.core.geometry import Color, Point
-from rosmc_server.core.model import SkillStatus
-from rosmc_server.core.vocabulary import (
+from rosmc_server.core.model.control import HoldCause
+from rosmc_server.core.model.model import SkillStatus
+from rosmc_server.core.robots.agent_status import AgentStatus
+from rosmc_server.core.robots.waiting import duration_text
+from rosmc_server.core.views.geometry import Color, Point
+from rosmc_server.core.views.vocabulary import (
+    HOLDING_LABEL,
     STATUS_COLOURS,
     STATUS_MARKS,
     STATUS_WORDS,
+    age_text,
     dbm,
     percent,
     rgb,
 )
-from rosmc_server.core.waiting import duration_text
 
 from .labels import LINE_SPACING, VIEW_PITCH, Box, Label
 
@@ -125,13 +130,18 @@ def status_color(status: SkillStatus) -> Color:
     return Color(*rgb(STATUS_COLOURS[status]))
 
 
-def skill_row(skill: str, status: SkillStatus | None, waiting_on: str = "") -> IconRow:
-    """The robot's current skill and its status (waiting: on whom); a failure in capitals."""
+def skill_row(
+    skill: str, status: SkillStatus | None, waiting_on: str = "", waited: float = -1.0
+) -> IconRow:
+    """The robot's current skill and its status (waiting: on whom, since how long); a
+    failure in capitals."""
     if not skill or status is None or status is SkillStatus.IDLE:
         return IconRow("skill", "idle", NEUTRAL)
     word = STATUS_WORDS[status]
     if status is SkillStatus.SYNCWAITING and waiting_on:
         word = f"{word} on {waiting_on}"
+    if status is SkillStatus.SYNCWAITING and waited >= 0:
+        word = f"{word} since {age_text(waited)}"
     if status is SkillStatus.FAILURE:
         word = word.upper()
     return IconRow("skill", f"{skill} {STATUS_MARKS[status]} {word}", status_color(status))
@@ -150,8 +160,13 @@ def status_parts(status: AgentStatus | None, skill_label: str = "") -> tuple[Ico
             wifi_row(None),
             battery_row(None),
         )
+    if status.hold is not HoldCause.NONE:
+        skill = IconRow("skill", HOLDING_LABEL, BAD)
+    else:
+        name = skill_label or status.current_skill
+        skill = skill_row(name, status.current_status, status.waiting_on, status.barrier_wait)
     return (
-        skill_row(skill_label or status.current_skill, status.current_status, status.waiting_on),
+        skill,
         link_row(
             status.link,
             status.last_heard,

@@ -15,7 +15,7 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
-from rosmc_server.core.geometry import CHAR_WIDTH
+from rosmc_server.core.views.geometry import CHAR_WIDTH
 
 LINE_SPACING = 1.25  # from one line's centre to the next, in letter heights
 VIEW_PITCH = 1.25  # the steepest shipped view looks north, this far below the horizon (rad)

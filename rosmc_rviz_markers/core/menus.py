@@ -2,14 +2,18 @@
 
 * Robot: ``Add skill ▸ <skill>`` (exactly that robot's skills). Pose parameters default to
   the robot's pose; a parameter that takes a task marker gets a new marker in front of the
-  robot, already bound.
+  robot, already bound. Then ``Resume`` (what frees a robot holding after its lost-link
+  policy acted).
 * Static agent (lander, payload box): ``Add skill ▸ <robot> ▸ <skill>`` for the skills that
   take that object: a text parameter whose choices name it (``pick_box box=wifi_box``), or a
   skill whose name or description mentions it (``return_to_lander``, ``recharge``: "at the
   lander").
-* Task marker: ``Add skill ▸ <robot> ▸ <skill>`` for skills with a parameter that accepts the
-  marker's kind (the new skill is bound to the marker), ``Rename ▸ <suggestion>`` and
-  ``Delete`` (only when no skill uses it; rename only while it is not locked).
+* Task marker: ``Add skill here ▸ <robot> ▸ <skill>`` for skills with a parameter that
+  accepts the marker's kind (the new skill is bound to the marker); a skill that works at a
+  point is offered a second time as ``<skill>, driving there first`` (the robot's move to
+  the marker, then the skill, both bound) unless the robot's task already ends there;
+  ``Rename ▸ <suggestion>`` and ``Delete`` (only when no skill uses it; rename only while it
+  is not locked).
 * Every one of them starts with an entry that names what was clicked, ``drone — robot``,
   ``RSS North — area`` (:func:`title_menu`; choosing it selects the object), and ends with
   ``Undo my last change`` and ``Redo`` (:data:`UNDO_MENU`).
@@ -19,15 +23,19 @@ Entries are numbered depth first from 1, as ``visualization_msgs/MenuEntry`` wan
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
-from rosmc_server.core.library import AgentKind, Library, SkillSpec
-from rosmc_server.core.markers import generated_name
-from rosmc_server.core.model import SkillInstance, TaskMarker
-from rosmc_server.core.params import MarkerType, ParamType, Value
-from rosmc_server.core.state import MissionState
+from rosmc_server.core.model.model import SkillInstance, TaskMarker
+from rosmc_server.core.model.state import MissionState
+from rosmc_server.core.rules.edit_rules import MarkerAction, marker_refusal
+from rosmc_server.core.rules.markers import generated_name
+from rosmc_server.core.skills.library import AgentKind, Library, SkillSpec
+from rosmc_server.core.skills.params import MarkerType, ParamType, Value
+from rosmc_server.core.views.drive_first import ARRIVED, move_skill
+from rosmc_server.core.views.places import first_location, location_xy
 
 
 @dataclass(frozen=True)
@@ -37,6 +45,8 @@ class AddSkill:
     ``bind``: the parameter the clicked task marker fills (None: none). ``values``: fixed
     parameter values (a static agent's name). ``from_robot``: the robot's menu, so pose
     parameters take its pose and marker parameters get new markers in front of it.
+    ``drive``: the robot's move skill and its target parameter, added (bound to the
+    clicked marker) just before the skill.
     """
 
     agent: str
@@ -44,6 +54,7 @@ class AddSkill:
     bind: str | None = None
     values: tuple[tuple[str, Value], ...] = ()
     from_robot: bool = False
+    drive: tuple[str, str] | None = None
 
 
 @dataclass(frozen=True)
@@ -70,8 +81,15 @@ class SelectObject:
     """Select the clicked object (the menu's first entry, the one that names it)."""
 
 
+@dataclass(frozen=True)
+class ResumeRobot:
+    """Resume ``agent``: what frees a robot holding after its lost-link policy acted."""
+
+    agent: str
+
+
 EditAction = AddSkill | RenameMarker | DeleteMarker
-MenuAction = EditAction | UndoEdit | SelectObject
+MenuAction = EditAction | UndoEdit | SelectObject | ResumeRobot
 
 
 @dataclass(frozen=True)
@@ -84,7 +102,7 @@ class Menu:
 
 
 UNDO_MENU = (Menu("Undo my last change", UndoEdit()), Menu("Redo", UndoEdit(redo=True)))
-"""Every marker's menu ends with these (see :mod:`.edit_history`)."""
+"""Every marker's menu ends with these (see :mod:`rosmc_server.core.live.edit_history`)."""
 
 ROBOT_WORD = "robot"
 OBJECT_WORD = "object"
@@ -137,12 +155,17 @@ def _skill_title(skill: str, param: str, several: bool) -> str:
 
 
 def robot_menu(library: Library, agent: str) -> tuple[Menu, ...]:
-    """``Add skill ▸ <skill>`` for every skill of ``agent``, alphabetical."""
+    """``Add skill ▸ <skill>`` for every skill of ``agent``, alphabetical, then ``Resume``.
+
+    ``Resume`` is always there (the menu does not change with the robot's state): a robot
+    holding after its lost-link policy says "Resume from its menu" on its label.
+    """
+    resume = Menu("Resume", ResumeRobot(agent))
     skills = sorted(library.skills_of(agent))
     if not skills:
-        return ()
+        return (resume,)
     children = tuple(Menu(s, AddSkill(agent, s, from_robot=True)) for s in skills)
-    return (Menu("Add skill", children=children),)
+    return (Menu("Add skill", children=children), resume)
 
 
 def _mentions(spec: SkillSpec, name: str) -> bool:
@@ -166,15 +189,17 @@ def object_skills(library: Library, obj: str) -> list[AddSkill]:
     return found
 
 
-def _by_robot(actions: Sequence[AddSkill], titles: Sequence[str]) -> tuple[Menu, ...]:
+def _by_robot(
+    actions: Sequence[AddSkill], titles: Sequence[str], title: str = "Add skill"
+) -> tuple[Menu, ...]:
     robots: dict[str, list[Menu]] = {}
-    for action, title in zip(actions, titles, strict=True):
-        robots.setdefault(action.agent, []).append(Menu(title, action))
+    for action, name in zip(actions, titles, strict=True):
+        robots.setdefault(action.agent, []).append(Menu(name, action))
     if not robots:
         return ()
     return (
         Menu(
-            "Add skill",
+            title,
             children=tuple(Menu(robot, children=tuple(items)) for robot, items in robots.items()),
         ),
     )
@@ -197,6 +222,44 @@ def marker_skills(library: Library, marker_type: MarkerType) -> list[tuple[AddSk
                     (AddSkill(robot, name, bind=param), _skill_title(name, param, len(params) > 1))
                 )
     return found
+
+
+ADD_HERE = "Add skill here"
+DRIVING = ", driving there first"
+
+
+def with_drives(
+    library: Library, state: MissionState, marker: TaskMarker, pairs: Sequence[tuple[AddSkill, str]]
+) -> list[tuple[AddSkill, str]]:
+    """``pairs``, each skill that works at a point followed by its "driving there first"."""
+    out: list[tuple[AddSkill, str]] = []
+    there: dict[str, bool] = {}  # per robot: its task already ends at the marker
+    for action, title in pairs:
+        out.append((action, title))
+        move = move_skill(library, action.agent)
+        param = library.skill(action.agent, action.skill).parameter(action.bind or "")
+        if move is None or action.skill == move[0] or param.marker_type is MarkerType.AREA:
+            continue
+        if action.agent not in there:
+            there[action.agent] = _ends_at(library, state, action.agent, marker)
+        if not there[action.agent]:
+            out.append((replace(action, drive=move), title + DRIVING))
+    return out
+
+
+def _ends_at(library: Library, state: MissionState, agent: str, marker: TaskMarker) -> bool:
+    """Whether ``agent``'s task already takes it to ``marker`` (its latest place is there)."""
+    skills = library.skills_of(agent)
+    for skill in reversed(state.task(agent)):  # from the end: the latest place is near it
+        spec = skills.get(skill.skill)
+        name = first_location(spec) if spec is not None else ""
+        if not name:
+            continue
+        if skill.bindings.get(name) == marker.name:
+            return True
+        xy = location_xy(skill.params.get(name))
+        return xy is not None and math.dist(xy, (marker.pose.x, marker.pose.y)) <= ARRIVED
+    return False
 
 
 def rename_suggestions(
@@ -225,13 +288,13 @@ def task_marker_menu(
     locked: bool,
 ) -> tuple[Menu, ...]:
     """The menu of a task marker (see the module docstring)."""
-    pairs = marker_skills(library, marker.type)
-    menus = list(_by_robot([a for a, _ in pairs], [t for _, t in pairs]))
+    pairs = with_drives(library, state, marker, marker_skills(library, marker.type))
+    menus = list(_by_robot([a for a, _ in pairs], [t for _, t in pairs], ADD_HERE))
     if not locked:
         names = rename_suggestions(state, marker, bound)
         if names:
             menus.append(Menu("Rename", children=tuple(Menu(n, RenameMarker(n)) for n in names)))
-    if not bound:
+    if marker_refusal(marker.name, bound, MarkerAction.DELETE) is None:  # the server's rule
         menus.append(Menu("Delete", DeleteMarker()))
     return tuple(menus)
 

@@ -11,11 +11,14 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from rosmc_server.core import areas
 from rosmc_server.core.errors import InvalidRequest
-from rosmc_server.core.library import Library
-from rosmc_server.core.model import TaskMarker
-from rosmc_server.core.params import MarkerType, ParamType, Pose, Value
+from rosmc_server.core.live.edit_history import EditKind
+from rosmc_server.core.model.model import TaskMarker
+from rosmc_server.core.skills.library import Library
+from rosmc_server.core.skills.params import MarkerType, ParamType, Pose, Value
+from rosmc_server.core.world import areas
+
+from .menus import DeleteMarker, EditAction, RenameMarker
 
 AHEAD = 4.0  # metres in front of a robot where new task markers appear
 AREA_AHEAD = 7.0  # an area's centre in front of the robot (so the robot is outside it)
@@ -103,3 +106,12 @@ def moved_pose(marker: TaskMarker, x: float, y: float, yaw: float) -> Pose:
     if marker.type is MarkerType.POSITION:
         yaw = 0.0
     return Pose(x, y, marker.pose.z, 0.0, 0.0, yaw)
+
+
+def edit_kind(action: EditAction) -> EditKind:
+    """The edit a menu entry makes (what undo can take back)."""
+    if isinstance(action, RenameMarker):
+        return EditKind.RENAME_MARKER
+    if isinstance(action, DeleteMarker):
+        return EditKind.DELETE_MARKER
+    return EditKind.ADD_SKILL

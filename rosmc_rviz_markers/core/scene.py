@@ -16,12 +16,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 
-from rosmc_server.core import geometry as geo
-from rosmc_server.core.agent_status import AgentStatus
-from rosmc_server.core.library import AgentKind, Library
-from rosmc_server.core.model import SkillInstance
-from rosmc_server.core.state import MissionState
-from rosmc_server.core.updates import (
+from rosmc_server.core.live.updates import (
     AgentStatusChanged,
     MarkerPut,
     MarkerRemoved,
@@ -31,6 +26,11 @@ from rosmc_server.core.updates import (
     SkillChanged,
     SkillRemoved,
 )
+from rosmc_server.core.model.model import SkillInstance
+from rosmc_server.core.model.state import MissionState
+from rosmc_server.core.robots.agent_status import AgentStatus
+from rosmc_server.core.skills.library import AgentKind, Library
+from rosmc_server.core.views import geometry as geo
 from rosmc_server.interface import MAP_FRAME
 
 from .labels import Box, Label, layout

@@ -13,11 +13,11 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from rosmc_server.core import geometry as geo
-from rosmc_server.core.frames import IDENTITY, Quaternion
-from rosmc_server.core.geometry import Color, Point, Primitive
-from rosmc_server.core.model import SkillInstance, TaskMarker
-from rosmc_server.core.params import MarkerType
+from rosmc_server.core.model.model import SkillInstance, TaskMarker
+from rosmc_server.core.skills.params import MarkerType
+from rosmc_server.core.views import geometry as geo
+from rosmc_server.core.views.geometry import Color, Point, Primitive
+from rosmc_server.core.world.frames import IDENTITY, Quaternion
 from rosmc_server.interface import MAP_FRAME, base_link
 
 from .labels import Label

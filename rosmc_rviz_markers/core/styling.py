@@ -11,8 +11,9 @@ from __future__ import annotations
 import enum
 from collections.abc import Iterable
 
-from rosmc_server.core.geometry import Color
-from rosmc_server.core.model import SkillInstance, SkillStatus, Transfer
+from rosmc_server.core.model.model import SkillInstance, SkillStatus, Transfer
+from rosmc_server.core.rules.edit_rules import MarkerAction, marker_refusal
+from rosmc_server.core.views.geometry import Color
 
 
 class MarkerUse(enum.IntEnum):
@@ -68,16 +69,7 @@ def marker_use(skills: Iterable[SkillInstance]) -> MarkerUse:
     return max((skill_use(s) for s in skills), default=MarkerUse.UNUSED)
 
 
-def locks(skill: SkillInstance) -> bool:
-    """Whether ``skill`` locks the markers it uses: synchronized (or uploading), unfinished."""
-    return not skill.is_editable and not skill.status.is_final
-
-
 def is_locked(skills: Iterable[SkillInstance]) -> bool:
-    """A marker is locked while any unfinished synchronized skill uses it."""
-    return any(locks(s) for s in skills)
-
-
-def can_delete(skills: Iterable[SkillInstance]) -> bool:
-    """Delete is offered only for a marker no skill uses (the server's rule)."""
-    return not any(True for _ in skills)
+    """A marker is locked (cannot move or be renamed) while a robot holds a skill that uses
+    it: the server's rule (:func:`~rosmc_server.core.rules.edit_rules.marker_refusal`)."""
+    return marker_refusal("", tuple(skills), MarkerAction.MOVE) is not None

@@ -11,7 +11,7 @@ from typing import Protocol
 
 import rospy
 
-from rosmc_server.core.mirror import MissionMirror
+from rosmc_server.core.live.mirror import MissionMirror
 
 from .. import topics
 from ..core.scene import Scene, Touched

@@ -14,8 +14,8 @@ from visualization_msgs.msg import (
 )
 
 from rosmc_server.conversions.primitives import color_msg, primitive_msg
-from rosmc_server.core import geometry as geo
-from rosmc_server.core.frames import quaternion_from_rpy, yaw_of
+from rosmc_server.core.views import geometry as geo
+from rosmc_server.core.world.frames import quaternion_from_rpy, yaw_of
 
 from ..core.icons import ICON_TEXT, IconRow, block_centre
 from ..core.menus import FlatMenu

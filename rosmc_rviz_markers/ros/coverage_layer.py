@@ -1,6 +1,6 @@
 """rviz's radio-coverage layer: ``/rosmc/coverage`` (visualization_msgs/MarkerArray).
 
-Builds a :class:`~rosmc_server.core.radio_map.RadioMap` from the robots' telemetry in
+Builds a :class:`~rosmc_server.core.robots.radio_map.RadioMap` from the robots' telemetry in
 ``/rosmc/agent_states`` (rosmc/AgentStates; journaled, so a replay grows the same map) and
 the radio model ``/rosmc/sim/coverage`` (rosmc/CoverageGrid, with the simulator), and
 draws it (:mod:`rosmc_rviz_markers.core.coverage`): namespace ``coverage_model`` (the
@@ -23,8 +23,8 @@ from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
 from rosmc_server.conversions.coverage import prediction_from_msg, reading_from_telemetry
-from rosmc_server.core.geometry import Color
-from rosmc_server.core.radio_map import RadioMap
+from rosmc_server.core.robots.radio_map import RadioMap
+from rosmc_server.core.views.geometry import Color
 from rosmc_server.interface import (
     AGENT_STATES_TOPIC,
     COVERAGE_MARKERS_TOPIC,

@@ -31,26 +31,38 @@ from geometry_msgs.msg import PointStamped, PoseStamped, PoseWithCovarianceStamp
 from visualization_msgs.msg import InteractiveMarkerFeedback as Feedback
 
 from rosmc_server import interface
-from rosmc_server.core import InvalidRequest, MarkerType, Pose, RosmcError, areas
-from rosmc_server.core.params import value_to_data
+from rosmc_server.core import InvalidRequest, MarkerType, Pose, RosmcError
+from rosmc_server.core.live.edit_history import EditHistory, EditKind
+from rosmc_server.core.model.control import ControlCommand
+from rosmc_server.core.skills.params import value_to_data
+from rosmc_server.core.world import areas
 from rosmc_server.ros.client import AsyncMissionClient, MissionClient, Outcome
 
 from .. import topics
-from ..core.edit_history import EditHistory
 from ..core.menus import (
     AddSkill,
     DeleteMarker,
     EditAction,
     RenameMarker,
+    ResumeRobot,
     SelectObject,
     UndoEdit,
 )
-from ..core.requests import SkillPlan, moved_area, moved_pose, new_marker, robot_skill_plan
+from ..core.requests import (
+    SkillPlan,
+    edit_kind,
+    moved_area,
+    moved_pose,
+    new_marker,
+    robot_skill_plan,
+)
 from ..core.scene import Selection
 from ..core.specs import Parsed, parse_name
 from ..core.styling import is_locked
 from .config import MarkerHost, MarkerNodeConfig
 from .convert import pose_numbers
+from .menu_calls import add_driving_first
+from .undo_calls import UndoCalls
 
 _log = logging.getLogger(__name__)
 Call = Callable[[MissionClient], Any]
@@ -64,6 +76,7 @@ class Interaction:
         self._config = config
         self._client = AsyncMissionClient(MissionClient(5.0, config.ns), "rosmc-markers-client")
         self.history = EditHistory()  # this rviz's own edits, for Undo / Redo
+        self.undo = UndoCalls(self.history, self._client, lambda: node.mirror.revision)
         self._drags: dict[str, tuple[float, float, float]] = {}
         self._timers: dict[str, threading.Timer] = {}
         self._lock = threading.Lock()
@@ -151,10 +164,15 @@ class Interaction:
             )
             return
         if isinstance(action, UndoEdit):
-            self._undo(action.redo)
+            self.undo.ask(action.redo)
             return
         if isinstance(action, SelectObject):
             self._select(parsed)
+            return
+        if isinstance(action, ResumeRobot):
+            agent = action.agent
+            # a control, not an edit (no EditKind): nothing for the undo history
+            self._submit(lambda c: c.control(ControlCommand.RESUME, agent), f"resume {agent}")
             return
         mirror = self._node.mirror
         scene = self._node.scene
@@ -169,12 +187,15 @@ class Interaction:
             status = mirror.agent_status(parsed.name) if parsed.kind == "robot" else None
             pose = status.pose if status is not None else None
         call = self._menu_call(action, parsed, scene.library, pose)
-        self._submit(call, f"{fb.marker_name}: {self._title(action)}", revision)
+        self._submit(
+            call, f"{fb.marker_name}: {self._title(action)}", revision, kind=edit_kind(action)
+        )
 
     @staticmethod
     def _title(action: EditAction) -> str:
         if isinstance(action, AddSkill):
-            return f"add {action.skill} to {action.agent}"
+            driving = f"{action.drive[0]} and " if action.drive else ""
+            return f"add {driving}{action.skill} to {action.agent}"
         if isinstance(action, RenameMarker):
             return f"rename to '{action.new_name}'"
         return "delete"
@@ -186,27 +207,14 @@ class Interaction:
             return lambda c: c.rename_task_marker(name, action.new_name)
         if isinstance(action, DeleteMarker):
             return lambda c: c.delete_task_marker(name)
+        if action.drive is not None and parsed.kind == "task":
+            return lambda c: add_driving_first(c, action, name)
         if action.from_robot:
             plan = robot_skill_plan(library, action.agent, action.skill, pose)
         else:
             bindings = ((action.bind, name),) if action.bind and parsed.kind == "task" else ()
             plan = SkillPlan(action.agent, action.skill, dict(action.values), (), bindings)
         return lambda c: _add_planned(c, plan)
-
-    def _undo(self, redo: bool) -> None:
-        """Ask the server to undo this rviz's newest edit (``redo``: its newest undo)."""
-        entry = self.history.take_redo() if redo else self.history.take_undo()
-        word = "redo" if redo else "undo"
-        if entry is None:
-            _log.warning("nothing of this rviz's to %s", word)
-            return
-        revision, what = entry
-        keep = self.history.redone if redo else self.history.undone
-        self._submit(
-            lambda c: c.undo_edit(revision),
-            f"{word} {what}",
-            record=lambda result: keep(result.revision, what),
-        )
 
     # -- drags ------------------------------------------------------------------------------------
     def _drag(self, fb: Any, parsed: Parsed) -> None:
@@ -266,6 +274,7 @@ class Interaction:
             f"move '{parsed.name}'",
             revision,
             on_error=lambda: self._node.snap_back(name),
+            kind=EditKind.MOVE_MARKER,
         )
 
     # -- selection --------------------------------------------------------------------------------
@@ -329,7 +338,8 @@ class Interaction:
             _log.warning("ignored a new %s marker: %s", what, error)
             return
         revision = self._node.mirror.revision
-        self._submit(lambda c: c.add_task_marker(marker), f"new {what} marker", revision)
+        call: Call = lambda c: c.add_task_marker(marker)  # noqa: E731
+        self._submit(call, f"new {what} marker", revision, kind=EditKind.ADD_MARKER)
 
     def on_reset(self, revision: int) -> None:
         """A snapshot came; one older than this node's last result means a new server."""
@@ -344,11 +354,10 @@ class Interaction:
         what: str,
         seen: int | None = None,
         on_error: Callable[[], None] | None = None,
-        record: Callable[[Any], None] | None = None,
+        kind: EditKind | None = None,
     ) -> None:
         """Run ``call`` on the client's thread against ``seen``, the revision the operator
-        saw; an accepted edit goes to the history (``record`` instead: how an undo or redo
-        is kept)."""
+        saw; an accepted edit (``kind``) goes to the history."""
 
         def done(outcome: Outcome[Any]) -> None:
             if outcome.error is not None:
@@ -357,10 +366,8 @@ class Interaction:
                     on_error()
                 return
             revision = getattr(outcome.value, "revision", None)
-            if record is not None:
-                record(outcome.value)
-            elif revision is not None:
-                self.history.done(revision, what)
+            if revision is not None:
+                self.history.done(kind, revision, what)
             _log.info("%s: done", what)
 
         future = self._client.submit(call, done, seen)

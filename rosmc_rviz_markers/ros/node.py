@@ -41,9 +41,9 @@ from visualization_msgs.msg import Marker
 
 from rosmc_server.common.ros.logging_bridge import bridge_logging_to_rosout
 from rosmc_server.core import AgentStatus, Library, MissionState, load_library
-from rosmc_server.core.geometry import Point
-from rosmc_server.core.mirror import MissionMirror
-from rosmc_server.core.updates import MirrorUpdate, MissionReset
+from rosmc_server.core.live.mirror import MissionMirror
+from rosmc_server.core.live.updates import MirrorUpdate, MissionReset
+from rosmc_server.core.views.geometry import Point
 from rosmc_server.interface import MAP_FRAME, base_link
 from rosmc_server.ros.client import MissionFollower, Outcome
 

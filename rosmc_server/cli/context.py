@@ -9,8 +9,8 @@ from dataclasses import asdict, dataclass, field
 from typing import Any, TextIO
 
 from ..core import AgentStatus
-from ..core.science import Science
-from ..core.site_source import SiteInForce
+from ..core.views.science import Science
+from ..core.world.site_source import SiteInForce
 from ..ros.client import MissionClient, MissionWatch, Result, ScienceWatch, SiteWatch, init_node
 from ..ros.client.latched import LatchedWatch, T
 

@@ -1,7 +1,7 @@
 """``rosmc key new [PATH]`` and ``rosmc key show [PATH]``: the deployment's radio key.
 
 No ROS master needed: they read and write the key file only (see
-:mod:`rosmc_server.core.radio_key`).
+:mod:`rosmc_server.core.robots.radio_key`).
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ..core.radio_key import default_key_path, load_key, make_key
+from ..core.robots.radio_key import default_key_path, load_key, make_key
 
 if TYPE_CHECKING:
     from .context import Context

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from collections.abc import Callable, Sequence
 
-from ..core.policy import DEFAULT_AFTER, LostLinkKind, LostLinkTrigger
+from ..core.skills.policy import DEFAULT_AFTER, LostLinkKind, LostLinkTrigger
 from .keys import add_commands as _add_keys
 from .replay import add_commands as _add_recording
 from .review import add_commands as _add_review
@@ -54,6 +54,14 @@ def _count(text: str) -> int:
     return value
 
 
+def _revision(text: str) -> int:
+    """A mission revision: 1 or more (no mission is at 0, which on the wire means no check)."""
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a mission revision (1 or more), got {text}")
+    return value
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``rosmc`` with all its subcommands."""
     parser = argparse.ArgumentParser(
@@ -71,10 +79,10 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--json", action="store_true", help="print machine-readable JSON")
     parser.add_argument(
         "--revision",
-        type=int,
+        type=_revision,
         metavar="N",
-        help="make changes against mission revision N: refused (exit 1) if the mission "
-        "has changed since (default: the current mission)",
+        help="make changes against mission revision N (1 or more): refused (exit 1) if the "
+        "mission has changed since (default: the current mission)",
     )
     common = argparse.ArgumentParser(add_help=False)
     common.add_argument("--json", action="store_true", default=argparse.SUPPRESS, help="print JSON")

@@ -162,7 +162,7 @@ def at(ctx: Context) -> int:
 
 def timeline(ctx: Context) -> int:
     """Draw the recording's per-robot timeline into an SVG or PNG file."""
-    from ..core.vocabulary import counted
+    from ..core.views.vocabulary import counted
     from ..recording.overlays import timeline_with_overlays
     from ..recording.timeline_svg import write_timeline
 

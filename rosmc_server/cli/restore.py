@@ -39,8 +39,8 @@ def restore(ctx: Context) -> int:
     """Load the recording's mission at ``--at`` into the running server as a blueprint."""
     import sys
 
-    from ..core.persistence import dump_mission
-    from ..core.vocabulary import counted
+    from ..core.files.persistence import dump_mission
+    from ..core.views.vocabulary import counted
     from ..recording.diff import resolve_when
     from ..recording.moments import review_histories
     from ..recording.restore import blueprint_from

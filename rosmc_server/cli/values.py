@@ -14,7 +14,7 @@ from collections.abc import Sequence
 import yaml
 
 from ..core import InvalidRequest, MarkerType, Pose, SkillSpec
-from ..core.params import ParamType, parse_text
+from ..core.skills.params import ParamType, parse_text
 
 
 def split_assignment(word: str) -> tuple[str, str]:

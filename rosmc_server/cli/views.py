@@ -7,7 +7,7 @@ import sys
 import time
 
 from ..core import AgentStatus, MissionEvent
-from ..core.site_source import site_line
+from ..core.world.site_source import site_line
 from ..ros.client import MissionWatch, ServerUnavailable, init_node
 from ..text import (
     agent_status_to_json,

@@ -11,7 +11,8 @@ import math
 import rosmc.msg as wire
 
 from ..core import AgentStatus, SkillStatus
-from ..core.link import LinkStatus
+from ..core.model.control import HoldCause
+from ..core.robots.link import LinkStatus
 from .values import pose_from_msg
 
 _LINK_STATES: dict[int, LinkStatus] = {
@@ -59,6 +60,8 @@ def agent_status_from_msg(msg: wire.AgentState) -> AgentStatus:
         policy=msg.policy,
         coverage_warning=msg.coverage_warning,
         radio_dropped=getattr(msg.link, "radio_dropped", 0),
+        hold=HoldCause.of(getattr(msg, "hold", "")),
+        barrier_wait=getattr(msg, "barrier_wait", -1.0),
     )
 
 

@@ -22,7 +22,7 @@ from typing import Any
 import rosmc.msg as wire
 
 from ..core import SkillInstance
-from ..core.commands import CommandSpec
+from ..core.robots.commands import CommandSpec
 from .mission import barrier_to_msg, skill_to_msg
 from .packing import skill_bytes, string_bytes
 

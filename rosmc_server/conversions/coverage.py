@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import rosmc.msg as wire
 
-from ..core.radio_map import GridSpec, Prediction, Reading
+from ..core.robots.radio_map import GridSpec, Prediction, Reading
 
 
 def prediction_from_msg(msg: wire.CoverageGrid) -> Prediction:

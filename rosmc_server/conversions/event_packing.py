@@ -23,12 +23,12 @@ from typing import Any
 import rosmc.msg as wire
 
 from ..core import MissionEvent
-from ..core.changes import PlacedSkill
+from ..core.model.changes import PlacedSkill
 from .mission import event_to_msg
 from .packing import serialized, skill_bytes, string_bytes
 
 # The rosmc/MissionEvent definition PackedEvent writes (with its nested types).
-PACKED_EVENT_MD5 = "b1445743a23e64ee6c9f7a4b412cdf11"
+PACKED_EVENT_MD5 = "b9c87033171a206238f41af42a33d931"
 
 _COUNT = struct.Struct("<I")
 _PUT_SKILLS_AT = 8 + 8 + 1  # revision, stamp and kind come before the agent and summary

@@ -23,7 +23,7 @@ from ..core import (
     SkillSpec,
     Value,
 )
-from ..core.site import SiteCheck
+from ..core.world.site import SiteCheck
 from .values import param_from_msg, param_to_msg
 
 

@@ -8,6 +8,7 @@ input, so service handlers can answer with an error). Round trips are exact.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -27,7 +28,7 @@ from ..core import (
     TaskMarker,
     Transfer,
 )
-from ..core.changes import SkillMove
+from ..core.model.changes import SkillMove
 from .move_fields import moves_from_fields, moves_to_fields
 from .values import (
     enum_from_number,
@@ -172,6 +173,7 @@ def event_to_msg(event: MissionEvent, agent_of: Callable[[str], str]) -> wire.Mi
         removed_barrier_ids=list(change.removed_barrier_ids),
         put_markers=[marker_to_msg(m) for m in change.put_markers],
         removed_marker_names=list(change.removed_marker_names),
+        undoes=event.undoes,
     )
     fields = moves_to_fields(change.moves)
     if fields is None:
@@ -196,7 +198,9 @@ def event_from_msg(msg: wire.MissionEvent) -> MissionEvent:
 
     An event recorded before reorders carried moves has no ``moves`` field and
     gives the whole new order in ``blueprint_order``; the core applies either. One
-    recorded before the packed move fields carries its moves in ``moves``.
+    recorded before the packed move fields carries its moves in ``moves``. One
+    recorded before events carried ``undoes`` names the edit it took back in its summary
+    only (see :func:`undoes_of`).
     """
     change = Change(
         put_skills=tuple(PlacedSkill(p.index, skill_from_msg(p.skill)) for p in msg.put_skills),
@@ -216,4 +220,26 @@ def event_from_msg(msg: wire.MissionEvent) -> MissionEvent:
         msg.summary,
         msg.stamp.to_sec(),
         change,
+        undoes_of(msg),
     )
+
+
+# How an undo's summary began before events carried ``undoes`` ("undo of revision 7 (...)").
+_OLD_UNDO_SUMMARY = re.compile(r"undo of revision (\d+) ")
+
+
+def undoes_of(msg: wire.MissionEvent) -> int:
+    """The revision of the edit ``msg`` takes back (0: none).
+
+    Events carry it in ``undoes``. A journal written before that field existed decodes
+    with its own recorded definition, which has no ``undoes``; there an undo's summary
+    was the only link ("undo of revision 7 (...)", the words the server has always
+    written), so it is read from the summary, here and nowhere else. The link matters
+    when such a journal is resumed: the server's undo history then knows that the edit
+    was undone, and that the undo itself can be undone (the redo).
+    """
+    undoes = getattr(msg, "undoes", None)
+    if undoes is not None:
+        return int(undoes)
+    match = _OLD_UNDO_SUMMARY.match(msg.summary)
+    return int(match.group(1)) if match else 0

@@ -5,7 +5,7 @@ moves. As ``rosmc/SkillMove[]`` genpy makes, writes and reads an object per move
 does every subscriber of the events topic. As ``move_ids`` (the ids joined by line
 breaks: a skill id holds none) and ``move_indexes`` (``uint32[]``), genpy writes and
 reads each field in one call, and a reader splits the ids in one call, straight into
-the core's :class:`~rosmc_server.core.moves.MoveList`. Recordings made before these
+the core's :class:`~rosmc_server.core.model.moves.MoveList`. Recordings made before these
 fields existed carry their moves in ``moves``, which is still read.
 
 A whole new order in a ``ReorderSkills`` request travels the same way: its ``order``
@@ -18,7 +18,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from ..core.errors import InvalidRequest
-from ..core.moves import MoveList, SkillMove, move_columns
+from ..core.model.moves import MoveList, SkillMove, move_columns
 
 SEPARATOR = "\n"
 

@@ -95,7 +95,7 @@ def skill_bytes(
     ``names`` keeps the encoded agent, skill and parameter names between calls (a library
     has few of them); pass the same dict to every call. ``shared`` keeps the bytes of
     each parameters dict written, for skills that share one (a loaded mission's alike
-    parameters, see :mod:`~rosmc_server.core.shared_params`): pass one dict to the calls
+    parameters, see :mod:`~rosmc_server.core.files.shared_params`): pass one dict to the calls
     for one mission.
     """
     if wire.Skill._md5sum != PACKED_SKILL_MD5:  # the definition changed: go through genpy

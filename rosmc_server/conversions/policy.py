@@ -13,7 +13,7 @@ from typing import Any
 import rosmc.msg as wire
 
 from ..core import InvalidRequest, LostLinkKind, LostLinkPolicy, LostLinkTrigger
-from ..core.policy import DEFAULT_AFTER
+from ..core.skills.policy import DEFAULT_AFTER
 from .values import params_from_msgs
 
 
@@ -34,7 +34,7 @@ def policy_from_request(request: Any) -> LostLinkPolicy:
     """The policy a ``rosmc/SetLostLinkPolicy`` request asks for.
 
     Omitted fields take the defaults: an empty kind is continue, an empty ``when`` silent,
-    ``after`` 0 :data:`~rosmc_server.core.policy.DEFAULT_AFTER` seconds.
+    ``after`` 0 :data:`~rosmc_server.core.skills.policy.DEFAULT_AFTER` seconds.
 
     The safe skill's parameters come as given; :meth:`LostLinkPolicy.checked` checks
     them against the library.

@@ -1,4 +1,4 @@
-"""Drawing primitives (:mod:`rosmc_server.core.geometry`) as ``visualization_msgs``.
+"""Drawing primitives (:mod:`rosmc_server.core.views.geometry`) as ``visualization_msgs``.
 
 The marker node draws robots, objects and task markers with them in rviz; ``rosmc export``
 draws the robots with the same bodies for Foxglove.
@@ -11,7 +11,7 @@ from geometry_msgs.msg import Quaternion
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker
 
-from rosmc_server.core import geometry as geo
+from rosmc_server.core.views import geometry as geo
 
 
 def color_msg(color: geo.Color) -> ColorRGBA:

@@ -23,7 +23,7 @@ from itertools import repeat
 from typing import Any
 
 from ..core import InvalidRequest, Resolution, SkillInstance, SkillStatus, Transfer
-from ..core.model import NO_BINDINGS
+from ..core.model.model import NO_BINDINGS
 from .param_unpacking import read_params
 
 _COUNT = struct.Struct("<I").unpack_from

@@ -6,8 +6,9 @@ skill: take_off}"`` sends, and it means what they would expect:
 
 - ``base_revision`` 0: no revision check (the change is made against whatever the mission
   is now). The GUIs and the Python client send the revision their view was made at, and a
-  stale one is refused (``CONFLICT``) as before. The one real view of revision 0 is the empty
-  mission a fresh server starts with, before any change.
+  stale one is refused (``CONFLICT``) as before. No mission is ever at revision 0: a fresh
+  one starts at :data:`FIRST_REVISION`, its first journal record, so every real view is
+  checked.
 - ``AddSkill.index`` 0: append at the end of the agent's task. ``-1`` appends too (what
   clients sent before); ``n >= 1`` inserts at task position ``n`` (counting from 0), as
   before; :data:`FRONT` (any value below -1) inserts at position 0, the front of the task.
@@ -21,6 +22,9 @@ from ..core import InvalidRequest
 
 NO_CHECK: Final = 0
 """``base_revision`` that asks for no revision check (what an omitted field sends)."""
+
+FIRST_REVISION: Final = 1
+"""The revision of a fresh mission (above :data:`NO_CHECK`, which no view is ever at)."""
 
 APPEND: Final = 0
 """``AddSkill.index`` that appends (what an omitted field sends); -1 appends too."""

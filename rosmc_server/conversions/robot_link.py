@@ -1,7 +1,7 @@
 """The robot link's protocol objects <-> robot-link and barrier messages.
 
 Part of :mod:`rosmc_server.conversions`, the one boundary between the ``rosmc``
-messages and the core (here :mod:`rosmc_server.core.protocol`, which the ground and
+messages and the core (here :mod:`rosmc_server.core.robots.protocol`, which the ground and
 the on-robot executor both speak).
 """
 
@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import rosmc.msg as wire
 
-from ..core.commands import CommandKind
-from ..core.protocol import Ack, BarrierInfo, Command, Report, Signal, SignalKind, Snapshot
+from ..core.robots.commands import CommandKind
+from ..core.robots.protocol import Ack, BarrierInfo, Command, Report, Signal, SignalKind, Snapshot
 from .mission import skill_from_msg, skill_to_msg
 from .values import time_to_msg
 
@@ -101,4 +101,6 @@ def snapshot_to_msg(agent: str, snapshot: Snapshot) -> wire.ExecutorSnapshot:
         policy=snapshot.policy,
         queue_omitted=not snapshot.full,
         status_digest=snapshot.status_digest,
+        hold=snapshot.hold.value,
+        waiting_since=snapshot.waiting_since,
     )

@@ -1,10 +1,10 @@
-"""The science state (``rosmc/ScienceState``) <-> :class:`~rosmc_server.core.science.Science`."""
+"""The science state (``rosmc/ScienceState``) <-> :class:`~.core.views.science.Science`."""
 
 from __future__ import annotations
 
 import rosmc.msg as wire
 
-from ..core.science import RegionScience, Science
+from ..core.views.science import RegionScience, Science
 
 
 def science_from_msg(msg: wire.ScienceState) -> Science:

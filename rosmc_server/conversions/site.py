@@ -9,8 +9,8 @@ from __future__ import annotations
 import rosmc.msg as wire
 
 from ..core import InvalidRequest
-from ..core.site import Footprint, GroundRobot, Shape, SiteModel, check_site
-from ..core.site_source import SiteInForce
+from ..core.world.site import Footprint, GroundRobot, Shape, SiteModel, check_site
+from ..core.world.site_source import SiteInForce
 from ..interface import MAP_FRAME
 from .values import time_to_msg
 

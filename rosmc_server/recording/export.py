@@ -31,7 +31,7 @@ from mcap_ros1.writer import Writer
 from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
-from rosmc_server.core import geometry as geo
+from rosmc_server.core.views import geometry as geo
 
 from ..conversions import event_from_msg, library_from_msg
 from ..conversions.primitives import primitive_msg

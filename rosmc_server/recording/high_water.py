@@ -35,7 +35,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from rosmc_server.core.durable import fsync_directory
+from rosmc_server.core.documents.durable import fsync_directory
 
 _log = logging.getLogger(__name__)
 

@@ -32,7 +32,7 @@ from rosmc_server.core import (
     NotFound,
     RosmcError,
 )
-from rosmc_server.core.updates import apply_event
+from rosmc_server.core.live.updates import apply_event
 from rosmc_server.interface import EVENTS_TOPIC, MISSION_TOPIC, ROBOT_REPORTS_TOPIC
 from rosmc_server.recording.damage import skipped_line
 from rosmc_server.recording.errors import JournalError
@@ -259,7 +259,7 @@ def _timeline(history: MissionHistory, records: tuple[JournalRecord, ...]) -> Ti
         try:
             event = event_from_msg(record.message)
             builder.event(mission[0], event, record.log_time)
-            apply_event(mission[0], event)
+            apply_event(mission[0], event, describe=False)
         except RosmcError:
             return False
         return True

@@ -19,7 +19,7 @@ import rosmc.msg as wire
 from rosmc_server.conversions import event_from_msg, mission_from_msg
 from rosmc_server.conversions.unpacking import UNPACKED_MISSION_MD5, mission_from_bytes
 from rosmc_server.core import MissionContent, MissionState, NotFound, RosmcError
-from rosmc_server.core.updates import apply_event
+from rosmc_server.core.live.updates import apply_event
 from rosmc_server.recording.lazy import JournalRecord
 
 CHECKPOINT_EVERY = 256
@@ -73,7 +73,7 @@ class StateBuilder:
                 state = MissionState(self._content(number), step.revision)
                 continue
             try:
-                apply_event(state, event_from_msg(step.event.message))
+                apply_event(state, event_from_msg(step.event.message), describe=False)
             except RosmcError as err:
                 self._break(number, str(err))
                 self._last = None

@@ -31,8 +31,9 @@ from pathlib import Path
 
 from rosmc_server.conversions import event_from_msg, mission_from_msg, mission_to_msg
 from rosmc_server.conversions.event_packing import packed_event
+from rosmc_server.conversions.request_fields import FIRST_REVISION
 from rosmc_server.core import Library, Mission, MissionContent, MissionEvent
-from rosmc_server.core.changes import EventKind
+from rosmc_server.core.model.changes import EventKind
 from rosmc_server.recording._mcap.codec import RosMessage
 from rosmc_server.recording._mcap.files import journal_parts
 from rosmc_server.recording.high_water import RevisionMark, first_mark, resumed_mark
@@ -170,8 +171,8 @@ class MissionJournal:
 
     @staticmethod
     def new_mission(library: Library, clock: Callable[[], float] = time.time) -> Mission:
-        """An empty mission at revision 0, to start a new journal with."""
-        return Mission(library, MissionContent.empty(library), clock=clock)
+        """An empty mission at :data:`FIRST_REVISION`, to start a new journal with."""
+        return Mission(library, MissionContent.empty(library), FIRST_REVISION, clock=clock)
 
 
 def _own_revision(report: ResumeReport, unacknowledged: int | None) -> int:

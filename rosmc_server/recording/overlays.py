@@ -11,7 +11,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..core import EventKind
-from ..core.vocabulary import ROBOT_EVENTS as _ROBOT_EVENTS  # drawn in the lanes: not marks
+from ..core.views.vocabulary import ROBOT_EVENTS as _ROBOT_EVENTS  # drawn in the lanes: not marks
 from ..interface import SCIENCE_TOPIC
 from .history import MissionHistory
 from .reader import read_journal

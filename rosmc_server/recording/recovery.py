@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from rosmc_server.core.vocabulary import counted
+from rosmc_server.core.views.vocabulary import counted
 from rosmc_server.recording.damage import Damage, skipped_line
 from rosmc_server.recording.high_water import LEASE, Mark, next_after_loss
 from rosmc_server.recording.mark_recovery import RecoveredMark

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ..core import SkillStatus
-from ..core.model import Resolution, SkillInstance
+from ..core.model.model import Resolution, SkillInstance
 from ..interface import (
     AGENT_STATES_TOPIC,
     EVENTS_TOPIC,

@@ -16,15 +16,15 @@ from rosmc_server.interface import (
     ROBOT_COMMANDS_TOPIC,
     ROBOT_REPORTS_TOPIC,
 )
-from rosmc_server.recording._mcap import head_mark
 from rosmc_server.recording._mcap import records as fmt
 from rosmc_server.recording._mcap.codec import RosMessage, serialize
-from rosmc_server.recording._mcap.files import journal_parts, part_path
+from rosmc_server.recording._mcap.files import journal_parts
 from rosmc_server.recording._mcap.reopen import reopen
 from rosmc_server.recording._mcap.write import PartFile
 from rosmc_server.recording.channels import JOURNAL_TOPICS, TELEMETRY_TOPICS
 from rosmc_server.recording.errors import JournalError
 from rosmc_server.recording.journal_options import DEFAULT_OPTIONS, JournalOptions
+from rosmc_server.recording.part_series import PartSeries
 from rosmc_server.recording.reader import JournalResult
 from rosmc_server.recording.space import DiskSpace
 
@@ -39,8 +39,8 @@ class JournalWriter:
     survives a crash of the process. ``close`` adds the summary that makes the file a
     complete, indexed MCAP file. Telemetry is skipped, and robot reports refused, near a
     full disk (:mod:`.space`); ask :meth:`require_space` before applying a change. A
-    journal that grows past ``part_bytes`` goes on in part files beside the first (see
-    :mod:`._mcap.files`). Open one with :meth:`create` or :meth:`resume`. Thread-safe:
+    journal that grows past ``part_bytes`` goes on in part files beside the first
+    (:mod:`.part_series`). Open one with :meth:`create` or :meth:`resume`. Thread-safe:
     appends from several threads are written one after the other. An advisory file
     lock keeps a second writer (in any process) off the same file.
     """
@@ -58,16 +58,10 @@ class JournalWriter:
         self._base = base
         self._library = library
         self._library_part = 0  # the part file the library was last written to
-        self._part = part
+        self._files = PartSeries(base, part, options)
         self._options = options
-        self._channels = part.section.channel_ids()
         self._events_since_snapshot = 0
-        self._events_in_part = part.section.counts.get(self._channels.get(EVENTS_TOPIC, -1), 0)
-        self._rotation_failed = False
         self._telemetry_skipped = False
-        self._mark: dict[str, str | int] | None = None  # the revision mark, for new parts
-        self._mark_writes = 0
-        self._first_head: head_mark.FirstFileHead | None = None  # once parts follow it
         self._newest_revision = -1  # of any event or snapshot written
         self._lock = threading.RLock()
         self.space = DiskSpace(part.path.parent, options.reserve_bytes)
@@ -151,6 +145,10 @@ class JournalWriter:
         return writer
 
     @property
+    def _part(self) -> PartFile:
+        return self._files.part
+
+    @property
     def path(self) -> Path:
         """The journal: its first file, which names every part for the readers."""
         return self._base
@@ -179,14 +177,7 @@ class JournalWriter:
     def snapshot_due(self) -> bool:
         """Whether a snapshot should be appended: ``snapshot_every`` events since the last
         one, or the current file is full (the snapshot then starts the next part)."""
-        return self._events_since_snapshot >= self._options.snapshot_every or self._part_full()
-
-    def _part_full(self) -> bool:
-        """Whether the current file holds ``part_bytes`` bytes or ``part_changes`` events."""
-        return (
-            self._part.offset >= self._options.part_bytes
-            or self._events_in_part >= self._options.part_changes
-        )
+        return self._events_since_snapshot >= self._options.snapshot_every or self._files.full()
 
     @property
     def needs_snapshot(self) -> bool:
@@ -237,17 +228,7 @@ class JournalWriter:
             JournalError: A head cannot be written.
         """
         with self._lock:
-            self._mark = dict(fields)
-            self._mark_writes += 1
-            self._part.write_mark(self._mark, self._mark_writes)
-            if self._part.number == 1:
-                return
-            if self._first_head is None:
-                self._first_head = head_mark.FirstFileHead(self._base)
-            try:
-                self._first_head.write(self._mark, self._mark_writes, sync and self._options.fsync)
-            except OSError as err:
-                raise JournalError(f"cannot write journal {self._base}: {err.strerror}") from err
+            self._files.write_mark(fields, sync)
 
     def append_due_snapshot(self, mission: RosMessage, log_time_ns: int) -> bool:
         """Record ``mission`` if a snapshot is due, the journal open and room left for it
@@ -290,7 +271,7 @@ class JournalWriter:
         writing this one."""
         with self._lock:
             self._part.open_fd()
-            self._rotate()
+            self._files.rotate()
 
     def sync(self) -> None:
         """Flush everything appended so far to the disk (fdatasync)."""
@@ -300,19 +281,14 @@ class JournalWriter:
     def close(self) -> None:
         """Write the summary and footer, sync and close; a closed journal is complete MCAP."""
         with self._lock:
-            self._close_first_head()
+            self._files.close_first_head()
             self._part.close()
 
     def abandon(self) -> None:
         """Close the file without a summary, as a crash leaves it; resume recovers it."""
         with self._lock:
-            self._close_first_head()
+            self._files.close_first_head()
             self._part.abandon()
-
-    def _close_first_head(self) -> None:
-        if self._first_head is not None:
-            self._first_head.close()
-            self._first_head = None
 
     def __enter__(self) -> Self:
         return self
@@ -345,13 +321,13 @@ class JournalWriter:
         with self._lock:
             self._part.open_fd()
             snapshot = messages[-1][0] == MISSION_TOPIC
-            if self._rotation_due(snapshot, late=snapshot and revision < self._newest_revision):
-                self._rotate()
+            if self._files.rotation_due(snapshot, snapshot and revision < self._newest_revision):
+                self._files.rotate()
             self._newest_revision = max(self._newest_revision, revision)
             part = self._part
             records: list[tuple[int, int, list[bytes]]] = []
             for (topic, _), body in zip(messages, data, strict=True):
-                channel_id = self._channels[topic]
+                channel_id = self._files.channels[topic]
                 earlier = sum(1 for r in records if r[0] == channel_id)
                 sequence = (part.section.sequence(channel_id) + earlier) & 0xFFFFFFFF
                 # The record is written in parts: a snapshot's megabytes are never copied.
@@ -372,7 +348,7 @@ class JournalWriter:
                     part.snapshots += 1
                 elif topic == EVENTS_TOPIC:
                     self._events_since_snapshot += 1
-                    self._events_in_part += 1
+                    self._files.events_in_part += 1
 
     def _room_for_telemetry(self, topic: str) -> bool:
         """Whether telemetry may still be written; skipped (said once) near a full disk."""
@@ -387,45 +363,3 @@ class JournalWriter:
             return False
         self._telemetry_skipped = False
         return True
-
-    def _rotation_due(self, snapshot: bool, late: bool) -> bool:
-        """Whether the next append starts a new part: a full part starts one with a snapshot,
-        so the part can start the mission on its own (any record does at twice the size).
-        A periodic snapshot journaled late (older than events already written) never does:
-        a resume that read the new part alone would miss those events. Nor is a part left
-        before it holds a snapshot: it could start nothing."""
-        if self._rotation_failed or late or not self._part_full() or not self._part.snapshots:
-            return False
-        return snapshot or self._part.offset >= 2 * self._options.part_bytes
-
-    def _rotate(self) -> None:
-        """Go on in the next part file; on failure keep writing this one."""
-        old = self._part
-        number = old.number + 1
-        try:
-            new = PartFile.create(
-                part_path(self._base, number), number, old.chunked, self._options.fsync
-            )
-        except JournalError as err:
-            _log.warning(
-                "journal %s: cannot start its next part (%s); going on in %s",
-                self._base,
-                err,
-                old.path.name,
-            )
-            self._rotation_failed = True
-            return
-        self._part = new
-        self._channels = new.section.channel_ids()
-        self._events_in_part = 0
-        if self._mark is not None:
-            self._mark_writes += 1
-            try:
-                new.write_mark(self._mark, self._mark_writes)
-            except JournalError as err:  # the side file and the older parts still hold it
-                _log.warning("journal %s: %s", self._base, err)
-        try:
-            old.close()
-        except JournalError as err:  # readers recover an unclosed part all the same
-            _log.warning("journal %s: %s", self._base, err)
-        _log.info("journal %s: continuing in %s", self._base, new.path.name)

@@ -12,7 +12,7 @@ import rospy
 
 from ..common.ros.radio import TopicListener
 from ..core import Barrier, Mission, MissionEvent
-from ..core.link import InboundSequence, Outbox
+from ..core.robots.link import InboundSequence, Outbox
 
 Operation = Callable[[Mission], MissionEvent | None]
 

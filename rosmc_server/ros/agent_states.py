@@ -17,7 +17,8 @@ import rospy
 from .. import interface
 from ..conversions.agents import link_state_to_msg
 from ..core import SkillStatus
-from ..core.advice import waiting_on_unsynced
+from ..core.rules.advice import waiting_on_unsynced
+from .agent_link import AgentLink
 from .coverage_watch import CoverageWatch
 from .server_host import ServerHost
 
@@ -115,9 +116,25 @@ class AgentStatePublisher:
             state.executor_state = link.snapshot.state
             state.waiting_on = link.snapshot.waiting_on
             state.policy = link.snapshot.policy
+            state.hold = link.snapshot.hold
+            state.barrier_wait = barrier_wait(link, report.last_heard)
+        else:
+            state.barrier_wait = -1.0
         state.coverage_warning = self._coverage.warning(server.mission.state, agent, state.policy)
         unsynced = waiting_on_unsynced(server.mission.state, agent)
         if unsynced and not state.waiting_on:
             # The robot cannot know: its partners' skills are still on the ground.
             state.waiting_on = f"{', '.join(unsynced)} (not synchronized)"
         return state
+
+
+def barrier_wait(link: AgentLink, last_heard: float) -> float:
+    """Seconds ``link``'s robot has waited at its barrier (-1: it does not wait at one).
+
+    Robot clock to robot clock (the newest message's stamp and the wait's start), then the
+    seconds since it was last heard: no clock is assumed equal to the ground's.
+    """
+    since = link.snapshot.waiting_since if link.snapshot is not None else 0.0
+    if since <= 0.0:
+        return -1.0
+    return max(0.0, link.newest_stamp - since) + max(0.0, last_heard)

@@ -10,7 +10,7 @@ from __future__ import annotations
 import rosmc.msg as wire
 
 from ..conversions import time_to_msg
-from ..core.link import Outgoing
+from ..core.robots.link import Outgoing
 
 
 def command_record(

@@ -1,6 +1,6 @@
 """The server's estimate of radio coverage, and its warning per robot.
 
-Feeds a :class:`~rosmc_server.core.radio_map.RadioMap` with the robots' telemetry (the
+Feeds a :class:`~rosmc_server.core.robots.radio_map.RadioMap` with the robots' telemetry (the
 server's agent-state publisher hands each message on) and the radio model's prediction,
 and says per robot whether its synchronized task ends out of coverage under a lost-link
 policy that would leave it there (``rosmc/AgentState.coverage_warning``).
@@ -18,7 +18,7 @@ import rospy
 from .. import interface
 from ..conversions.coverage import prediction_from_msg, reading_from_telemetry
 from ..core import Library, MissionState
-from ..core.radio_map import RadioMap, coverage_warning
+from ..core.robots.radio_map import RadioMap, coverage_warning
 
 
 class CoverageWatch:

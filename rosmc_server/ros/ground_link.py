@@ -11,7 +11,7 @@ Per dynamic agent, on the topics of :func:`rosmc_server.interface.ground_link`:
   commands at once, whatever TCP's backoff has grown to.
 
 Commands are retransmitted with backoff until acknowledged; while a robot is out of
-contact new commands wait unsent for it (:mod:`rosmc_server.core.waiting`); reports are
+contact new commands wait unsent for it (:mod:`rosmc_server.core.robots.waiting`); reports are
 applied once each and in order; the robot's periodic snapshot re-synchronizes
 numbering after restarts and reconciles statuses after outages, and its queue
 hash is checked against the ground's, with a repair sent on a mismatch
@@ -33,18 +33,18 @@ from ..common.ros.radio import GROUND, Radio, TopicListener, reconnect_in_backgr
 from ..conversions import time_to_msg
 from ..conversions.command_packing import command_msg
 from ..core import Mission, RosmcError, SkillStatus, StorageFull, Transfer
-from ..core.commands import CommandKind, CommandSpec, queued_barriers
-from ..core.drop_log import DropLog
-from ..core.link import (
+from ..core.robots.commands import CommandKind, CommandSpec, queued_barriers
+from ..core.robots.drop_log import DropLog
+from ..core.robots.link import (
     Arrival,
     LinkReport,
     LinkStatus,
     Outbox,
     Outgoing,
 )
-from ..core.radio import BEACON_PERIOD, ROBOT_SILENCE, ContactWatch
-from ..core.radio_key import RadioKey
-from ..core.waiting import collapse, waiting_work
+from ..core.robots.radio import BEACON_PERIOD, ROBOT_SILENCE, ContactWatch
+from ..core.robots.radio_key import RadioKey
+from ..core.robots.waiting import collapse, waiting_work
 from ..interface import ground_link
 from .agent_link import AgentLink, LinkHost, Operation
 from .command_records import command_record
@@ -54,7 +54,7 @@ _log = logging.getLogger(__name__)
 
 # Seconds between stamped report acks to each robot: they refresh the round trip of a quiet
 # link (the robot echoes them). Ground contact for the robots' lost-link policies is the
-# server's Heartbeat (ROS time); the ground's asks for a whole queue go out when made.
+# server's Heartbeat (wall time, like this); the ground's asks for a whole queue go out when made.
 HEARTBEAT_PERIOD = 10.0
 
 

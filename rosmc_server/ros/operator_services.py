@@ -7,7 +7,7 @@ revision; a refused request answers with an error code and one sentence, and
 the mission is unchanged. No handler lets an exception reach rospy: a server
 fault is logged with its traceback and answered as an INTERNAL error.
 Services never wait for robots: a command for a robot out of contact is accepted and
-waits for it (:mod:`rosmc_server.core.waiting`), and the answer's note says so.
+waits for it (:mod:`rosmc_server.core.robots.waiting`), and the answer's note says so.
 """
 
 from __future__ import annotations
@@ -47,12 +47,12 @@ from ..core import (
     StaleRevision,
     Unavailable,
 )
-from ..core.advice import unsynced_partners
-from ..core.commands import CommandKind, CommandSpec
-from ..core.execution import take_back_command
-from ..core.link import LinkStatus
-from ..core.policy import options_argument
-from ..core.waiting import queued_notes, room_refusal
+from ..core.robots.commands import CommandKind, CommandSpec
+from ..core.robots.link import LinkStatus
+from ..core.robots.waiting import check_link_command, queued_notes
+from ..core.rules.advice import unsynced_partners
+from ..core.rules.execution import take_back_command
+from ..core.skills.policy import options_argument
 from .caller_id import caller_id
 from .server_host import ServerHost
 from .team_sync import synchronize_team
@@ -170,14 +170,10 @@ class OperatorServices:
 
     def _require_link(self, agent: str, kind: CommandKind | None = CommandKind.UPLOAD) -> None:
         """``agent`` has a robot link, and room for a command of ``kind`` (None: one that
-        adds no work) by the core's bound (:func:`~rosmc_server.core.waiting.room_refusal`)."""
-        if agent not in self._server.library.dynamic_agents:
-            self._server.library.agent(_text(agent, "the agent name"))
-            raise RuleViolation(f"'{agent}' is a static agent and has no robot link")
-        # Out of contact is no reason to refuse (the command waits); only the core's bound is.
-        sentence = room_refusal(agent, kind, self._server.link.waiting_work(agent))
-        if sentence:
-            raise Unavailable(sentence)
+        adds no work): the core's rule (:func:`~..core.robots.waiting.check_link_command`)."""
+        _text(agent, "the agent name")
+        link = self._server.link
+        check_link_command(self._server.library, agent, kind, lambda: link.waiting_work(agent))
 
     # -- blueprint ----------------------------------------------------------------
     def _add_skill(self, req: Any, resp: Any) -> MissionEvent:

@@ -51,6 +51,7 @@ def state_key(state: wire.AgentState) -> tuple[Any, ...]:
         state.executor_state,
         state.waiting_on,
         state.policy,
+        state.hold,
         _step(telemetry.battery, BATTERY_STEP),
         _step(telemetry.wifi_signal, WIFI_STEP),
         telemetry.in_coverage,

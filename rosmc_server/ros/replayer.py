@@ -50,8 +50,8 @@ import rospy
 
 from .. import interface
 from ..conversions import event_from_msg
-from ..conversions.packing import PackedGetMissionResponse, PackedMission, SnapshotPacker
-from ..core import EventKind, InvalidRequest, MissionEvent, NotFound, RosmcError
+from ..conversions.packing import PackedGetMissionResponse, PackedMission
+from ..core import EventKind, InvalidRequest, MissionEvent, RosmcError
 from ..recording import JournalRecord
 from ..recording.history import MissionHistory
 from ..recording.playback import PlaybackClock, PlaybackStatus, Playlist
@@ -59,6 +59,7 @@ from .graph_names import taken_names
 from .node_setup import init_node
 from .replay_control import ReplayControl
 from .replay_library import GET_LIBRARY, serve_library
+from .replay_mission import ReplayMission
 from .replay_output import TYPES, ReplayOutput, first_telemetry
 
 _log = logging.getLogger(__name__)
@@ -147,16 +148,13 @@ class RecordingReplayer:
         self._output: ReplayOutput | None = None
         self._control: ReplayControl | None = None
         self._revision = -1  # of the last snapshot published on /rosmc/mission
-        self._current = history.revision_at(config.start).revision  # of the replay's mission
-        self._stamp = self._mission_stamp(config.start)  # mission clock of _current
-        self._built: tuple[int, Any] | None = None  # the last snapshot built, for get_mission
-        self._packer = SnapshotPacker()
+        self._mission = ReplayMission(history, self._playlist, config.start)
 
     # -- steering (any thread) -------------------------------------------------------------
     def status(self) -> PlaybackStatus:
         """Where the replay is: position, rate, paused, seeks and the mission revision there."""
         with self._lock:
-            return replace(self._clock.status(), revision=self._current)
+            return replace(self._clock.status(), revision=self._mission.current)
 
     def pause(self) -> PlaybackStatus:
         """Stop where it is."""
@@ -199,9 +197,7 @@ class RecordingReplayer:
         may call it before :meth:`run`.
         """
         with self._lock:
-            self._current = self._history.revision_at(position).revision
-            self._stamp = self._mission_stamp(position)
-            return self._mission_msg(self._current, position)
+            return self._mission.move_to(position)
 
     def stop(self) -> None:
         """End :meth:`run` early (thread-safe)."""
@@ -265,10 +261,10 @@ class RecordingReplayer:
         with self._handled:
             self._playing = True
         if self._stop.wait(WARM_UP):
-            return self._current
+            return self._mission.current
         self._out().wait_for_subscribers(CONNECT_TIMEOUT, self._stop)
         if self._stop.is_set():
-            return self._current
+            return self._mission.current
         self._clock.start()
         playlist, seen, index = self._playlist, -1, 0
         last_snapshot = time.monotonic()
@@ -302,7 +298,7 @@ class RecordingReplayer:
                 self._flush_snapshot()
                 last_snapshot = now
         self._stop.wait(LINGER)
-        return self._current
+        return self._mission.current
 
     def _await_seek(self, seeks: int) -> None:
         """Wait until the state at seek number ``seeks`` is out (while the replay plays)."""
@@ -321,14 +317,14 @@ class RecordingReplayer:
         position = status.position
         with self._handled:
             self.mission_at(position)  # built here, published (from the cache) below
-            self._publish_snapshot(self._current, position)
+            self._publish_snapshot(self._mission.current, position)
             self._out().publish_state_at(
                 self._playlist, position, moved=status.seeks > 0, paused=status.paused
             )
             self._handled_seeks = status.seeks
             self._handled.notify_all()
         self._announce()
-        _log.debug("replay: at %.2f s, revision %d", position, self._current)
+        _log.debug("replay: at %.2f s, revision %d", position, self._mission.current)
         return self._playlist.index_after(position)
 
     def _publish(self, record: JournalRecord) -> bool:
@@ -339,56 +335,31 @@ class RecordingReplayer:
                 self._out().publish(topic, record.message)
                 return False
             revision = record.revision  # read from the bytes: a snapshot is decoded only if new
-            if revision <= self._current:
+            if revision <= self._mission.current:
                 return False  # part of the mission published already
             msg = record.message
             self._out().publish(topic, msg)
-            self._current = revision
+            self._mission.current = revision
             if topic == interface.MISSION_TOPIC:  # a revision the history could not rebuild
                 self._revision = revision
                 return False
-            self._stamp = msg.stamp.to_sec()
+            self._mission.stamp = msg.stamp.to_sec()
         if self._on_event is not None:
             self._on_event(revision, _decoded(msg), self._history.seconds(record.log_time))
         return bool(msg.kind == EventKind.MISSION_REPLACED)
 
     def _flush_snapshot(self) -> None:
         with self._lock:
-            if self._current > self._revision:
-                self._publish_snapshot(self._current)
+            if self._mission.current > self._revision:
+                self._publish_snapshot(self._mission.current)
 
     def _publish_snapshot(self, revision: int, position: float | None = None) -> None:
-        msg = self._mission_msg(revision, position)
+        with self._lock:
+            msg = self._mission.message(revision, position)
         if msg is not None:
             self._out().publish(interface.MISSION_TOPIC, msg)
             self._revision = revision
             _log.debug("replay: snapshot of revision %d", revision)
-
-    def _mission_msg(self, revision: int, position: float | None = None) -> Any:
-        """The mission at ``revision`` as a message (None if the history lacks it)."""
-        with self._lock:
-            if self._built is not None and self._built[0] == revision:
-                return self._built[1]
-            try:
-                state = self._history.at_revision(revision)
-            except NotFound:  # a gap in the recording: its recorded snapshot follows
-                if position is None:
-                    return None
-                recorded = self._playlist.latest(interface.MISSION_TOPIC, position)
-                return None if recorded is None else recorded.message
-            # Packed: a seek serializes only the skills not in the last snapshot built.
-            msg = self._packer.pack(state.content(), revision, self._stamp)
-            self._built = (revision, msg)
-            return msg
-
-    def _mission_stamp(self, position: float) -> float:
-        """The mission clock of the last change recorded at or before ``position``."""
-        records = [
-            self._playlist.latest(topic, position)
-            for topic in (interface.EVENTS_TOPIC, interface.MISSION_TOPIC)
-        ]
-        latest = max((r for r in records if r is not None), key=lambda r: r.log_time, default=None)
-        return 0.0 if latest is None else float(latest.field("stamp").to_sec())
 
     def _out(self) -> ReplayOutput:
         assert self._output is not None, "the replay publishes only while it runs"
@@ -400,7 +371,7 @@ class RecordingReplayer:
 
     def _on_get_mission(self, _request: Any) -> Any:
         with self._lock:
-            msg = self._mission_msg(self._current, self._clock.status().position)
+            msg = self._mission.message(self._mission.current, self._clock.status().position)
         if isinstance(msg, PackedMission):
             return PackedGetMissionResponse(msg)
         return wire_srv.GetMissionResponse(mission=msg)

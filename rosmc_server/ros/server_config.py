@@ -11,7 +11,7 @@ from pathlib import Path
 import rospy
 
 from ..common.ros import station
-from ..core.operators import OperatorAllowList
+from ..core.rules.operators import OperatorAllowList
 from ..recording import JournalOptions
 
 PACKAGE_ROOT = Path(__file__).resolve().parents[2]

@@ -41,13 +41,13 @@ Parameters (private):
     ``~operators`` (list of str, or one string of names): nodes (full names, or prefixes
         ending in ``/`` or ``*``) that may call the operator services; empty (the default)
         lets every node in. Guards against mistakes, not attackers (see
-        :mod:`rosmc_server.core.operators`).
+        :mod:`rosmc_server.core.rules.operators`).
     ``~mission_dir`` (str): the only directory (with its subdirectories) where SaveMission
         and LoadMission read or write files on the server's host (default ``missions/``);
         elsewhere, clients pass the document itself.
     ``~radio_key`` (str): the deployment's radio key file, which signs the radio side
         channel's datagrams (default ``$ROS_HOME/rosmc/radio.key``, made there if missing;
-        a key given here must exist: see :mod:`rosmc_server.core.radio_key`).
+        a key given here must exist: see :mod:`rosmc_server.core.robots.radio_key`).
     ``~cwd`` (str): relative paths above are resolved against it (launch files pass the
         directory the user typed the command in; see :mod:`.station`).
     ``~station_journal`` (str): set by a launch file that restarts the server: a server that
@@ -85,8 +85,8 @@ from ..core import (
     Unavailable,
     load_library,
 )
-from ..core.changes import EventKind
-from ..core.commands import commands_for_event, default_policy_commands
+from ..core.model.changes import EventKind
+from ..core.robots.commands import commands_for_event, default_policy_commands
 from ..recording import JournalOptions, default_journal_path
 from ..recording.mission_journal import MissionJournal
 from .agent_states import AgentStatePublisher

@@ -2,12 +2,12 @@
 
 Subscribes ``/rosmc/site`` (rosmc/SiteMap, latched; the simulator publishes it, a real
 site's map provider would too). Each sane map replaces the previous one in the mission's
-:class:`~rosmc_server.core.site.SiteGuard`, under the server lock and nothing else, so the
+:class:`~rosmc_server.core.world.site.SiteGuard`, under the server lock and nothing else, so the
 server never waits on the map provider: until a map arrives (or if none ever does) the
 checks are skipped, and the log says so.
 
 ROS 1 lets any node publish there, so a map is checked first
-(:func:`~rosmc_server.core.site.check_site`: finite numbers within bounds, a bounded
+(:func:`~rosmc_server.core.world.site.check_site`: finite numbers within bounds, a bounded
 obstacle count); one that fails is refused with a WARN naming the node that sent it, and
 the map in force stays.
 
@@ -28,7 +28,7 @@ import rospy
 
 from ..conversions import site_from_msg, site_in_force_to_msg
 from ..core import InvalidRequest, Mission
-from ..core.site_source import SiteInForce
+from ..core.world.site_source import SiteInForce
 from ..interface import SITE_IN_FORCE_TOPIC, SITE_TOPIC
 from ..recording import JournalWriter
 from .caller_id import caller_id

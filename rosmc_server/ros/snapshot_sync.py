@@ -18,9 +18,9 @@ from collections.abc import Callable
 import rosmc.msg as wire
 
 from ..core import Mission, MissionEvent, RosmcError, SkillStatus
-from ..core.commands import CommandSpec, repair_command, synced_ids
-from ..core.link import InboundSequence, queue_hash, status_digest
-from ..core.reconcile import RobotSkill
+from ..core.robots.commands import CommandSpec, repair_command, synced_ids
+from ..core.robots.link import InboundSequence, queue_hash, status_digest
+from ..core.robots.reconcile import RobotSkill
 from .agent_link import AgentLink, LinkHost, Operation
 
 _log = logging.getLogger(__name__)

@@ -13,8 +13,8 @@ from typing import Any
 
 from ..conversions.request_fields import base_of
 from ..core import InvalidRequest, MissionEvent
-from ..core.advice import unsynced_partners
-from ..core.team import robots_with_blueprints
+from ..core.rules.advice import unsynced_partners
+from ..core.rules.team import robots_with_blueprints
 from .server_host import ServerHost
 
 

@@ -7,7 +7,7 @@ advertises them): ``/rosmc/get_mission`` (rosmc/GetMission), ``/rosmc/save_missi
 A mission of 10,000 skills is megabytes of YAML or of message, so none of them builds it
 afresh: GetMission answers with the snapshot of the current revision, serialized once
 (see :class:`~rosmc_server.conversions.packing.SnapshotPacker`); SaveMission reuses the
-file lines of unchanged skills (:class:`~rosmc_server.core.persistence.MissionDumper`)
+file lines of unchanged skills (:class:`~rosmc_server.core.files.persistence.MissionDumper`)
 and returns the document only to a client that needs it; LoadMission parses and checks
 the document and serializes the new skills before it takes the server's lock.
 """
@@ -34,7 +34,7 @@ from ..core import (
     parse_mission,
 )
 from ..core.collector import collector_paused
-from ..core.persistence import MissionDumper, write_document
+from ..core.files.persistence import MissionDumper, write_document
 from ..core.validation import check_file_path
 from .allocator import release_free_memory
 from .server_host import ServerHost

@@ -15,9 +15,9 @@ from ..core import (
     SkillSpec,
     TaskMarker,
 )
-from ..core.agent_status import AgentStatus
-from ..core.params import value_to_data
-from ..core.site_source import SiteInForce
+from ..core.robots.agent_status import AgentStatus
+from ..core.skills.params import value_to_data
+from ..core.world.site_source import SiteInForce
 
 
 def mission_to_json(
@@ -107,6 +107,8 @@ def agent_status_to_json(status: AgentStatus) -> dict[str, Any]:
         "policy": status.policy,
         "coverage_warning": status.coverage_warning,
         "radio_dropped": status.radio_dropped,
+        "hold": status.hold.value,
+        "barrier_wait": status.barrier_wait,
     }
 
 

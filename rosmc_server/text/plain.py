@@ -19,13 +19,16 @@ from ..core import (
     Pose,
     SkillInstance,
     SkillSpec,
+    SkillStatus,
     TaskMarker,
     Transfer,
     Value,
 )
-from ..core.agent_status import AgentStatus
-from ..core.link import LinkStatus
-from ..core.vocabulary import STATUS_MARKS, counted, dbm, number, percent, wifi_words
+from ..core.model.control import HoldCause
+from ..core.robots.agent_status import AgentStatus
+from ..core.robots.link import LinkStatus
+from ..core.views import holding
+from ..core.views.vocabulary import STATUS_MARKS, counted, dbm, number, percent, wifi_words
 
 _RULE = "    " + "-" * 56
 
@@ -50,6 +53,7 @@ def format_tasks(
         lines.append(f"  {agent}")
         if statuses is not None:
             lines.append(f"    {format_agent_status(statuses.get(agent))}")
+            lines.extend(f"    {line}" for line in hold_lines(state, statuses.get(agent)))
         task = state.task(agent)
         synced_end = state.sections(agent).synced_end
         for index, skill in enumerate(task):
@@ -61,6 +65,29 @@ def format_tasks(
         if synced_end == len(task):
             lines.append(_RULE + " blueprint (empty)")
     return "\n".join(lines)
+
+
+def hold_lines(state: MissionState, status: AgentStatus | None) -> list[str]:
+    """What a robot holding after its lost-link policy blocks and the command that frees
+    it, and what a robot waiting at a barrier waits for, since how long (none: [])."""
+    if status is None:
+        return []
+    agent, out = status.agent, []
+
+    def find(skill_id: str) -> SkillInstance | None:
+        return state.skill(skill_id) if state.has_skill(skill_id) else None
+
+    if status.hold is not HoldCause.NONE:
+        partners = holding.barrier_partners(state.barriers, find, agent)
+        sentence = holding.hold_sentence(agent, status.hold, partners, status.link is LinkStatus.UP)
+        out.append(f"HOLDING: {sentence} Free it: rosmc resume {agent}")
+    current = find(status.current_skill) if status.current_skill else None
+    barrier = state.barrier_of(current.id) if current is not None else None
+    if current is not None and barrier is not None and current.status is SkillStatus.SYNCWAITING:
+        members = [s for i in barrier.skill_ids if (s := find(i)) is not None]
+        missing = holding.not_arrived(members, agent)
+        out.append(f"{agent} {holding.wait_sentence(missing, barrier.id, status.barrier_wait)}")
+    return out
 
 
 def _skill_line(state: MissionState, skill: SkillInstance) -> str:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 
-from rosmc_server.core.radio_map import GridSpec, Prediction
+from rosmc_server.core.robots.radio_map import GridSpec, Prediction
 
 from .sim import Simulation
 

@@ -13,9 +13,9 @@ from typing import Any
 
 import yaml
 
-from rosmc_server.core.documents import DocumentReader, load_yaml
+from rosmc_server.core.documents.documents import DocumentReader, load_yaml
 from rosmc_server.core.errors import RosmcError
-from rosmc_server.core.site import Footprint, Shape
+from rosmc_server.core.world.site import Footprint, Shape
 
 SCENARIO_VERSION = 1
 ROBOT_KINDS = ("drone", "science_rover", "manipulator_rover")

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 
-from rosmc_server.core.site import GroundRobot, SiteModel
+from rosmc_server.core.world.site import GroundRobot, SiteModel
 
 from .sim import Simulation
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import pybullet as pb
 
-from rosmc_server.core.vocabulary import PALETTE
+from rosmc_server.core.views.vocabulary import PALETTE
 
 from .scenario import Scenario
 

@@ -34,9 +34,9 @@ import rospy
 
 from rosmc_server.common.ros.station import launch_path
 from rosmc_server.core import MarkerType, Pose, RosmcError, SkillStatus, TaskMarker
-from rosmc_server.core.changes import EventKind
-from rosmc_server.core.link import LinkStatus
-from rosmc_server.core.vocabulary import OPERATOR_EVENTS, counted
+from rosmc_server.core.model.changes import EventKind
+from rosmc_server.core.robots.link import LinkStatus
+from rosmc_server.core.views.vocabulary import OPERATOR_EVENTS, counted
 from rosmc_server.ros.client import ControlCommand, MissionClient, MissionWatch
 
 from .topics import SCIENCE_TOPIC

@@ -13,7 +13,7 @@ import rospy
 from nav_msgs.msg import Odometry
 
 from rosmc_server.core import Pose
-from rosmc_server.core.frames import yaw_of
+from rosmc_server.core.world.frames import yaw_of
 from rosmc_server.executor.core.lost_link import PoseSource
 
 from .topics import odom_topic

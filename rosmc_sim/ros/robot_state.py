@@ -28,7 +28,7 @@ from geometry_msgs.msg import Quaternion, TransformStamped, Vector3
 from nav_msgs.msg import Odometry
 from std_msgs.msg import Bool
 
-from rosmc_server.core.frames import quaternion_from_rpy
+from rosmc_server.core.world.frames import quaternion_from_rpy
 from rosmc_server.interface import MAP_FRAME, TELEMETRY_TOPIC, base_link
 
 from ..core.sim import Robot, Simulation

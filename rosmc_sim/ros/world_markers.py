@@ -25,8 +25,8 @@ from geometry_msgs.msg import Point
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
-from rosmc_server.core.geometry import CHAR_WIDTH
-from rosmc_server.core.vocabulary import PALETTE, counted
+from rosmc_server.core.views.geometry import CHAR_WIDTH
+from rosmc_server.core.views.vocabulary import PALETTE, counted
 from rosmc_server.interface import MAP_FRAME
 
 from ..core.sim import LEVEL_COLLABORATIVE, LEVEL_SCIENCE, Simulation

@@ -38,10 +38,10 @@ from std_msgs.msg import Bool
 from rosmc_server import interface
 from rosmc_server.conversions import mission_from_msg, param_to_msg, skill_to_msg
 from rosmc_server.core import MissionState, SkillInstance, SkillStatus
-from rosmc_server.core.commands import CommandKind
-from rosmc_server.core.radio import DatagramKind, parse_endpoint
-from rosmc_server.core.radio_auth import Sealer
-from rosmc_server.core.radio_key import RadioKey, obtain_key
+from rosmc_server.core.robots.commands import CommandKind
+from rosmc_server.core.robots.radio import DatagramKind, parse_endpoint
+from rosmc_server.core.robots.radio_auth import Sealer
+from rosmc_server.core.robots.radio_key import RadioKey, obtain_key
 from rosmc_server.recording import read_journal
 from tests.conftest import wait_until
 
@@ -103,6 +103,27 @@ class EventLog:
     def __len__(self) -> int:
         with self.lock:
             return len(self.events)
+
+    def statuses(self, skill_id: str) -> list[SkillStatus]:
+        """Every status the events carried for ``skill_id``, in order, repeats collapsed."""
+        went: list[SkillStatus] = []
+        for _, event in self.since(0):
+            for placed in event.put_skills:
+                status = SkillStatus(placed.skill.status.value)
+                if placed.skill.id == skill_id and went[-1:] != [status]:
+                    went.append(status)
+        return went
+
+    def wait_went(self, skill_id: str, status: SkillStatus, timeout: float = 60.0) -> None:
+        """Wait until an event showed ``skill_id`` at ``status``: a change that happened (and
+        is kept), never a passing state a look at the mission could miss."""
+        deadline = time.monotonic() + timeout
+        while status not in self.statuses(skill_id):
+            if time.monotonic() > deadline:
+                raise AssertionError(
+                    f"no event showed {skill_id} {status.name}: {self.statuses(skill_id)}"
+                )
+            time.sleep(0.02)
 
 
 class Operator:

@@ -122,6 +122,14 @@ def _methods(operator: Any) -> dict[str, Callable[..., Any]]:
     def wait_status(ids: list[str], status: str, timeout: float) -> dict[str, list[Any]]:
         return statuses(operator.wait_status(ids, SkillStatus[status], timeout))
 
+    def wait_started(ids: list[str], timeout: float) -> dict[str, float]:
+        """Wait until each skill has a start stamp (kept once it started, whatever it
+        does next); the stamps."""
+        state = operator.wait_mission(
+            lambda m: all(m.skill(i).started > 0.0 for i in ids), timeout, f"{ids} to start"
+        )
+        return {i: state.skill(i).started for i in ids}
+
     def links(agents: list[str]) -> dict[str, str]:
         names = {wire.LinkState.UNKNOWN: "UNKNOWN", wire.LinkState.UP: "UP", 2: "DOWN"}
         return {a: names[operator.agent_state(a).link.state] for a in agents}
@@ -134,10 +142,12 @@ def _methods(operator: Any) -> dict[str, Callable[..., Any]]:
         "add_barrier": operator.add_barrier,
         "wait_links": operator.wait_links,
         "wait_status": wait_status,
+        "wait_started": wait_started,
         "statuses": lambda: statuses(operator.mission()),
         "started": lambda: {s.id: s.started for s in operator.mission().skills()},
         "links": links,
         "waiting_on": lambda agent: operator.agent_state(agent).waiting_on,
+        "barrier_wait": lambda agent: operator.agent_state(agent).barrier_wait,
         "revision": lambda: operator.mission().revision,
     }
 

@@ -8,8 +8,9 @@ parameters the launch files leave at their defaults (the sim step, the server's 
 timeout, the executors' snapshot period) so that minutes of sim time take seconds.
 
 :class:`Operator` is the only way the tests change anything: :class:`MissionClient` (the
-public operator services), :class:`MissionWatch` (``/rosmc/agent_states``), and the sim's
-public topics ``/rosmc/sim/science`` and ``/<robot>/telemetry``.
+public operator services), :class:`MissionWatch` (``/rosmc/agent_states``), the mission
+events (``/rosmc/mission_events``, kept: what a skill went through), and the sim's public
+topics ``/rosmc/sim/science`` and ``/<robot>/telemetry``.
 """
 
 from __future__ import annotations
@@ -34,9 +35,11 @@ import rospy
 from rosgraph_msgs.msg import Clock
 
 from rosmc_server.core import AgentStatus, MissionState, RosmcError, SkillStatus, Transfer
+from rosmc_server.interface import EVENTS_TOPIC
 from rosmc_server.ros.client import ControlCommand, MissionClient, MissionWatch
 from rosmc_sim.ros.topics import SCIENCE_TOPIC, blackout_topic
 from tests.conftest import wait_until
+from tests.integration.executor_fixtures import EventLog
 
 REPO = Path(__file__).resolve().parents[2]
 SCENARIO = REPO / "tests" / "data" / "scenario_team.yaml"
@@ -333,9 +336,14 @@ class Operator:
         self.science = Science()
         self.telemetry = {robot: Latest(f"/{robot}/telemetry", wire.Telemetry) for robot in ROBOTS}
         self.timings: list[Timed] = []
+        self.events = EventLog()
+        self._events = rospy.Subscriber(
+            EVENTS_TOPIC, wire.MissionEvent, self.events.on_event, queue_size=10000
+        )
 
     def close(self) -> None:
         """Unsubscribe and drop connections."""
+        self._events.unregister()
         self.watch.close()
         self.science.close()
         for latest in self.telemetry.values():
@@ -477,13 +485,25 @@ class Operator:
         what: str,
         timeout: float = 30.0,
     ) -> wire.Telemetry:
-        """Wait until the robot's telemetry satisfies ``predicate``; that telemetry."""
+        """Wait until a telemetry message of the robot satisfies ``predicate``; that message.
 
-        def reached() -> wire.Telemetry | None:
-            telemetry = self.telemetry[robot].last
-            return telemetry if telemetry is not None and predicate(telemetry) else None
+        Every message is tested as it arrives (not only the latest at each look), so a
+        robot that passes where the predicate holds is seen there however busy the test is.
+        """
+        seen: list[wire.Telemetry] = []
+        last = self.telemetry[robot].last
+        if last is not None and predicate(last):
+            return last
 
-        return wait_until(reached, timeout, f"{robot}: {what}")
+        def keep(telemetry: wire.Telemetry) -> None:
+            if not seen and predicate(telemetry):
+                seen.append(telemetry)
+
+        subscriber = rospy.Subscriber(f"/{robot}/telemetry", wire.Telemetry, keep, queue_size=100)
+        try:
+            return wait_until(lambda: seen[0] if seen else None, timeout, f"{robot}: {what}")
+        finally:
+            subscriber.unregister()
 
 
 def describe(state: MissionState) -> str:

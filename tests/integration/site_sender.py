@@ -12,7 +12,7 @@ import rosmc.msg as wire
 import rospy
 
 from rosmc_server.conversions import site_to_msg
-from rosmc_server.core.site import Footprint, Shape, SiteModel
+from rosmc_server.core.world.site import Footprint, Shape, SiteModel
 from rosmc_server.interface import SITE_TOPIC
 
 

@@ -39,7 +39,7 @@ from rosmc_server.core import (
     load_library,
 )
 from rosmc_server.core.errors import ServerUnavailable
-from rosmc_server.core.science import RegionScience, Science
+from rosmc_server.core.views.science import RegionScience, Science
 from rosmc_server.interface import SCIENCE_TOPIC
 from rosmc_server.ros.client import MissionClient, RevisionConflict, library_from_msg
 from rosmc_server.ros.node_setup import init_node
@@ -368,6 +368,11 @@ def test_every_error_class_exits_1_with_one_line(
     }
     for result, needle in zip(run_many(server.env, list(cases)), cases.values(), strict=True):
         assert_refused(result, needle)
+    # 0 would ask for no check at all: the command line takes only a mission's revisions.
+    before = fresh.get_mission().revision
+    (zero,) = run_many(server.env, [("--revision", "0", "add", "drone", "land")])
+    assert zero.returncode == 2 and "must be a mission revision (1 or more)" in zero.stderr
+    assert fresh.get_mission().revision == before
 
 
 def test_client_conflicts_and_local_checks(server: Server, fresh: MissionClient) -> None:
@@ -717,9 +722,9 @@ def test_client_reconnects_after_server_restart(server: Server, client: MissionC
     server.stop(signal.SIGKILL)  # connections break, the registrations stay behind
     with pytest.raises(ServerUnavailable):  # after its timeout, not a hang
         MissionClient(timeout=1.0).get_mission()
-    server.start()  # a new mission at revision 0, in a new journal
-    assert client.get_mission().revision == 0  # the broken connection was replaced
-    assert client.add_skill("drone", "land").revision == 1
+    server.start()  # a new mission at revision 1 (never 0: no check), in a new journal
+    assert client.get_mission().revision == 1  # the broken connection was replaced
+    assert client.add_skill("drone", "land").revision == 2
     server.stop()  # cleanly: the services are gone, the master stays
     (result,) = run_many(server.env, [["--timeout", "1", "add", "drone", "land"]])
     assert result.returncode == 3

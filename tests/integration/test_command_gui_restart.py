@@ -49,12 +49,13 @@ def connected(window: Window) -> None:
 def restarted_from(window: Window, revision: int, count: int) -> str:
     """The ``count``-th "restarted" message, which must name ``revision``."""
 
-    def oldest_first() -> list[str]:
-        return [m for m in reversed(window.w.messages.messages()) if "restarted" in m]
+    def oldest_first() -> list[tuple[str, str]]:
+        entries = reversed(window.w.messages.entries())
+        return [(text, detail) for text, detail in entries if "restarted" in text]
 
     said = wait_until(lambda: oldest_first()[count - 1 :], 30, f"restart message {count}")
-    text = str(said[0])
-    assert f"revision {revision}" in text, text
+    text, detail = said[0]
+    assert detail == f"restarted from mission revision {revision}", (text, detail)
     return text
 
 

@@ -43,8 +43,8 @@ from rosmc_rqt_command.standalone import build
 from rosmc_server.conversions.science import science_to_msg
 from rosmc_server.conversions.site import site_to_msg
 from rosmc_server.core import LostLinkKind, LostLinkPolicy
-from rosmc_server.core.science import RegionScience, Science
-from rosmc_server.core.site import Footprint, Shape, SiteModel
+from rosmc_server.core.views.science import RegionScience, Science
+from rosmc_server.core.world.site import Footprint, Shape, SiteModel
 from rosmc_server.interface import SCIENCE_TOPIC, SITE_TOPIC
 from rosmc_server.ros.client import MissionClient
 from tests import conftest
@@ -344,7 +344,8 @@ def test_a_two_robot_barrier_plan_goes_out_with_one_click_and_one_question(
     team = questions.asked[1]
     assert "drone: 2 skills, its whole task" in team and "science_rover: 2 skills" in team
     assert "Warnings" not in team, team
-    assert f"(revision {before + 1})" in message, message
+    detail = window.w.messages.detail_of(message)
+    assert detail == f"mission revision {before + 1}", (message, detail)
     wait_until(
         lambda: all(
             window.w.view.view(agent).editable == () for agent in ("drone", "science_rover")

@@ -89,7 +89,8 @@ def drive() -> None:
     from rosmc_rqt_command.core.legality import RobotAction
     from rosmc_rqt_command.core.requests import Answer, ask
     from rosmc_server.core import AgentStatus, SkillStatus
-    from rosmc_server.core.library import library_from_dict
+    from rosmc_server.core.live.edit_history import EditKind
+    from rosmc_server.core.skills.library import library_from_dict
     from tests.unit.conftest import TEST_LIBRARY, make_mission
     from tests.unit.test_command_harness import Gui
 
@@ -201,7 +202,7 @@ def drive() -> None:
     # answer to its undo (revision 42), which redo undoes in turn.
     for request in backend.requests:
         widget.on_answer(Answer(request, error="not served here"))
-    deleted = ask(lambda c: c.delete_skills, "delete")([alpha[1]])
+    deleted = ask(lambda c: c.delete_skills, "delete", kind=EditKind.DELETE_SKILLS)([alpha[1]])
     widget.on_answer(Answer(deleted, value=SimpleNamespace(revision=41)))
     widget.activateWindow()
     QTest.qWaitForWindowActive(widget, 5000)

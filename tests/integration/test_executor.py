@@ -33,8 +33,8 @@ from rosmc_server.core import (
     SkillStatus,
     Transfer,
 )
-from rosmc_server.core.commands import CommandKind
-from rosmc_server.core.link import queue_hash, status_digest
+from rosmc_server.core.robots.commands import CommandKind
+from rosmc_server.core.robots.link import queue_hash, status_digest
 from rosmc_server.recording import read_journal
 from rosmc_server.ros.client import MissionClient
 from tests.conftest import wait_until
@@ -273,11 +273,11 @@ def test_skills_complete_during_a_blackout_and_report_in_order_after_it(rosmc: S
     system, op = rosmc(agents=("r1",), emulated=("r1",), server_params=("_link_timeout:=1.0",))
     robot_side = LinkEnd("r1", "ground", robot_names=True)  # hears r1 behind the emulator
     wait_until(robot_side.connected, 30.0, "r1's side of the link")
-    ids = [op.add("r1", "wait", {"duration": 0.6}) for _ in range(3)]
+    ids = [op.add("r1", "wait", {"duration": 1.0}) for _ in range(3)]
     op.sync("r1")
     wait_all_synced(op, ids)
     op.start("r1")
-    op.wait_status(ids[:1], S.RUNNING)
+    op.events.wait_went(ids[0], S.RUNNING)  # the event, not a look that could miss the state
     op.blackout("r1", True)
     robot_side.wait_heard("report", lambda r: r.skill_id == ids[2] and r.status.value == S.SUCCESS)
     wait_until(
@@ -305,19 +305,20 @@ def test_skills_complete_during_a_blackout_and_report_in_order_after_it(rosmc: S
 # -- operator workflows ---------------------------------------------------------------------
 def test_unsync_while_running_keeps_the_running_skill(rosmc: Start) -> None:
     system, op = rosmc(agents=("r1",))
-    first, *later = [op.add("r1", "wait", {"duration": d}) for d in (1.5, 0.1, 0.1)]
+    first, *later = [op.add("r1", "wait", {"duration": d}) for d in (3.0, 0.1, 0.1)]
     op.sync("r1")
     wait_all_synced(op, [first, *later])
     op.start("r1")
-    op.wait_status([first], S.RUNNING)
+    op.events.wait_went(first, S.RUNNING)
     assert op.unsync("r1") == later
-    state = op.wait_mission(
+    op.wait_mission(
         lambda m: all(m.skill(i).status is S.IDLE and not m.skill(i).transfer for i in later),
         30.0,
         "the later skills to return to the blueprint",
     )
-    assert state.skill(first).status is S.RUNNING
     op.wait_status([first], S.SUCCESS)
+    # The running skill went on to its end: never stopped, never sent back.
+    assert op.events.statuses(first)[-2:] == [S.RUNNING, S.SUCCESS], op.events.statuses(first)
     time.sleep(0.5)  # the later skills stay in the blueprint: nothing to wait on
     state = op.mission()
     assert [state.skill(i).status for i in later] == [S.IDLE, S.IDLE]
@@ -506,7 +507,7 @@ def test_executor_restart_mid_mission_keeps_the_queue(rosmc: Start) -> None:
     op.sync("r1")
     wait_all_synced(op, ids)
     op.start("r1")
-    op.wait_status(ids[1:2], S.RUNNING)
+    op.events.wait_went(ids[1], S.RUNNING)
     system.stop("r1", signal.SIGKILL)
     system.start_executor("r1")
     # The robot's snapshot may show the skill back on the shelf before its report says why.

@@ -156,7 +156,7 @@ def test_the_marker_nodes_worker_fills_the_base_revision_too(
 def test_after_a_fresh_server_requests_are_made_against_its_revisions(
     client_node: Any, start_server: StartServer
 ) -> None:
-    """A new server process with a new mission counts from 0 again: the window's client
+    """A new server process with a new mission counts from 1 again: the window's client
     forgets the old server's revisions once the new snapshot arrives."""
     server = start_server()
     app = QApplication.instance() or QApplication([])
@@ -167,13 +167,14 @@ def test_after_a_fresh_server_requests_are_made_against_its_revisions(
             seen = bridge.mirror_revision
             assert answer_of(bridge, ask(lambda c: c.add_task_marker, "new", seen)(POINT)).ok
         server.stop()
-        start_server("second")  # an empty mission at revision 0
+        start_server("second")  # an empty mission at revision 1 (0 would mean no check)
         conftest.wait_until(
-            lambda: bridge.mirror_revision == 0, 60, "the new mission", pause=conftest.qt_pause
+            lambda: bridge.mirror_revision == 1, 60, "the new mission", pause=conftest.qt_pause
         )
-        answer = answer_of(bridge, ask(lambda c: c.add_task_marker, "new", 0)(POINT))
+        # Made against what the view shows (1), not the old server's 4: checked, and accepted.
+        answer = answer_of(bridge, ask(lambda c: c.add_task_marker, "new", 1)(POINT))
         assert answer.ok, answer
-        assert mission_now()[0] == 1
+        assert mission_now()[0] == 2
     finally:
         bridge.close()
         app.processEvents()

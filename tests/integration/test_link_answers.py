@@ -16,7 +16,7 @@ import pytest
 import rosmc.msg as wire
 
 from rosmc_server.core import SkillStatus, Transfer
-from rosmc_server.core.link import queue_hash
+from rosmc_server.core.robots.link import queue_hash
 from tests.conftest import RosMaster, wait_until
 from tests.integration.executor_fixtures import LinkEnd, Operator, RosmcSystem
 

@@ -1,6 +1,7 @@
 """A rover whose synchronized task ends out of coverage, on the real simulated team.
 
-With its library default (``return_to_link`` after 60 s idle without a link) it drives
+With its library default (``return_to_link`` after 60 s idle without a link, wall seconds on
+the robot's steady clock whatever the sim's speed) it drives
 back to where it last had a link, the ground hears it again, and it holds; work the operator
 sent while it was out of contact reaches it then. With ``continue`` (the old default) it
 stays out. The team is this module's own: the second test leaves the
@@ -11,6 +12,7 @@ from __future__ import annotations
 
 import math
 import re
+import time
 from collections.abc import Iterator
 from typing import Any
 
@@ -18,6 +20,7 @@ import pytest
 import rospy
 
 from rosmc_server.core import LostLinkKind, LostLinkPolicy, SkillStatus
+from rosmc_server.core.model.control import HoldCause
 from rosmc_server.ros.client import ControlCommand
 from tests.conftest import wait_until
 from tests.integration.scenario_fixtures import Operator, Team, TeamSettings
@@ -81,8 +84,8 @@ def test_by_default_a_rover_left_out_of_coverage_returns_to_its_link_and_holds(
     op.wait_link(ARM, "down", timeout=30.0)
     op.wait_robot(ARM, reached_out, "it reaches the far spot", timeout=60.0)
 
-    # 60 sim seconds idle without a link later it drives back, and the ground hears it.
-    op.wait_link(ARM, "up", timeout=60.0)
+    # 60 wall seconds idle without a link later it drives back, and the ground hears it.
+    op.wait_link(ARM, "up", timeout=120.0)
     op.wait_status([far], SkillStatus.SUCCESS, timeout=30.0)
     held = wait_until(
         lambda: (s := op.agent_state(ARM)) and "(done); holding" in s.policy and s,
@@ -90,6 +93,7 @@ def test_by_default_a_rover_left_out_of_coverage_returns_to_its_link_and_holds(
         "the robot holds after its return",
     )
     assert held.executor_state == "paused", held
+    assert held.hold is HoldCause.RETURN_POINT, held  # said as a field, not only in words
     where = re.search(r"returning to the last link position \((\S+), (\S+)\)", held.policy)
     assert where, held.policy
     goal = (float(where[1]), float(where[2]))
@@ -132,7 +136,7 @@ def test_work_sent_while_out_of_contact_reaches_the_rover_when_its_default_bring
     # Its plan done, idle a minute without a link, the rover's library default drives it back
     # into coverage; what waited reaches it there, once and in order.
     op.wait_status([far], SkillStatus.SUCCESS, timeout=90.0)
-    op.wait_link(ARM, "up", timeout=60.0)
+    op.wait_link(ARM, "up", timeout=120.0)
     state = op.wait_stored(ARM)
     assert state.skill(home).status is SkillStatus.IDLE_SYNCHRONIZED
     assert state.skill(extra).is_editable, "the taken-back skill never went"
@@ -158,9 +162,10 @@ def test_with_policy_continue_the_rover_stays_out(op: Operator) -> None:
     )
     out_of_coverage_plan(op)
     op.wait_link(ARM, "down", timeout=30.0)
-    arrived = op.wait_robot(ARM, reached_out, "it reaches the far spot", timeout=60.0)
-    # Nothing happens: three times the default's minute of idleness, in sim time.
-    later = arrived.stamp.to_sec() + 180.0
-    op.wait_robot(ARM, lambda t: t.stamp.to_sec() > later, "three sim minutes", timeout=60.0)
+    op.wait_robot(ARM, reached_out, "it reaches the far spot", timeout=60.0)
+    # Nothing happens: longer than the default's minute of idleness, in wall seconds (the
+    # robot's link clock), ten times that in sim time.
+    later = time.monotonic() + 75.0
+    op.wait_robot(ARM, lambda t: time.monotonic() > later, "75 wall seconds", timeout=120.0)
     assert reached_out(op.where(ARM)), "the rover stayed where its plan ended"
     assert op.agent_state(ARM).link == "down"  # type: ignore[union-attr]

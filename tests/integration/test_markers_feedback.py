@@ -76,12 +76,12 @@ def test_task_marker_menu_adds_a_skill_bound_to_it(mission: Any, rviz: Rviz) -> 
     name = add_marker(mission, rviz, TaskMarker("drop", MarkerType.POSE, Pose(5.0, 6.0, yaw=0.5)))
     assert rviz.titles(f"task/{name}") == [
         f"{name} \u2014 pose",  # the first entry names the object
-        "Add skill",
+        "Add skill here",
         "Rename",
         "Delete",
         *UNDO_TITLES,
     ]
-    rviz.select_menu(f"task/{name}", "Add skill", "manipulator_rover", "place_box")
+    rviz.select_menu(f"task/{name}", "Add skill here", "manipulator_rover", "place_box")
     (skill,) = wait_for(lambda: skills_of(mission, "manipulator_rover"), "place_box")
     assert skill.skill == "place_box" and skill.bindings == {"target": name}
     assert skill.params["target"] == Pose(5.0, 6.0, yaw=0.5)

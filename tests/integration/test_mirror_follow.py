@@ -20,7 +20,12 @@ import rospy
 from rosmc_server import interface
 from rosmc_server.core import MarkerType, NotFound, Pose, TaskMarker
 from rosmc_server.core.errors import ServerUnavailable
-from rosmc_server.core.updates import AgentStatusChanged, MirrorUpdate, MissionReset, SkillAdded
+from rosmc_server.core.live.updates import (
+    AgentStatusChanged,
+    MirrorUpdate,
+    MissionReset,
+    SkillAdded,
+)
 from rosmc_server.ros.client import AsyncMissionClient, MissionClient, MissionFollower, Outcome
 from tests.conftest import wait_until
 from tests.integration.server_fixtures import ServerProcess, StartServer
@@ -135,7 +140,7 @@ def test_a_restarted_server_is_followed_from_its_new_mission(
             client.get_mission()  # this client's known revision is the old server's
             client.add_skill("science_rover", "explore")
             wait_until(lambda: mirrored(follower, client), 45.0, "the mirror of the new server")
-        assert follower.mirror.revision == 1
+        assert follower.mirror.revision == 2  # the fresh mission's 1, then the one change
         wait_until(lambda: connection == [True, False, True], 10.0, "the new server seen")
     finally:
         follower.close()

@@ -22,7 +22,7 @@ import rosmc.msg as wire
 
 from rosmc_server import interface
 from rosmc_server.core import SkillStatus
-from rosmc_server.core.commands import CommandKind
+from rosmc_server.core.robots.commands import CommandKind
 from rosmc_server.recording import read_journal
 from tests.integration.barrier_cuts import (
     CutOutcome,
@@ -100,7 +100,9 @@ def test_no_member_starts_when_every_radio_is_cut_during_the_release(team: LabSy
 
 
 @pytest.mark.timeout(120)
-def test_the_ground_sees_whom_a_member_waits_for_during_a_cut(team: LabSystem) -> None:
+def test_the_ground_sees_whom_a_member_waits_for_and_since_when_during_a_cut(
+    team: LabSystem,
+) -> None:
     lab, op = team.radio, team.operator()
     op("wait_links", ["r1", "r2"], 60.0, timeout=70.0)
     op("start")
@@ -116,6 +118,12 @@ def test_the_ground_sees_whom_a_member_waits_for_during_a_cut(team: LabSystem) -
         waiting = op("waiting_on", "r1")
         time.sleep(0.2)
     assert waiting.startswith(f"r2 at {barrier}"), waiting
+    # Since when, robot clock to robot clock (r1's host keeps its own): an age that grows.
+    first = op("barrier_wait", "r1")
+    assert first >= 0.0, first
+    while time.time() < deadline and op("barrier_wait", "r1") <= first:
+        time.sleep(0.2)
+    assert op("barrier_wait", "r1") > first
     lab.restore(["r2"])
 
 

@@ -12,9 +12,9 @@ import rospy
 
 from rosmc_server import interface
 from rosmc_server.common.ros.radio import Radio
-from rosmc_server.core.radio import DatagramKind
-from rosmc_server.core.radio_auth import Sealer
-from rosmc_server.core.radio_key import RadioKey
+from rosmc_server.core.robots.radio import DatagramKind
+from rosmc_server.core.robots.radio_auth import Sealer
+from rosmc_server.core.robots.radio_key import RadioKey
 from tests.conftest import RosMaster, wait_until
 
 

@@ -10,7 +10,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from rosmc_server.core.radio_key import default_key_path, load_key, make_key
+from rosmc_server.core.robots.radio_key import default_key_path, load_key, make_key
 from tests.conftest import RosMaster, wait_until
 from tests.integration.executor_fixtures import REPO_ROOT, RosmcSystem
 

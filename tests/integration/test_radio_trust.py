@@ -22,9 +22,9 @@ import rospy
 from rosmc_server import interface
 from rosmc_server.conversions import agent_status_from_msg, time_to_msg
 from rosmc_server.core import SkillStatus as S
-from rosmc_server.core.radio import DatagramKind, parse_endpoint
-from rosmc_server.core.radio_auth import SIGNATURE_BYTES, Sealer
-from rosmc_server.core.radio_key import RadioKey
+from rosmc_server.core.robots.radio import DatagramKind, parse_endpoint
+from rosmc_server.core.robots.radio_auth import SIGNATURE_BYTES, Sealer
+from rosmc_server.core.robots.radio_key import RadioKey
 from rosmc_server.text import format_agent_status
 from tests.conftest import wait_until
 from tests.integration.executor_fixtures import (

@@ -26,8 +26,8 @@ from visualization_msgs.msg import Marker, MarkerArray
 
 from rosmc_server.conversions import event_to_msg, mission_to_msg, site_to_msg
 from rosmc_server.core import Mission, Pose, TaskMarker, load_library
-from rosmc_server.core.params import MarkerType
-from rosmc_server.core.site import SiteModel
+from rosmc_server.core.skills.params import MarkerType
+from rosmc_server.core.world.site import SiteModel
 from rosmc_server.interface import (
     MAP_FRAME,
     SCIENCE_TOPIC,

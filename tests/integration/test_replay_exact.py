@@ -142,7 +142,8 @@ def fresh(client_node: Any, tmp_path_factory: pytest.TempPathFactory) -> Iterato
     try:
         robot = FakeRobot("drone")
         recording = Fresh(path=Path())
-        recording.truth[0] = raw.mission()
+        first = raw.mission()  # the fresh mission, at revision 1
+        recording.truth[first.revision] = first
         site.start()
         _session(recording, raw, client, robot, site)
         robot.close()

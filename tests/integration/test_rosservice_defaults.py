@@ -78,6 +78,22 @@ def test_the_guis_revision_check_still_refuses_a_stale_view(fresh: Client) -> No
     assert skill_ids(fresh.mission(), "drone")[-1] == done.skill_id
 
 
+def test_a_fresh_server_starts_at_revision_1_so_every_view_is_checked(
+    module_server: Any, start_server: Any
+) -> None:
+    """0 only ever means "no check": no mission is at revision 0, not even a new server's."""
+    module_server.stop()  # one server at a time on these service names
+    start_server("fresh-start")
+    with Client() as client:
+        seen = client.revision()
+        assert seen == 1, seen
+        accepted(client.call("add_skill", base_revision=seen, agent="drone", skill="take_off"))
+        # A view of the fresh mission, once another operator changed it, is refused.
+        stale = client.call("add_skill", base_revision=seen, agent="drone", skill="land")
+        assert stale.error_code == wire.ErrorCode.CONFLICT, stale
+        assert len(skill_ids(client.mission(), "drone")) == 1  # the refused one changed nothing
+
+
 def test_other_services_typed_with_their_defaults(fresh: Client, client_node: Any) -> None:
     env = dict(client_node.env)
     added = rosservice_call(env, "/rosmc/add_task_marker", "{marker: {type: 0}}")

@@ -31,7 +31,7 @@ import numpy as np
 import pytest
 import yaml
 
-from rosmc_server.core.vocabulary import PALETTE
+from rosmc_server.core.views.vocabulary import PALETTE
 from rosmc_sim.core.scenario import load_scenario
 from rosmc_sim.ros.robot_state import MAP_FRAME, base_link
 from rosmc_sim.ros.topics import WORLD_TOPIC, odom_topic

@@ -10,7 +10,8 @@ background colour fills rows and columns). Each test checks the outcome in the m
 * dragging a pose marker by its heading arrow moves it without turning it, and dragging
   its ring's knob turns it without moving it;
 * right-clicking the drone where it rests on the lander opens the drone's own menu, whose
-  first entry names it;
+  first entry names it, and whose *Resume* (what frees a robot holding after its lost-link
+  policy) goes to the drone;
 * right-clicking a flag's ground disc near its rim (outside the 1.2 m disc flags had)
   opens that marker's menu, and its first entry (the marker's name) selects it.
 """
@@ -34,7 +35,8 @@ from visualization_msgs.msg import InteractiveMarkerFeedback
 
 from rosmc_rviz_markers import topics
 from rosmc_server import interface
-from rosmc_server.core import MarkerType, Pose, TaskMarker, geometry
+from rosmc_server.core import MarkerType, Pose, TaskMarker
+from rosmc_server.core.views import geometry
 from rosmc_server.ros.client import MissionClient
 from tests.conftest import RosMaster
 from tests.integration.markers_fixtures import wait_for
@@ -270,3 +272,66 @@ def test_a_flag_is_hit_near_its_rim_and_its_menu_names_it(screen: Screen, tmp_pa
         for subscriber in subscribers:
             subscriber.unregister()
     assert mission_markers(client)[name].pose == marker.pose, "naming it changed nothing"
+
+
+@pytest.mark.usefixtures("gui_programs", "sim")
+def test_a_flags_menu_adds_a_skill_there_driving_there_first(
+    screen: Screen, tmp_path: Path
+) -> None:
+    client = MissionClient(10.0)
+    client.get_mission()
+    name = client.add_task_marker(TaskMarker("stone", MarkerType.POSITION, Pose(*FLAG_AT))).name
+    time.sleep(2.0)  # rviz shows the new marker and its menu
+    screen.click((FLAG_AT[0] + 0.85, FLAG_AT[1], 0.04), button=3)  # its menu opens
+    time.sleep(1.0)
+    # Add skill here ▸ manipulator_rover ▸ "pick_stone, driving there first" (after
+    # identify_stones, its driving variant and navigate_to)
+    screen.xdotool("key", "Down", "Down", "Right", "Down", "Down", "Right")
+    screen.xdotool("key", "Down", "Down", "Down", "Down")
+    screen.save(tmp_path / "add_here.png")
+    screen.xdotool("key", "Return")
+
+    def added() -> list[Any]:
+        return list(client.get_mission().task("manipulator_rover"))
+
+    what = f"the skills added ({tmp_path / 'add_here.png'})"
+    drive, pick = wait_for(lambda: len(added()) == 2 and added(), what)
+    assert (drive.skill, drive.bindings) == ("navigate_to", {"target": name})
+    assert (pick.skill, pick.bindings) == ("pick_stone", {"position": name})
+    assert (pick.params["position"].x, pick.params["position"].y) == FLAG_AT
+    client.close()
+
+
+@pytest.mark.usefixtures("gui_programs", "sim")
+def test_resume_from_the_robots_menu_goes_to_the_robot(screen: Screen, tmp_path: Path) -> None:
+    """The entry a holding robot's label points to: *Resume* in its menu, clicked in rviz."""
+    chosen: list[InteractiveMarkerFeedback] = []
+    waiting: list[int] = []
+
+    def on_feedback(feedback: InteractiveMarkerFeedback) -> None:
+        if feedback.event_type == InteractiveMarkerFeedback.MENU_SELECT:
+            chosen.append(feedback)
+
+    def on_states(msg: wire.AgentStates) -> None:
+        waiting.extend(a.link.commands_waiting for a in msg.agents if a.agent == "drone")
+
+    feedback_topic = topics.topic(topics.MARKERS_NS, "") + "/feedback"
+    subscribers = [
+        rospy.Subscriber(feedback_topic, InteractiveMarkerFeedback, on_feedback),
+        rospy.Subscriber(interface.AGENT_STATES_TOPIC, wire.AgentStates, on_states),
+    ]
+    try:
+        wait_for(lambda: list(waiting), "the drone's state")
+        before = waiting[-1]  # commands waiting for it already (its library policy)
+        screen.click((*DRONE_AT, geometry.PIN_CENTRE), button=3)
+        time.sleep(1.0)
+        screen.save(tmp_path / "resume_menu.png")
+        screen.xdotool("key", "Down", "Down", "Down", "Return")  # its name, Add skill, Resume
+        feedback = wait_for(lambda: list(chosen), f"an entry chosen ({tmp_path})")[0]
+        assert feedback.marker_name == "robot/drone"
+        assert feedback.menu_entry_id > 1, "not the entry that names it"
+        # No executor runs here: the server keeps the Resume waiting for the drone's contact.
+        wait_for(lambda: waiting[-1] == before + 1, "the Resume sent to the drone")
+    finally:
+        for subscriber in subscribers:
+            subscriber.unregister()

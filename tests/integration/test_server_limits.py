@@ -15,7 +15,7 @@ from rosmc.msg import ErrorCode
 
 pytest.register_assert_rewrite("tests.integration.server_fixtures")
 
-from rosmc_server.core.mission_text import digest_line  # noqa: E402
+from rosmc_server.core.files.mission_text import digest_line  # noqa: E402
 from rosmc_server.core.validation import MAX_CORNERS, MAX_SKILLS  # noqa: E402
 from tests.integration.server_fixtures import Client, ServerProcess, mission_key  # noqa: E402
 

@@ -24,7 +24,7 @@ import yaml
 
 from rosmc_server import interface
 from rosmc_server.conversions import event_from_msg
-from rosmc_server.core.link import status_digest
+from rosmc_server.core.robots.link import status_digest
 
 pytest.register_assert_rewrite("tests.integration.server_fixtures")
 

@@ -19,7 +19,7 @@ from rosmc.msg import ErrorCode
 
 from rosmc_server.core import LostLinkKind, LostLinkPolicy, Transfer
 from rosmc_server.core import SkillStatus as S
-from rosmc_server.core.waiting import MAX_WAITING
+from rosmc_server.core.robots.waiting import MAX_WAITING
 from rosmc_server.ros.client import MissionClient
 from rosmc_server.text import format_tasks
 from tests.conftest import wait_until

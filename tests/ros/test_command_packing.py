@@ -22,10 +22,10 @@ from rosmc_server.conversions.command_packing import (
 )
 from rosmc_server.conversions.packing import serialized
 from rosmc_server.core import Barrier
-from rosmc_server.core.commands import CommandKind, CommandSpec
-from rosmc_server.core.library import library_from_dict
-from rosmc_server.core.link import Outbox
-from rosmc_server.core.waiting import collapse
+from rosmc_server.core.robots.commands import CommandKind, CommandSpec
+from rosmc_server.core.robots.link import Outbox
+from rosmc_server.core.robots.waiting import collapse
+from rosmc_server.core.skills.library import library_from_dict
 from tests.ros.test_event_packing import ALPHABET
 from tests.unit.conftest import TEST_LIBRARY
 from tests.unit.random_missions import random_content, text

@@ -77,13 +77,14 @@ from rosmc_server.core import (
     TaskMarker,
     Transfer,
 )
-from rosmc_server.core.changes import SkillMove
-from rosmc_server.core.commands import CommandKind
-from rosmc_server.core.protocol import Signal, SignalKind
-from rosmc_server.core.radio_map import GridSpec, Prediction, Reading
-from rosmc_server.core.science import RegionScience, Science
-from rosmc_server.core.site import Footprint, GroundRobot, Shape, SiteCheck, SiteModel
-from rosmc_server.core.site_source import SiteInForce
+from rosmc_server.core.model.changes import SkillMove
+from rosmc_server.core.model.control import HoldCause
+from rosmc_server.core.robots.commands import CommandKind
+from rosmc_server.core.robots.protocol import Signal, SignalKind
+from rosmc_server.core.robots.radio_map import GridSpec, Prediction, Reading
+from rosmc_server.core.views.science import RegionScience, Science
+from rosmc_server.core.world.site import Footprint, GroundRobot, Shape, SiteCheck, SiteModel
+from rosmc_server.core.world.site_source import SiteInForce
 
 
 def over_the_wire(msg: Any) -> Any:
@@ -336,6 +337,8 @@ def test_every_agent_state_field_reaches_the_agent_status() -> None:
         waiting_on="drone",
         policy="on link loss: hold after 30 s",
         coverage_warning="the task ends out of coverage",
+        hold="return_point",
+        barrier_wait=92.5,
     )
     status = agent_status_from_msg(over_the_wire(msg))
     assert_no_default_field(status)
@@ -361,6 +364,8 @@ def test_every_agent_state_field_reaches_the_agent_status() -> None:
         waiting_on="drone",
         policy="on link loss: hold after 30 s",
         coverage_warning="the task ends out of coverage",
+        hold=HoldCause.RETURN_POINT,
+        barrier_wait=92.5,
     )
     nan = wire.AgentState(agent="lander", telemetry=wire.Telemetry(battery=math.nan))
     assert agent_status_from_msg(nan).battery is None

@@ -23,8 +23,8 @@ from rosmc_server.conversions.event_packing import (
 from rosmc_server.conversions.move_fields import order_from_field, order_to_field
 from rosmc_server.conversions.packing import serialized
 from rosmc_server.core import Barrier, EventKind, Library, MissionEvent
-from rosmc_server.core.changes import Change, PlacedSkill, SkillMove
-from rosmc_server.core.library import library_from_dict
+from rosmc_server.core.model.changes import Change, PlacedSkill, SkillMove
+from rosmc_server.core.skills.library import library_from_dict
 from tests.unit.conftest import TEST_LIBRARY
 from tests.unit.random_missions import random_content, text
 
@@ -69,9 +69,9 @@ def random_events(library: Library, count: int, seed: int) -> list[MissionEvent]
         )
         kind = rng.choice(list(EventKind))
         stamp = rng.randrange(0, 2**31) + rng.randrange(0, 10**9) / 1e9
-        events.append(
-            MissionEvent(number, kind, text(rng, ALPHABET), text(rng, ALPHABET), stamp, change)
-        )
+        undoes = rng.choice((0, 0, rng.randrange(1, 2**40)))
+        agent, summary = text(rng, ALPHABET), text(rng, ALPHABET)
+        events.append(MissionEvent(number, kind, agent, summary, stamp, change, undoes))
     return events
 
 
@@ -92,6 +92,7 @@ def test_every_event_packs_as_genpy_serializes_it(library: Library) -> None:
         assert read == expected
         assert event_from_msg(read) == event_from_msg(expected)
         assert packed.revision == event.revision and packed.epoch == epoch
+        assert event_from_msg(read).undoes == event.undoes
 
 
 def test_a_whole_reorder_event_carries_every_move_in_order(library: Library) -> None:

@@ -35,6 +35,7 @@ pytest.importorskip("rosmc.msg", reason="rosmc messages are not built (source bu
 
 from rosmc_server.conversions import mission_to_msg
 from rosmc_server.conversions.packing import serialized
+from rosmc_server.conversions.request_fields import FIRST_REVISION
 from rosmc_server.core import Library, Mission, MissionEvent, load_library
 from rosmc_server.recording import JournalError, JournalOptions
 from rosmc_server.recording.history import MissionHistory
@@ -78,7 +79,7 @@ class Session:
         self.library = library
         self.mission = MissionJournal.new_mission(library)
         self.journal = MissionJournal.create(folder / NAME, self.mission, OPTIONS)
-        log.note(Acked(0, content_of(self.mission)))
+        log.note(Acked(self.mission.revision, content_of(self.mission)))
 
     def change(self, operation: Callable[[Mission], MissionEvent]) -> MissionEvent:
         event = operation(self.mission)
@@ -197,7 +198,7 @@ def test_a_crash_at_any_write_loses_no_acknowledged_change(
         except JournalError:  # the journal was being created: nothing was acknowledged yet
             assert not acked, f"crash before op {upto} (+{torn} bytes)"
             continue
-        last = acked[-1].revision if acked else 0
+        last = acked[-1].revision if acked else FIRST_REVISION
         where = f"crash before op {upto} (+{torn} bytes)"
         assert resumed.report.alert() == "", f"{where}: {resumed.report.alert()}"
         revision = resumed.mission.revision

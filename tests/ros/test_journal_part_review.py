@@ -65,7 +65,7 @@ def session(
     path = tmp_path_factory.mktemp("parts") / "m.mcap"
     mission = MissionJournal.new_mission(library)
     journal = MissionJournal.create(path, mission, OPTIONS)
-    live = {0: content_of(mission)}
+    live = {mission.revision: content_of(mission)}
 
     def change(event: MissionEvent) -> None:
         journal.record(event, mission, snapshot_of)  # type: ignore[arg-type]
@@ -232,4 +232,6 @@ def test_a_journal_of_one_file_is_read_whole(tmp_path: Path, library: Library) -
     journal.close()
     assert moments.segments(path) is None
     history = moments.review_histories(path, ["r3"])[0]
-    assert [r.revision for r in history.revisions] == [0, 1, 2, 3, 4, 5]
+    assert [r.revision for r in history.revisions] == list(
+        range(mission.revision - 5, mission.revision + 1)
+    )

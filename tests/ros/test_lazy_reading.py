@@ -33,7 +33,7 @@ from rosmc_server.core import (  # noqa: E402
     MissionState,
     RosmcError,
 )
-from rosmc_server.core.updates import apply_event  # noqa: E402
+from rosmc_server.core.live.updates import apply_event  # noqa: E402
 from rosmc_server.interface import EVENTS_TOPIC, MISSION_TOPIC  # noqa: E402
 from rosmc_server.recording import (  # noqa: E402
     JournalOptions,

@@ -12,7 +12,7 @@ from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import SetBoolResponse
 
 from rosmc_server.core import ParamType, Pose, SkillSetupError
-from rosmc_server.core.bindings import FieldSource
+from rosmc_server.core.skills.bindings import FieldSource
 from rosmc_server.executor.ros.message_fields import (
     MessageRecipe,
     Template,

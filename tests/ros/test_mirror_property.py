@@ -26,7 +26,7 @@ from rosmc_server.conversions import (
     mission_to_msg,
 )
 from rosmc_server.core import MissionEvent, MissionState
-from rosmc_server.core.mirror import MissionMirror
+from rosmc_server.core.live.mirror import MissionMirror
 from tests.unit.test_mirror import View
 from tests.unit.test_properties import MissionMachine
 

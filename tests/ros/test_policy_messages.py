@@ -9,7 +9,7 @@ import rosmc.srv as srv
 
 from rosmc_server.conversions import param_to_msg, policy_from_request, policy_to_request
 from rosmc_server.core import InvalidRequest, LostLinkKind, LostLinkPolicy, Pose
-from rosmc_server.core.policy import DEFAULT_AFTER
+from rosmc_server.core.skills.policy import DEFAULT_AFTER
 
 POLICIES = [
     LostLinkPolicy(),

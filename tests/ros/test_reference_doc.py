@@ -122,3 +122,19 @@ def test_every_request_field_of_a_service_says_what_it_means(generated) -> None:
             and row.count("|") == 4  # a field (a constant's row has its value too)
         ]
     assert blank == [], "give these fields a comment in rosmc_msgs/srv"
+
+
+def test_an_indented_comment_line_goes_on_with_the_field_above(tool) -> None:
+    section = tool.parse_section(
+        [
+            'string policy   # in force; "" = as last said',
+            "                # (repeated only now and then)",
+            "# said of the field below",
+            "float64 echo    # echoed",
+        ],
+        leading_description=False,
+    )
+    assert [(f.name, f.comment) for f in section.fields] == [
+        ("policy", 'in force; "" = as last said (repeated only now and then)'),
+        ("echo", "said of the field below echoed"),
+    ]

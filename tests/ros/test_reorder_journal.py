@@ -37,7 +37,7 @@ from rosmc_server.core import (  # noqa: E402
     RuleViolation,
     load_library,
 )
-from rosmc_server.core.changes import SkillMove  # noqa: E402
+from rosmc_server.core.model.changes import SkillMove  # noqa: E402
 from rosmc_server.interface import EVENTS_TOPIC, MISSION_TOPIC  # noqa: E402
 from rosmc_server.recording import JournalWriter, latest_state, read_journal  # noqa: E402
 from rosmc_server.recording._mcap.codec import serialize  # noqa: E402
@@ -112,12 +112,13 @@ def test_reorders_journaled_as_moves_replay_to_the_order_of_every_revision(
     assert resumed(path).state.content() == mission.state.content()
 
 
-PACKED_MOVES = ("string move_ids", "uint32[] move_indexes")
+PACKED_MOVES = ("string move_ids", "uint32[] move_indexes", "uint64 undoes")
 
 
 def old_mission_event_definition(moves_as_messages: bool = False) -> bytes:
-    """``rosmc/MissionEvent`` as journals recorded it before the packed move fields, and
-    (unless ``moves_as_messages``) before reorders carried moves at all."""
+    """``rosmc/MissionEvent`` as journals recorded it before the packed move fields (and
+    ``undoes``, which came later), and (unless ``moves_as_messages``) before reorders
+    carried moves at all."""
     dropped = PACKED_MOVES if moves_as_messages else ("SkillMove[]", *PACKED_MOVES)
     main, *sections = str(wire.MissionEvent._full_text).split(SECTION)
     main = "\n".join(line for line in main.split("\n") if not line.startswith(dropped))
@@ -126,25 +127,26 @@ def old_mission_event_definition(moves_as_messages: bool = False) -> bytes:
 
 
 def old_event_bytes(event: MissionEvent, mission: Mission) -> bytes:
-    """The event serialized without ``moves`` and the packed move fields: with an empty
-    epoch, its last 16 bytes are four empty fields (moves, epoch, move ids, move indexes),
-    of which the old definition has one."""
+    """The event serialized without ``moves``, the packed move fields and ``undoes``: with
+    an empty epoch, its last 24 bytes are five empty fields (moves, epoch, move ids, move
+    indexes, undoes), of which the old definition has one."""
     msg = event_to_msg(event, mission.state.agent_of)
-    assert not msg.moves and not msg.move_indexes and not msg.epoch
+    assert not msg.moves and not msg.move_indexes and not msg.epoch and not msg.undoes
     data = serialize(msg)
-    assert data.endswith(b"\0" * 16)
-    return data[:-12]
+    assert data.endswith(b"\0" * 24)
+    return data[:-20]
 
 
 def moves_as_messages_bytes(event: MissionEvent, mission: Mission) -> bytes:
     """The event serialized as journals did before the packed move fields: its moves as
-    ``SkillMove`` messages, and without the two packed fields (empty: the last 8 bytes)."""
+    ``SkillMove`` messages, and without the two packed fields and ``undoes`` (empty: the
+    last 16 bytes)."""
     msg = event_to_msg(event, mission.state.agent_of)
     msg.moves = moves_to_msgs(event.change.moves)
     msg.move_ids, msg.move_indexes = "", ()
     data = serialize(msg)
-    assert data.endswith(b"\0" * 8)
-    return data[:-8]
+    assert data.endswith(b"\0" * 16)
+    return data[:-16]
 
 
 def write_old_journal(

@@ -35,7 +35,7 @@ from rosmc_server.core import (  # noqa: E402
     Transfer,
     load_library,
 )
-from rosmc_server.core.persistence import dump_mission, parse_mission  # noqa: E402
+from rosmc_server.core.files.persistence import dump_mission, parse_mission  # noqa: E402
 from rosmc_server.interface import SCIENCE_TOPIC  # noqa: E402
 from rosmc_server.recording import JournalWriter  # noqa: E402
 from rosmc_server.recording.diff import diff_missions, resolve_when  # noqa: E402

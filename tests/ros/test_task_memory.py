@@ -22,7 +22,7 @@ from rosmc_server.conversions.unpacking import (
     remembering_get_mission,
 )
 from rosmc_server.core import Library, MissionContent, SkillInstance, SkillStatus
-from rosmc_server.core.library import library_from_dict
+from rosmc_server.core.skills.library import library_from_dict
 from tests.unit.conftest import TEST_LIBRARY
 from tests.unit.random_missions import random_content
 

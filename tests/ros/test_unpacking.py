@@ -39,7 +39,7 @@ from rosmc_server.core import (
     SkillStatus,
     Transfer,
 )
-from rosmc_server.core.library import library_from_dict
+from rosmc_server.core.skills.library import library_from_dict
 from tests.unit.conftest import TEST_LIBRARY
 from tests.unit.random_missions import random_content
 

@@ -24,7 +24,7 @@ from rosmc_server.core import (
     load_library,
     mission_to_dict,
 )
-from rosmc_server.core.library import library_from_dict
+from rosmc_server.core.skills.library import library_from_dict
 
 REPO = Path(__file__).resolve().parents[2]
 SHIPPED_LIBRARY = REPO / "rosmc_server" / "config" / "mars_team.yaml"

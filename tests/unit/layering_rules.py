@@ -44,7 +44,7 @@ Besides the order, by what a module imports from outside:
   ``rosmc_server/core``. A robot may run without the ground's code and the other way round.
 * **The packages in order** (:data:`PACKAGE_RANK`): ``rosmc_server`` < ``rosmc_sim`` <
   the GUIs. The server imports no GUI and no simulator (drawing primitives are in
-  ``rosmc_server/core/geometry.py``), the simulator no GUI.
+  ``rosmc_server/core/views/geometry.py``), the simulator no GUI.
 * **The executor imports nothing of the ground's own modules** (:data:`GROUND_ONLY`): the
   ROS helpers both ends run (radio, station, logging bridge) are ``rosmc_server/common``.
 * **The server's insides**: apps reach the graph through the client. They import nothing
@@ -155,7 +155,7 @@ FOR_APPS = (
 )
 COMMON_ROS = "rosmc_server.common.ros"
 # The packages in their order: a package imports only from its own rank or below (the
-# GUIs draw with rosmc_server.core.geometry; the server never imports a GUI or the sim).
+# GUIs draw with rosmc_server.core.views.geometry; the server never imports a GUI or the sim).
 PACKAGE_RANK = {
     "rosmc_server": 0,
     "rosmc_sim": 1,

@@ -28,7 +28,7 @@ from rosmc_server.core import (
     TaskMarker,
     Transfer,
 )
-from rosmc_server.core.markers import check_marker
+from rosmc_server.core.rules.markers import check_marker
 
 S = SkillStatus
 # Text any parameter string may hold.

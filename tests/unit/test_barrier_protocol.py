@@ -13,8 +13,8 @@ from dataclasses import dataclass, field
 import pytest
 
 from rosmc_server.core import SkillStatus
-from rosmc_server.core.commands import CommandKind as K
-from rosmc_server.core.protocol import Signal, SignalKind
+from rosmc_server.core.robots.commands import CommandKind as K
+from rosmc_server.core.robots.protocol import Signal, SignalKind
 from rosmc_server.executor.core.barriers import READY_LEASE, BarrierBoard
 from tests.unit.test_executor_engine import Robot, Team, barrier_of, make_skill
 

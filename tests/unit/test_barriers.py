@@ -14,7 +14,7 @@ from rosmc_server.core import (
     SkillStatus,
     StaleRevision,
 )
-from rosmc_server.core.barriers import describe_cycle, find_deadlock
+from rosmc_server.core.rules.barriers import describe_cycle, find_deadlock
 
 S = SkillStatus
 

@@ -25,8 +25,8 @@ from rosmc_server.core import (
     RuleViolation,
     SkillInstance,
 )
-from rosmc_server.core.barriers import check_moves, check_new_barrier, find_deadlock
-from rosmc_server.core.changes import SkillMove, moves_between
+from rosmc_server.core.model.changes import SkillMove, moves_between
+from rosmc_server.core.rules.barriers import check_moves, check_new_barrier, find_deadlock
 
 Tasks = dict[str, list[str]]
 Groups = list[tuple[str, ...]]

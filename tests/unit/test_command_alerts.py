@@ -12,7 +12,7 @@ import pytest
 from rosmc_rqt_command.core import alerts
 from rosmc_rqt_command.core.legality import Action
 from rosmc_server.core import AgentStatus, Library, Mission, SkillStatus
-from rosmc_server.core.library import library_from_dict
+from rosmc_server.core.skills.library import library_from_dict
 from tests.unit.test_command_harness import Gui, open_gui
 
 S = SkillStatus
@@ -68,8 +68,8 @@ def test_a_member_on_the_robot_with_its_partner_planned_is_a_standing_warning(gu
     ("signal", "in_coverage", "planned", "expected"),
     [
         (-50.0, True, 2, None),
-        (-80.0, True, 2, "alpha is about to leave Wi-Fi range (-80 dBm) with 2 planned skills"),
-        (-80.0, True, 1, "alpha is about to leave Wi-Fi range (-80 dBm) with 1 planned skill "),
+        (-80.0, True, 2, "alpha is about to leave Wi-Fi range (weak signal) with 2 planned skills"),
+        (-80.0, True, 1, "alpha is about to leave Wi-Fi range (weak signal) with 1 planned skill "),
         (-95.0, False, 1, "alpha is out of Wi-Fi range with 1 planned skill not on board; what"),
         (-80.0, True, 0, None),  # nothing planned: nothing to lose
         (None, False, 2, None),  # no telemetry yet: no guess
@@ -222,9 +222,9 @@ def test_a_journal_alert_is_said_when_it_begins_and_when_it_clears(gui: Gui) -> 
 
 
 def test_the_gui_and_the_server_warn_of_the_same_barriers(gui: Gui, mission: Mission) -> None:
-    """One rule (rosmc_server.core.advice): a partner being uploaded is on its way, not
+    """One rule (rosmc_server.core.rules.advice): a partner being uploaded is on its way, not
     planned; the GUI's standing warning and the server's note on an upload agree."""
-    from rosmc_server.core.advice import unsynced_partners
+    from rosmc_server.core.rules.advice import unsynced_partners
 
     feed = gui.feed
     first, partner = feed.add("alpha", "wait"), feed.add("bravo", "wait")

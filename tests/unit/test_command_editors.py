@@ -27,7 +27,7 @@ from rosmc_rqt_command.qt.param_editors import (
     make_editor,
 )
 from rosmc_server.core import InvalidRequest, Library, Mission, ParamType, Pose
-from rosmc_server.core.library import ParameterSpec
+from rosmc_server.core.skills.library import ParameterSpec
 from tests.unit.test_command_harness import Gui, open_gui
 
 
@@ -271,3 +271,19 @@ def test_unreadable_list_text_raises_a_sentence(gui: Gui) -> None:
     with pytest.raises(InvalidRequest) as caught:
         editor.value()
     assert "\n" not in str(caught.value) and str(caught.value)
+
+
+def test_a_refused_label_tint_goes_with_the_selection(gui: Gui) -> None:
+    shown(gui, "alpha", "wait")
+    panel = gui.widget.parameters
+    panel.label_edit.setFocus()
+    panel.label_edit.selectAll()
+    QTest.keyClick(panel.label_edit, Qt.Key_Backspace)
+    QTest.keyClick(panel.label_edit, Qt.Key_Return)
+    assert panel.label_edit.styleSheet(), "refused: tinted"
+    gui.widget.actions_.clear_selection.trigger()  # the label field keeps the focus
+    gui.app.processEvents()
+    assert panel.skill is None
+    assert panel.label_edit.styleSheet() == "" and panel.label_edit.text() == ""
+    shown(gui, "alpha", "wait")  # the next selection starts clean too
+    assert panel.label_edit.styleSheet() == ""

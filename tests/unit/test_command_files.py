@@ -1,7 +1,7 @@
 """The File menu: when the operator is asked about unsaved changes, and what each answer does.
 
 Requests the widget sends are answered as the server would, with the real mission and
-the real mission-file format (``rosmc_server.core.persistence``).
+the real mission-file format (``rosmc_server.core.files.persistence``).
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import pytest
 
 from rosmc_rqt_command.core.requests import Answer, Request
 from rosmc_server.core import Library, Mission, SkillStatus
-from rosmc_server.core.persistence import dump_mission, parse_mission
+from rosmc_server.core.files.persistence import dump_mission, parse_mission
 from tests.unit.test_command_harness import Gui, open_gui
 
 

@@ -1,7 +1,7 @@
 """The command GUI's unit-test harness (offscreen Qt, no ROS), and checks of the harness.
 
 A real :class:`~rosmc_server.core.Mission` makes the changes; its events go through a
-real :class:`~rosmc_server.core.mirror.MissionMirror` and
+real :class:`~rosmc_server.core.live.mirror.MissionMirror` and
 :func:`~rosmc_rqt_command.core.view_state.view_update` (the code the ROS bridge runs) into the
 widget, so the widget sees exactly the updates it would see live. Only the ROS side is
 absent: requests the widget sends are recorded by :class:`RecordingBackend` (tests may
@@ -31,8 +31,8 @@ from rosmc_rqt_command.qt.command_widget import CommandWidget
 from rosmc_rqt_command.qt.section_table import SectionTable
 from rosmc_rqt_command.qt.task_model import SKILL, STATUS
 from rosmc_server.core import AgentStatus, Library, Mission, MissionEvent, MissionState
-from rosmc_server.core.mirror import MissionMirror
-from rosmc_server.core.updates import MirrorUpdate
+from rosmc_server.core.live.mirror import MissionMirror
+from rosmc_server.core.live.updates import MirrorUpdate
 
 
 def qt_app() -> QApplication:

@@ -22,7 +22,7 @@ from python_qt_binding.QtWidgets import QApplication, QMainWindow
 from rosmc_rqt_command.qt.replay_bar import ReplayBar
 from rosmc_rqt_command.replay_ticks import RecordingOutline
 from rosmc_server.core import AgentStatus, Library
-from rosmc_server.core.library import load_library
+from rosmc_server.core.skills.library import load_library
 from tests.team_gui import settle
 from tests.unit.conftest import SHIPPED_LIBRARY, make_mission
 from tests.unit.test_command_harness import Gui

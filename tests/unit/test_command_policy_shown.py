@@ -7,6 +7,7 @@ test reads the open dialog and presses its buttons with the mouse.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
+from typing import Any
 
 import pytest
 from python_qt_binding.QtCore import Qt, QTimer
@@ -17,7 +18,9 @@ from rosmc_rqt_command.core.policy_words import policy_in_force
 from rosmc_rqt_command.qt.policy_dialog import PolicyDialog
 from rosmc_server.core import AgentStatus, Library, LostLinkKind, LostLinkPolicy, Mission
 from rosmc_server.core import LostLinkTrigger as T
+from rosmc_server.core.skills.library import library_from_dict
 from tests.team_gui import settle
+from tests.unit.conftest import make_mission
 from tests.unit.test_command_harness import Gui, open_gui
 
 HOLD_30 = LostLinkPolicy(LostLinkKind.HOLD, 30.0)
@@ -102,3 +105,27 @@ def test_the_dialog_opens_on_the_policy_in_force_and_shows_one_waiting(gui: Gui)
     gui.feed.statuses(AgentStatus("alpha", link="up", last_heard=0.0, policy=HOLD_30.describe()))
     settle(gui.widget)
     assert "waiting for contact" not in column.status_label.text()
+
+
+def test_before_the_robot_reports_the_dialog_opens_on_the_librarys_default(
+    library_data: dict[str, Any],
+) -> None:
+    library_data["models"]["walker"]["lost_link"] = {"policy": "hold", "after": 20}
+    library = library_from_dict(library_data, "unit_team.yaml")
+    gui = Gui(make_mission(library), library)
+    try:
+        settle(gui.widget)
+        column = gui.widget.tasks.columns["alpha"]
+        seen: list[tuple[LostLinkPolicy, str]] = []
+
+        def look(dialog: PolicyDialog) -> None:
+            seen.append((dialog.policy(), dialog.in_force.text()))
+            QTest.mouseClick(dialog.buttons.button(dialog.buttons.Cancel), Qt.LeftButton)
+
+        with_dialog(look, lambda: QTest.mouseClick(column.policy_button, Qt.LeftButton))
+        default = LostLinkPolicy(LostLinkKind.HOLD, 20.0)
+        assert seen == [
+            (default, f"In force: {default.describe()} (library default, not reported yet)")
+        ], "not on keep going"
+    finally:
+        gui.close()

@@ -1,4 +1,5 @@
-"""Nothing is sent to a robot by a slip of the mouse, and a held robot is said in words.
+"""Nothing is sent to a robot by a slip of the mouse; a held robot, a barrier wait and a robot
+out of contact are said in words.
 
 The real widget (offscreen Qt) follows a real mission through the unit harness; the
 operator's clicks are real mouse clicks, and the questions are the real message boxes.
@@ -7,6 +8,7 @@ operator's clicks are real mouse clicks, and the questions are the real message 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
+from types import SimpleNamespace
 
 import pytest
 from python_qt_binding.QtCore import QPoint, Qt, QTimer
@@ -15,9 +17,19 @@ from python_qt_binding.QtWidgets import QApplication, QMessageBox
 
 from rosmc_rqt_command.core.holding import lost_link_hold
 from rosmc_rqt_command.core.legality import RobotAction
-from rosmc_rqt_command.core.requests import Answer
-from rosmc_server.core import AgentStatus, Library, LostLinkKind, LostLinkPolicy, Mission
-from rosmc_server.core.control import ControlCommand
+from rosmc_rqt_command.core.phrasing import answer_detail, answer_message
+from rosmc_rqt_command.core.presentation import LAST_KNOWN_TEXT_COLOUR, last_known_colour
+from rosmc_rqt_command.core.requests import Answer, ask
+from rosmc_rqt_command.qt.task_model import STATUS
+from rosmc_server.core import (
+    AgentStatus,
+    Library,
+    LostLinkKind,
+    LostLinkPolicy,
+    Mission,
+    SkillStatus,
+)
+from rosmc_server.core.model.control import ControlCommand, HoldCause
 from rosmc_server.executor.core.lost_link import LostLinkGuard
 from tests.team_gui import click, columns, settle, step_right
 from tests.team_twenty import stage, twenty_robot_library
@@ -162,17 +174,20 @@ def held(gui: Gui) -> tuple[str, str]:
     feed.sync("alpha")
     feed.sync("bravo")
     feed.statuses(
-        AgentStatus("alpha", link="up", executor_state="paused", policy=HELD_POLICY),
+        AgentStatus(
+            "alpha",
+            link="up",
+            executor_state="paused",
+            policy=HELD_POLICY,
+            hold=HoldCause.RETURN_POINT,
+        ),
         AgentStatus("bravo", link="up", last_heard=0.0, executor_state="waiting"),
     )
     settle(gui.widget)
     return member, partner
 
 
-SENTENCE = (
-    "alpha is holding after its link came back: it will not start new work; its barrier "
-    "partners bravo wait for it. Press Resume alpha."
-)
+SENTENCE = "alpha holds at its lost-link return point \u2014 its barrier partners bravo wait."
 
 
 def test_a_held_robot_and_whom_it_blocks_are_said_with_resume_one_click_away(gui: Gui) -> None:
@@ -187,6 +202,40 @@ def test_a_held_robot_and_whom_it_blocks_are_said_with_resume_one_click_away(gui
     assert gui.backend.requests[0].args == (ControlCommand.RESUME, "alpha")
 
 
+def test_the_warnings_area_resumes_a_held_robot_with_one_click(gui: Gui) -> None:
+    held(gui)
+    gui.widget.repaints.warn_now()
+    messages = gui.widget.messages
+    assert list(messages.hold_buttons) == ["alpha"]
+    button = messages.hold_buttons["alpha"]
+    assert button.isVisible() and button.text() == "Resume alpha"
+    QTest.mouseClick(button, Qt.LeftButton)
+    assert gui.backend.operations() == ["control"]
+    assert gui.backend.requests[0].args == (ControlCommand.RESUME, "alpha")
+    gui.feed.statuses(AgentStatus("alpha", link="up", executor_state="idle"))
+    settle(gui.widget)
+    gui.widget.repaints.warn_now()
+    assert not messages.hold_bar.isVisible() and not messages.hold_buttons
+
+
+def test_a_barrier_partner_says_whom_it_waits_for_and_since_when(gui: Gui) -> None:
+    _member, partner = held(gui)
+    gui.feed("report_status", partner, SkillStatus.SYNCWAITING)
+    gui.feed.statuses(
+        AgentStatus(
+            "bravo",
+            link="up",
+            executor_state="waiting",
+            current_skill=partner,
+            barrier_wait=92.0,
+        )
+    )
+    settle(gui.widget)
+    label = gui.widget.tasks.columns["bravo"].wait_label
+    assert label.isVisible()
+    assert label.text() == "bravo waits for alpha at barrier B1 since 1 min 32 s"
+
+
 def test_sending_work_to_a_held_robot_warns_that_it_will_not_start(gui: Gui) -> None:
     held(gui)
     gui.feed.add("alpha", "move")
@@ -196,20 +245,87 @@ def test_sending_work_to_a_held_robot_warns_that_it_will_not_start(gui: Gui) -> 
     assert "until you press Resume alpha" in asked.texts[0]
 
 
-def test_the_executors_own_words_for_a_hold_are_recognised(gui: Gui) -> None:
+def test_a_hold_is_read_from_the_typed_field_not_from_the_policy_words(gui: Gui) -> None:
     now = [100.0]
     guard = LostLinkGuard("alpha", lambda: now[0], {})
     guard.adopt(LostLinkPolicy(LostLinkKind.HOLD, 5.0), default=False)
     now[0] += 10.0
-    guard.trigger(now[0], True, lambda _note: None)
+    guard.trigger(True, lambda _note: None)
     guard.contact()
+    assert guard.held is HoldCause.LOST_LINK
+    words = guard.describe()
     gui.feed.statuses(
-        AgentStatus("alpha", link="up", executor_state="paused", policy=guard.describe())
+        AgentStatus("alpha", link="up", executor_state="paused", policy=words, hold=guard.held)
     )
     settle(gui.widget)
     hold = lost_link_hold(gui.widget.view, "alpha")
     assert hold is not None and hold.link_back and hold.partners == ()
-    # Paused by the operator, not by the policy: no hold.
-    gui.feed.statuses(AgentStatus("alpha", link="up", executor_state="paused", policy=""))
+    assert hold.sentence() == "alpha holds where it lost the link."
+    # The same words without the field: not a hold (the wording is not read).
+    gui.feed.statuses(AgentStatus("alpha", link="up", executor_state="paused", policy=words))
     settle(gui.widget)
     assert lost_link_hold(gui.widget.view, "alpha") is None
+
+
+def test_rows_of_a_robot_out_of_contact_read_last_known_with_their_age(gui: Gui) -> None:
+    gui.feed.add("alpha", "move")
+    (running,) = gui.feed.sync("alpha")
+    gui.feed("report_status", running, SkillStatus.RUNNING)
+    gui.feed.statuses(AgentStatus("alpha", link="up", last_heard=0.0))
+    settle(gui.widget)
+    model = gui.widget.tasks.columns["alpha"].synced_model
+    cell = model.index(0, STATUS)
+    assert model.data(cell) == "running"
+    current = model.data(cell, Qt.BackgroundRole).color().name()
+    gui.feed.statuses(AgentStatus("alpha", link="down", last_heard=40.0))
+    settle(gui.widget)
+    assert model.data(cell) == "running (last known, 40 s ago)"
+    greyed = model.data(cell, Qt.BackgroundRole).color().name()
+    assert greyed != current and greyed == last_known_colour(current)
+    assert model.data(cell, Qt.ForegroundRole).color().name() == LAST_KNOWN_TEXT_COLOUR
+    assert model.data(cell, Qt.FontRole).italic()
+    gui.feed.statuses(AgentStatus("alpha", link="down", last_heard=95.0))
+    settle(gui.widget)
+    assert model.data(cell) == "running (last known, 1 min ago)"
+    gui.feed.statuses(AgentStatus("alpha", link="up", last_heard=0.0))
+    settle(gui.widget)
+    assert model.data(cell) == "running"
+    assert model.data(cell, Qt.BackgroundRole).color().name() == current
+
+
+def test_answers_are_said_without_the_revision_which_stays_in_the_tooltip(gui: Gui) -> None:
+    request = ask(lambda c: c.delete_skills, "delete 'go'")(["s1"])
+    answer = Answer(request, SimpleNamespace(revision=626))
+    assert answer_message(answer, "Ctrl+Z undoes it") == (
+        "Done: delete 'go' (Ctrl+Z undoes it).",
+        "ok",
+    )
+    assert answer_detail(answer) == "mission revision 626"
+    assert answer_detail(Answer(request, error="no such skill")) == ""
+    gui.widget.messages.say(*answer_message(answer), answer_detail(answer))
+    item = gui.widget.messages.log.item(0)
+    assert "626" not in item.text() and item.toolTip() == "mission revision 626"
+
+
+def test_the_status_cell_names_the_barrier_by_its_tag(gui: Gui) -> None:
+    _member, partner = held(gui)
+    gui.feed("report_status", partner, SkillStatus.SYNCWAITING)
+    barrier_id = gui.feed.mission.state.barriers[0].id
+    gui.feed.statuses(
+        AgentStatus("bravo", link="up", current_skill=partner, waiting_on=f"alpha at {barrier_id}")
+    )
+    settle(gui.widget)
+    model = gui.widget.tasks.columns["bravo"].synced_model
+    assert model.data(model.index(0, STATUS)) == "waiting on alpha at B1"
+
+
+def test_a_replay_says_a_hold_but_offers_no_resume(mission: Mission, library: Library) -> None:
+    replay = Gui(mission, library, read_only=True)
+    try:
+        held(replay)
+        replay.widget.repaints.warn_now()
+        notice = replay.widget.tasks.columns["alpha"].hold_notice
+        assert notice.isVisible() and not notice.resume_button.isEnabled()
+        assert not replay.widget.messages.hold_buttons["alpha"].isEnabled()
+    finally:
+        replay.close()

@@ -15,8 +15,8 @@ from collections.abc import Iterator
 import pytest
 
 from rosmc_server.core import Library, Mission, RosmcError, SkillStatus
-from rosmc_server.core.legality import TaskView
-from rosmc_server.core.updates import SkillChanged
+from rosmc_server.core.live.updates import SkillChanged
+from rosmc_server.core.rules.legality import TaskView
 from tests.unit.test_command_harness import Gui
 from tests.unit.test_legality import ids, random_step
 

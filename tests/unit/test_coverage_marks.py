@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from rosmc_rviz_markers.core.coverage import OLD_AFTER, last_links
-from rosmc_server.core.radio_map import RadioMap, Reading
+from rosmc_server.core.robots.radio_map import RadioMap, Reading
 
 
 def test_a_robot_in_contact_has_an_unlabelled_mark_and_one_out_of_contact_a_label() -> None:

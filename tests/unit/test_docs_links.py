@@ -2,7 +2,7 @@
 
 Covers README.md, CONTRIBUTING.md and docs/*.md. Anchors are made from headings as GitHub
 makes them (lower case, punctuation dropped, spaces to hyphens). Every repository path the
-docs name in backticks (``rosmc_server/core/mission.py``) exists too.
+docs name in backticks (``rosmc_server/core/rules/mission.py``) exists too.
 """
 
 from __future__ import annotations

@@ -22,8 +22,8 @@ from rosmc_server.core import (
     TaskMarker,
     Transfer,
 )
-from rosmc_server.core.commands import CommandKind, commands_for_event
-from rosmc_server.core.updates import BarrierPut, BarrierRemoved, apply_and_describe, apply_event
+from rosmc_server.core.live.updates import BarrierPut, BarrierRemoved, apply_event
+from rosmc_server.core.robots.commands import CommandKind, commands_for_event
 
 S = SkillStatus
 
@@ -451,7 +451,7 @@ def test_the_barrier_change_of_a_retry_and_a_skip_replays_identically(
     puts, removed = [], []
     for event in events:
         apply_event(start, event)
-        for change in apply_and_describe(described, event):
+        for change in apply_event(described, event):
             if isinstance(change, BarrierPut):
                 puts.append((change.old.skill_ids if change.old else None, change.new.skill_ids))
             if isinstance(change, BarrierRemoved):

@@ -24,8 +24,9 @@ from rosmc_server.core import (
     SkillStatus,
     Transfer,
 )
-from rosmc_server.core.commands import CommandKind
-from rosmc_server.core.link import queue_hash
+from rosmc_server.core.model.control import HoldCause
+from rosmc_server.core.robots.commands import CommandKind
+from rosmc_server.core.robots.link import queue_hash
 from rosmc_server.executor.basic_skills import Count
 from rosmc_server.executor.core import (
     AckResult,
@@ -1356,3 +1357,48 @@ def test_saving_is_atomic_and_leaves_no_temporary_file(robot: Robot, tmp_path: P
     robot.upload(make_skill("a"))
     save_state(robot.engine, tmp_path / "r1.json")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r1.json"]
+
+
+def test_the_snapshot_says_since_when_it_waits_at_its_barrier() -> None:
+    robot = Robot("r1")
+    barrier = BarrierInfo("B", (("a", "r1"), ("x", "r2")))
+    robot.upload(make_skill("a"), barriers=(barrier,))
+    assert robot.engine.snapshot().waiting_since == 0.0
+    arrived = robot.clock.now
+    robot.send(K.START)
+    robot.run_for(5.0)
+    snapshot = robot.engine.snapshot()
+    assert snapshot.waiting_on == "r2 at B" and snapshot.waiting_since == arrived
+    assert snapshot.stamp - snapshot.waiting_since == 5.0  # its age, on its own clock
+    robot.send(K.PAUSE)  # paused: it does not wait at the barrier
+    assert robot.engine.snapshot().waiting_since == 0.0
+
+
+def test_a_hold_after_the_policy_is_reported_until_the_operator_starts_it(robot: Robot) -> None:
+    robot.send(K.SET_OPTIONS, argument=json.dumps({"lost_link": {"policy": "hold", "after": 5}}))
+    robot.upload(make_skill("a", params={"duration": 30.0}))
+    robot.send(K.START)
+    robot.run_for(4.0)
+    assert robot.engine.snapshot().hold is HoldCause.NONE
+    robot.run_for(2.0)  # 6 s without the ground: the policy holds it
+    assert robot.status("a") is S.PAUSED
+    assert robot.engine.snapshot().hold is HoldCause.LOST_LINK
+    robot.send(K.PAUSE)  # an operator's pause keeps it held for the same reason
+    assert robot.engine.snapshot().hold is HoldCause.LOST_LINK
+    robot.send(K.RESUME)
+    assert robot.status("a") is S.RUNNING and robot.engine.snapshot().hold is HoldCause.NONE
+
+
+def test_a_hold_survives_an_executor_restart(robot: Robot, tmp_path: Path) -> None:
+    robot.send(K.SET_OPTIONS, argument=json.dumps({"lost_link": {"policy": "hold", "after": 5}}))
+    robot.upload(make_skill("a", params={"duration": 30.0}))
+    robot.send(K.START)
+    robot.run_for(6.0)
+    assert robot.engine.snapshot().hold is HoldCause.LOST_LINK
+    save_state(robot.engine, tmp_path / "r1.json")
+    fresh = Robot()
+    load_state(fresh.engine, tmp_path / "r1.json")
+    assert fresh.engine.snapshot().hold is HoldCause.LOST_LINK, "still paused: still held"
+    fresh.seq = robot.seq  # the ground numbers on
+    fresh.send(K.START)
+    assert fresh.engine.snapshot().hold is HoldCause.NONE

@@ -1,4 +1,4 @@
-"""Orientation math (core/frames.py) and the TF frame names (interface.py)."""
+"""Orientation math (core/world/frames.py) and the TF frame names (interface.py)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 
 from rosmc_server import interface
 from rosmc_server.core import InvalidRequest
-from rosmc_server.core.frames import (
+from rosmc_server.core.world.frames import (
     IDENTITY,
     quaternion_from_rpy,
     rpy_from_quaternion,

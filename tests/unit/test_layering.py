@@ -44,19 +44,19 @@ def test_there_are_core_modules_to_scan() -> None:
         f"rosmc_server/core/{name}.py"
         for name in (
             "errors",
-            "params",
-            "library",
-            "model",
-            "changes",
-            "state",
-            "barriers",
-            "editing",
-            "execution",
-            "markers",
-            "mission",
-            "persistence",
-            "policy",
-            "frames",
+            "skills/params",
+            "skills/library",
+            "model/model",
+            "model/changes",
+            "model/state",
+            "rules/barriers",
+            "rules/editing",
+            "rules/execution",
+            "rules/markers",
+            "rules/mission",
+            "files/persistence",
+            "skills/policy",
+            "world/frames",
         )
     }
     assert expected <= modules
@@ -78,7 +78,7 @@ def test_every_module_has_a_layer() -> None:
 @pytest.mark.parametrize(
     ("relative", "layer"),
     [
-        ("rosmc_server/core/mission.py", "core"),
+        ("rosmc_server/core/rules/mission.py", "core"),
         ("rosmc_server/executor/core/engine.py", "core"),
         ("rosmc_server/interface.py", "core"),
         ("rosmc_server/conversions/mission.py", "conversions"),
@@ -456,4 +456,45 @@ def test_ros_adapter_naming() -> None:
     assert not is_ros_adapter("rosmc_rqt_command/plugin.py")
     assert not is_ros_adapter("rosmc_rqt_command/widgets/tasks.py")
     assert not is_ros_adapter("rosmc_rviz_markers/core/labels.py")
-    assert not is_ros_adapter("rosmc_server/core/mission.py")
+    assert not is_ros_adapter("rosmc_server/core/rules/mission.py")
+
+
+# -- the core's subpackages ------------------------------------------------------------
+
+
+def _core_part(path: str) -> str:
+    """The core subpackage a core module path is in, or its name for the foundation."""
+    return path.removeprefix("rosmc_server/core/").split("/")[0].removesuffix(".py")
+
+
+def test_the_core_subpackages_import_only_those_before_them() -> None:
+    from rosmc_server.core import FOUNDATION, SUBPACKAGE_ORDER
+    from tests.unit.import_circles import import_graph
+
+    rank = {name: index for index, name in enumerate(SUBPACKAGE_ORDER)}
+    rank.update({name: -1 for name in FOUNDATION})
+    rank["__init__"] = len(SUBPACKAGE_ORDER)
+    climbs = []
+    for module, imported in import_graph().items():
+        if not module.startswith("rosmc_server/core/"):
+            continue
+        in_core = (target for target in imported if target.startswith("rosmc_server/core/"))
+        climbs += [
+            f"{module} imports {target}"
+            for target in in_core
+            if rank[_core_part(target)] > rank[_core_part(module)]
+        ]
+    assert climbs == []
+
+
+def test_every_core_module_is_in_a_subpackage_of_the_order() -> None:
+    from rosmc_server.core import FOUNDATION, SUBPACKAGE_ORDER
+
+    parts = {_core_part(p.relative_to(REPO).as_posix()) for p in core_modules()}
+    core_parts = {
+        _core_part(p.relative_to(REPO).as_posix())
+        for p in core_modules()
+        if p.relative_to(REPO).as_posix().startswith("rosmc_server/core/")
+    }
+    assert parts  # the scan found modules
+    assert core_parts <= {*SUBPACKAGE_ORDER, *FOUNDATION, "__init__"}

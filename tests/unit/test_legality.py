@@ -2,7 +2,7 @@
 
 Random missions (random operator requests and robot answers on a real
 :class:`~rosmc_server.core.Mission`, many refused) are checked skill by skill and robot by
-robot: an action is legal by :mod:`rosmc_server.core.legality` exactly when the server's
+robot: an action is legal by :mod:`rosmc_server.core.rules.legality` exactly when the server's
 operation on a copy of the mission is accepted; and the command GUI's legality over its
 own view of the mission (built from mirror updates, as live) says the same. Reordering is
 not covered: a move is offered whenever it has room, and the server may still refuse one
@@ -32,19 +32,19 @@ from rosmc_server.core import (
     SkillInstance,
     SkillStatus,
 )
-from rosmc_server.core.control import ExecutorState
-from rosmc_server.core.legality import (
+from rosmc_server.core.live.mirror import MissionMirror
+from rosmc_server.core.live.updates import MirrorUpdate
+from rosmc_server.core.model.control import ExecutorState
+from rosmc_server.core.rules.legality import (
     RobotAction,
     SkillAction,
     StatePicture,
     TaskView,
     legal_skill_actions,
 )
-from rosmc_server.core.legality import (
+from rosmc_server.core.rules.legality import (
     legal_robot_actions as robot_rules,
 )
-from rosmc_server.core.mirror import MissionMirror
-from rosmc_server.core.updates import MirrorUpdate
 
 S = SkillStatus
 A = SkillAction

@@ -19,8 +19,8 @@ from rosmc_server.core import (
     RuleViolation,
     load_library,
 )
-from rosmc_server.core.library import library_from_dict
-from rosmc_server.core.site import SiteCheck
+from rosmc_server.core.skills.library import library_from_dict
+from rosmc_server.core.world.site import SiteCheck
 
 
 def write(tmp_path: Path, data: Any, name: str = "team.yaml") -> Path:

@@ -9,7 +9,7 @@ import pytest
 import yaml
 
 from rosmc_server.core import LibraryError, ParamType, load_library
-from rosmc_server.core.package_paths import PackagePath, package_reference
+from rosmc_server.core.skills.package_paths import PackagePath, package_reference
 
 REPO = Path(__file__).resolve().parents[2]
 MARS = REPO / "rosmc_server" / "config" / "mars_team.yaml"

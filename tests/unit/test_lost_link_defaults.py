@@ -19,9 +19,9 @@ from rosmc_server.core import (
     Pose,
     SkillStatus,
 )
-from rosmc_server.core.commands import CommandKind
-from rosmc_server.core.library import library_from_dict
-from rosmc_server.core.policy import options_argument, options_from_argument
+from rosmc_server.core.robots.commands import CommandKind
+from rosmc_server.core.skills.library import library_from_dict
+from rosmc_server.core.skills.policy import options_argument, options_from_argument
 from rosmc_server.executor.core import Engine, SkillType
 from rosmc_server.executor.core.engine import Mode
 from rosmc_server.executor.core.lost_link import LINK_MARGIN
@@ -245,3 +245,26 @@ def test_work_started_while_the_robot_returns_runs_once_it_is_back(rover: Rover)
     assert rover.status("home") is SkillStatus.RUNNING or rover.status("home") is (
         SkillStatus.SUCCESS
     )
+
+
+def test_silence_is_counted_on_the_link_clock_not_on_mission_time() -> None:
+    """A fast or loaded sim runs mission time ahead of the radio: only wall seconds of
+    silence count, on the robot as on the ground."""
+    Timed.instances.clear()
+    mission, wall = FakeClock(), FakeClock()
+    out = Recorder()
+    engine = Engine("r1", SKILL_TYPES, mission, out, lambda: Pose(3.0, 4.0), link_clock=wall)
+    engine.lost_link.adopt(RETURN, default=False)
+    engine.lost_link.contact()
+    for _ in range(1000):  # 1,000 sim seconds in 10 wall seconds (a factor of 100)
+        mission.now += 1.0
+        wall.now += 0.01
+        engine.tick()
+    assert not Timed.instances and engine.mode is not Mode.PAUSED
+    for _ in range(510):  # 51 more wall seconds: 60 s idle without the ground
+        mission.now += 10.0
+        wall.now += 0.1
+        engine.tick()
+    ret = Timed.instances[-1]
+    assert ret.ctx is not None and ret.ctx.params["target"] == Pose(3.0, 4.0)
+    assert "after 60 s without ground contact" in engine.snapshot().policy

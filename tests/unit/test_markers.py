@@ -18,6 +18,7 @@ from rosmc_server.core import (
     StaleRevision,
     TaskMarker,
 )
+from rosmc_server.core.rules.edit_rules import MarkerAction, legal_marker_actions
 
 TRIANGLE = (Pose(0.0, 0.0), Pose(3.0, 0.0), Pose(0.0, 3.0, 3.0))
 
@@ -237,3 +238,43 @@ def test_delete_refused_when_in_use(mission: Any, drv: Any, rejected: Any, bound
     drv.finish(bound["scan"])
     rejected(mission, RuleViolation, mission.delete_marker, "spot", match="in use")
     assert mission.state.skill(bound["scan"]).status is SkillStatus.SUCCESS
+
+
+# -- what a GUI offers -------------------------------------------------------------
+MARKERS = ("goal", "spot", "field", "rock")
+
+
+def attempt(mission: Any, name: str, action: MarkerAction) -> None:
+    """The operation a GUI sends for ``action`` on marker ``name`` (moved where it is)."""
+    if action is MarkerAction.MOVE:
+        where = mission.state.marker(name)
+        mission.move_marker(name, where.pose, where.vertices)
+    elif action is MarkerAction.RENAME:
+        mission.rename_marker(name, f"{name} 2")
+    else:
+        mission.delete_marker(name)
+
+
+def test_the_offered_marker_actions_are_the_ones_accepted(
+    mission: Any, drv: Any, bound: Any
+) -> None:
+    """legal_marker_actions says of each marker what the operations then accept."""
+    mission.add_marker(marker("rock"))
+    drv.sync("bravo", bound["scan"])  # 'field' and 'spot' locked; 'goal' and 'rock' not
+    offered = {name: legal_marker_actions(mission.state, name) for name in MARKERS}
+    assert offered == {
+        "goal": {MarkerAction.MOVE, MarkerAction.RENAME},
+        "spot": set(),
+        "field": set(),
+        "rock": set(MarkerAction),
+    }
+    for name in MARKERS:
+        for action in MarkerAction:
+            try:
+                attempt(mission, name, action)
+            except RuleViolation:
+                assert action not in offered[name], (name, action)
+            else:
+                assert action in offered[name], (name, action)
+                mission.undo(mission.revision)  # back to the marker as it was
+            assert mission.state.has_marker(name), (name, action)

@@ -1,35 +1,27 @@
-"""Undo and redo of this rviz's own edits: the history and the menu entries."""
+"""Undo and redo in rviz: every menu ends with both (the history is the shared one,
+tested in ``test_edit_history.py``), and each menu entry says which edit it makes."""
 
 from __future__ import annotations
 
-from rosmc_rviz_markers.core.edit_history import EditHistory
-from rosmc_rviz_markers.core.menus import UNDO_MENU, UndoEdit, flatten
-
-
-def test_undo_takes_the_newest_edit_and_redo_takes_back_the_newest_undo() -> None:
-    history = EditHistory()
-    history.done(3, "add take_off to drone")
-    history.done(5, "move Pose 1")
-    assert history.take_undo() == (5, "move Pose 1")
-    history.undone(6, "move Pose 1")
-    assert history.take_redo() == (6, "move Pose 1")
-    history.redone(7, "move Pose 1")
-    assert history.take_undo() == (7, "move Pose 1")  # the redo can be undone again
-    assert history.take_undo() == (3, "add take_off to drone")
-    assert history.take_undo() is None and history.take_redo() is None
-
-
-def test_a_new_edit_forgets_what_could_be_redone_and_clear_forgets_all() -> None:
-    history = EditHistory()
-    history.done(1, "a")
-    history.undone(2, "a")
-    history.done(3, "b")
-    assert history.take_redo() is None
-    history.clear()
-    assert history.take_undo() is None
+from rosmc_rviz_markers.core.menus import (
+    UNDO_MENU,
+    AddSkill,
+    DeleteMarker,
+    RenameMarker,
+    UndoEdit,
+    flatten,
+)
+from rosmc_rviz_markers.core.requests import edit_kind
+from rosmc_server.core.live.edit_history import EditKind
 
 
 def test_every_menu_can_end_with_undo_and_redo() -> None:
     flat = flatten(UNDO_MENU)
     assert [(e.title, e.parent) for e in flat.entries] == [("Undo my last change", 0), ("Redo", 0)]
     assert list(flat.actions.values()) == [UndoEdit(), UndoEdit(redo=True)]
+
+
+def test_each_menu_edit_has_its_kind() -> None:
+    assert edit_kind(RenameMarker("Pose 2")) is EditKind.RENAME_MARKER
+    assert edit_kind(DeleteMarker()) is EditKind.DELETE_MARKER
+    assert edit_kind(AddSkill("drone", "navigate_to")) is EditKind.ADD_SKILL

@@ -25,10 +25,10 @@ from rosmc_server.core import (
     MissionState,
     Pose,
     TaskMarker,
-    geometry,
     load_library,
 )
-from rosmc_server.core.changes import Change
+from rosmc_server.core.model.changes import Change
+from rosmc_server.core.views import geometry
 
 LIBRARY = load_library(
     Path(__file__).resolve().parents[2] / "rosmc_server" / "config" / "mars_team.yaml"

@@ -19,10 +19,10 @@ from rosmc_server.core import (
     MissionState,
     Pose,
     TaskMarker,
-    geometry,
     load_library,
 )
-from rosmc_server.core.changes import Change
+from rosmc_server.core.model.changes import Change
+from rosmc_server.core.views import geometry
 
 LIBRARY = load_library(
     Path(__file__).resolve().parents[2] / "rosmc_server" / "config" / "mars_team.yaml"
@@ -67,7 +67,7 @@ def test_each_menu_starts_with_the_object_it_belongs_to() -> None:
     # the entries that do things follow, as before
     drone = scene.agent_spec("drone", mission, None)
     top = [e.title for e in drone.menu.entries if e.parent == 0]
-    assert top == ["drone \u2014 robot", "Add skill", "Undo my last change", "Redo"]
+    assert top == ["drone \u2014 robot", "Add skill", "Resume", "Undo my last change", "Redo"]
 
 
 def test_a_replay_has_no_menus_and_so_no_titles() -> None:

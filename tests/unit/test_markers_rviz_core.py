@@ -29,10 +29,12 @@ from rosmc_rviz_markers.core.menus import (
     AddSkill,
     DeleteMarker,
     RenameMarker,
+    ResumeRobot,
     flatten,
     robot_menu,
     static_agent_menu,
     task_marker_menu,
+    with_drives,
 )
 from rosmc_rviz_markers.core.requests import moved_area, moved_pose, robot_skill_plan
 from rosmc_rviz_markers.core.scene import Scene, Selection
@@ -49,12 +51,12 @@ from rosmc_server.core import (
     SkillStatus,
     TaskMarker,
     Transfer,
-    areas,
-    geometry,
     load_library,
 )
-from rosmc_server.core.changes import Change, PlacedSkill
-from rosmc_server.core.updates import AgentStatusChanged, MarkerPut, MirrorUpdate, SkillChanged
+from rosmc_server.core.live.updates import AgentStatusChanged, MarkerPut, MirrorUpdate, SkillChanged
+from rosmc_server.core.model.changes import Change, PlacedSkill
+from rosmc_server.core.views import geometry
+from rosmc_server.core.world import areas
 
 LIBRARY = load_library(
     Path(__file__).resolve().parents[2] / "rosmc_server" / "config" / "mars_team.yaml"
@@ -255,9 +257,10 @@ def test_icon_levels_stack_only_robots_standing_together() -> None:
 
 
 # -- menus --------------------------------------------------------------------------------------
-def test_robot_menu_lists_exactly_its_skills() -> None:
-    (add,) = robot_menu(LIBRARY, "drone")
+def test_robot_menu_lists_exactly_its_skills_then_resume() -> None:
+    add, resume = robot_menu(LIBRARY, "drone")
     assert add.title == "Add skill"
+    assert resume.title == "Resume" and resume.action == ResumeRobot("drone")
     assert [c.title for c in add.children] == sorted(LIBRARY.skills_of("drone"))
     assert all(isinstance(c.action, AddSkill) and c.action.from_robot for c in add.children)
 
@@ -281,10 +284,11 @@ def test_task_marker_menu_and_flattening() -> None:
     pose = TaskMarker("Pose 1", MarkerType.POSE, Pose(3, 4))
     state = state_with(pose)
     menu = task_marker_menu(LIBRARY, state, pose, [], locked=False)
-    assert [m.title for m in menu] == ["Add skill", "Rename", "Delete"]
+    assert [m.title for m in menu] == ["Add skill here", "Rename", "Delete"]
     robots = {r.title: [c.title for c in r.children] for r in menu[0].children}
     # a pose marker fills pose and position parameters
     assert robots["drone"] == ["navigate_to"]
+    assert robots["manipulator_rover"][-2:] == ["place_box", "place_box, driving there first"]
     assert "identify_stones" in robots["science_rover"]
     assert "place_box" in robots["manipulator_rover"]
     flat = flatten(menu)
@@ -296,9 +300,24 @@ def test_task_marker_menu_and_flattening() -> None:
     assert renames and all(a.new_name != "Pose 1" for a in renames)
     area = TaskMarker("Area 1", MarkerType.AREA, Pose(2, 2), SQUARE)
     menu = task_marker_menu(LIBRARY, state_with(area), area, [skill()], locked=True)
-    assert [m.title for m in menu] == ["Add skill"], "locked and in use: no rename, no delete"
+    assert [m.title for m in menu] == ["Add skill here"], "locked and in use: no rename, no delete"
     robots = {r.title: [c.title for c in r.children] for r in menu[0].children}
-    assert robots == {"drone": ["fly_over"], "science_rover": ["explore"]}
+    assert robots == {"drone": ["fly_over"], "science_rover": ["explore"]}  # an area: no drive
+
+
+def test_driving_there_first_is_offered_unless_the_robot_goes_there_already() -> None:
+    rock = TaskMarker("rock", MarkerType.POSITION, Pose(7, 8))
+    drive = AddSkill("manipulator_rover", "pick_stone", bind="position")
+    offered = dict(with_drives(LIBRARY, state_with(rock), rock, [(drive, "pick_stone")]))
+    assert offered == {
+        drive: "pick_stone",
+        replace(drive, drive=("navigate_to", "target")): "pick_stone, driving there first",
+    }
+    going = SkillInstance(
+        "s1", "manipulator_rover", "navigate_to", "", {"target": Pose(7, 8)}, {"target": "rock"}
+    )
+    state = state_with(rock, skills=(going,))
+    assert dict(with_drives(LIBRARY, state, rock, [(drive, "pick_stone")])) == {drive: "pick_stone"}
 
 
 def test_robot_skill_plan_puts_new_markers_in_front() -> None:

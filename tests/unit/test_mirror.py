@@ -1,4 +1,4 @@
-"""The client's mission mirror (rosmc_server.core.mirror) and the one event-apply path.
+"""The client's mission mirror (rosmc_server.core.live.mirror) and the one event-apply path.
 
 A real :class:`Mission` on the shipped library produces the events; the mirror is fed
 them in order, out of order, twice, with gaps and with replaced missions, and must end
@@ -28,9 +28,8 @@ from rosmc_server.core import (
     TaskMarker,
     load_library,
 )
-from rosmc_server.core.changes import Change, SkillMove, moves_between
-from rosmc_server.core.mirror import MissionMirror
-from rosmc_server.core.updates import (
+from rosmc_server.core.live.mirror import MissionMirror
+from rosmc_server.core.live.updates import (
     AgentStatusChanged,
     BarrierPut,
     BarrierRemoved,
@@ -45,6 +44,7 @@ from rosmc_server.core.updates import (
     SnapshotNeeded,
     apply_event,
 )
+from rosmc_server.core.model.changes import Change, SkillMove, moves_between
 
 REPO = Path(__file__).resolve().parents[2]
 LIBRARY = load_library(REPO / "rosmc_server" / "config" / "mars_team.yaml")

@@ -23,14 +23,13 @@ from hypothesis import strategies as st
 from rosmc_server.core import (
     Library,
     MissionFileError,
-    document_reading,
     dump_mission,
-    mission_text,
     parse_mission,
 )
-from rosmc_server.core.document_reading import read_document
-from rosmc_server.core.documents import load_yaml, yaml_problem
-from rosmc_server.core.mission_text import (
+from rosmc_server.core.documents.documents import load_yaml, yaml_problem
+from rosmc_server.core.files import document_reading, mission_text
+from rosmc_server.core.files.document_reading import read_document
+from rosmc_server.core.files.mission_text import (
     MissionDumper,
     digest_line,
     entry,

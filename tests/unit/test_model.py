@@ -16,7 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rosmc_server.core import Library, Pose, SkillInstance
-from rosmc_server.core.model import NO_BINDINGS, skill_with
+from rosmc_server.core.model.model import NO_BINDINGS, skill_with
 from tests.unit.random_missions import random_content
 
 

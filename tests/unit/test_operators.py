@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from rosmc_server.core import NotPermitted
-from rosmc_server.core.operators import OperatorAllowList
+from rosmc_server.core.rules.operators import OperatorAllowList
 
 
 def test_an_empty_list_lets_every_node_in() -> None:

@@ -1,8 +1,8 @@
 """Parameter values: the quick path agrees with the full check; numbers too large are refused.
 
-:func:`~rosmc_server.core.params.quick_value` accepts a value in its usual form without
+:func:`~rosmc_server.core.skills.params.quick_value` accepts a value in its usual form without
 building an error sentence (a mission of 10,000 skills is read through it). Wherever it
-answers, :func:`~rosmc_server.core.params.check_value` must give the same value of the
+answers, :func:`~rosmc_server.core.skills.params.check_value` must give the same value of the
 same type; where it does not, the full check decides. Integers YAML reads from a long
 string of digits are too large for a float or an int64: every check says so in a
 sentence instead of raising OverflowError.
@@ -18,9 +18,15 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from rosmc_server.core import InvalidRequest, ParamType, Pose
-from rosmc_server.core.editing import check_timeout
-from rosmc_server.core.params import INT_MAX, INT_MIN, check_value, quick_checker, quick_value
-from rosmc_server.core.policy import LostLinkKind, LostLinkPolicy
+from rosmc_server.core.rules.editing import check_timeout
+from rosmc_server.core.skills.params import (
+    INT_MAX,
+    INT_MIN,
+    check_value,
+    quick_checker,
+    quick_value,
+)
+from rosmc_server.core.skills.policy import LostLinkKind, LostLinkPolicy
 from rosmc_server.core.validation import check_time, finite_float
 
 HUGE = 10**400  # what YAML reads from "1" and 400 zeros

@@ -22,13 +22,13 @@ from rosmc_server.core import (
     SkillStatus,
     TaskMarker,
     dump_mission,
-    durable,
     load_mission,
     mission_to_dict,
     parse_mission,
     save_mission,
 )
-from rosmc_server.core.persistence import mission_from_dict
+from rosmc_server.core.documents import durable
+from rosmc_server.core.files.persistence import mission_from_dict
 
 S = SkillStatus
 

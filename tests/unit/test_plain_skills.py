@@ -1,6 +1,6 @@
 """Skill entries checked a column at a time accept and build exactly what entry by entry does.
 
-:func:`~rosmc_server.core.plain_skills.read_plain` is a shortcut of the mission reader: for
+:func:`~rosmc_server.core.files.plain_skills.read_plain` is a shortcut of the mission reader: for
 random tasks of entries in the writer's usual form, some of them wrong in one field (an id,
 a label, a skill name, a status, a parameter), it either declines or gives the very skills
 the entry-by-entry reader gives, and it takes the usual case: a blueprint written by ROSMC.
@@ -28,10 +28,10 @@ from rosmc_server.core import (
     mission_to_dict,
     parse_mission,
 )
-from rosmc_server.core.documents import DocumentReader
-from rosmc_server.core.mission_reader import _TaskReader, mission_from_dict
-from rosmc_server.core.model import NO_BINDINGS
-from rosmc_server.core.plain_skills import PLAIN_FORM, read_plain
+from rosmc_server.core.documents.documents import DocumentReader
+from rosmc_server.core.files.mission_reader import _TaskReader, mission_from_dict
+from rosmc_server.core.files.plain_skills import PLAIN_FORM, read_plain
+from rosmc_server.core.model.model import NO_BINDINGS
 from tests.unit.random_missions import random_content
 
 GOOD = {

@@ -1,8 +1,8 @@
 """A digested task of plain lines is read from the text of its fields, exactly as YAML reads it.
 
-:func:`~rosmc_server.core.document_reading.read_document` with ``plain_tasks`` gives a task
+:func:`~rosmc_server.core.files.document_reading.read_document` with ``plain_tasks`` gives a task
 that a document as its writer wrote it holds as one run of skill lines in the plain form as
-a :class:`~rosmc_server.core.plain_skills.PlainTask` (no mapping per line). Whatever the
+a :class:`~rosmc_server.core.files.plain_skills.PlainTask` (no mapping per line). Whatever the
 lines hold (quotes, escapes, braces, a key more, a parameters text that is not one
 mapping), the data it stands for is what YAML reads; a task it cannot take is read as
 before, and a wrong entry in one is named as precisely as in an undigested document.
@@ -27,11 +27,16 @@ from rosmc_server.core import (
     Transfer,
     parse_mission,
 )
-from rosmc_server.core.document_reading import read_document
-from rosmc_server.core.mission_reader import mission_from_dict
-from rosmc_server.core.mission_text import MissionDumper, digest_line, flow_line, skill_to_dict
-from rosmc_server.core.model import NO_BINDINGS
-from rosmc_server.core.plain_skills import PlainTask
+from rosmc_server.core.files.document_reading import read_document
+from rosmc_server.core.files.mission_reader import mission_from_dict
+from rosmc_server.core.files.mission_text import (
+    MissionDumper,
+    digest_line,
+    flow_line,
+    skill_to_dict,
+)
+from rosmc_server.core.files.plain_skills import PlainTask
+from rosmc_server.core.model.model import NO_BINDINGS
 from tests.unit.random_missions import random_content
 
 

@@ -1,6 +1,6 @@
 """Plain YAML built from the parser's events reads exactly what PyYAML's safe loader reads.
 
-:func:`~rosmc_server.core.plain_yaml.load_plain` must be invisible: for any plain
+:func:`~rosmc_server.core.documents.plain_yaml.load_plain` must be invisible: for any plain
 document (random data written by ``yaml.safe_dump`` in every style, shared values as
 aliases, every implicit scalar form of YAML 1.1) it gives the loader's data, value for
 value and type for type; for anything else it declines, and ``load_yaml`` then gives the
@@ -19,8 +19,13 @@ import yaml
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rosmc_server.core.documents import _UniqueKeyLoader, load_yaml, read_yaml, yaml_problem
-from rosmc_server.core.plain_yaml import load_plain
+from rosmc_server.core.documents.documents import (
+    _UniqueKeyLoader,
+    load_yaml,
+    read_yaml,
+    yaml_problem,
+)
+from rosmc_server.core.documents.plain_yaml import load_plain
 
 
 def typed(data: Any) -> Any:

@@ -1,4 +1,4 @@
-"""The lost-link policy (core/policy.py): checks, plain data, the robot command's argument."""
+"""The lost-link policy (core/skills/policy.py): checks, plain data, the command argument."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from typing import Any
 import pytest
 
 from rosmc_server.core import InvalidRequest, Library, LostLinkKind, LostLinkPolicy, NotFound, Pose
-from rosmc_server.core.policy import DEFAULT_AFTER, options_argument, policy_from_argument
+from rosmc_server.core.skills.policy import DEFAULT_AFTER, options_argument, policy_from_argument
 
 HOME = LostLinkPolicy(LostLinkKind.SAFE_SKILL, 30.0, "navigate_to", {"speed": 2.0})
 

@@ -14,7 +14,9 @@ ones), and checks after every step that:
 * the revision grows by exactly one per accepted change (with one event of the
   right kind) and not at all on a rejection, which leaves the mission identical;
 * save -> load reproduces the mission exactly;
-* replaying all events on a fresh mission gives the same mission.
+* replaying all events on a fresh mission gives the same mission;
+* the typed changes the one applier describes, taken by a view with no rule of the core,
+  give the same mission.
 """
 
 from __future__ import annotations
@@ -55,9 +57,12 @@ from rosmc_server.core import (
     mission_to_dict,
     parse_mission,
 )
-from rosmc_server.core.barriers import find_deadlock
-from rosmc_server.core.changes import SkillMove
-from rosmc_server.core.persistence import mission_from_dict
+from rosmc_server.core.files.persistence import mission_from_dict
+from rosmc_server.core.live.updates import apply_event
+from rosmc_server.core.model.changes import SkillMove
+from rosmc_server.core.model.state import MissionState
+from rosmc_server.core.rules.barriers import find_deadlock
+from tests.unit.described_view import DescribedView
 
 S = SkillStatus
 REPO = Path(__file__).resolve().parents[2]
@@ -188,6 +193,9 @@ class MissionMachine(RuleBasedStateMachine):
         )
         self.start = self.mission.state.content()
         self.events: list[MissionEvent] = []
+        self.follower = MissionState(self.start, self.mission.revision)  # a client's copy
+        self.described = DescribedView(self.follower)
+        self.followed = 0  # events the follower has applied
         self.finished: dict[str, SkillInstance] = {}
         self.renamed: dict[str, str] = {}  # markers renamed since the last invariant check
         self.saved_revision = -1
@@ -720,6 +728,16 @@ class MissionMachine(RuleBasedStateMachine):
         loaded, loaded_revision = parse_mission(text, LIBRARY, "property.yaml")
         assert (loaded, loaded_revision) == (content, revision)
         assert dump_mission(loaded, loaded_revision) == text
+
+    @invariant()
+    def described_changes_rebuild_the_mission(self) -> None:
+        """New events through the one applier, as a client applies them: its state and the
+        view kept from the changes it describes are the server's mission."""
+        for event in self.events[self.followed :]:
+            self.described.take(apply_event(self.follower, event))
+        self.followed = len(self.events)
+        assert self.follower.revision == self.mission.revision
+        assert self.described.matches(self.mission.state)
 
     @invariant()
     def replay_rebuilds_the_mission(self) -> None:

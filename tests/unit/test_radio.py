@@ -7,8 +7,8 @@ import itertools
 import pytest
 
 from rosmc_server.core import InvalidRequest
-from rosmc_server.core.link import Outbox
-from rosmc_server.core.radio import (
+from rosmc_server.core.robots.link import Outbox
+from rosmc_server.core.robots.radio import (
     DIRECTORY_MAX_PERIOD,
     DIRECTORY_PERIOD,
     BeaconPlan,

@@ -9,10 +9,10 @@ from pathlib import Path
 import pytest
 
 from rosmc_server.core import RosmcError
-from rosmc_server.core.drop_log import DropLog
 from rosmc_server.core.errors import RadioKeyError
-from rosmc_server.core.radio import MAX_DATAGRAM, DatagramKind
-from rosmc_server.core.radio_auth import (
+from rosmc_server.core.robots.drop_log import DropLog
+from rosmc_server.core.robots.radio import MAX_DATAGRAM, DatagramKind
+from rosmc_server.core.robots.radio_auth import (
     MAGIC,
     OVERHEAD,
     SIGNATURE_BYTES,
@@ -22,7 +22,7 @@ from rosmc_server.core.radio_auth import (
     Sealer,
     stamp_of,
 )
-from rosmc_server.core.radio_key import (
+from rosmc_server.core.robots.radio_key import (
     KEY_BYTES,
     RadioKey,
     default_key_path,

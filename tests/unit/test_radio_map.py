@@ -1,11 +1,11 @@
-"""The radio map (core/radio_map.py): readings, prediction, last link, the task-end warning."""
+"""The radio map (core/robots/radio_map.py): readings, prediction, the task-end warning."""
 
 from __future__ import annotations
 
 import math
 
 from rosmc_server.core import LostLinkKind, LostLinkPolicy, Pose, SkillInstance, SkillStatus
-from rosmc_server.core.radio_map import (
+from rosmc_server.core.robots.radio_map import (
     GridSpec,
     Prediction,
     RadioMap,

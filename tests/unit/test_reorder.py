@@ -18,12 +18,12 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from rosmc_server.core import Change, MissionState, RuleViolation
-from rosmc_server.core.barriers import check_moves, check_new_barrier, find_deadlock
-from rosmc_server.core.changes import SkillMove, moves_between
-from rosmc_server.core.moves import MoveList
-from rosmc_server.core.reorder import play_moves, play_one_by_one
-from rosmc_server.core.state import BULK_MOVES
-from rosmc_server.core.undo import inverse_change
+from rosmc_server.core.model.changes import SkillMove, moves_between
+from rosmc_server.core.model.moves import MoveList
+from rosmc_server.core.model.reorder import play_moves, play_one_by_one
+from rosmc_server.core.model.state import BULK_MOVES
+from rosmc_server.core.rules.barriers import check_moves, check_new_barrier, find_deadlock
+from rosmc_server.core.rules.undo import inverse_change
 from tests.unit.test_change_indexes import (
     SETTINGS,
     Groups,
@@ -174,8 +174,8 @@ def test_a_whole_new_order_is_planned_once_not_decoded_again(
     # The planner knows the new order: checking, undo history and apply all take it.
     import random
 
-    from rosmc_server.core import task_order as state_module
-    from rosmc_server.core.editing import plan_reorder
+    from rosmc_server.core.model import task_order as state_module
+    from rosmc_server.core.rules.editing import plan_reorder
     from tests.unit.test_change_indexes import state_of
 
     ids = [f"a{n}" for n in range(400)]

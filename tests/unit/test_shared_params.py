@@ -1,6 +1,6 @@
 """Skills of a mission file whose parameters are exactly alike share one checked dict.
 
-:class:`~rosmc_server.core.shared_params.SharedParams` lets the mission reader check the
+:class:`~rosmc_server.core.files.shared_params.SharedParams` lets the mission reader check the
 parameters of a skill once for every later skill of the same kind with the very same raw
 values; values equal but of another type or sign are checked for themselves.
 """
@@ -13,7 +13,7 @@ from typing import Any
 import pytest
 
 from rosmc_server.core import Library, MissionFileError
-from rosmc_server.core.mission_reader import mission_from_dict
+from rosmc_server.core.files.mission_reader import mission_from_dict
 
 WAIT = {"seconds": 3, "verbose": True, "note": "n", "options": {"a": 0.0}}
 MOVE = {"target": {"x": 1.0, "y": 2.0}, "speed": 1.5}

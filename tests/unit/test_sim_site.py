@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from rosmc_server.core.site import Shape, SiteCheck
+from rosmc_server.core.world.site import Shape, SiteCheck
 from rosmc_sim.core.scenario import load_scenario
 from rosmc_sim.core.sim import Simulation
 from rosmc_sim.core.site_map import site_model

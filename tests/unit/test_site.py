@@ -1,4 +1,4 @@
-"""The site model and the skill-target checks the mission runs against it (core/site.py).
+"""The site model and the skill-target checks the mission runs against it (core/world/site.py).
 
 Geometry of obstacle footprints, what each named check refuses and says, the library's
 ``check`` key, and the mission refusing an add, edit, marker move or load whose target
@@ -28,8 +28,8 @@ from rosmc_server.core import (
     SkillStatus,
     TaskMarker,
 )
-from rosmc_server.core.library import library_from_dict
-from rosmc_server.core.site import (
+from rosmc_server.core.skills.library import library_from_dict
+from rosmc_server.core.world.site import (
     Footprint,
     GroundRobot,
     Shape,
@@ -37,7 +37,7 @@ from rosmc_server.core.site import (
     SiteModel,
     check_site,
 )
-from rosmc_server.core.site_source import NO_SITE, SiteInForce, site_line
+from rosmc_server.core.world.site_source import NO_SITE, SiteInForce, site_line
 
 ON_SITE, GROUND = SiteCheck.ON_SITE, SiteCheck.REACHABLE_GROUND
 ROCK = Footprint("rock_3", Shape.CYLINDER, 12.0, 3.5, radius=2.0, height=2.5)
@@ -259,7 +259,7 @@ def test_without_a_site_the_checks_are_skipped_and_that_is_said_once(
     library_data: dict[str, Any], caplog: pytest.LogCaptureFixture
 ) -> None:
     mission = Mission(checked_library(library_data), clock=lambda: 1.0)
-    with caplog.at_level(logging.INFO, logger="rosmc_server.core.site_guard"):
+    with caplog.at_level(logging.INFO, logger="rosmc_server.core.rules.site_guard"):
         mission.add_skill("alpha", "move", target(12.0, 3.5))
         mission.add_skill("alpha", "move", target(99.0, 0.0))
         mission.add_skill("alpha", "noop")

@@ -8,8 +8,8 @@ from typing import Any
 import pytest
 
 from rosmc_server.core import LibraryError, ParamType, SkillSetupError, SkillSpec
-from rosmc_server.core.bindings import BindingKind, BindingSpec, FieldSource
-from rosmc_server.core.library import library_from_dict, load_library
+from rosmc_server.core.skills.bindings import BindingKind, BindingSpec, FieldSource
+from rosmc_server.core.skills.library import library_from_dict, load_library
 from rosmc_server.executor.basic_skills import Wait, skill_types
 from rosmc_server.executor.core import SkillType
 from rosmc_server.executor.core.fitting import fit_to_library

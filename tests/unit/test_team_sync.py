@@ -7,9 +7,9 @@ from collections.abc import Callable
 import pytest
 
 from rosmc_server.core import Mission, NotFound, RuleViolation, Transfer
-from rosmc_server.core.changes import EventKind
-from rosmc_server.core.commands import CommandKind, commands_for_event
-from rosmc_server.core.state import MissionState
+from rosmc_server.core.model.changes import EventKind
+from rosmc_server.core.model.state import MissionState
+from rosmc_server.core.robots.commands import CommandKind, commands_for_event
 
 Uploads = dict[str, str | None]
 

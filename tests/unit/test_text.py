@@ -17,7 +17,7 @@ from rosmc_server.core import (
     SkillStatus,
     TaskMarker,
 )
-from rosmc_server.core.params import parse_text
+from rosmc_server.core.skills.params import parse_text
 from rosmc_server.text import (
     event_to_json,
     format_agent_status,

@@ -2,7 +2,7 @@
 
 Each view is driven through its own public functions (the command GUI's presentation, the
 rviz status block, the text of ``rosmc``), and what it shows is checked against
-:mod:`rosmc_server.core.vocabulary`; and the simulator and rviz paint bodies from one palette.
+:mod:`rosmc_server.core.views.vocabulary`; and the simulator and rviz paint bodies from one palette.
 """
 
 from __future__ import annotations
@@ -13,9 +13,10 @@ import pytest
 
 from rosmc_rqt_command.core import presentation
 from rosmc_rviz_markers.core import icons
-from rosmc_server.core import EventKind, Mission, SkillInstance, SkillStatus, geometry
-from rosmc_server.core.agent_status import AgentStatus
-from rosmc_server.core.vocabulary import (
+from rosmc_server.core import EventKind, Mission, SkillInstance, SkillStatus
+from rosmc_server.core.robots.agent_status import AgentStatus
+from rosmc_server.core.views import geometry
+from rosmc_server.core.views.vocabulary import (
     OPERATOR_EVENTS,
     PALETTE,
     ROBOT_EVENTS,

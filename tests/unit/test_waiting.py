@@ -1,12 +1,12 @@
-"""Commands for a robot out of contact wait, collapse and leave once, in order (core/waiting.py)."""
+"""Commands for a robot out of contact wait, collapse, leave once (core/robots/waiting.py)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from rosmc_server.core.commands import CommandKind
-from rosmc_server.core.link import InboundSequence, LinkStatus, Outbox
-from rosmc_server.core.waiting import (
+from rosmc_server.core.robots.commands import CommandKind
+from rosmc_server.core.robots.link import InboundSequence, LinkStatus, Outbox
+from rosmc_server.core.robots.waiting import (
     MAX_WAITING,
     collapse,
     duration_text,

@@ -43,15 +43,15 @@ import rosmc.msg as wire
 import rospy
 
 from ...core import RosmcError
-from ...core.drop_log import DropLog
-from ...core.radio import (
+from ...core.robots.drop_log import DropLog
+from ...core.robots.radio import (
     DIRECTORY_PERIOD,
     DatagramKind,
     next_directory_period,
     parse_endpoint,
 )
-from ...core.radio_auth import DatagramRefused, Opener, Sealer
-from ...core.radio_key import RadioKey, obtain_key
+from ...core.robots.radio_auth import DatagramRefused, Opener, Sealer
+from ...core.robots.radio_key import RadioKey, obtain_key
 from ...interface import RADIO_DIRECTORY
 from .connections import TimeoutTransport
 

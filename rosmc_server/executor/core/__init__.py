@@ -1,6 +1,6 @@
 """Executor logic in pure Python: queue, barriers, skills, store-and-forward reports."""
 
-from rosmc_server.core.protocol import (
+from rosmc_server.core.robots.protocol import (
     Ack,
     AckResult,
     BarrierInfo,

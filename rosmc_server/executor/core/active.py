@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from rosmc_server.core import SkillStatus
-from rosmc_server.core.protocol import BarrierInfo
+from rosmc_server.core.robots.protocol import BarrierInfo
 
 from .barrier_wait import Announcements
 from .skills import SkillBehavior
@@ -17,7 +17,8 @@ class ActiveSkill:
 
     ``behavior`` is set once the skill runs (before, it waits at ``barrier``);
     ``deadline`` bounds the run or the wait (0: none) and moves on by the time paused;
-    ``told`` is what this robot last announced to its barrier partners.
+    ``told`` is what this robot last announced to its barrier partners;
+    ``waiting_since`` when (engine clock) it last began waiting at its barrier.
     """
 
     skill_id: str
@@ -27,6 +28,7 @@ class ActiveSkill:
     deadline: float = 0.0
     paused_at: float = 0.0
     retries_used: int = 0
+    waiting_since: float = 0.0
     told: Announcements = field(default_factory=Announcements)
 
     @property

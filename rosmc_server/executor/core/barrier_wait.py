@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from rosmc_server.core.protocol import BarrierInfo, Signal, SignalKind
+from rosmc_server.core.robots.protocol import BarrierInfo, Signal, SignalKind
 
 from .barriers import BarrierBoard
 

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from rosmc_server.core.protocol import BarrierInfo, Signal, SignalKind
+from rosmc_server.core.robots.protocol import BarrierInfo, Signal, SignalKind
 
 READY_LEASE = 2.0  # seconds; waiting robots repeat their signal every 0.5 s
 REPLY_INTERVAL = 0.2  # seconds: at most one RELEASED answer per barrier this often

@@ -12,9 +12,9 @@ from collections.abc import Callable, Mapping
 from typing import Protocol
 
 from rosmc_server.core import InvalidRequest, LostLinkKind, LostLinkPolicy, SkillInstance
-from rosmc_server.core.commands import CommandKind
-from rosmc_server.core.policy import options_from_argument
-from rosmc_server.core.protocol import Ack, AckResult, BarrierInfo, Command
+from rosmc_server.core.robots.commands import CommandKind
+from rosmc_server.core.robots.protocol import Ack, AckResult, BarrierInfo, Command
+from rosmc_server.core.skills.policy import options_from_argument
 
 from . import queueing
 from .barriers import BarrierBoard

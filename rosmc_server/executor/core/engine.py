@@ -18,8 +18,8 @@ from collections.abc import Callable, Mapping
 from typing import Protocol
 
 from rosmc_server.core import SkillStatus
-from rosmc_server.core.control import ExecutorState
-from rosmc_server.core.protocol import (
+from rosmc_server.core.model.control import ExecutorState, HoldCause
+from rosmc_server.core.robots.protocol import (
     Ack,
     BarrierInfo,
     Command,
@@ -29,7 +29,7 @@ from rosmc_server.core.protocol import (
     Snapshot,
 )
 
-from . import commanding, queueing
+from . import commanding, queueing, reporting
 from .active import ActiveSkill
 from .barrier_wait import ANNOUNCE_PERIOD, BarrierWaits
 from .barriers import BarrierBoard
@@ -60,6 +60,10 @@ class Engine:
     The ground commands (:mod:`.commanding`) work through its public surface: the
     ``queue``, the barrier ``board``, :meth:`advance`, :meth:`start`, :meth:`pause`,
     :meth:`stop`, :meth:`set_barriers`, :attr:`active_skill_id` and ``lost_link.policy``.
+
+    ``clock`` is mission time (skills, timeouts, report stamps; sim time in simulation);
+    ``pace_clock`` paces progress texts and ``link_clock`` measures ground contact, both
+    steady wall clocks on a robot (each defaults to ``clock``).
     """
 
     def __init__(
@@ -70,6 +74,7 @@ class Engine:
         outputs: EngineOutputs,
         pose_source: PoseSource = no_pose,
         pace_clock: Callable[[], float] | None = None,
+        link_clock: Callable[[], float] | None = None,
     ) -> None:
         self.agent = agent
         self.skill_types = dict(skill_types)
@@ -80,7 +85,7 @@ class Engine:
         self.commands = CommandLog()
         self.board = BarrierBoard(agent)
         self.waits = BarrierWaits(agent, self.board, clock, outputs.signal)
-        self.lost_link = LostLinkGuard(agent, clock, self.skill_types, pose_source)
+        self.lost_link = LostLinkGuard(agent, clock, self.skill_types, pose_source, link_clock)
         self._active: ActiveSkill | None = None
         # Progress texts from skill threads, applied by tick() at most once a period.
         self._progress_box = ProgressBox(pace_clock or clock)
@@ -138,8 +143,8 @@ class Engine:
         self._apply_progress()
         idle = self.idle
         self.lost_link.observe(now)
-        if self.lost_link.due(now, idle):
-            self.lost_link.trigger(now, idle, self.pause)
+        if self.lost_link.due(idle):
+            self.lost_link.trigger(idle, self.pause)
             self.outputs.changed()
         if self.lost_link.step(now):
             self.outputs.changed()
@@ -187,6 +192,11 @@ class Engine:
         return upcoming is None or upcoming.status is S.FAILURE or self.mode is not Mode.STARTED
 
     @property
+    def active(self) -> ActiveSkill | None:
+        """The skill being worked on (at its barrier, running or paused), if any."""
+        return self._active
+
+    @property
     def active_skill_id(self) -> str:
         """The skill being worked on (at its barrier, running or paused); "" if none."""
         return self._active.skill_id if self._active is not None else ""
@@ -231,6 +241,7 @@ class Engine:
             return
         if upcoming.timeout > 0:  # the timeout bounds the wait too: partners may never come
             active.deadline = self.clock() + upcoming.timeout
+        active.waiting_since = self.clock()
         self.ledger.set(upcoming.id, S.SYNCWAITING, text=self.waits.text(active.barrier))
         self._announce_wait(active)
         self._try_release(active)
@@ -347,6 +358,7 @@ class Engine:
             if active.barrier is not None:
                 # Back to waiting at the barrier, not to PAUSED (and not straight to running).
                 waiting = self.waits.text(active.barrier)
+                active.waiting_since = self.clock()
                 self.ledger.set(active.skill_id, S.SYNCWAITING, text=waiting)
                 self._announce_wait(active)
             self._try_release(active)  # runs it if its barrier went away meanwhile
@@ -371,33 +383,15 @@ class Engine:
 
     def state(self) -> ExecutorState:
         """What the executor is doing now."""
-        if self.lost_link.contingency is not None:
-            return ExecutorState.CONTINGENCY
-        if self.mode is not Mode.STARTED:
-            return ExecutorState(self.mode.value)
-        if queueing.holding(self.ledger.queue):
-            return ExecutorState.HOLDING
-        active = self._active
-        if active is None:
-            return ExecutorState.IDLE
-        return ExecutorState.WAITING if active.behavior is None else ExecutorState.RUNNING
+        return reporting.executor_state(self)
 
     def snapshot(self, full: bool = True) -> Snapshot:
         """The state for the periodic snapshot: the queue only if ``full``, its digest always."""
-        active = self._active
-        waiting = ""
-        if active is not None and active.at_barrier and active.barrier is not None:
-            waiting = self.waits.summary(active.barrier)
-        return Snapshot(
-            self.clock(),
-            self.commands.last_seq,
-            self.ledger.last_report_seq,
-            self.queue_hash(),
-            tuple(self.ledger.queue) if full else (),
-            self.state_name(),
-            active.skill_id if active else "",
-            waiting,
-            self.lost_link.describe(),
-            full,
-            self.ledger.status_digest(),
-        )
+        return reporting.snapshot(self, full)
+
+    def hold(self) -> HoldCause:
+        """Why the robot holds after its lost-link policy acted (NONE: it does not).
+
+        Only while it stays paused: an operator's Start or Stop ends the hold.
+        """
+        return self.lost_link.held if self.mode is Mode.PAUSED else HoldCause.NONE

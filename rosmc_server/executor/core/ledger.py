@@ -13,8 +13,8 @@ from dataclasses import replace
 from typing import Protocol
 
 from rosmc_server.core import SkillInstance, SkillStatus
-from rosmc_server.core.link import queue_hash, status_digest
-from rosmc_server.core.protocol import Ack, Report
+from rosmc_server.core.robots.link import queue_hash, status_digest
+from rosmc_server.core.robots.protocol import Ack, Report
 
 
 class ReportOutputs(Protocol):

@@ -1,6 +1,6 @@
 """The lost-link policy at work on the robot: ground contact, the trigger, the safe skill.
 
-The policy itself (:class:`~rosmc_server.core.policy.LostLinkPolicy`) is the core's,
+The policy itself (:class:`~rosmc_server.core.skills.policy.LostLinkPolicy`) is the core's,
 shared with the server and the operators' tools; this module only runs it.
 
 Where the robot is comes from a :data:`PoseSource` that the robot's integration gives
@@ -12,6 +12,14 @@ after it went, so the very last contact can lie beyond the edge of coverage. The
 come from the robot's own steady sampling, not only from the moments the ground was
 heard: over a poor radio those are seconds apart, and a sim running many times faster
 than real time hears the ground once per many simulated seconds.
+
+Two clocks, each for its own purpose. Ground contact is link liveness, so the silence a
+policy counts (and the idleness it may add) is measured on the robot's ``link_clock``: a
+steady wall clock, as the ground measures a robot's silence and paces its heartbeat. A
+radio is silent for wall seconds whatever the simulation's speed; counted in sim seconds,
+a loaded machine that delays the heartbeat by half a wall second would look like a minute
+without the ground at a real-time factor of 100. Where the robot was is mission time: the
+poses are stamped with the engine's ``clock``, like the skills that move it.
 """
 
 from __future__ import annotations
@@ -21,13 +29,14 @@ from collections import deque
 from collections.abc import Callable, Mapping
 
 from rosmc_server.core import LostLinkKind, LostLinkPolicy, LostLinkTrigger, ParamType
-from rosmc_server.core.params import Pose, value_to_data
+from rosmc_server.core.model.control import HoldCause
+from rosmc_server.core.skills.params import Pose, value_to_data
 
 from .skills import SkillBehavior, SkillContext, SkillType
 
 _log = logging.getLogger(__name__)
 LINK_MARGIN = 10.0
-"""Seconds before the last ground contact where the robot returns to."""
+"""Seconds of mission time before the last ground contact: where the robot returns to."""
 POSE_SAMPLE_PERIOD = 0.5
 """Seconds between the poses the guard remembers while the robot works."""
 
@@ -51,15 +60,18 @@ class LostLinkGuard:
 
     Args:
         agent: The robot.
-        clock: Seconds (the engine's clock).
+        clock: Seconds of mission time (the engine's clock): poses, the safe skill.
         skill_types: The skills the robot implements (the safe skill is one of them).
         pose_source: Where the robot is (remembered whenever the ground is heard).
+        link_clock: Steady wall seconds for ground contact (``clock`` if not given).
 
     Attributes:
         policy: The policy in force.
         is_default: Whether ``policy`` is the library's default (no operator chose one).
         note: What the policy did last, for operators ("" until it acted).
         contingency: The safe skill while it runs (the robot is held meanwhile).
+        held: Why the policy left the robot holding (NONE until it did, and once the
+            operator started the robot again).
     """
 
     def __init__(
@@ -68,18 +80,21 @@ class LostLinkGuard:
         clock: Callable[[], float],
         skill_types: Mapping[str, SkillType],
         pose_source: PoseSource = no_pose,
+        link_clock: Callable[[], float] | None = None,
     ) -> None:
         self.agent = agent
         self.clock = clock
+        self.link_clock = link_clock or clock
         self.skill_types = skill_types
         self.policy = LostLinkPolicy()
         self.is_default = False
         self.note = ""
         self.contingency: SkillBehavior | None = None
+        self.held = HoldCause.NONE
         self._recent: deque[tuple[float, Pose]] = deque()  # poses within the margin
         self._link_pose: Pose | None = None
         self._pose_source = pose_source
-        self._last_contact = clock()
+        self._last_contact = self.link_clock()
         self._idle_since: float | None = None
         self._triggered = False
 
@@ -103,8 +118,8 @@ class LostLinkGuard:
 
     def contact(self) -> bool:
         """The ground was heard; True if that ends a triggered policy (the note changed)."""
-        now = self._last_contact = self.clock()
-        self._sample(now)
+        self._last_contact = self.link_clock()
+        self._sample(self.clock())
         if self._recent:
             self._link_pose = self._recent[0][1]
         if not self._triggered:
@@ -116,6 +131,7 @@ class LostLinkGuard:
     def operator_took_over(self) -> None:
         """The robot was started again: what the policy did is over (its note would still
         say "holding"), unless its skill still runs (its note says so)."""
+        self.held = HoldCause.NONE
         if self.contingency is None:
             self.note = ""
 
@@ -142,12 +158,14 @@ class LostLinkGuard:
         """
         return self._link_pose
 
-    def due(self, now: float, idle: bool) -> bool:
+    def due(self, idle: bool) -> bool:
         """Whether the policy acts now (``idle``: the robot has nothing left to do).
 
         A ``silent`` policy counts the seconds without the ground; an ``idle`` one the
-        seconds both idle and without the ground. It acts once per outage.
+        seconds both idle and without the ground, both on the link clock. It acts once per
+        outage.
         """
+        now = self.link_clock()
         if not idle:
             self._idle_since = None
         elif self._idle_since is None:
@@ -161,13 +179,13 @@ class LostLinkGuard:
             since = max(since, self._idle_since)
         return now - since >= self.policy.after
 
-    def trigger(self, now: float, idle: bool, pause: Callable[[str], None]) -> None:
+    def trigger(self, idle: bool, pause: Callable[[str], None]) -> None:
         """Act: hold the robot with ``pause``, then run the policy's skill.
 
         A ``silent`` safe_skill policy only holds a robot that is ``idle`` (it keeps its
         meaning from before idle triggers existed).
         """
-        silent = now - self._last_contact
+        silent = self.link_clock() - self._last_contact
         self._triggered = True
         policy = self.policy
         params: dict[str, object] = dict(policy.params)
@@ -184,6 +202,7 @@ class LostLinkGuard:
                 params.update(target)
         if just_hold:
             self.note = held
+            self.held = HoldCause.LOST_LINK
             pause(self.note)
         else:
             self.note = self._running_note(silent)
@@ -220,6 +239,8 @@ class LostLinkGuard:
         done = "done" if outcome.success else f"failed: {outcome.reason}"
         self.note += f" ({done}); holding"
         self.contingency = None
+        returned = self.policy.kind is LostLinkKind.RETURN_TO_LINK and outcome.success
+        self.held = HoldCause.RETURN_POINT if returned else HoldCause.SAFE_SKILL
         return True
 
     def describe(self) -> str:

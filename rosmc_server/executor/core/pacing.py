@@ -14,7 +14,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
-from ...core.protocol import Snapshot
+from ...core.robots.protocol import Snapshot
 
 IDLE_PERIOD = 5.0  # seconds between unchanged snapshots, at most
 POLICY_REPEAT = 30.0  # seconds after which a snapshot repeats an unchanged policy text

@@ -2,7 +2,7 @@
 
 The queue is the ordered list of skills the robot holds. These functions
 implement the command semantics the ground relies on (see
-:mod:`rosmc_server.core.commands`) and never touch execution state.
+:mod:`rosmc_server.core.robots.commands`) and never touch execution state.
 """
 
 from __future__ import annotations

@@ -110,7 +110,7 @@ class SkillType:
 
     def coerce(self, params: Mapping[str, object]) -> dict[str, Value]:
         """Parameters from plain data (JSON): pose mappings become poses."""
-        from rosmc_server.core.params import Pose
+        from rosmc_server.core.skills.params import Pose
 
         out: dict[str, Value] = {}
         for name, value in params.items():
@@ -131,7 +131,7 @@ class SkillType:
 
 
 def _matches(ptype: ParamType, value: Value) -> bool:
-    from rosmc_server.core.params import Pose
+    from rosmc_server.core.skills.params import Pose
 
     checks: Mapping[ParamType, Callable[[Value], bool]] = {
         ParamType.BOOL: lambda v: isinstance(v, bool),

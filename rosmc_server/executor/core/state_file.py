@@ -22,7 +22,8 @@ from rosmc_server.core import (
     SkillStatus,
     Transfer,
 )
-from rosmc_server.core.protocol import (
+from rosmc_server.core.model.control import HoldCause
+from rosmc_server.core.robots.protocol import (
     Ack,
     AckResult,
     BarrierInfo,
@@ -56,6 +57,7 @@ def save_state(engine: Engine, path: Path) -> None:
         "policy": engine.lost_link.policy.to_dict(),
         "policy_note": engine.lost_link.note,
         "policy_default": engine.lost_link.is_default,
+        "held": engine.lost_link.held.value,
     }
     path.parent.mkdir(parents=True, exist_ok=True)
     temporary = path.with_name(f".{path.name}.tmp")
@@ -98,6 +100,7 @@ def load_state(engine: Engine, path: Path) -> list[str]:
         raise ValueError(f"{path}: {error}") from error
     engine.lost_link.note = str(data.get("policy_note", ""))
     engine.lost_link.is_default = data.get("policy_default") is True
+    engine.lost_link.held = HoldCause.of(str(data.get("held", "")))  # still paused: still held
     mode = Mode(data["mode"])
     engine.mode = Mode.STOPPED if mode is Mode.STARTED else mode
     return _interrupted_by_restart(engine)

@@ -1,6 +1,6 @@
 """Library bindings made into skill types: a skill by configuration, no code.
 
-:func:`bound_skill_type` resolves a :class:`~rosmc_server.core.bindings.BindingSpec` when
+:func:`bound_skill_type` resolves a :class:`~rosmc_server.core.skills.bindings.BindingSpec` when
 the executor starts: the message types by name, every field against its parameter, the
 status and outcome texts against the feedback and result. Anything that does not fit
 stops the executor with a :class:`SkillSetupError` of one sentence. It also makes the
@@ -19,7 +19,7 @@ import rospy
 from roslib.message import get_service_class
 
 from rosmc_server.core import SkillSetupError, SkillSpec
-from rosmc_server.core.bindings import BindingKind, BindingSpec
+from rosmc_server.core.skills.bindings import BindingKind, BindingSpec
 
 from ..core import SkillBehavior, SkillType
 from ..core.fitting import parameter_types

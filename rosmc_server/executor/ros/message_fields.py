@@ -36,7 +36,7 @@ from roslib.message import get_message_class
 
 from rosmc_server.conversions.values import value_type
 from rosmc_server.core import ParamType, Pose, SkillSetupError, Value
-from rosmc_server.core.bindings import FieldSource, template_fields
+from rosmc_server.core.skills.bindings import FieldSource, template_fields
 from rosmc_server.interface import MAP_FRAME
 
 Convert = Callable[[Any], Any]

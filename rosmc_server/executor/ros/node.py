@@ -11,7 +11,7 @@ Publishes:
     its digest always), ``/rosmc/barriers`` (rosmc/BarrierSignal, a copy for observers).
 Radio side channel (UDP, :mod:`rosmc_server.common.ros.radio`, registered as
     ``/rosmc/radio/<robot>``): barrier signals to and from the other robots, and beacons
-    to and from the ground (:class:`~rosmc_server.core.radio.BeaconPlan`: seldom while it
+    to and from the ground (:class:`~rosmc_server.core.robots.radio.BeaconPlan`: seldom while it
     hears the ground); a ground beacon after a silence reconnects the link's topics.
 
 ``<link>`` is ``/rosmc/link/<robot>`` (talking to the ground directly) or, with
@@ -34,7 +34,7 @@ Parameters (private):
     ``~tick_rate`` (float, Hz, 50), ``~robot_side`` (bool, false).
     ``~radio_key`` (str): the deployment's radio key file, which signs the radio side
         channel's datagrams (default ``$ROS_HOME/rosmc/radio.key``, made there if missing;
-        a key given here must exist: see :mod:`rosmc_server.core.radio_key`).
+        a key given here must exist: see :mod:`rosmc_server.core.robots.radio_key`).
     ``~cwd`` (str): a relative ``~state_file`` is taken from there (launch files pass the
     directory roslaunch was typed in).
 
@@ -45,12 +45,13 @@ Parameters (private):
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
 import logging
 import sys
 import threading
 import time
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 from typing import cast
 
@@ -77,10 +78,10 @@ from ...conversions.robot_link import (
     snapshot_to_msg,
 )
 from ...core import LibraryError, RosmcError, SkillSetupError
-from ...core.drop_log import DropLog
 from ...core.errors import RadioKeyError
-from ...core.radio import BeaconPlan, ContactWatch
-from ...core.radio_key import RadioKey
+from ...core.robots.drop_log import DropLog
+from ...core.robots.radio import BeaconPlan, ContactWatch
+from ...core.robots.radio_key import RadioKey
 from ..core import Command, Engine, Report, Signal, SkillType
 from ..core.lost_link import PoseSource, no_pose
 from ..core.pacing import SnapshotPacer
@@ -127,7 +128,9 @@ class ExecutorNode:
         self._lock = threading.RLock()
         self._state_file = state_file
         self._dirty = False
-        self._held_reports: list[Report] | None = None  # while a command is being answered
+        # Reports made while a command is answered or the engine ticks: they go out after
+        # the state is persisted (and the command's ack).
+        self._held_reports: list[Report] | None = None
         self._echo: tuple[float, float] | None = None  # newest stamped report ack: sent, heard
         # The whole queue goes in the first snapshot and again whenever the ground asks
         # (a new ground, or one whose statuses disagree with the digest).
@@ -140,8 +143,16 @@ class ExecutorNode:
         self._barrier_pub = rospy.Publisher(
             interface.BARRIER_TOPIC, wire.BarrierSignal, queue_size=100
         )
+        # Mission time is ROS time (sim time in simulation); ground contact is measured
+        # in wall seconds, as the ground measures the robot's silence.
         self.engine = Engine(
-            agent, skill_types, rospy.get_time, self, pose_source, pace_clock=time.monotonic
+            agent,
+            skill_types,
+            rospy.get_time,
+            self,
+            pose_source,
+            pace_clock=time.monotonic,
+            link_clock=time.monotonic,
         )
         if state_file is not None and state_file.exists():
             try:
@@ -169,9 +180,10 @@ class ExecutorNode:
 
     # -- engine outputs (called with the lock held) ------------------------------------
     def report(self, report: Report) -> None:
-        """Publish a new report now (it is retransmitted until acknowledged)."""
+        """Publish a new report (it is retransmitted until acknowledged); inside
+        :meth:`_durable_step`, once the state is persisted."""
         if self._held_reports is not None:
-            self._held_reports.append(report)  # goes out after the command's ack
+            self._held_reports.append(report)
             return
         self._report_pub.publish(report_to_msg(self.agent, report))
 
@@ -198,22 +210,16 @@ class ExecutorNode:
         except (ValueError, RosmcError) as error:  # refused below, so the link goes on
             _log.warning("%s: refusing malformed command %d: %s", self.agent, msg.seq, error)
             reason = f"the robot cannot read command {msg.seq}: {error}"
-        with self._lock:
+        with self._lock, self._durable_step():
+            if command is None:
+                ack = self.engine.refuse_command(msg.seq, reason)
+            else:
+                ack = self.engine.handle_command(command)
+            self._persist()  # before answering: an acknowledged command survives a crash
             # The ground learns from the ack that an uploaded skill is on the robot; a
             # report about that skill (it may start at once) must not overtake it.
-            self._held_reports = []
-            try:
-                if command is None:
-                    ack = self.engine.refuse_command(msg.seq, reason)
-                else:
-                    ack = self.engine.handle_command(command)
-                self._persist()  # before answering: an acknowledged command survives a crash
-                if ack is not None:
-                    self._ack_pub.publish(ack_to_msg(self.agent, ack, rospy.get_time()))
-            finally:
-                held, self._held_reports = self._held_reports, None
-                for report in held:
-                    self._report_pub.publish(report_to_msg(self.agent, report))
+            if ack is not None:
+                self._ack_pub.publish(ack_to_msg(self.agent, ack, rospy.get_time()))
 
     def _on_report_ack(self, msg: wire.ReportAck) -> None:
         if msg.agent == self.agent:
@@ -259,7 +265,7 @@ class ExecutorNode:
         except ValueError as error:
             self._dropped(self._dropped_signals, "it cannot be read", f"from {msg.agent}: {error}")
             return
-        with self._lock:
+        with self._lock, self._durable_step():
             self.engine.hear(signal)
 
     def _dropped(self, log: DropLog, reason: str, detail: str) -> None:
@@ -281,10 +287,11 @@ class ExecutorNode:
             if beacon is not None:
                 self.radio.beacon(GROUND, beacon)
             with self._lock:
-                try:
-                    self.engine.tick()
-                except Exception:  # keep the robot's executor alive whatever a skill does
-                    _log.exception("%s: executor tick failed", self.agent)
+                with self._durable_step():
+                    try:
+                        self.engine.tick()
+                    except Exception:  # keep the robot's executor alive whatever a skill does
+                        _log.exception("%s: executor tick failed", self.agent)
                 if now >= next_retry:
                     next_retry = now + report_retry
                     for report in self.engine.ledger.unacked:
@@ -297,6 +304,22 @@ class ExecutorNode:
                 self._persist()
             time.sleep(max(0.0, period - (time.monotonic() - now)))
         self.radio.close()
+
+    @contextlib.contextmanager
+    def _durable_step(self) -> Iterator[None]:
+        """Hold the reports the engine makes inside; persist, then publish them.
+
+        A report leaves only once what it says is on disk: a robot killed right after
+        reporting a skill's end must not run that skill again. Called with the lock held.
+        """
+        self._held_reports = []
+        try:
+            yield
+        finally:
+            self._persist()
+            held, self._held_reports = self._held_reports, None
+            for report in held:
+                self._report_pub.publish(report_to_msg(self.agent, report))
 
     def _persist(self) -> None:
         if self._dirty and self._state_file is not None:

@@ -17,7 +17,7 @@ from pathlib import Path
 
 from mcap.opcode import Opcode
 
-from rosmc_server.core.durable import fsync_directory
+from rosmc_server.core.documents.durable import fsync_directory
 from rosmc_server.recording._mcap import head_mark, layout
 from rosmc_server.recording._mcap import records as fmt
 from rosmc_server.recording._mcap.files import open_locked

@@ -2,7 +2,7 @@
 
 :class:`MissionClient` calls the operator services; :class:`AsyncMissionClient` runs
 those calls on a worker thread for GUIs. :class:`MissionFollower` keeps a
-:class:`~rosmc_server.core.mirror.MissionMirror` (a live copy of the mission) current from
+:class:`~rosmc_server.core.live.mirror.MissionMirror` (a live copy of the mission) current from
 the events, agent states and snapshots; :class:`MissionWatch` queues the raw events
 (``rosmc watch``). All speak core objects and raise one error family, rooted in
 :class:`RosmcError`: the server's refusals (:class:`RevisionConflict` for a stale

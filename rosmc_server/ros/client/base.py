@@ -10,6 +10,7 @@ from typing import Any, Self
 from rosmc.msg import ErrorCode
 
 from ...conversions import library_from_msg, param_to_msg
+from ...conversions.request_fields import FIRST_REVISION
 from ...core import Library, MissionState, SkillInstance, SkillSpec
 from .connection import ServiceCaller, raise_for
 
@@ -64,12 +65,14 @@ class ClientBase:
 
         Each call without its own ``base_revision`` is then made against ``seen``, or
         against the client's own last result if that is newer (calls run in order, so a
-        quick second click is not refused because of the first). ``seen`` None or negative
-        (nothing shown yet): the client's known revision, as outside the block. Holds the
-        client's lock for the block.
+        quick second click is not refused because of the first). ``seen`` None or below
+        :data:`FIRST_REVISION` (nothing shown yet; no mission is at 0, which on the wire means
+        no check): the client's known revision, as outside the block. Holds the client's lock
+        for the block.
         """
+        shown = seen if seen is not None and seen >= FIRST_REVISION else None
         with self._lock:
-            before, self._seen = self._seen, seen if seen is not None and seen >= 0 else None
+            before, self._seen = self._seen, shown
             try:
                 yield
             finally:

@@ -1,4 +1,4 @@
-"""Keeps a :class:`~rosmc_server.core.mirror.MissionMirror` current from the ROS graph.
+"""Keeps a :class:`~rosmc_server.core.live.mirror.MissionMirror` current from the ROS graph.
 
 Subscribes (each name behind ``prefix``, e.g. ``/replay``):
     ``/rosmc/mission_events`` (rosmc/MissionEvent): one message per accepted change.
@@ -32,7 +32,7 @@ import rospy
 from ... import interface
 from ...conversions import agent_statuses_from_msg, event_from_msg
 from ...core import Library, MissionState
-from ...core.mirror import MissionMirror
+from ...core.live.mirror import MissionMirror
 from .mission_client import MissionClient
 from .worker import AsyncMissionClient, Outcome
 

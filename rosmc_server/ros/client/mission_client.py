@@ -9,8 +9,8 @@ from ...conversions import moves_to_msgs, policy_to_request
 from ...conversions.move_fields import order_to_field
 from ...conversions.request_fields import insert_index_to_msg
 from ...core import InvalidRequest, LostLinkPolicy
-from ...core.changes import SkillMove
-from ...core.editing import check_retries, check_timeout
+from ...core.model.changes import SkillMove
+from ...core.rules.editing import check_retries, check_timeout
 from .connection import raise_for
 from .marker_calls import MarkerCalls
 from .results import (

@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ...core import RosmcError, StaleRevision
-from ...core.control import ControlCommand as ControlCommand  # callers import it from here
+from ...core.model.control import ControlCommand as ControlCommand  # callers import it from here
 
 
 class RevisionConflict(StaleRevision):

@@ -12,7 +12,7 @@ import rosmc.msg as wire
 
 from ... import interface
 from ...conversions.science import science_from_msg
-from ...core.science import Science
+from ...core.views.science import Science
 from .latched import LatchedWatch
 
 SCIENCE_TYPE = "rosmc/ScienceState"

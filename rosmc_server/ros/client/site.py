@@ -13,7 +13,7 @@ import rosmc.msg as wire
 from ... import interface
 from ...conversions import site_in_force_from_msg
 from ...core import InvalidRequest
-from ...core.site_source import SiteInForce
+from ...core.world.site_source import SiteInForce
 from .latched import LatchedWatch
 
 
