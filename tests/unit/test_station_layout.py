@@ -27,7 +27,7 @@ from rosmc_rqt_command.core.station_layout import (
 from rosmc_rqt_command.qt.replay_bar import ReplayBar
 from rosmc_rqt_command.qt.station_menu import StationHooks, StationMenu
 from rosmc_server.core import Library
-from rosmc_server.core.library import load_library
+from rosmc_server.core.skills.library import load_library
 from tests.team_gui import settle
 from tests.unit.conftest import SHIPPED_LIBRARY, make_mission
 from tests.unit.test_command_harness import Gui
