@@ -23,10 +23,13 @@ from python_qt_binding.QtWidgets import QApplication, QMainWindow, QWidget
 from rosmc_server.ros.client import init_node
 
 from .core.pending_backend import PendingBackend, follows_replay
+from .core.station_layout import MISSION
 from .core.view_state import ViewUpdate
 from .qt.command_widget import CommandWidget
 from .qt.replay_mode import ReplayHooks, ReplayMode, ReplaySteering
 from .qt.startup_report import StartupReport
+from .qt.station_menu import StationHooks, StationMenu
+from .qt.window_layout import place_on_screen
 from .ros_bridge import RosBridge
 
 
@@ -89,7 +92,7 @@ class CommandWindow(QMainWindow):  # type: ignore[misc]
         self.widget = widget
         self.setWindowTitle(title)
         self.setCentralWidget(widget)
-        self.resize(1560, 920)
+        place_on_screen(self)  # the right part of the screen; rviz takes the left
 
     def closeEvent(self, event: object) -> None:
         """Offer to save first; Cancel keeps the window open, Save until the save is done."""
@@ -158,6 +161,8 @@ class _Live:
     def __init__(self, widget: CommandWidget, prefix: str, report: StartupReport | None):
         self.widget, self.prefix, self.report = widget, prefix, report
         self.bridge: RosBridge | None = None
+        self.station: Any = None  # the StationLink (rviz, the clock), once the node is up
+        self.menu: StationMenu | None = None
 
     def on_node_ready(self) -> None:
         """Make the bridge, hand it what the window asked meanwhile, start following."""
@@ -169,6 +174,8 @@ class _Live:
             self.report.follow(bridge.updated, self.widget.tasks)
         self.widget.set_backend(bridge)
         follow(self.widget, bridge)
+        if self.menu is not None and not follows_replay(self.prefix):
+            self.station = join_station(self.widget, self.menu)
         if isinstance(pending, PendingBackend):
             pending.hand_over(bridge)
 
@@ -177,6 +184,36 @@ class _Live:
         if self.bridge is not None:
             self.widget.replay.close()
             self.bridge.close()
+        if self.station is not None:
+            self.station.close()
+
+
+def join_station(widget: CommandWidget, menu: StationMenu) -> Any:
+    """Connect ``widget`` (following the live mission) to rviz; returns the StationLink.
+
+    Show 3D view and the clock go through the link; Open recording… makes rviz show the
+    replay, Return to live the live mission; rviz's Open command window brings the
+    window to the front.
+    """
+    from .ros_station import StationLink
+
+    station = StationLink()
+    menu.hooks = station.hooks()
+    menu.tick()
+    widget.replay.show_source = station.show_source
+    station.raise_requested.connect(lambda: bring_to_front(widget.window()))
+    return station
+
+
+def bring_to_front(window: QWidget) -> None:
+    """Show ``window`` un-minimized, on top, with the keyboard focus."""
+    window.showNormal()
+    window.raise_()
+    window.activateWindow()
+
+
+def _not_yet() -> str:
+    return "The 3D view opens once this window has joined the ROS graph."
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -205,6 +242,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     replay = follows_replay(options.ns)
     title = "ROSMC command" + (f" — following {options.ns} (read-only)" if replay else "")
     window = CommandWindow(widget, title)
+    live.menu = StationMenu(widget, StationHooks(_not_yet, lambda: (None, MISSION)), window.close)
     if report is not None:
         report.watch(window)
     window.show()

@@ -13,6 +13,8 @@ NODE = f"{NAMESPACE}/markers"
 MARKERS_NS = f"{NAMESPACE}/markers"
 # visualization_msgs/MarkerArray, latched: status icons above every robot.
 ICONS_TOPIC = f"{MARKERS_NS}/icons"
+# visualization_msgs/MarkerArray, latched: the mission clock over the lander.
+CLOCK_TOPIC = f"{MARKERS_NS}/clock"
 # Stock rviz tools point here (rviz/operator.rviz):
 NEW_POSITION_TOPIC = f"{MARKERS_NS}/new_position"  # geometry_msgs/PointStamped (Publish Point)
 NEW_POSE_TOPIC = f"{MARKERS_NS}/new_pose"  # geometry_msgs/PoseStamped (2D Nav Goal)

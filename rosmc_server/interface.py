@@ -110,6 +110,15 @@ def base_link(agent: str) -> str:
 SELECTION_TOPIC = f"{NAMESPACE}/selection"
 
 
+# The operator station's two windows open each other and show the same source:
+# std_msgs/Empty requests to bring rviz / the command window to the front, and the prefix
+# rviz shows (std_msgs/String, latched: "" the live mission, "/replay" a replay).
+STATION_NAMESPACE = f"{NAMESPACE}/station"
+SHOW_3D_TOPIC = f"{STATION_NAMESPACE}/show_3d"
+SHOW_COMMAND_TOPIC = f"{STATION_NAMESPACE}/show_command"
+VIEW_SOURCE_TOPIC = f"{STATION_NAMESPACE}/view_source"
+RVIZ_NODE = "/rviz_operator"  # the operator's rviz (launch/rviz.launch)
+
 # Robot-to-robot barrier coordination (never through the ground station).
 BARRIER_TOPIC = f"{NAMESPACE}/barriers"  # rosmc/BarrierSignal, for observers
 # Parameter namespace of the radio side channel: <name> -> "host:port" (ros/radio.py).

@@ -20,6 +20,7 @@ from python_qt_binding.QtWidgets import (
     QLabel,
     QPushButton,
     QToolTip,
+    QVBoxLayout,
     QWidget,
 )
 
@@ -188,19 +189,20 @@ class ReplayBar(QFrame):  # type: ignore[misc]
         self.live_button = QPushButton("Return to live")
         self.live_button.setObjectName("replay_live")
         self.live_button.setToolTip("Stop the replay and show the live mission again")
-        layout = QHBoxLayout(self)
+        # Two rows, so that the bar fits a window half a screen wide: what is replayed and
+        # the way back above, the controls and the timeline below.
+        layout = QVBoxLayout(self)
         layout.setContentsMargins(6, 2, 6, 2)
-        for widget in (
-            self.title,
-            self.play_button,
-            self.slower_button,
-            self.rate_label,
-            self.faster_button,
-        ):
-            layout.addWidget(widget)
-        layout.addWidget(self.slider, 1)
+        layout.setSpacing(2)
+        top, controls = QHBoxLayout(), QHBoxLayout()
+        top.addWidget(self.title, 1)
         for widget in (self.time_label, self.end_label, self.live_button):
-            layout.addWidget(widget)
+            top.addWidget(widget)
+        for widget in (self.play_button, self.slower_button, self.rate_label, self.faster_button):
+            controls.addWidget(widget)
+        controls.addWidget(self.slider, 1)
+        layout.addLayout(top)
+        layout.addLayout(controls)
         self.shown: ShownStatus | None = None
         self._timer = QTimer(self)
         self._timer.setInterval(100)

@@ -2,7 +2,8 @@
 
 :class:`ReplayMode` starts the replay's child processes (:mod:`.replay_process`), points
 the window at the replay's prefix with a fresh read-only backend, and shows the timeline
-bar (:mod:`.replay_bar`) above the task panel. "Return to live" (or the replay leaving on
+bar (:mod:`.replay_bar`) above the task panel; rviz is told to show the replay too
+(:attr:`ReplayMode.show_source`, which the window sets). "Return to live" (or the replay leaving on
 its own) ends the children and points the window at the live mission again. The window's
 live backend is only set aside meanwhile, so the way back needs no reconnection.
 
@@ -21,6 +22,7 @@ from python_qt_binding.QtWidgets import QAction, QFileDialog
 
 from rosmc_server.core import RosmcError
 
+from ..core.station_layout import REPLAY
 from ..replay_process import ReplayProcess
 from ..replay_ticks import outline_of
 from .replay_bar import ReplayBar, ShownStatus
@@ -80,7 +82,7 @@ class ReplayMode(QObject):  # type: ignore[misc]
     Args:
         widget: The command window's widget (its backend is the live one now).
         hooks: The ROS side (see :class:`ReplayHooks`).
-        prefix: Where the replay publishes; rviz follows it with ``rviz.launch ns:=PREFIX``.
+        prefix: Where the replay publishes; rviz follows it (see :attr:`show_source`).
     """
 
     def __init__(self, widget: CommandWidget, hooks: ReplayHooks, prefix: str = PREFIX) -> None:
@@ -94,6 +96,8 @@ class ReplayMode(QObject):  # type: ignore[misc]
         self._link: ReplaySteering | None = None
         self._ended_said = False
         self._live_science: Any = None  # the live score, shown again on the way back
+        # Tells rviz which mission to show: the prefix, or "" for the live one again.
+        self.show_source: Callable[[str], None] = lambda _prefix: None
         self.bar = ReplayBar()
         self.bar.hide()
         widget.layout().insertWidget(1, self.bar)  # under the banner, above the task panel
@@ -141,9 +145,10 @@ class ReplayMode(QObject):  # type: ignore[misc]
         self.bar.set_outline(outline)
         self.bar.show()
         self._watch.start()
+        self.show_source(self.prefix)
         self._widget.messages.say(
-            f"Replaying {outline.path.name} ({outline.duration:.1f} s), paused at the start; "
-            f"rviz follows it with: roslaunch rosmc rviz.launch ns:={self.prefix}",
+            f"Replaying {outline.path.name} ({outline.duration:.1f} s) here and in the 3D "
+            "view, paused at the start.",
             "info",
         )
 
@@ -152,11 +157,17 @@ class ReplayMode(QObject):  # type: ignore[misc]
         if not self.active:
             return
         self._leave_replay()
+        self.show_source("")
         self._switch(None, self._live)
         self._widget.science.show_science(self._live_science)
         self._live.refresh()
         self.bar.hide()
         self._widget.messages.say("Back to the live mission.", "ok")
+
+    def clock(self) -> tuple[float | None, str]:
+        """The replayed time: where the replay is in its recording (None before it is heard)."""
+        shown = self.bar.shown
+        return (None if shown is None else shown.position_now()), REPLAY
 
     def close(self) -> None:
         """End the replay's processes (the window closes)."""

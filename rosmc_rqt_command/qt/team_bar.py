@@ -13,7 +13,6 @@ from python_qt_binding.QtCore import Qt
 from python_qt_binding.QtWidgets import (
     QAction,
     QButtonGroup,
-    QHBoxLayout,
     QLabel,
     QLineEdit,
     QMenu,
@@ -25,6 +24,7 @@ from rosmc_server.core.views.vocabulary import counted
 
 from ..core.mission_view import MissionView
 from ..core.team_filter import StatusFilter, TeamFilter, visible_agents
+from .flow_layout import FlowLayout
 from .labels import never_widen
 from .task_widget import TaskWidget
 
@@ -90,17 +90,15 @@ class TeamBar(QWidget):  # type: ignore[misc]
         self.count.setObjectName("team_count")
         never_widen(self.count, wrap=False)
         self.count.setAlignment(Qt.AlignRight | Qt.AlignVCenter)
-        layout = QHBoxLayout(self)
+        # The controls wrap onto a second row in a narrow window (half a screen wide).
+        layout = FlowLayout(self)
         layout.setContentsMargins(2, 0, 2, 0)
         layout.addWidget(self.text)
         layout.addWidget(self.robots_button)
-        layout.addSpacing(8)
         layout.addWidget(QLabel("Show:", self))
         for button in self.status_buttons.values():
             layout.addWidget(button)
-        layout.addSpacing(8)
         layout.addWidget(self.compact)
-        layout.addStretch(1)
         layout.addWidget(self.count)
 
     def refresh(self) -> None:

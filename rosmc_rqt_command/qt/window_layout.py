@@ -5,8 +5,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from python_qt_binding.QtCore import Qt
-from python_qt_binding.QtWidgets import QLabel, QMenuBar, QSplitter, QVBoxLayout, QWidget
+from python_qt_binding.QtWidgets import (
+    QApplication,
+    QLabel,
+    QMenuBar,
+    QSplitter,
+    QVBoxLayout,
+    QWidget,
+)
 
+from ..core.station_layout import Rect, split_screen
 from .actions import CommandActions
 from .control_panel import ControlPanel
 from .labels import never_widen
@@ -81,7 +89,7 @@ def lay_out(window: QWidget, panels: Panels) -> Layout:
     splitter.setStretchFactor(1, 0)
     # Neither side can be dragged away: a collapsed parameter panel took edits nowhere.
     splitter.setChildrenCollapsible(False)
-    splitter.setSizes([1200, 400])
+    splitter.setSizes([1200, RIGHT_MIN_WIDTH])
     layout = QVBoxLayout(window)
     layout.setContentsMargins(2, 2, 2, 2)
     layout.setMenuBar(menu_bar)
@@ -108,3 +116,18 @@ def _menus(window: QWidget, panels: Panels) -> QMenuBar:
     mission_menu.addAction(actions.refresh)
     mission_menu.addAction(actions.clear_selection)
     return menu_bar
+
+
+def place_on_screen(window: QWidget) -> None:
+    """Put ``window`` on its share of the screen: the right part, beside rviz on the left.
+
+    The share follows the screen's available area (without the desktop's panels), see
+    :func:`~..core.station_layout.split_screen`.
+    """
+    screen = QApplication.primaryScreen()
+    if screen is None:  # no screen at all (a headless platform without one)
+        window.resize(760, 940)
+        return
+    area = screen.availableGeometry()
+    place = split_screen(Rect(area.x(), area.y(), area.width(), area.height())).command
+    window.setGeometry(place.x, place.y, place.width, place.height)

@@ -12,6 +12,9 @@ ROS interface (every name behind ``~ns``):
     above the origin once the mission server restarted, naming its revision; all of them
     to a subscriber as it connects, then only what changed, see :mod:`.icon_layer`),
     ``/rosmc/selection`` (rosmc/Selection, latched: what the operator clicked),
+    ``/rosmc/markers/clock`` (visualization_msgs/MarkerArray, latched: the mission clock)
+    and the ``station`` interactive marker (its menu opens the command window), see
+    :mod:`.station_layer`,
     ``/rosmc/coverage`` (visualization_msgs/MarkerArray, latched: radio coverage, see
     :mod:`.coverage_layer`, which also subscribes ``/rosmc/sim/coverage``).
     Subscribes ``/rosmc/markers/feedback`` (InteractiveMarkerFeedback), ``/rosmc/selection``,
@@ -54,11 +57,12 @@ from .convert import icon_markers, interactive_marker_msg, pose_msg
 from .coverage_layer import CoverageLayer
 from .icon_layer import IconLayer
 from .interaction import Interaction
+from .station_layer import STATION_MARKER, StationLayer
 from .tf_presence import TfPresence
 
 _log = logging.getLogger(__name__)
 SERVER_ICON = "mission_server"  # the status text of the server itself (icons/mission_server)
-SERVER_NOTE_AT = (0.0, 0.0, 9.0)  # + ICON_BASE: over the lander (map origin), above its score
+SERVER_NOTE_AT = (0.0, 0.0, 9.3)  # + ICON_BASE: over the lander, above its score and clock
 SERVER_NOTE_TEXT = 0.8  # letter height (m): as large as the site's region labels
 
 
@@ -86,6 +90,8 @@ class MarkerNode:
         self._icons = IconLayer(topics.topic(topics.ICONS_TOPIC, config.ns))
         self.interaction = Interaction(self, config)
         self.coverage = CoverageLayer(config.ns)  # radio coverage and last-link marks
+        # the mission clock over the lander, whose menu opens the command window
+        self.station = StationLayer(self.server, self._lock, config.ns, menu=not config.read_only)
         self._tf: TfPresence | None = None  # which agents have TF (follow_tf only)
         self._worker = threading.Thread(target=self._run, name="rosmc-markers", daemon=True)
 
@@ -126,6 +132,7 @@ class MarkerNode:
     def start(self) -> None:
         """Fetch the library, follow the mission and start publishing."""
         self._worker.start()
+        self.station.start()
         self.follower.start()
         if self.config.library:
             self._take_library(load_library(self.config.library))
@@ -138,6 +145,7 @@ class MarkerNode:
             self._closed = True
             self._wake.notify()
         self.interaction.close()
+        self.station.close()
         self.follower.close()
         if self._tf is not None:
             self._tf.close()
@@ -322,7 +330,10 @@ class MarkerNode:
 
     # -- feedback ---------------------------------------------------------------------------------
     def _on_feedback(self, feedback: object) -> None:
-        self.interaction.on_feedback(feedback)
+        if getattr(feedback, "marker_name", "") == STATION_MARKER:
+            self.station.on_feedback(feedback)
+        else:
+            self.interaction.on_feedback(feedback)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
