@@ -9,14 +9,17 @@ from __future__ import annotations
 import time
 from collections.abc import Sequence
 
-from python_qt_binding.QtCore import Signal
+from python_qt_binding.QtCore import Qt, Signal
 from python_qt_binding.QtGui import QBrush, QColor
 from python_qt_binding.QtWidgets import (
+    QFrame,
     QHBoxLayout,
     QLabel,
     QListWidget,
     QListWidgetItem,
     QPushButton,
+    QScrollArea,
+    QSplitter,
     QVBoxLayout,
     QWidget,
 )
@@ -24,6 +27,11 @@ from python_qt_binding.QtWidgets import (
 from .labels import never_widen
 
 MAX_MESSAGES = 300
+LOG_LINES = 3  # message lines kept in view under the warnings
+MIN_FIT_WIDTH = 200  # before the first layout, fit the warnings to at least this width
+WARNINGS_SHARE = 0.25  # of the window's height the warnings may take before they scroll
+MIN_WARNINGS_HEIGHT = 60
+PANE_FLOOR = 120  # the least a pane above keeps when the messages claim room
 SEVERITY_COLOURS = {"info": "#1d1d1d", "ok": "#11632b", "warning": "#8a5a00", "error": "#b00020"}
 
 
@@ -44,7 +52,14 @@ class MessageArea(QWidget):  # type: ignore[misc]
         self.warnings_label.setStyleSheet(
             "QLabel { background:#fff3c4; border:1px solid #e0b000; padding:4px; }"
         )
-        self.warnings_label.hide()
+        # Many long warnings on a small screen scroll inside their box, never cut short.
+        self.warnings_box = QScrollArea()
+        self.warnings_box.setObjectName("warnings_box")
+        self.warnings_box.setWidgetResizable(True)
+        self.warnings_box.setFrameShape(QFrame.NoFrame)
+        self.warnings_box.setHorizontalScrollBarPolicy(Qt.ScrollBarAlwaysOff)
+        self.warnings_box.setWidget(self.warnings_label)
+        self.warnings_box.hide()
         self.hold_bar = QWidget()
         self.hold_bar.setObjectName("hold_bar")
         self._hold_row = QHBoxLayout(self.hold_bar)
@@ -58,7 +73,7 @@ class MessageArea(QWidget):  # type: ignore[misc]
         self.log.setAlternatingRowColors(True)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
-        layout.addWidget(self.warnings_label)
+        layout.addWidget(self.warnings_box)
         layout.addWidget(self.hold_bar)
         layout.addWidget(self.log)
         self.warnings: list[str] = []
@@ -69,7 +84,8 @@ class MessageArea(QWidget):  # type: ignore[misc]
             return
         self.warnings = list(warnings)
         self.warnings_label.setText("<br>".join(f"⚠ {w}" for w in warnings))
-        self.warnings_label.setVisible(bool(warnings))
+        self.warnings_box.setVisible(bool(warnings))
+        self._fit()
 
     def set_read_only(self, read_only: bool) -> None:
         """Follow a replay: a robot held in the recording cannot be resumed from here."""
@@ -88,6 +104,54 @@ class MessageArea(QWidget):  # type: ignore[misc]
                 self._hold_row.insertWidget(self._hold_row.count() - 1, button)
                 self.hold_buttons[agent] = button
         self.hold_bar.setVisible(bool(agents))
+        self._fit()
+
+    def resizeEvent(self, event: object) -> None:
+        """A new width wraps the warnings anew: keep room for all of them."""
+        super().resizeEvent(event)
+        self._fit()
+
+    def _fit(self) -> None:
+        """Give the warnings the lines they need, up to a share of the window (beyond it
+        they scroll), and keep a few messages in view under them: a warning cut to its
+        first line tells the operator half of it."""
+        if not self.warnings_box.isHidden():
+            # Fit to the width left beside a scroll bar: with it, the text wraps no more.
+            bar = self.warnings_box.verticalScrollBar().sizeHint().width()
+            width = max(self.warnings_box.width() - bar, MIN_FIT_WIDTH)
+            wanted = self.warnings_label.heightForWidth(width) + 12  # border, padding, margins
+            room = max(MIN_WARNINGS_HEIGHT, int(self.window().height() * WARNINGS_SHARE))
+            height = min(wanted, room)
+            if height != self.warnings_box.height():
+                self.warnings_box.setFixedHeight(height)
+        need = LOG_LINES * self.log.fontMetrics().lineSpacing() + 12
+        if not self.warnings_box.isHidden():
+            need += self.warnings_box.height()
+        if not self.hold_bar.isHidden():
+            need += self.hold_bar.sizeHint().height()
+        if need != self.minimumHeight():
+            self.setMinimumHeight(need)
+        self._claim(need)
+
+    def _claim(self, need: int) -> None:
+        """Take the room ``need`` from the panes above in the splitter, the first (the
+        parameters, which scroll) first: a splitter keeps its sizes when a minimum grows."""
+        splitter = self.parentWidget()
+        if not isinstance(splitter, QSplitter):
+            return
+        sizes, here = splitter.sizes(), splitter.indexOf(self)
+        deficit = need - sizes[here]
+        for index in range(here):
+            if deficit <= 0:
+                break
+            pane = splitter.widget(index)
+            spare = sizes[index] - max(pane.minimumSizeHint().height(), PANE_FLOOR)
+            taken = max(0, min(spare, deficit))
+            sizes[index] -= taken
+            sizes[here] += taken
+            deficit -= taken
+        if sizes != splitter.sizes():
+            splitter.setSizes(sizes)
 
     def say(self, text: str, severity: str = "info", detail: str = "") -> None:
         """Add one message (``severity``: info, ok, warning or error); ``detail`` (numbers

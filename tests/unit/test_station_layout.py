@@ -121,6 +121,10 @@ def test_the_command_window_is_whole_in_its_share_of_the_screen(
     widget = gui.widget
     for part in (widget.parameters, widget.control, widget.team, widget.messages):
         assert part.isVisible() and main.rect().contains(inside(main, part)), part
+    warnings, box = widget.messages.warnings_label, widget.messages.warnings_box
+    whole = box.viewport().height() >= warnings.heightForWidth(box.viewport().width())
+    assert whole or box.verticalScrollBar().isVisible(), "every warning line is whole or scrolls"
+    assert box.height() >= 3 * warnings.fontMetrics().lineSpacing(), "more than a line shows"
     assert widget.parameters.width() >= 300
     for name, button in widget.control.buttons.items():  # no button is cut short
         assert button.width() >= button.sizeHint().width(), name
