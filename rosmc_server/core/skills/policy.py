@@ -257,6 +257,27 @@ class LostLinkPolicy:
         )
 
 
+@dataclass(frozen=True)
+class PolicyInForce:
+    """The lost-link policy a robot reports in force, and what it did.
+
+    Attributes:
+        policy: The policy the robot applies.
+        library_default: Whether it is the library's default (no operator chose one).
+        acted: What the policy did last, for operators ("" until it acted), e.g.
+            ``held after 31 s without ground contact``.
+    """
+
+    policy: LostLinkPolicy = field(default_factory=LostLinkPolicy)
+    library_default: bool = False
+    acted: str = ""
+
+    def describe(self) -> str:
+        """One line for operators: the policy's words, whether it is the default, what it did."""
+        text = self.policy.describe() + (" (library default)" if self.library_default else "")
+        return text + (f"; {self.acted}" if self.acted else "")
+
+
 def _name(value: object, what: str) -> str:
     if not isinstance(value, str):
         raise InvalidRequest(f"the lost-link {what} must be given by name")
