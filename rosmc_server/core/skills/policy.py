@@ -184,6 +184,21 @@ class LostLinkPolicy:
             return f"on link loss: return to {where} {wait}, then hold"
         return f"on link loss: run {self.skill} {wait}, then hold"
 
+    def taken_as(self, in_force: LostLinkPolicy) -> bool:
+        """Whether a robot reporting ``in_force`` took this policy (as sent, unchecked).
+
+        The server completes a policy before sending it (:meth:`checked`): the safe skill's
+        parameters not given take the library's defaults, so only those given must agree.
+        """
+        same = (self.kind, self.after, self.skill, self.when) == (
+            in_force.kind,
+            in_force.after,
+            in_force.skill,
+            in_force.when,
+        )
+        given = in_force.params
+        return same and all(name in given and given[name] == v for name, v in self.params.items())
+
     def leaves_robot_out(self) -> bool:
         """Whether an idle robot out of coverage stays there under this policy."""
         return self.kind in (LostLinkKind.CONTINUE, LostLinkKind.HOLD)
