@@ -33,8 +33,9 @@ class AgentStatus:
     way). ``lost_link`` is the lost-link policy the robot reports in force (whether it is
     the library's default, what it did); None if the robot has not said (:attr:`policy`
     words it). ``commands_waiting`` commands wait for contact with the robot, the oldest for
-    ``waiting_for`` seconds (-1: none waits). ``coverage_warning`` is the server's warning that the synchronized task ends
-    out of coverage under a policy that would leave the robot there ("" if none).
+    ``waiting_for`` seconds (-1: none waits). ``coverage_warning`` is the server's warning
+    that the synchronized task ends out of coverage under a policy that would leave the
+    robot there ("" if none).
     ``radio_dropped`` radio datagrams were dropped at either end of the robot's link since
     they started (unsigned, forged, replayed: never acted on; :attr:`radio_text`).
     ``hold`` says why the robot holds after its lost-link policy acted (NONE: it does not):
