@@ -26,7 +26,7 @@ from python_qt_binding.QtWidgets import (
     QWidget,
 )
 
-from rosmc_server.core import AgentStatus, LostLinkPolicy, SkillStatus
+from rosmc_server.core import AgentStatus, LostLinkPolicy, PolicyInForce, SkillStatus
 from rosmc_server.core.live.updates import SkillAdded, SkillChanged, SkillRemoved
 from rosmc_server.core.robots.link import LinkStatus
 from rosmc_server.core.robots.waiting import duration_text
@@ -109,7 +109,7 @@ class AgentColumn(QFrame):  # type: ignore[misc]
         self.wait_label.hide()
         self.hold_notice = HoldNotice(agent, self)
         self.hold_notice.resume_requested.connect(self._on_hold_notice_resume_requested)
-        self.policy_in_force = ""
+        self.policy_in_force: PolicyInForce | None = None  # as the robot reports it
         self.default_policy: LostLinkPolicy | None = None  # the library's, for its model
         self.pending_policy: LostLinkPolicy | None = None  # chosen here, not yet in force
         self.skill_names: list[str] = []
@@ -248,9 +248,9 @@ class AgentColumn(QFrame):  # type: ignore[misc]
             self.blueprint_model.refresh()
         elif out_of_contact:  # its rows say how long ago the robot was heard
             self.synced_model.refresh()
-        self.policy_in_force = status.policy if status is not None else ""
-        pending = self.pending_policy
-        if pending is not None and self.policy_in_force.startswith(pending.describe()):
+        self.policy_in_force = status.lost_link if status is not None else None
+        pending, in_force = self.pending_policy, self.policy_in_force
+        if pending is not None and in_force is not None and pending.taken_as(in_force.policy):
             self.pending_policy = None  # the robot took it
         if self.pending_policy is not None:
             self.status_label.setText(
@@ -291,11 +291,11 @@ class AgentColumn(QFrame):  # type: ignore[misc]
 
     def _on_policy_button_clicked(self) -> None:
         in_force, default = self.policy_in_force, self.default_policy
-        if not in_force and default is not None:  # not reported yet: the server sends this
-            in_force = f"{default.describe()} (library default, not reported yet)"
-        args = (self.agent, self.skill_names, self, in_force)
-        pending = self.pending_policy
-        policy = self.ask_policy(*args) if pending is None else self.ask_policy(*args, pending)
+        reported = in_force is not None
+        if in_force is None and default is not None:  # not reported yet: the server sends this
+            in_force = PolicyInForce(default, library_default=True)
+        args = (self.agent, self.skill_names, self, in_force, self.pending_policy, reported)
+        policy = self.ask_policy(*args)
         if policy is not None:
             self.pending_policy = policy  # shown as waiting until the robot reports it
             self.policy_chosen.emit(self.agent, policy)

@@ -23,10 +23,14 @@ from python_qt_binding.QtWidgets import (
     QWidget,
 )
 
-from rosmc_server.core import InvalidRequest, LostLinkKind, LostLinkPolicy, LostLinkTrigger
+from rosmc_server.core import (
+    InvalidRequest,
+    LostLinkKind,
+    LostLinkPolicy,
+    LostLinkTrigger,
+    PolicyInForce,
+)
 from rosmc_server.core.skills.policy import DEFAULT_AFTER
-
-from ..core.policy_words import policy_in_force
 
 KIND_WORDS = {
     LostLinkKind.CONTINUE: "keep going",
@@ -44,8 +48,10 @@ class PolicyDialog(QDialog):  # type: ignore[misc]
         agent: The robot.
         skills: The skills the robot can run as its safe skill.
         preferred: The safe skill offered first if the robot has it.
-        in_force: The policy the robot reports in force, as it words it ("" if unknown).
+        in_force: The policy the robot reports in force (None if unknown).
         pending: A policy chosen and waiting for contact with the robot (None if none).
+        reported: False: ``in_force`` is the library's default, which the server sends the
+            robot, not reported by the robot yet.
 
     It opens on the pending policy, else on the policy in force (never on a choice the
     operator did not make).
@@ -57,8 +63,9 @@ class PolicyDialog(QDialog):  # type: ignore[misc]
         skills: Sequence[str],
         preferred: str = "return_to_lander",
         parent: QWidget | None = None,
-        in_force: str = "",
+        in_force: PolicyInForce | None = None,
         pending: LostLinkPolicy | None = None,
+        reported: bool = True,
     ) -> None:
         super().__init__(parent)
         self.setWindowTitle(f"{agent}: when the link is lost")
@@ -81,7 +88,7 @@ class PolicyDialog(QDialog):  # type: ignore[misc]
             self.skill_combo.setCurrentIndex(names.index(preferred))
         self.idle_check = QCheckBox("count only while the robot has nothing left to do")
         self.idle_check.setObjectName("policy_idle")
-        self.in_force = QLabel(f"In force: {in_force or 'not reported yet'}")
+        self.in_force = QLabel(f"In force: {in_force_words(in_force, reported)}")
         self.in_force.setObjectName("policy_in_force")
         self.in_force.setWordWrap(True)
         self.pending = QLabel(
@@ -111,7 +118,7 @@ class PolicyDialog(QDialog):  # type: ignore[misc]
         self.buttons.rejected.connect(self.reject)
         self.kind_combo.currentIndexChanged.connect(self._on_kind_combo_current_index_changed)
         self._on_kind_combo_current_index_changed(0)
-        shown = pending or policy_in_force(in_force)
+        shown = pending or (in_force.policy if in_force is not None else None)
         if shown is not None:
             self.show_policy(shown)
 
@@ -165,15 +172,27 @@ class PolicyDialog(QDialog):  # type: ignore[misc]
         self.accept()
 
 
+def in_force_words(in_force: PolicyInForce | None, reported: bool = True) -> str:
+    """The policy in force for the dialog's first line (``reported``: see PolicyDialog)."""
+    if in_force is None:
+        return "not reported yet"
+    if reported:
+        return in_force.describe()
+    return f"{in_force.policy.describe()} (library default, not reported yet)"
+
+
 def ask_policy(
     agent: str,
     skills: Sequence[str],
     parent: QWidget | None = None,
-    in_force: str = "",
+    in_force: PolicyInForce | None = None,
     pending: LostLinkPolicy | None = None,
+    reported: bool = True,
 ) -> LostLinkPolicy | None:
     """Show the dialog; the chosen policy, or None if the operator cancels."""
-    dialog = PolicyDialog(agent, skills, parent=parent, in_force=in_force, pending=pending)
+    dialog = PolicyDialog(
+        agent, skills, parent=parent, in_force=in_force, pending=pending, reported=reported
+    )
     if dialog.exec_() != QDialog.Accepted:
         return None
     return dialog.policy()

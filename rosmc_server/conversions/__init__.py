@@ -17,7 +17,8 @@ Modules:
   (import it from the module);
 * :mod:`.library`: the skill library, both ways;
 * :mod:`.agents`: agent states (``rosmc/AgentStates``) as core ``AgentStatus``;
-* :mod:`.policy`: the lost-link policy <-> ``rosmc/SetLostLinkPolicy`` request fields;
+* :mod:`.policy`: the lost-link policy <-> ``rosmc/SetLostLinkPolicy`` request fields, and
+  the policy a robot reports in force <-> ``rosmc/LostLinkPolicy``;
 * :mod:`.site`: the site map (``rosmc/SiteMap``) the server checks skill targets against;
 * :mod:`.robot_link`: the robot link's protocol (commands, acks, reports, barrier
   signals, snapshots); import it from the module.
@@ -43,7 +44,12 @@ from .mission import (
     skill_from_msg,
     skill_to_msg,
 )
-from .policy import policy_from_request, policy_to_request
+from .policy import (
+    policy_from_request,
+    policy_in_force_from_msg,
+    policy_in_force_to_msg,
+    policy_to_request,
+)
 from .site import site_from_msg, site_in_force_from_msg, site_in_force_to_msg, site_to_msg
 from .values import (
     MAX_JSON_NESTING,
@@ -77,6 +83,8 @@ __all__ = [
     "parameter_spec_to_msg",
     "params_from_msgs",
     "policy_from_request",
+    "policy_in_force_from_msg",
+    "policy_in_force_to_msg",
     "policy_to_request",
     "pose_from_msg",
     "pose_to_msg",

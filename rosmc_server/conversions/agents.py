@@ -10,9 +10,10 @@ import math
 
 import rosmc.msg as wire
 
-from ..core import AgentStatus, SkillStatus
+from ..core import AgentStatus, InvalidRequest, PolicyInForce, SkillStatus
 from ..core.model.control import HoldCause
 from ..core.robots.link import LinkStatus
+from .policy import policy_in_force_from_msg
 from .values import pose_from_msg
 
 _LINK_STATES: dict[int, LinkStatus] = {
@@ -57,12 +58,21 @@ def agent_status_from_msg(msg: wire.AgentState) -> AgentStatus:
         current_status=SkillStatus(msg.current_status.value) if current else None,
         executor_state=msg.executor_state,
         waiting_on=msg.waiting_on,
-        policy=msg.policy,
+        lost_link=_policy(msg),
         coverage_warning=msg.coverage_warning,
         radio_dropped=getattr(msg.link, "radio_dropped", 0),
         hold=HoldCause.of(getattr(msg, "hold", "")),
         barrier_wait=getattr(msg, "barrier_wait", -1.0),
     )
+
+
+def _policy(msg: wire.AgentState) -> PolicyInForce | None:
+    """The policy in force; None if unsaid, or in a journal from before it was typed (which
+    has only its words) or malformed (a display must not fail over it)."""
+    try:
+        return policy_in_force_from_msg(getattr(msg, "lost_link", None))
+    except InvalidRequest:
+        return None
 
 
 def _finite(number: float) -> float | None:

@@ -12,6 +12,7 @@ import rosmc.msg as wire
 from ..core.robots.commands import CommandKind
 from ..core.robots.protocol import Ack, BarrierInfo, Command, Report, Signal, SignalKind, Snapshot
 from .mission import skill_from_msg, skill_to_msg
+from .policy import policy_in_force_to_msg
 from .values import time_to_msg
 
 
@@ -98,7 +99,7 @@ def snapshot_to_msg(agent: str, snapshot: Snapshot) -> wire.ExecutorSnapshot:
         state=snapshot.state,
         active_skill_id=snapshot.active_skill_id,
         waiting_on=snapshot.waiting_on,
-        policy=snapshot.policy,
+        policy=policy_in_force_to_msg(snapshot.policy),
         queue_omitted=not snapshot.full,
         status_digest=snapshot.status_digest,
         hold=snapshot.hold.value,

@@ -53,7 +53,7 @@ from .skills.library import (
     load_library,
 )
 from .skills.params import MarkerType, ParamType, Pose, Value
-from .skills.policy import LostLinkKind, LostLinkPolicy, LostLinkTrigger
+from .skills.policy import LostLinkKind, LostLinkPolicy, LostLinkTrigger, PolicyInForce
 
 __all__ = [
     "AgentKind",
@@ -79,6 +79,7 @@ __all__ = [
     "ParamType",
     "ParameterSpec",
     "PlacedSkill",
+    "PolicyInForce",
     "Pose",
     "Resolution",
     "RosmcError",

@@ -16,7 +16,8 @@ import rospy
 
 from .. import interface
 from ..conversions.agents import link_state_to_msg
-from ..core import SkillStatus
+from ..conversions.policy import policy_in_force_from_msg
+from ..core import InvalidRequest, PolicyInForce, SkillStatus
 from ..core.rules.advice import waiting_on_unsynced
 from .agent_link import AgentLink
 from .coverage_watch import CoverageWatch
@@ -115,12 +116,13 @@ class AgentStatePublisher:
         if link.snapshot is not None:
             state.executor_state = link.snapshot.state
             state.waiting_on = link.snapshot.waiting_on
-            state.policy = link.snapshot.policy
+            state.lost_link = link.snapshot.policy
             state.hold = link.snapshot.hold
             state.barrier_wait = barrier_wait(link, report.last_heard)
         else:
             state.barrier_wait = -1.0
-        state.coverage_warning = self._coverage.warning(server.mission.state, agent, state.policy)
+        in_force = _in_force(agent, state.lost_link)
+        state.coverage_warning = self._coverage.warning(server.mission.state, agent, in_force)
         unsynced = waiting_on_unsynced(server.mission.state, agent)
         if unsynced and not state.waiting_on:
             # The robot cannot know: its partners' skills are still on the ground.
@@ -138,3 +140,12 @@ def barrier_wait(link: AgentLink, last_heard: float) -> float:
     if since <= 0.0:
         return -1.0
     return max(0.0, link.newest_stamp - since) + max(0.0, last_heard)
+
+
+def _in_force(agent: str, msg: wire.LostLinkPolicy) -> PolicyInForce | None:
+    """The policy ``agent``'s robot reports; None if it has not said, or said nonsense."""
+    try:
+        return policy_in_force_from_msg(msg)
+    except InvalidRequest as error:
+        rospy.logwarn_throttle(60.0, f"{agent}: its lost-link policy is unreadable: {error}")
+        return None

@@ -17,7 +17,7 @@ import rospy
 
 from .. import interface
 from ..conversions.coverage import prediction_from_msg, reading_from_telemetry
-from ..core import Library, MissionState
+from ..core import Library, MissionState, PolicyInForce
 from ..core.robots.radio_map import RadioMap, coverage_warning
 
 
@@ -43,8 +43,9 @@ class CoverageWatch:
         with self._lock:
             self._radio.add(reading)
 
-    def warning(self, state: MissionState, agent: str, policy_text: str) -> str:
-        """The warning about ``agent``'s task ("" if none)."""
+    def warning(self, state: MissionState, agent: str, in_force: PolicyInForce | None) -> str:
+        """The warning about ``agent``'s task under the policy it reports ("" if none)."""
         default = self._library.default_policy(agent)
+        policy = in_force.policy if in_force is not None else None
         with self._lock:
-            return coverage_warning(state.task(agent), self._radio, policy_text, default)
+            return coverage_warning(state.task(agent), self._radio, policy, default)

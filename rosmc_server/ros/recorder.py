@@ -50,7 +50,7 @@ def state_key(state: wire.AgentState) -> tuple[Any, ...]:
         state.current_status.value,
         state.executor_state,
         state.waiting_on,
-        state.policy,
+        state.lost_link,
         state.hold,
         _step(telemetry.battery, BATTERY_STEP),
         _step(telemetry.wifi_signal, WIFI_STEP),

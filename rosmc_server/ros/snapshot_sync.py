@@ -69,7 +69,7 @@ class SnapshotSync:
         if link.outbox.robot_numbering(msg.last_command_seq, self._clock()):
             _log.info("link %s: robot executed commands up to %d", agent, msg.last_command_seq)
         fresh = link.reports is None or msg.last_report_seq < link.reports.last
-        if not msg.policy and link.snapshot is not None:
+        if msg.policy.kind == wire.LostLinkPolicy.UNSAID and link.snapshot is not None:
             msg.policy = link.snapshot.policy  # unchanged: the robot says it only now and then
         link.snapshot = msg
         if fresh:

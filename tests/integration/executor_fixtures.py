@@ -36,7 +36,12 @@ from rosmc.msg import ErrorCode
 from std_msgs.msg import Bool
 
 from rosmc_server import interface
-from rosmc_server.conversions import mission_from_msg, param_to_msg, skill_to_msg
+from rosmc_server.conversions import (
+    mission_from_msg,
+    param_to_msg,
+    policy_in_force_from_msg,
+    skill_to_msg,
+)
 from rosmc_server.core import MissionState, SkillInstance, SkillStatus
 from rosmc_server.core.robots.commands import CommandKind
 from rosmc_server.core.robots.radio import DatagramKind, parse_endpoint
@@ -49,6 +54,12 @@ REPO_ROOT = Path(__file__).resolve().parents[2]
 TEST_LIBRARY = REPO_ROOT / "tests" / "data" / "test_team.yaml"
 S = SkillStatus
 STOP_TIMEOUT = 30.0
+
+
+def policy_words(msg: wire.LostLinkPolicy) -> str:
+    """The policy in force a snapshot or agent state carries, in words ("" if unsaid)."""
+    in_force = policy_in_force_from_msg(msg)
+    return in_force.describe() if in_force is not None else ""
 
 
 class OperatorError(RuntimeError):

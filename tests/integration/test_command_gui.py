@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import math
 import os
+import subprocess
+import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
@@ -24,14 +26,23 @@ from python_qt_binding.QtWidgets import QApplication, QMessageBox
 
 from rosmc_rqt_command.core import presentation
 from rosmc_rqt_command.qt.command_widget import CommandWidget
+from rosmc_rqt_command.qt.policy_dialog import PolicyDialog
 from rosmc_rqt_command.qt.section_table import SectionTable
 from rosmc_rqt_command.qt.task_model import SKILL, STATUS, TAG
 from rosmc_rqt_command.ros_bridge import RosBridge
 from rosmc_rqt_command.standalone import build
-from rosmc_server.core import MarkerType, Pose, SkillStatus, TaskMarker
+from rosmc_server.core import (
+    LostLinkKind,
+    LostLinkPolicy,
+    LostLinkTrigger,
+    MarkerType,
+    Pose,
+    SkillStatus,
+    TaskMarker,
+)
 from rosmc_server.ros.client import MissionClient
 from tests import conftest
-from tests.integration.executor_fixtures import Operator, RosmcSystem
+from tests.integration.executor_fixtures import REPO_ROOT, Operator, RosmcSystem
 
 S = SkillStatus
 LIBRARY = """
@@ -389,6 +400,48 @@ def test_operator_builds_edits_runs_and_adapts_a_two_robot_mission(team: Any) ->
     )
     refusals = [m for m in w.messages.messages() if "Could not" in m]
     assert not refusals, refusals
+
+
+def test_a_policy_set_with_the_cli_opens_the_link_loss_dialog_on_it(
+    team: Any, tmp_path: Path
+) -> None:
+    system, _operator, gui = team
+    rosmc = [sys.executable, str(REPO_ROOT / "scripts" / "rosmc"), "lost-link-policy", "r2"]
+    chosen = ["safe_skill", "--skill", "wait", "--param", "duration=5", "--after", "45"]
+    done = subprocess.run(
+        [*rosmc, *chosen, "--when", "idle"],
+        env=dict(system.env),
+        capture_output=True,
+        text=True,
+        timeout=60.0,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    reported = LostLinkPolicy(
+        LostLinkKind.SAFE_SKILL, 45.0, "wait", {"duration": 5.0}, LostLinkTrigger.IDLE
+    )
+    column = gui.column("r2")
+    wait_until(
+        lambda: column.policy_in_force is not None and column.policy_in_force.policy == reported,
+        60,
+        "r2 reporting the policy in force",
+    )
+    seen: list[tuple[LostLinkPolicy, str]] = []
+
+    def look() -> None:
+        dialog = QApplication.activeModalWidget()
+        if not isinstance(dialog, PolicyDialog) or not dialog.isVisible():
+            QTimer.singleShot(20, look)
+            return
+        seen.append((dialog.policy(), dialog.in_force.text()))
+        dialog.grab().save(str(tmp_path / "policy_dialog.png"))
+        QTest.mouseClick(dialog.buttons.button(dialog.buttons.Cancel), Qt.LeftButton)
+
+    QTimer.singleShot(20, look)
+    QTest.mouseClick(column.policy_button, Qt.LeftButton)
+    preselected = LostLinkPolicy(LostLinkKind.SAFE_SKILL, 45.0, "wait", when=LostLinkTrigger.IDLE)
+    in_force = "In force: on link loss: run wait after 45 s idle without a link, then hold"
+    assert seen == [(preselected, in_force)], "the dialog opened on the policy the CLI set"
 
 
 def _action(name: str) -> Any:

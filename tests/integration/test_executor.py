@@ -49,6 +49,7 @@ from tests.integration.executor_fixtures import (
     describe,
     journal_reports,
     journal_timelines,
+    policy_words,
     send_datagrams,
     signal_datagram,
 )
@@ -752,13 +753,17 @@ def test_lost_link_policy_hold_on_a_silent_link(rosmc: Start) -> None:
     # followed by silence would trigger the policy anew a second later, possibly before the
     # robot's next snapshot showed the contact.
     deadline = time.monotonic() + 60.0
-    while not [s for s in ground.received("snapshot") if "ground contact is back" in s.policy]:
+    while not [
+        s for s in ground.received("snapshot") if "ground contact is back" in policy_words(s.policy)
+    ]:
         assert time.monotonic() < deadline, "the robot never said that ground contact is back"
         ground.publish("report_ack", wire.ReportAck(agent="r1", seq=held.seq))
         time.sleep(0.2)
-    snapshot = ground.wait_heard("snapshot", lambda s: "ground contact is back" in s.policy)
+    snapshot = ground.wait_heard(
+        "snapshot", lambda s: "ground contact is back" in policy_words(s.policy)
+    )
     assert snapshot.state == "paused"
-    assert snapshot.policy.startswith("on link loss: hold after 1 s; held after 1 s")
+    assert policy_words(snapshot.policy).startswith("on link loss: hold after 1 s; held after 1 s")
     ground.publish("command", command_msg("r1", 4, K.RESUME))
     resumed = ground.wait_heard("report", lambda r: r.seq > held.seq)
     assert (resumed.skill_id, resumed.status.value) == ("long", S.RUNNING)
@@ -819,7 +824,9 @@ def test_lost_link_policy_hold_set_by_the_operator(rosmc: Start) -> None:
     with MissionClient(timeout=60.0) as client:
         client.set_lost_link_policy("r1", LostLinkPolicy(LostLinkKind.HOLD, after=1.0))
     op.wait_mission(
-        lambda m: "hold after 1 s" in op.agent_state("r1").policy, 30.0, "the policy to be in force"
+        lambda m: "hold after 1 s" in policy_words(op.agent_state("r1").lost_link),
+        30.0,
+        "the policy to be in force",
     )
     long = op.add("r1", "wait", {"duration": 30.0})
     op.sync("r1")
@@ -833,7 +840,9 @@ def test_lost_link_policy_hold_set_by_the_operator(rosmc: Start) -> None:
     state = op.wait_status([long], S.PAUSED)
     assert state.skill(long).status_text == "held after 1 s without ground contact"
     wait_until(
-        lambda: "ground contact is back" in op.agent_state("r1").policy, 30.0, "the robot to say so"
+        lambda: "ground contact is back" in policy_words(op.agent_state("r1").lost_link),
+        30.0,
+        "the robot to say so",
     )
     assert op.mission().skill(long).status is S.PAUSED  # the operator decides when to go on
     op.control("r1", srv.ControlRequest.RESUME)
@@ -1001,7 +1010,9 @@ def test_commands_for_a_robot_out_of_contact_wait_and_arrive_once_in_order(rosmc
     op.blackout("r1", False)
     op.wait_status([keep], S.IDLE_SYNCHRONIZED, timeout=60.0)
     op.wait_mission(
-        lambda m: "hold after 45 s" in op.agent_state("r1").policy, 60.0, "the last policy"
+        lambda m: "hold after 45 s" in policy_words(op.agent_state("r1").lost_link),
+        60.0,
+        "the last policy",
     )
     reached = robot.received("command")[reached_before:]
     once = {c.seq: c for c in reached}  # retransmissions carry the same number

@@ -33,7 +33,13 @@ from rosmc_rviz_markers import topics
 from rosmc_server.core import LostLinkKind, LostLinkPolicy, SkillStatus
 from rosmc_server.ros.client import MissionClient
 from tests import conftest
-from tests.integration.executor_fixtures import LinkEnd, Operator, RosmcSystem, init_test_node
+from tests.integration.executor_fixtures import (
+    LinkEnd,
+    Operator,
+    RosmcSystem,
+    init_test_node,
+    policy_words,
+)
 from tests.integration.markers_fixtures import MarkerNodeProcess, Rviz
 
 pytestmark = pytest.mark.integration
@@ -94,7 +100,9 @@ def hold_r1_before_its_barrier(op: Operator) -> tuple[str, str, str]:
     with MissionClient(timeout=60.0) as client:
         client.set_lost_link_policy("r1", LostLinkPolicy(LostLinkKind.HOLD, after=1.0))
     conftest.wait_until(
-        lambda: "hold after 1 s" in op.agent_state("r1").policy, 30.0, "r1's policy in force"
+        lambda: "hold after 1 s" in policy_words(op.agent_state("r1").lost_link),
+        30.0,
+        "r1's policy in force",
     )
     work = op.add("r1", "wait", {"duration": 4.0})
     meet_r1 = op.add("r1", "wait", {"duration": 0.1})

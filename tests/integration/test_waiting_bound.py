@@ -28,6 +28,7 @@ from tests.integration.executor_fixtures import (
     OperatorError,
     RosmcSystem,
     describe,
+    policy_words,
 )
 
 
@@ -79,7 +80,9 @@ def test_at_the_bound_pause_policy_and_resume_are_accepted_and_uploads_are_not(
     op.blackout("r1", False)
     op.wait_status(skills[:MAX_WAITING], S.IDLE_SYNCHRONIZED, timeout=90.0)
     op.wait_mission(
-        lambda m: "hold after 45 s" in op.agent_state("r1").policy, 60.0, "the last policy"
+        lambda m: "hold after 45 s" in policy_words(op.agent_state("r1").lost_link),
+        60.0,
+        "the last policy",
     )
     assert op.agent_state("r1").link.commands_waiting == 0
 

@@ -34,6 +34,8 @@ from rosmc_server.conversions import (
     mission_to_msg,
     param_from_msg,
     param_to_msg,
+    policy_in_force_from_msg,
+    policy_in_force_to_msg,
     pose_from_msg,
     pose_to_msg,
     site_from_msg,
@@ -52,6 +54,7 @@ from rosmc_server.conversions.robot_link import (
     command_from_msg,
     signal_from_msg,
     signal_to_msg,
+    snapshot_to_msg,
 )
 from rosmc_server.conversions.science import science_from_msg, science_to_msg
 from rosmc_server.core import (
@@ -63,12 +66,16 @@ from rosmc_server.core import (
     EventKind,
     InvalidRequest,
     Library,
+    LostLinkKind,
+    LostLinkPolicy,
+    LostLinkTrigger,
     MarkerType,
     MissionContent,
     MissionEvent,
     ParameterSpec,
     ParamType,
     PlacedSkill,
+    PolicyInForce,
     Pose,
     Resolution,
     SkillInstance,
@@ -80,7 +87,7 @@ from rosmc_server.core import (
 from rosmc_server.core.model.changes import SkillMove
 from rosmc_server.core.model.control import HoldCause
 from rosmc_server.core.robots.commands import CommandKind
-from rosmc_server.core.robots.protocol import Signal, SignalKind
+from rosmc_server.core.robots.protocol import Signal, SignalKind, Snapshot
 from rosmc_server.core.robots.radio_map import GridSpec, Prediction, Reading
 from rosmc_server.core.views.science import RegionScience, Science
 from rosmc_server.core.world.site import Footprint, GroundRobot, Shape, SiteCheck, SiteModel
@@ -308,6 +315,63 @@ def test_an_obstacle_of_unknown_shape_is_refused() -> None:
         site_from_msg(msg)
 
 
+RETURNING = PolicyInForce(
+    LostLinkPolicy(
+        LostLinkKind.RETURN_TO_LINK, 90.0, "navigate_to", {"speed": 0.5}, LostLinkTrigger.IDLE
+    ),
+    library_default=True,
+    acted="returning to the last link position (18.9, -1.0) after 68 s without ground contact",
+)
+
+
+@pytest.mark.parametrize(
+    "in_force",
+    [
+        PolicyInForce(),
+        PolicyInForce(LostLinkPolicy(LostLinkKind.HOLD, 12.5), acted="held after 13 s"),
+        PolicyInForce(
+            LostLinkPolicy(
+                LostLinkKind.SAFE_SKILL,
+                60.0,
+                "return_to_lander",
+                {k: v for k, v in PARAMS.items() if k != "target"}
+                | {"target": {"x": 1.0, "y": 2.0}},
+            ),
+        ),
+        RETURNING,
+    ],
+)
+def test_the_policy_in_force_survives_both_ways(in_force: PolicyInForce) -> None:
+    msg = over_the_wire(policy_in_force_to_msg(in_force))
+    assert msg.kind != wire.LostLinkPolicy.UNSAID
+    assert policy_in_force_from_msg(msg) == in_force
+
+
+def test_a_policy_not_said_is_none_and_unknown_numbers_are_refused() -> None:
+    unsaid = over_the_wire(policy_in_force_to_msg(None))
+    assert unsaid.kind == wire.LostLinkPolicy.UNSAID
+    assert policy_in_force_from_msg(unsaid) is None
+    with pytest.raises(InvalidRequest, match="unknown lost-link policy numbers"):
+        policy_in_force_from_msg(wire.LostLinkPolicy(kind=9, after=1.0))
+    with pytest.raises(InvalidRequest, match="unknown lost-link policy numbers"):
+        policy_in_force_from_msg(wire.LostLinkPolicy(kind=wire.LostLinkPolicy.HOLD, when=7))
+    with pytest.raises(InvalidRequest, match="positive number of seconds"):
+        policy_in_force_from_msg(wire.LostLinkPolicy(kind=wire.LostLinkPolicy.HOLD, after=0.0))
+
+
+def test_the_executor_snapshot_carries_the_policy_in_force_or_leaves_it_unsaid() -> None:
+    snapshot = Snapshot(5.0, 4, 9, "abc", (), "idle", "", "", RETURNING, False, "d1")
+    msg = over_the_wire(snapshot_to_msg("rover", snapshot))
+    assert policy_in_force_from_msg(msg.policy) == RETURNING
+    unsaid = over_the_wire(snapshot_to_msg("rover", dataclasses.replace(snapshot, policy=None)))
+    assert unsaid.policy.kind == wire.LostLinkPolicy.UNSAID
+
+
+def test_an_agent_state_whose_robot_has_not_said_its_policy_has_none() -> None:
+    status = agent_status_from_msg(over_the_wire(wire.AgentState(agent="rover")))
+    assert status.lost_link is None and status.policy == ""
+
+
 def test_every_agent_state_field_reaches_the_agent_status() -> None:
     msg = wire.AgentState(
         agent="rover",
@@ -335,7 +399,7 @@ def test_every_agent_state_field_reaches_the_agent_status() -> None:
         current_status=wire.SkillStatus(value=wire.SkillStatus.SYNCWAITING),
         executor_state="waiting",
         waiting_on="drone",
-        policy="on link loss: hold after 30 s",
+        lost_link=policy_in_force_to_msg(RETURNING),
         coverage_warning="the task ends out of coverage",
         hold="return_point",
         barrier_wait=92.5,
@@ -362,7 +426,7 @@ def test_every_agent_state_field_reaches_the_agent_status() -> None:
         current_status=SkillStatus.SYNCWAITING,
         executor_state="waiting",
         waiting_on="drone",
-        policy="on link loss: hold after 30 s",
+        lost_link=RETURNING,
         coverage_warning="the task ends out of coverage",
         hold=HoldCause.RETURN_POINT,
         barrier_wait=92.5,

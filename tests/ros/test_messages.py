@@ -284,7 +284,7 @@ def test_robot_link_messages_round_trip() -> None:
         state="running",
         active_skill_id="r2",
         waiting_on="scout",
-        policy="hold after 30 s",
+        policy=m.LostLinkPolicy(kind=m.LostLinkPolicy.HOLD, after=30.0, acted="held"),
     )
     signal = m.BarrierSignal(
         agent="rover", barrier_id="b1", skill_id="r2", kind=m.BarrierSignal.READY, stamp=stamp(7)

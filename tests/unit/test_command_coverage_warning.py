@@ -17,6 +17,7 @@ from rosmc_server.core import (
     LostLinkPolicy,
     LostLinkTrigger,
     Mission,
+    PolicyInForce,
 )
 from tests.unit.test_command_harness import Gui, open_gui
 
@@ -24,9 +25,9 @@ WARNING = (
     "the task ends out of coverage at (17.0, 0.0) (predicted -71 dBm) and the lost-link "
     "policy would leave the robot there"
 )
-DEFAULT = (
-    "on link loss: return to the last link position (move) after 60 s idle without a link, "
-    "then hold (library default)"
+DEFAULT = PolicyInForce(
+    LostLinkPolicy(LostLinkKind.RETURN_TO_LINK, 60.0, "move", when=LostLinkTrigger.IDLE),
+    library_default=True,
 )
 
 
@@ -38,7 +39,7 @@ def gui(mission: Mission, library: Library) -> Iterator[Gui]:
 def test_the_column_warns_while_the_server_does(gui: Gui) -> None:
     column = gui.widget.tasks.columns["alpha"]
     assert not column.warning_label.isVisibleTo(gui.widget)
-    gui.feed.statuses(AgentStatus("alpha", link="up", policy="on link loss: continue",
+    gui.feed.statuses(AgentStatus("alpha", link="up", lost_link=PolicyInForce(),
                                   coverage_warning=WARNING))  # fmt: skip
     gui.widget.repaints.show_statuses_now()  # the header refreshes on its timer
     assert column.warning_label.isVisibleTo(gui.widget)
@@ -46,18 +47,24 @@ def test_the_column_warns_while_the_server_does(gui: Gui) -> None:
     assert "Link loss" in column.warning_label.toolTip()
     other = gui.widget.tasks.columns["bravo"]
     assert not other.warning_label.isVisibleTo(gui.widget)
-    gui.feed.statuses(AgentStatus("alpha", link="up", policy=DEFAULT))  # the operator fixed it
+    gui.feed.statuses(AgentStatus("alpha", link="up", lost_link=DEFAULT))  # the operator fixed it
     gui.widget.repaints.show_statuses_now()
     assert not column.warning_label.isVisibleTo(gui.widget)
 
 
 def test_the_dialog_shows_the_policy_in_force_and_offers_the_return(gui: Gui) -> None:
     column = gui.widget.tasks.columns["alpha"]
-    gui.feed.statuses(AgentStatus("alpha", link="up", policy=DEFAULT))
+    gui.feed.statuses(AgentStatus("alpha", link="up", lost_link=DEFAULT))
     gui.widget.repaints.show_statuses_now()
     shown: list[str] = []
 
-    def ask(agent: str, skills: Sequence[str], parent: object, in_force: str) -> LostLinkPolicy:
+    def ask(
+        agent: str,
+        skills: Sequence[str],
+        parent: object,
+        in_force: PolicyInForce | None,
+        *_: object,
+    ) -> LostLinkPolicy:
         dialog = PolicyDialog(agent, skills, parent=None, in_force=in_force)
         shown.append(dialog.in_force.text())
         dialog.set_kind(LostLinkKind.RETURN_TO_LINK)
@@ -67,7 +74,7 @@ def test_the_dialog_shows_the_policy_in_force_and_offers_the_return(gui: Gui) ->
 
     column.ask_policy = ask
     QTest.mouseClick(column.policy_button, Qt.LeftButton)
-    assert shown == [f"In force: {DEFAULT}"]
+    assert shown == [f"In force: {DEFAULT.describe()}"]
     [request] = gui.backend.requests
     assert request.args == (
         "alpha",

@@ -21,17 +21,24 @@ from python_qt_binding.QtWidgets import QApplication, QMainWindow
 
 from rosmc_rqt_command.qt.replay_bar import ReplayBar
 from rosmc_rqt_command.replay_ticks import RecordingOutline
-from rosmc_server.core import AgentStatus, Library
+from rosmc_server.core import (
+    AgentStatus,
+    Library,
+    LostLinkKind,
+    LostLinkPolicy,
+    LostLinkTrigger,
+    PolicyInForce,
+)
 from rosmc_server.core.skills.library import load_library
 from tests.team_gui import settle
 from tests.unit.conftest import SHIPPED_LIBRARY, make_mission
 from tests.unit.test_command_harness import Gui
 
 ROBOTS = ("drone", "science_rover", "manipulator_rover")
-LONG_POLICY = (
-    "on link loss: return to the last link position (navigate_to) after 60 s idle without a "
-    "link, then hold; returning to the last link position (18.9, -1.0) after 68 s without "
-    "ground contact; ground contact is back (done); holding"
+LONG_POLICY = PolicyInForce(
+    LostLinkPolicy(LostLinkKind.RETURN_TO_LINK, 60.0, "navigate_to", when=LostLinkTrigger.IDLE),
+    acted="returning to the last link position (18.9, -1.0) after 68 s without ground contact; "
+    "ground contact is back (done); holding",
 )
 LONG_NAME = "/home/operator/recordings/" + "mars_sample_return_2024_06_30_" * 4 + ".mcap"
 
@@ -69,7 +76,7 @@ def every_warning(gui: Gui) -> None:
                 battery=0.5,
                 wifi_signal=-80.0,
                 executor_state="paused",
-                policy=LONG_POLICY,
+                lost_link=LONG_POLICY,
                 coverage_warning="its synchronized task ends at (30.0, -16.0), out of radio "
                 "coverage, and its policy on link loss: continue would leave it there",
                 commands_waiting=2,

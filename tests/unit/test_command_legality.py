@@ -184,9 +184,7 @@ def test_the_lost_link_policy_is_chosen_among_the_robots_skills(gui: Gui) -> Non
     assert column.policy_button.isEnabled()
     offered: list[list[str]] = []
 
-    def ask(
-        agent: str, skills: Sequence[str], parent: object, in_force: str
-    ) -> LostLinkPolicy | None:
+    def ask(agent: str, skills: Sequence[str], parent: object, *_: object) -> LostLinkPolicy | None:
         offered.append(list(skills))
         dialog = PolicyDialog(agent, skills, preferred="wait")
         dialog.set_kind(LostLinkKind.SAFE_SKILL)

@@ -1,5 +1,7 @@
 """The *Link loss…* dialog opens on the policy in force, and a policy waiting is shown.
 
+The robot reports its policy typed (:attr:`AgentStatus.lost_link`); nothing reads words back.
+
 The real column and the real dialog (offscreen Qt): the operator clicks *Link loss…*, the
 test reads the open dialog and presses its buttons with the mouse.
 """
@@ -14,9 +16,15 @@ from python_qt_binding.QtCore import Qt, QTimer
 from python_qt_binding.QtTest import QTest
 from python_qt_binding.QtWidgets import QApplication
 
-from rosmc_rqt_command.core.policy_words import policy_in_force
 from rosmc_rqt_command.qt.policy_dialog import PolicyDialog
-from rosmc_server.core import AgentStatus, Library, LostLinkKind, LostLinkPolicy, Mission
+from rosmc_server.core import (
+    AgentStatus,
+    Library,
+    LostLinkKind,
+    LostLinkPolicy,
+    Mission,
+    PolicyInForce,
+)
 from rosmc_server.core import LostLinkTrigger as T
 from rosmc_server.core.skills.library import library_from_dict
 from tests.team_gui import settle
@@ -37,15 +45,19 @@ def gui(mission: Mission, library: Library) -> Iterator[Gui]:
     [
         LostLinkPolicy(),
         HOLD_30,
-        LostLinkPolicy(LostLinkKind.HOLD, 12.5, when=T.IDLE),
+        LostLinkPolicy(LostLinkKind.HOLD, 12.0, when=T.IDLE),
         LostLinkPolicy(LostLinkKind.SAFE_SKILL, 60.0, "wait"),
         LostLinkPolicy(LostLinkKind.RETURN_TO_LINK, 90.0, "move", when=T.IDLE),
     ],
 )
-def test_the_reported_line_reads_back_as_the_policy(policy: LostLinkPolicy) -> None:
-    for tail in ("", " (library default)", "; held after 68 s without ground contact"):
-        assert policy_in_force(policy.describe() + tail) == policy
-    assert policy_in_force("") is None
+def test_the_dialog_opens_on_each_kind_in_force(policy: LostLinkPolicy) -> None:
+    app = QApplication.instance() or QApplication([])  # kept alive for the whole test
+    in_force = PolicyInForce(policy, library_default=True, acted="held after 68 s")
+    dialog = PolicyDialog("alpha", ["move", "wait"], preferred="wait", in_force=in_force)
+    assert dialog.policy() == policy
+    assert dialog.in_force.text() == f"In force: {in_force.describe()}"
+    dialog.close()
+    assert app is not None
 
 
 def with_dialog(handle: Callable[[PolicyDialog], None], press: Callable[[], None]) -> None:
@@ -69,7 +81,7 @@ def test_the_dialog_opens_on_the_policy_in_force_and_shows_one_waiting(gui: Gui)
     column = gui.widget.tasks.columns["alpha"]
     reported = LostLinkPolicy(LostLinkKind.SAFE_SKILL, 45.0, "wait", when=T.IDLE)
     gui.feed.statuses(
-        AgentStatus("alpha", link="down", last_heard=20.0, policy=reported.describe())
+        AgentStatus("alpha", link="down", last_heard=20.0, lost_link=PolicyInForce(reported))
     )
     settle(gui.widget)
     seen: list[LostLinkPolicy] = []
@@ -87,7 +99,7 @@ def test_the_dialog_opens_on_the_policy_in_force_and_shows_one_waiting(gui: Gui)
     assert seen == [reported], "it opened on the policy in force, not on keep going"
     assert gui.backend.requests[-1].args == ("alpha", HOLD_30)
     gui.feed.statuses(
-        AgentStatus("alpha", link="down", last_heard=21.0, policy=reported.describe())
+        AgentStatus("alpha", link="down", last_heard=21.0, lost_link=PolicyInForce(reported))
     )
     settle(gui.widget)
     assert "new policy waiting for contact: on link loss: hold after 30 s" in (
@@ -102,7 +114,9 @@ def test_the_dialog_opens_on_the_policy_in_force_and_shows_one_waiting(gui: Gui)
 
     with_dialog(look, click)
     assert seen[-1] == HOLD_30, "it opened on the policy waiting"
-    gui.feed.statuses(AgentStatus("alpha", link="up", last_heard=0.0, policy=HOLD_30.describe()))
+    # The robot reports it with what it did: still the policy taken.
+    took = PolicyInForce(HOLD_30, acted="held after 31 s without ground contact")
+    gui.feed.statuses(AgentStatus("alpha", link="up", last_heard=0.0, lost_link=took))
     settle(gui.widget)
     assert "waiting for contact" not in column.status_label.text()
 

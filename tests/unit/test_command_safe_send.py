@@ -26,7 +26,9 @@ from rosmc_server.core import (
     Library,
     LostLinkKind,
     LostLinkPolicy,
+    LostLinkTrigger,
     Mission,
+    PolicyInForce,
     SkillStatus,
 )
 from rosmc_server.core.model.control import ControlCommand, HoldCause
@@ -36,10 +38,10 @@ from tests.team_twenty import stage, twenty_robot_library
 from tests.unit.conftest import make_mission
 from tests.unit.test_command_harness import Gui, open_gui
 
-HELD_POLICY = (
-    "on link loss: return to the last link position (navigate_to) after 60 s idle without a "
-    "link, then hold; returning to the last link position (18.9, -1.0) after 68 s without "
-    "ground contact; ground contact is back (done); holding"
+HELD_POLICY = PolicyInForce(
+    LostLinkPolicy(LostLinkKind.RETURN_TO_LINK, 60.0, "navigate_to", when=LostLinkTrigger.IDLE),
+    acted="returning to the last link position (18.9, -1.0) after 68 s without ground contact; "
+    "ground contact is back (done); holding",
 )
 
 
@@ -178,7 +180,7 @@ def held(gui: Gui) -> tuple[str, str]:
             "alpha",
             link="up",
             executor_state="paused",
-            policy=HELD_POLICY,
+            lost_link=HELD_POLICY,
             hold=HoldCause.RETURN_POINT,
         ),
         AgentStatus("bravo", link="up", last_heard=0.0, executor_state="waiting"),
@@ -253,16 +255,18 @@ def test_a_hold_is_read_from_the_typed_field_not_from_the_policy_words(gui: Gui)
     guard.trigger(True, lambda _note: None)
     guard.contact()
     assert guard.held is HoldCause.LOST_LINK
-    words = guard.describe()
+    in_force = guard.in_force()
     gui.feed.statuses(
-        AgentStatus("alpha", link="up", executor_state="paused", policy=words, hold=guard.held)
+        AgentStatus(
+            "alpha", link="up", executor_state="paused", lost_link=in_force, hold=guard.held
+        )
     )
     settle(gui.widget)
     hold = lost_link_hold(gui.widget.view, "alpha")
     assert hold is not None and hold.link_back and hold.partners == ()
     assert hold.sentence() == "alpha holds where it lost the link."
-    # The same words without the field: not a hold (the wording is not read).
-    gui.feed.statuses(AgentStatus("alpha", link="up", executor_state="paused", policy=words))
+    # The same policy in force without the field: not a hold (what it did is not read).
+    gui.feed.statuses(AgentStatus("alpha", link="up", executor_state="paused", lost_link=in_force))
     settle(gui.widget)
     assert lost_link_hold(gui.widget.view, "alpha") is None
 

@@ -18,6 +18,7 @@ import pytest
 from rosmc_server.core import (
     LostLinkKind,
     ParamType,
+    PolicyInForce,
     Pose,
     Resolution,
     SkillInstance,
@@ -47,6 +48,13 @@ from rosmc_server.executor.core.state_file import load_state, save_state
 
 S = SkillStatus
 K = CommandKind
+
+
+def policy_words(engine: Any) -> str:
+    """The policy in force as the engine's snapshot reports it, in words."""
+    policy = engine.snapshot().policy
+    assert policy is not None, "a whole snapshot says the policy"
+    return str(policy.describe())
 
 
 class FakeClock:
@@ -702,9 +710,9 @@ def test_set_options_sets_the_policy(robot: Robot) -> None:
     argument = json.dumps({"lost_link": {"policy": "safe_skill", "after": 30, "skill": "home"}})
     ack = robot.send(K.SET_OPTIONS, argument=argument)
     assert ack.result is AckResult.ACCEPTED
-    assert robot.engine.snapshot().policy == "on link loss: run home after 30 s, then hold"
+    assert policy_words(robot.engine) == "on link loss: run home after 30 s, then hold"
     assert robot.send(K.SET_OPTIONS, argument="").result is AckResult.ACCEPTED
-    assert robot.engine.snapshot().policy == "on link loss: continue"
+    assert policy_words(robot.engine) == "on link loss: continue"
 
 
 def test_sync_state_adopts_the_grounds_list_keeping_what_started(robot: Robot) -> None:
@@ -734,7 +742,7 @@ def test_snapshot_describes_the_whole_state(robot: Robot) -> None:
     assert snap.queue_hash == queue_hash(["a", "b"])
     assert [s.id for s in snap.queue] == ["a", "b"]
     assert (snap.state, snap.active_skill_id, snap.waiting_on) == ("running", "a", "")
-    assert snap.policy == "on link loss: continue"
+    assert snap.policy == PolicyInForce()
     assert snap.stamp == robot.clock.now
 
 
@@ -1089,11 +1097,11 @@ def test_hold_after_losing_the_ground(robot: Robot) -> None:
     robot.run_for(0.2)
     assert robot.status("a") is S.PAUSED
     assert robot.skill("a").status_text == "held after 5 s without ground contact"
-    assert robot.engine.snapshot().policy == (
+    assert policy_words(robot.engine) == (
         "on link loss: hold after 5 s; held after 5 s without ground contact"
     )
     robot.engine.report_acknowledged(0)  # the ground is back
-    assert robot.engine.snapshot().policy.endswith("; ground contact is back")
+    assert policy_words(robot.engine).endswith("; ground contact is back")
     robot.run_for(10.0)
     assert robot.status("a") is S.PAUSED  # the operator decides when to go on
     robot.send(K.RESUME)
@@ -1156,7 +1164,7 @@ def test_safe_skill_runs_then_holds(robot: Robot) -> None:
     assert robot.status("a") is S.PAUSED and robot.status("b") is S.IDLE_SYNCHRONIZED
     robot.send(K.RESUME)
     assert robot.status("a") is S.RUNNING
-    assert "holding" not in robot.engine.snapshot().policy  # what it did is over
+    assert "holding" not in policy_words(robot.engine)  # what it did is over
 
 
 def test_a_robot_started_while_its_safe_skill_runs_goes_on_after_it(robot: Robot) -> None:

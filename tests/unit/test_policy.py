@@ -7,7 +7,17 @@ from typing import Any
 
 import pytest
 
-from rosmc_server.core import InvalidRequest, Library, LostLinkKind, LostLinkPolicy, NotFound, Pose
+from rosmc_server.core import (
+    AgentStatus,
+    InvalidRequest,
+    Library,
+    LostLinkKind,
+    LostLinkPolicy,
+    LostLinkTrigger,
+    NotFound,
+    PolicyInForce,
+    Pose,
+)
 from rosmc_server.core.skills.policy import DEFAULT_AFTER, options_argument, policy_from_argument
 
 HOME = LostLinkPolicy(LostLinkKind.SAFE_SKILL, 30.0, "navigate_to", {"speed": 2.0})
@@ -27,6 +37,38 @@ def test_the_default_policy_continues() -> None:
 def test_descriptions() -> None:
     assert LostLinkPolicy(LostLinkKind.HOLD, 30).describe() == "on link loss: hold after 30 s"
     assert HOME.describe() == "on link loss: run navigate_to after 30 s, then hold"
+
+
+def test_the_policy_in_force_words_the_policy_its_default_and_what_it_did() -> None:
+    hold = LostLinkPolicy(LostLinkKind.HOLD, 30)
+    assert PolicyInForce(hold).describe() == "on link loss: hold after 30 s"
+    assert PolicyInForce(HOME, library_default=True, acted="held after 31 s").describe() == (
+        "on link loss: run navigate_to after 30 s, then hold (library default); held after 31 s"
+    )
+    assert PolicyInForce() == PolicyInForce(LostLinkPolicy())
+
+
+def test_an_agent_status_carries_the_policy_typed_and_words_it() -> None:
+    in_force = PolicyInForce(HOME, acted="ran 'navigate_to' after 30 s without ground contact")
+    status = AgentStatus("r1", lost_link=in_force)
+    assert status.lost_link == in_force and status.policy == in_force.describe()
+    assert AgentStatus("r1").lost_link is None and AgentStatus("r1").policy == ""
+    assert AgentStatus("r1", lost_link=in_force).news_since(AgentStatus("r1"))
+    assert not AgentStatus("r1", lost_link=in_force).news_since(status)
+
+
+def test_a_policy_sent_is_taken_when_the_robot_reports_it_completed() -> None:
+    sent = LostLinkPolicy(LostLinkKind.SAFE_SKILL, 30.0, "navigate_to", when=LostLinkTrigger.IDLE)
+    # The server filled in the skill's defaults before sending it.
+    completed = LostLinkPolicy(
+        LostLinkKind.SAFE_SKILL, 30.0, "navigate_to", {"speed": 1.0}, LostLinkTrigger.IDLE
+    )
+    assert sent.taken_as(completed)
+    assert HOME.taken_as(HOME)
+    assert not HOME.taken_as(completed)  # speed 2.0 was asked for
+    assert not sent.taken_as(LostLinkPolicy(LostLinkKind.SAFE_SKILL, 30.0, "navigate_to"))
+    assert not sent.taken_as(LostLinkPolicy(LostLinkKind.HOLD, 30.0, when=LostLinkTrigger.IDLE))
+    assert not LostLinkPolicy(LostLinkKind.HOLD, 30.0).taken_as(LostLinkPolicy(LostLinkKind.HOLD))
 
 
 def test_a_kind_given_by_name_is_read() -> None:

@@ -72,13 +72,12 @@ def test_the_plan_ends_at_the_last_pose_still_to_run() -> None:
 def test_a_plan_ending_out_of_coverage_warns_only_under_a_policy_that_leaves_it_there() -> None:
     radio = RadioMap(prediction=model())
     out = [skill("out", S.RUNNING, target=Pose(17.0, 0.0))]
-    warning = coverage_warning(out, radio, "on link loss: continue", RETURN)
+    warning = coverage_warning(out, radio, LostLinkPolicy(), RETURN)
     assert warning.startswith("the task ends out of coverage at (17.0, 0.0) (predicted ")
-    assert coverage_warning(out, radio, "on link loss: hold after 60 s", None)
-    returning = RETURN.describe() + " (library default)"
-    assert coverage_warning(out, radio, returning, None) == ""
+    assert coverage_warning(out, radio, LostLinkPolicy(LostLinkKind.HOLD), None)
+    assert coverage_warning(out, radio, RETURN, None) == ""
     # Before the robot reports a policy, the library default counts.
-    assert coverage_warning(out, radio, "", RETURN) == ""
-    assert coverage_warning(out, radio, "", None)
+    assert coverage_warning(out, radio, None, RETURN) == ""
+    assert coverage_warning(out, radio, None, None)
     inside = [skill("in", S.RUNNING, target=Pose(8.0, 0.0))]
-    assert coverage_warning(inside, radio, "on link loss: continue", None) == ""
+    assert coverage_warning(inside, radio, LostLinkPolicy(), None) == ""

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from ..model.control import ExecutorState, HoldCause
 from ..model.model import SkillStatus
 from ..skills.params import Pose
+from ..skills.policy import PolicyInForce
 from ..views.vocabulary import counted
 from .link import LinkStatus
 from .waiting import waiting_text
@@ -29,11 +30,12 @@ class AgentStatus:
     -1 if unknown. ``battery`` (0..1), ``wifi_signal`` (dBm) and ``pose`` are None without
     telemetry. ``queue_hash`` is the synchronized queue as the ground sees it and
     ``robot_queue_hash`` as the robot last reported it (``hash_mismatch``: a repair is under
-    way). ``policy`` is the lost-link policy the robot reports in force (and whether it
-    triggered), as the robot words it; "" if the robot has not said. ``commands_waiting``
-    commands wait for contact with the robot, the oldest for ``waiting_for`` seconds (-1:
-    none waits). ``coverage_warning`` is the server's warning that the synchronized task ends
-    out of coverage under a policy that would leave the robot there ("" if none).
+    way). ``lost_link`` is the lost-link policy the robot reports in force (whether it is
+    the library's default, what it did); None if the robot has not said (:attr:`policy`
+    words it). ``commands_waiting`` commands wait for contact with the robot, the oldest for
+    ``waiting_for`` seconds (-1: none waits). ``coverage_warning`` is the server's warning
+    that the synchronized task ends out of coverage under a policy that would leave the
+    robot there ("" if none).
     ``radio_dropped`` radio datagrams were dropped at either end of the robot's link since
     they started (unsigned, forged, replayed: never acted on; :attr:`radio_text`).
     ``hold`` says why the robot holds after its lost-link policy acted (NONE: it does not):
@@ -57,7 +59,7 @@ class AgentStatus:
     current_status: SkillStatus | None = None
     executor_state: str = ""
     waiting_on: str = ""
-    policy: str = ""
+    lost_link: PolicyInForce | None = None
     commands_waiting: int = 0
     waiting_for: float = -1.0
     coverage_warning: str = ""
@@ -88,6 +90,11 @@ class AgentStatus:
     def executor(self) -> ExecutorState:
         """``executor_state`` as a state (UNKNOWN if not reported)."""
         return ExecutorState.of(self.executor_state)
+
+    @property
+    def policy(self) -> str:
+        """The policy in force in one line (``on link loss: hold after 30 s``), "" if unsaid."""
+        return self.lost_link.describe() if self.lost_link is not None else ""
 
     @property
     def waiting_text(self) -> str:

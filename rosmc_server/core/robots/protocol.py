@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 from ..model.control import HoldCause
 from ..model.model import SkillInstance, SkillStatus
+from ..skills.policy import PolicyInForce
 from .commands import CommandKind
 
 
@@ -107,7 +108,7 @@ class Snapshot:
     state: str
     active_skill_id: str
     waiting_on: str
-    policy: str
+    policy: PolicyInForce | None  # the lost-link policy in force; None: as last said
     full: bool = True  # ``queue`` holds every skill; False: it is left out (the digest stands)
     status_digest: str = ""
     hold: HoldCause = HoldCause.NONE  # why the robot holds after its lost-link policy acted

@@ -19,8 +19,6 @@ from ..skills.policy import LostLinkPolicy
 
 MEASURED_NEAR = 1.5
 """How far (m) a reading speaks for its surroundings when coverage is estimated."""
-LEAVES_OUT = ("on link loss: continue", "on link loss: hold")
-"""How the policies that leave an idle robot out of coverage describe themselves."""
 
 
 @dataclass(frozen=True)
@@ -158,24 +156,23 @@ def plan_end(task: Sequence[SkillInstance]) -> Pose | None:
     return end
 
 
-def leaves_robot_out(policy_text: str, default: LostLinkPolicy | None) -> bool:
+def leaves_robot_out(in_force: LostLinkPolicy | None, default: LostLinkPolicy | None) -> bool:
     """Whether the policy a robot reports (else the library's default) leaves it out of
     coverage once idle there."""
-    if policy_text:
-        return policy_text.startswith(LEAVES_OUT)
-    return default is None or default.leaves_robot_out()
+    policy = in_force or default
+    return policy is None or policy.leaves_robot_out()
 
 
 def coverage_warning(
     task: Sequence[SkillInstance],
     radio: RadioMap,
-    policy_text: str,
+    in_force: LostLinkPolicy | None,
     default: LostLinkPolicy | None,
 ) -> str:
     """One sentence if the task ends out of coverage under a policy that leaves the robot
     there; "" otherwise (also when nothing is known of the coverage there)."""
     end = plan_end(task)
-    if end is None or not leaves_robot_out(policy_text, default):
+    if end is None or not leaves_robot_out(in_force, default):
         return ""
     estimate = radio.estimate(end.x, end.y)
     if estimate is None or estimate.covered:

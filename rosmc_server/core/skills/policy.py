@@ -184,6 +184,21 @@ class LostLinkPolicy:
             return f"on link loss: return to {where} {wait}, then hold"
         return f"on link loss: run {self.skill} {wait}, then hold"
 
+    def taken_as(self, in_force: LostLinkPolicy) -> bool:
+        """Whether a robot reporting ``in_force`` took this policy (as sent, unchecked).
+
+        The server completes a policy before sending it (:meth:`checked`): the safe skill's
+        parameters not given take the library's defaults, so only those given must agree.
+        """
+        same = (self.kind, self.after, self.skill, self.when) == (
+            in_force.kind,
+            in_force.after,
+            in_force.skill,
+            in_force.when,
+        )
+        given = in_force.params
+        return same and all(name in given and given[name] == v for name, v in self.params.items())
+
     def leaves_robot_out(self) -> bool:
         """Whether an idle robot out of coverage stays there under this policy."""
         return self.kind in (LostLinkKind.CONTINUE, LostLinkKind.HOLD)
@@ -255,6 +270,27 @@ class LostLinkPolicy:
             data.get("params", {}),
             LostLinkTrigger.parse(_name(data.get("when", "silent"), "trigger")),
         )
+
+
+@dataclass(frozen=True)
+class PolicyInForce:
+    """The lost-link policy a robot reports in force, and what it did.
+
+    Attributes:
+        policy: The policy the robot applies.
+        library_default: Whether it is the library's default (no operator chose one).
+        acted: What the policy did last, for operators ("" until it acted), e.g.
+            ``held after 31 s without ground contact``.
+    """
+
+    policy: LostLinkPolicy = field(default_factory=LostLinkPolicy)
+    library_default: bool = False
+    acted: str = ""
+
+    def describe(self) -> str:
+        """One line for operators: the policy's words, whether it is the default, what it did."""
+        text = self.policy.describe() + (" (library default)" if self.library_default else "")
+        return text + (f"; {self.acted}" if self.acted else "")
 
 
 def _name(value: object, what: str) -> str:

@@ -28,7 +28,13 @@ import logging
 from collections import deque
 from collections.abc import Callable, Mapping
 
-from rosmc_server.core import LostLinkKind, LostLinkPolicy, LostLinkTrigger, ParamType
+from rosmc_server.core import (
+    LostLinkKind,
+    LostLinkPolicy,
+    LostLinkTrigger,
+    ParamType,
+    PolicyInForce,
+)
 from rosmc_server.core.model.control import HoldCause
 from rosmc_server.core.skills.params import Pose, value_to_data
 
@@ -243,7 +249,6 @@ class LostLinkGuard:
         self.held = HoldCause.RETURN_POINT if returned else HoldCause.SAFE_SKILL
         return True
 
-    def describe(self) -> str:
-        """The policy in force and what it did, in one line."""
-        text = self.policy.describe() + (" (library default)" if self.is_default else "")
-        return text + (f"; {self.note}" if self.note else "")
+    def in_force(self) -> PolicyInForce:
+        """The policy in force and what it did, as the robot reports it."""
+        return PolicyInForce(self.policy, self.is_default, self.note)

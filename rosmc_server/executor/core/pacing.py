@@ -4,9 +4,9 @@ A snapshot is the robot's heartbeat on the link as well as its state: the ground
 link DOWN when it has heard nothing for its link timeout. While the robot works, its
 snapshot changes and goes every period; once it is idle, only its stamp changes, and it
 goes every ``idle_period`` seconds, but twice within the ground's link timeout (which the
-ground's report acks carry). The lost-link policy's text, the longest part of an idle
+ground's report acks carry). The lost-link policy in force, the longest part of an idle
 snapshot, goes when it changed, in every whole snapshot, and every ``policy_repeat``
-seconds; the others leave it empty and the ground keeps the last one.
+seconds; the others leave it out (None) and the ground keeps the last one.
 """
 
 from __future__ import annotations
@@ -15,9 +15,10 @@ import dataclasses
 from dataclasses import dataclass
 
 from ...core.robots.protocol import Snapshot
+from ...core.skills.policy import PolicyInForce
 
 IDLE_PERIOD = 5.0  # seconds between unchanged snapshots, at most
-POLICY_REPEAT = 30.0  # seconds after which a snapshot repeats an unchanged policy text
+POLICY_REPEAT = 30.0  # seconds after which a snapshot repeats an unchanged policy
 
 
 @dataclass
@@ -27,7 +28,7 @@ class SnapshotPacer:
     Args:
         period: Seconds between snapshots while they change.
         idle_period: Seconds between unchanged ones (see the module docstring).
-        policy_repeat: Seconds after which an unchanged policy text is said again.
+        policy_repeat: Seconds after which an unchanged policy is said again.
 
     Attributes:
         ground_timeout: The ground's link timeout (0 until the ground said it).
@@ -39,7 +40,7 @@ class SnapshotPacer:
     ground_timeout: float = 0.0
     _content: Snapshot | None = None  # the last sent, stamp left out
     _sent: float = 0.0
-    _policy: tuple[str, float] = ("", 0.0)  # the policy text last said, and when
+    _policy: tuple[PolicyInForce | None, float] = (None, 0.0)  # the policy last said, and when
 
     def unchanged_period(self) -> float:
         """Seconds between unchanged snapshots now."""
@@ -57,7 +58,7 @@ class SnapshotPacer:
         if snapshot.full or snapshot.policy != said or now >= when + self.policy_repeat:
             self._policy = (snapshot.policy, now)
             return snapshot
-        return dataclasses.replace(snapshot, policy="")
+        return dataclasses.replace(snapshot, policy=None)
 
     def next_check(self, now: float) -> float:
         """When to ask next: after ``period``, or when an unchanged one falls due."""

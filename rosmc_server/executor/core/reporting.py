@@ -90,7 +90,7 @@ def snapshot(engine: Reporting, full: bool) -> Snapshot:
         executor_state(engine).value,
         active.skill_id if active else "",
         waiting,
-        engine.lost_link.describe(),
+        engine.lost_link.in_force(),
         full,
         engine.ledger.status_digest(),
         engine.hold(),

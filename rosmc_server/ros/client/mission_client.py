@@ -243,7 +243,7 @@ class MissionClient(MarkerCalls):
 
         The safe skill's parameters are checked against the library here and on the
         server (those not given take the default). The robot reports the policy in
-        force in its agent state (:attr:`AgentStatus.policy`). While the robot cannot be
+        force in its agent state (:attr:`AgentStatus.lost_link`). While the robot cannot be
         reached the change waits for contact (a newer one replaces it); Unavailable when
         too many commands already wait.
         """
