@@ -141,10 +141,11 @@ def test_create_refuses_beside_the_parts_of_an_older_journal(tmp_path: Path) -> 
 
 def test_a_part_created_just_before_a_crash_is_replaced(tmp_path: Path) -> None:
     path = tmp_path / "m.mcap"
-    options = JournalOptions(part_bytes=PART, snapshot_every=10**6)
+    options = JournalOptions(part_bytes=2 * PART, snapshot_every=10**6)
     writer = JournalWriter.create(path, mission(0), T0, options)
     grow(writer, 1, 20)
     writer.abandon()
+    assert not (tmp_path / "m.part002.mcap").exists(), "the 20 events fill one part"
     (tmp_path / "m.part002.mcap").write_bytes(b"")  # created, nothing written yet
     with JournalWriter.resume(path, options) as resumed:
         assert resumed.part_path == path
