@@ -133,10 +133,12 @@ test-busy: setup
 # PYTEST_WORKERS processes share the test files (pytest-xdist, a file stays on one worker:
 # module fixtures start once). Most tests wait on ROS processes, so two workers halve the
 # time even on two cores; three were faster still but made the sim scenarios' timing
-# flaky there. PYTEST_WORKERS=0 runs everything in this process.
+# flaky there. PYTEST_WORKERS=0 runs everything in this process. A worker that crashes is
+# not replaced: the run fails at once with the crash's trace (a replaced worker could leave
+# the run waiting for ever on the files it held).
 PYTEST_WORKERS ?= 2
 pytest: setup
-	$(IN_ENV) python -m pytest $(if $(filter-out 0,$(PYTEST_WORKERS)),-n $(PYTEST_WORKERS) --dist loadfile) $(PYTEST_ARGS)
+	$(IN_ENV) python -m pytest $(if $(filter-out 0,$(PYTEST_WORKERS)),-n $(PYTEST_WORKERS) --dist loadfile --max-worker-restart 0) $(PYTEST_ARGS)
 
 # Benchmarks print JSON figures; run_all collects them (one after another: they measure time).
 bench: setup

@@ -157,11 +157,14 @@ class Gui:
     def answer_dialog(self, button: Any) -> None:
         """Press ``button`` in the next modal dialog (as soon as it opens)."""
 
+        tries = [1500]  # 30 s: a dialog that never opens leaves no timer for later tests
+
         def press() -> None:
             box = QApplication.activeModalWidget()
-            if isinstance(box, QMessageBox):
+            if isinstance(box, QMessageBox) and box.button(button) is not None:
                 box.button(button).click()
-            else:
+            elif tries[0] > 0:
+                tries[0] -= 1
                 QTimer.singleShot(20, press)
 
         QTimer.singleShot(20, press)
