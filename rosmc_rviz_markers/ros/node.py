@@ -39,6 +39,7 @@ from collections.abc import Mapping, Sequence
 import rospy
 from visualization_msgs.msg import Marker
 
+from rosmc_server.common.ros.graph_join import join_graph
 from rosmc_server.common.ros.logging_bridge import bridge_logging_to_rosout
 from rosmc_server.core import AgentStatus, Library, MissionState, load_library
 from rosmc_server.core.live.mirror import MissionMirror
@@ -339,7 +340,7 @@ class MarkerNode:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``markers_node``."""
     rospy.myargv(argv if argv is not None else sys.argv)
-    rospy.init_node("markers", anonymous=False)
+    join_graph("markers", anonymous=False)
     bridge_logging_to_rosout()
     node = MarkerNode(MarkerNodeConfig.from_params())
     node.start()

@@ -38,6 +38,7 @@ from std_msgs.msg import Empty, String
 
 from rosmc_rqt_command.core.station_layout import Rect, rviz_config_at, split_screen
 from rosmc_server import interface
+from rosmc_server.common.ros.graph_join import join_graph
 from rosmc_server.common.ros.logging_bridge import bridge_logging_to_rosout
 
 from .. import topics
@@ -176,7 +177,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("-d", dest="config", type=Path, required=True, help="the rviz config")
     parser.add_argument("--ns", default="", help="show the mission under this prefix only")
     options = parser.parse_args(args)
-    rospy.init_node("rviz_operator", disable_signals=True)
+    join_graph("rviz_operator", disable_signals=True)
     bridge_logging_to_rosout()
     config = placed_config(options.config)
     window = RvizWindow(config, rospy.get_name().lstrip("/"), options.ns)

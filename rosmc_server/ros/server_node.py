@@ -73,6 +73,7 @@ import rospy
 
 from .. import interface
 from ..common.ros import station
+from ..common.ros.graph_join import join_graph
 from ..common.ros.logging_bridge import bridge_logging_to_rosout
 from ..common.ros.radio import node_radio_key
 from ..conversions import library_to_msg, time_to_msg
@@ -328,7 +329,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     parser.parse_args(args[1:])
     keep_large_blocks_apart()
-    rospy.init_node("mission_server", anonymous=False)
+    join_graph("mission_server", anonymous=False)
     bridge_logging_to_rosout()
     config = ServerConfig.from_params()
     try:

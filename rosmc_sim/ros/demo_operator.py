@@ -32,6 +32,7 @@ from typing import TypeVar
 import rosmc.msg as wire
 import rospy
 
+from rosmc_server.common.ros.graph_join import join_graph
 from rosmc_server.common.ros.station import launch_path
 from rosmc_server.core import MarkerType, Pose, RosmcError, SkillStatus, TaskMarker
 from rosmc_server.core.model.changes import EventKind
@@ -233,7 +234,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     argparse.ArgumentParser(
         prog="demo_operator", description="Scripted operator of the ROSMC demo mission."
     ).parse_args(args[1:])
-    rospy.init_node("demo_operator")
+    join_graph("demo_operator")
     deadline = time.monotonic() + float(rospy.get_param("~timeout", 600.0))
     client = MissionClient(timeout=30.0)
     operator = DemoOperator(client, deadline)

@@ -35,6 +35,7 @@ import rosmc.msg as wire
 import rospy
 from std_msgs.msg import Bool
 
+from rosmc_server.common.ros.graph_join import join_graph
 from rosmc_server.common.ros.logging_bridge import bridge_logging_to_rosout
 from rosmc_server.interface import ground_link, robot_link
 
@@ -109,7 +110,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         description="Relays the robot links with latency, loss and blackouts "
         "(_agents:=[a,b] _latency:=SECONDS _drop:=P).",
     ).parse_args(args[1:])
-    rospy.init_node("link_emulator")
+    join_graph("link_emulator")
     bridge_logging_to_rosout()
     agents = rospy.get_param("~agents", [])
     if isinstance(agents, str):

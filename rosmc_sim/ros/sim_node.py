@@ -49,6 +49,7 @@ import rospy.impl.simtime
 import rospy.rostime
 from rosgraph_msgs.msg import Clock
 
+from rosmc_server.common.ros.graph_join import join_graph
 from rosmc_server.common.ros.logging_bridge import bridge_logging_to_rosout
 from rosmc_server.common.ros.station import CWD_PARAM, resolve_against
 
@@ -226,7 +227,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         description="The pybullet simulation of the Mars site (_scenario:=FILE "
         "_real_time_factor:=X _step:=S _clock_rate:=HZ _gui:=BOOL _seed:=N).",
     ).parse_args(args[1:])
-    rospy.init_node("sim", disable_signals=True)
+    join_graph("sim", disable_signals=True)
     stop = _stop_on_signals()
     bridge_logging_to_rosout()
     try:

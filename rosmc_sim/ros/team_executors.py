@@ -31,6 +31,7 @@ from pathlib import Path
 import roslib.packages
 import rospy
 
+from rosmc_server.common.ros.graph_join import join_graph
 from rosmc_server.common.ros.logging_bridge import bridge_logging_to_rosout
 from rosmc_sim.core.scenario import RobotSpec, load_scenario
 
@@ -149,7 +150,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         prog="team_executors",
         description="One mission executor per robot of a scenario (_scenario:=FILE).",
     ).parse_args(args[1:])
-    rospy.init_node("team_executors")
+    join_graph("team_executors")
     bridge_logging_to_rosout()
     config = TeamConfig.from_params()
     robots = load_scenario(config.scenario).robots

@@ -59,6 +59,7 @@ import rosmc.msg as wire
 import rospy
 
 from rosmc_server import interface
+from rosmc_server.common.ros.graph_join import join_graph
 from rosmc_server.common.ros.logging_bridge import bridge_logging_to_rosout
 from rosmc_server.common.ros.station import launch_path
 
@@ -336,7 +337,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "(_agent:=NAME, _skills:=module:function, _state_file:=PATH).",
     )
     parser.parse_args(args[1:])
-    rospy.init_node("mission_executor")
+    join_graph("mission_executor")
     bridge_logging_to_rosout()
     config = ExecutorConfig.from_params()
     if not config.agent:
