@@ -47,6 +47,7 @@ class AgentLink:
     report_ack_pub: rospy.Publisher
     reports: InboundSequence | None = None  # None until the robot's numbering is known
     snapshot: wire.ExecutorSnapshot | None = None
+    asked_after: float | None = None  # the silence the last policy sent acts after
     robot_hash: str = ""
     mismatch: bool = False
     barriers_sent: tuple[Barrier, ...] = ()

@@ -45,6 +45,7 @@ from ..core.robots.link import (
 from ..core.robots.radio import BEACON_PERIOD, ROBOT_SILENCE, ContactWatch
 from ..core.robots.radio_key import RadioKey
 from ..core.robots.waiting import collapse, waiting_work
+from ..core.skills.policy import ground_contact_period, options_from_argument
 from ..interface import ground_link
 from .agent_link import AgentLink, LinkHost, Operation
 from .command_records import command_record
@@ -125,6 +126,14 @@ class GroundLink:
         robot = int(getattr(snapshot, "radio_dropped", 0)) if snapshot is not None else 0
         return robot + self.radio.dropped_from(agent)
 
+    def contact_period(self, agent: str) -> float:
+        """Seconds between the ground's beats to ``agent``, per its lost-link policy.
+
+        Callable without the server lock (the heartbeat's thread): it reads two fields.
+        """
+        link = self._links[agent]
+        return ground_contact_period(link.asked_after, _reported_after(link.snapshot))
+
     def expected_hash(self, agent: str) -> str:
         """The queue hash the ground expects the robot to have."""
         return self._snapshots.expected_hash(agent)
@@ -133,6 +142,9 @@ class GroundLink:
     def send(self, spec: CommandSpec) -> None:
         """Queue a command for its robot; it goes out as soon as the link allows."""
         link = self._links[spec.agent]
+        if spec.kind is CommandKind.SET_OPTIONS:
+            # Beat for the new policy at once: the robot keeps it before the ground hears so.
+            link.asked_after = options_from_argument(spec.argument)[0].acts_after
         if spec.kind is CommandKind.BARRIERS and spec.barriers == link.barriers_sent:
             return  # the robot already has exactly these barriers
         if spec.kind in (CommandKind.UPLOAD, CommandKind.BARRIERS, CommandKind.SYNC_STATE):
@@ -329,3 +341,13 @@ class GroundLink:
             self._host.apply(operation)
         except RosmcError as error:
             _log.warning("robot link: %s", error)
+
+
+def _reported_after(snapshot: wire.ExecutorSnapshot | None) -> float | None:
+    """The silence after which the robot says its policy acts (None: never, or unsaid)."""
+    if snapshot is None:
+        return None
+    policy = snapshot.policy
+    if policy.kind in (wire.LostLinkPolicy.UNSAID, wire.LostLinkPolicy.CONTINUE):
+        return None
+    return float(policy.after)

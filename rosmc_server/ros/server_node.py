@@ -146,7 +146,8 @@ class MissionServer:
                 self.link.send(spec)
         self._snapshots.start()
         self._agent_states.start()
-        Heartbeat(self.library.dynamic_agents).start()  # idle robots in coverage hear the ground
+        # Idle robots in coverage hear the ground, often enough for their lost-link policy.
+        Heartbeat(self.library.dynamic_agents, self.link.contact_period).start()
         self._recorder.start()
         self._services.advertise()
         self._site = SiteListener(self, lambda: self._journal)

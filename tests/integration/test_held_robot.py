@@ -25,6 +25,7 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 from python_qt_binding.QtCore import Qt
 from python_qt_binding.QtTest import QTest
 from python_qt_binding.QtWidgets import QApplication
+from rosgraph_msgs.msg import Log
 from visualization_msgs.msg import MarkerArray
 
 from rosmc_rqt_command.qt.task_model import STATUS
@@ -53,6 +54,21 @@ SHOTS = "ROSMC_SCREENSHOTS"  # a directory: the window with the held robot is sa
 def wait_until(condition: Any, timeout: float, what: str) -> Any:
     """Run the Qt event loop until ``condition()`` is truthy; fail after ``timeout``."""
     return conftest.wait_until(condition, timeout, what, pause=conftest.qt_pause)
+
+
+class Holds:
+    """The robots' "held after" lines on ``/rosout`` (what rqt_console shows)."""
+
+    def __init__(self) -> None:
+        self.lines: list[str] = []
+        self._sub = rospy.Subscriber("/rosout", Log, self._on_log, queue_size=1000)
+
+    def _on_log(self, msg: Log) -> None:
+        if " held after " in msg.msg:
+            self.lines.append(msg.msg)
+
+    def close(self) -> None:
+        self._sub.unregister()
 
 
 class Icons:
@@ -104,7 +120,7 @@ def hold_r1_before_its_barrier(op: Operator) -> tuple[str, str, str]:
         30.0,
         "r1's policy in force",
     )
-    work = op.add("r1", "wait", {"duration": 4.0})
+    work = op.add("r1", "wait", {"duration": 12.0})
     meet_r1 = op.add("r1", "wait", {"duration": 0.1})
     meet_r2 = op.add("r2", "wait", {"duration": 0.1})
     op.add_barrier([meet_r1, meet_r2])
@@ -115,7 +131,7 @@ def hold_r1_before_its_barrier(op: Operator) -> tuple[str, str, str]:
     conftest.wait_until(robot_side.connected, 30.0, "r1's side of the link")
     op.start("r1")
     op.start("r2")
-    op.wait_status([work], S.RUNNING)
+    op.events.wait_went(work, S.RUNNING)
     op.wait_status([meet_r2], S.SYNCWAITING)
     op.blackout("r1", True)
     robot_side.wait_heard("report", lambda r: r.skill_id == work and r.status.value == S.PAUSED)
@@ -147,6 +163,7 @@ def test_a_held_robot_is_said_everywhere_and_resume_frees_its_partners(
     app = QApplication.instance() or QApplication([])
     markers = MarkerNodeProcess(dict(ros_master.env), tmp_path / "markers.log")
     icons = Icons()
+    holds = Holds()
     widget, bridge = build(timeout=5.0)
     try:
         widget.resize(1600, 1000)  # as the other pictures of docs/
@@ -193,12 +210,19 @@ def test_a_held_robot_is_said_everywhere_and_resume_frees_its_partners(
         QTest.mouseClick(button, Qt.LeftButton)
         state = op.wait_status([work, meet_r1, meet_r2], S.SUCCESS, timeout=60.0)
         assert state.skill(meet_r2).started >= state.skill(work).finished
+        # Held once, for the blackout: in contact, the ground's beats keep its policy (hold
+        # after 1 s of silence) quiet for the rest of the 12 s work; a beat every 2 s, as
+        # before the beats followed the policy, held it again and again.
+        went = op.events.statuses(work)
+        assert went[went.index(S.RUNNING) :] == [S.RUNNING, S.PAUSED, S.RUNNING, S.SUCCESS], went
         wait_until(lambda: not notice.isVisible(), 30.0, "the notice goes")
         widget.repaints.warn_now()
         assert not widget.messages.hold_bar.isVisible()
         assert op.agent_state("r1").hold == ""
+        assert len(holds.lines) == 1, holds.lines  # never again in contact
     finally:
         icons.close()
+        holds.close()
         bridge.close()
         widget.close()
         widget.deleteLater()

@@ -18,7 +18,12 @@ from rosmc_server.core import (
     PolicyInForce,
     Pose,
 )
-from rosmc_server.core.skills.policy import DEFAULT_AFTER, options_argument, policy_from_argument
+from rosmc_server.core.skills.policy import (
+    DEFAULT_AFTER,
+    ground_contact_period,
+    options_argument,
+    policy_from_argument,
+)
 
 HOME = LostLinkPolicy(LostLinkKind.SAFE_SKILL, 30.0, "navigate_to", {"speed": 2.0})
 
@@ -162,3 +167,28 @@ def test_checked_fills_defaults_and_checks_against_the_library(shipped_library: 
         LostLinkPolicy(LostLinkKind.SAFE_SKILL, 3, "navigate_to", {"speed": 99.0}).checked(
             shipped_library, "drone"
         )
+
+
+@pytest.mark.parametrize(
+    ("afters", "period"),
+    [
+        ((), 2.0),  # nothing known: the slowest beat
+        ((None, None), 2.0),  # continue never acts
+        ((60.0,), 2.0),  # a long policy: still every 2 s, so an idle robot knows its link
+        ((4.0,), 1.0),  # four beats within the policy's silence
+        ((1.0,), 0.25),
+        ((0.1,), 0.25),  # never faster than four a second
+        ((60.0, 2.0), 0.5),  # asked and reported differ: the shorter holds until settled
+        ((None, 6.0), 1.5),
+    ],
+)
+def test_the_ground_beats_often_enough_for_the_shortest_policy(
+    afters: tuple[float | None, ...], period: float
+) -> None:
+    assert ground_contact_period(*afters) == period
+
+
+def test_only_a_policy_that_acts_has_a_silence() -> None:
+    assert LostLinkPolicy(LostLinkKind.CONTINUE, 5.0).acts_after is None
+    assert LostLinkPolicy(LostLinkKind.HOLD, 5.0).acts_after == 5.0
+    assert HOME.acts_after == 30.0

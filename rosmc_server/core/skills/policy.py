@@ -76,6 +76,28 @@ class SkillSource(Protocol):
 DEFAULT_AFTER = 60.0
 """Seconds without the ground before a policy acts, unless the operator says otherwise."""
 
+# A robot must hear the ground this many times within its policy's ``after`` for a healthy
+# link never to look lost: one late beat on a loaded machine must not make the robot hold.
+CONTACTS_PER_WINDOW = 4
+LONGEST_CONTACT_PERIOD = 2.0
+"""Seconds between the ground's beats to a robot with a long policy (or none)."""
+SHORTEST_CONTACT_PERIOD = 0.25
+"""The ground never beats faster: a policy of a second or less cannot be kept on a loaded link."""
+
+
+def ground_contact_period(*afters: float | None) -> float:
+    """Seconds between the ground's beats to a robot whose policy may act after ``afters``.
+
+    ``afters`` are the silences after which the robot's policy acts, as the robot reported
+    it and as the ground last asked (None: it never acts, or is not known); the shortest
+    counts, since the robot may hold either until the ground hears which it took.
+    """
+    known = [after for after in afters if after is not None]
+    if not known:
+        return LONGEST_CONTACT_PERIOD
+    period = min(known) / CONTACTS_PER_WINDOW
+    return max(SHORTEST_CONTACT_PERIOD, min(LONGEST_CONTACT_PERIOD, period))
+
 
 class LostLinkKind(enum.StrEnum):
     """What the robot does once the link has been silent for ``after`` seconds."""
@@ -167,6 +189,11 @@ class LostLinkPolicy:
             raise InvalidRequest(
                 f"a {self.kind.value} lost-link policy runs no safe skill (give safe_skill)"
             )
+
+    @property
+    def acts_after(self) -> float | None:
+        """Seconds of silence after which the policy acts (None: continue never acts)."""
+        return None if self.kind is LostLinkKind.CONTINUE else self.after
 
     def describe(self) -> str:
         """One line for operators, e.g. ``on link loss: hold after 30 s``."""
