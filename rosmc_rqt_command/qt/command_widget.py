@@ -65,7 +65,7 @@ class CommandWidget(QWidget):  # type: ignore[misc]
         self.control = ControlPanel(self.actions_)
         self.messages = MessageArea()
         self.files = FileController(self, self.actions_, view, self.messages, self.send)
-        self.history = UndoHistory(self, view, self.send, self.messages.say)
+        self.history = UndoHistory(self, view, self.send)
         self.team = TeamBar(self.tasks, view)
         self.enabling = Enabling(view, self.actions_, self.tasks, self.history)
         self.repaints = Repaints(view, self.messages, self._show_statuses)

@@ -6,7 +6,7 @@ undone, and a Duplicate's copies are joined into one entry; undo asks the server
 the newest (``undo_edit``, against the revision shown), redo undoes that undo. A refusal
 by the mission rules (the skills were sent since, someone changed them) drops the entry
 and the message area shows the server's sentence; a conflict or no answer keeps it, and
-the message area says so.
+Undo stays offered; the message area says each answer once, as for any request.
 """
 
 from __future__ import annotations
@@ -22,8 +22,6 @@ from ..core.mission_view import MissionView
 from ..core.requests import Answer, Request, ask
 from .actions import CommandActions
 
-Say = Callable[[str, str], None]  # (sentence, level) to the message area
-
 
 class UndoHistory(QObject):  # type: ignore[misc]
     """The undo and redo actions of one command window.
@@ -32,7 +30,6 @@ class UndoHistory(QObject):  # type: ignore[misc]
         owner: The command widget (the actions' shortcuts work inside it).
         view: The mission as shown (for the base revision).
         send: Hands a request to the backend.
-        say: Shows a sentence in the message area (why an entry is kept).
     """
 
     def __init__(
@@ -40,12 +37,10 @@ class UndoHistory(QObject):  # type: ignore[misc]
         owner: QWidget,
         view: MissionView,
         send: Callable[[Request], None],
-        say: Say | None = None,
     ) -> None:
         super().__init__(owner)
         self._view = view
         self._send = send
-        self._say = say
         self.edits = EditHistory()
         self.read_only = False
         self.undo_action = CommandActions.make(
@@ -110,9 +105,9 @@ class UndoHistory(QObject):  # type: ignore[misc]
                 if answer.unreachable
                 else Failure.REFUSED
             )
-            sentence = self.edits.failed(step, failure, answer.error)
-            if failure is not Failure.REFUSED and self._say is not None:
-                self._say(sentence, "error")  # the refusal's own sentence is said already
+            # The message area says the answer once, as for any request; the entry is
+            # kept (Undo stays offered) on a conflict or no answer.
+            self.edits.failed(step, failure, answer.error)
         self._update()
 
     def set_read_only(self, read_only: bool) -> None:

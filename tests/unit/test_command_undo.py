@@ -57,8 +57,10 @@ def test_undo_kept_on_a_conflict_and_dropped_on_a_refusal(gui: Gui) -> None:
     assert sent.seen == gui.widget.view.revision and not undo.isEnabled()  # one at a time
     gui.widget.on_answer(Answer(sent, error="revision 2 is stale", conflict=True))
     assert undo.isEnabled() and undo.text() == "&Undo delete 'go'"
-    kept = gui.widget.messages.messages()[0]
-    assert "Could not undo delete 'go' (revision 2 is stale); it is kept: try again" in kept
+    said = [m for m in gui.widget.messages.messages() if "Could not undo delete 'go'" in m]
+    assert len(said) == 1, said  # once, by the message area, not again by the history
+    assert "someone else changed the mission first (revision 2 is stale)" in said[0]
+    assert "try again" in said[0]
     if SCREENSHOT:
         gui.widget.grab().save(SCREENSHOT)
 
