@@ -27,6 +27,7 @@ from python_qt_binding.QtWidgets import QApplication
 from rosmc_rqt_command.core.legality import RobotAction
 from rosmc_rqt_command.qt.science_strip import NO_REPLAY_SCORE
 from rosmc_rqt_command.replay_ticks import TickKind
+from rosmc_server.core.robots.link import LinkStatus
 from rosmc_server.core.views.science import Science
 from rosmc_server.recording import read_journal
 from rosmc_server.recording.history import MissionHistory
@@ -83,6 +84,22 @@ def first_poses() -> dict[str, tuple[float, float]]:
                 if status.pose is not None:
                     found.setdefault(agent, (status.pose.x, status.pose.y))
     return found
+
+
+def links(window: Window) -> dict[str, LinkStatus]:
+    """The link each of the window's robots shows, by name."""
+    return {agent: status.link for agent, status in window.w.view.statuses.items()}
+
+
+def recorded_links(history: MissionHistory, seconds: float) -> dict[str, LinkStatus]:
+    """The robots' links in the last agent states recorded at or before ``seconds``."""
+    until = history.start + round(seconds * 1e9)
+    last = None
+    for record in read_journal(SAMPLE).records:
+        if record.topic == "/rosmc/agent_states" and record.log_time <= until:
+            last = record
+    assert last is not None
+    return {a: s.link for a, s in agent_statuses_from_msg(last.message).items()}
 
 
 def marker_topics() -> set[str]:
@@ -176,6 +193,11 @@ def test_open_a_recording_seek_to_an_event_play_to_the_end_and_return_to_live(
     wait_until(lambda: widget.view.revision == revision, 20, f"r{revision} at {tick.text}")
     assert skill_statuses(window) == recorded_statuses(history, tick.time)
     assert "SUCCESS" in skill_statuses(window).values()
+    # The robots as recorded then (heard, their links up), though the replay is paused: it
+    # published their states for the new time before it said it had moved.
+    then = recorded_links(history, tick.time)
+    assert set(then.values()) == {LinkStatus.UP}, then
+    wait_until(lambda: links(window) == then, 20, "the robots' links as recorded then")
     wait_until(lambda: bar.shown and bar.shown.status.position == tick.time, 10, "the bar there")
 
     # Read-only: a skill selected, nothing that would change the mission can act.

@@ -337,6 +337,23 @@ def test_a_restarted_server_s_robots_start_unknown() -> None:
     assert mirror.agent_statuses == {}
 
 
+def test_a_moved_replay_s_mission_is_taken_and_its_robots_stay() -> None:
+    """A replay publishes the robots' states for its new time, then says it moved."""
+    mission = make_mission()
+    mirror = MissionMirror()
+    mirror.on_snapshot(snapshot_of(mission))
+    later = snapshot_of(mission)
+    for event in busy_mission(mission):
+        mirror.on_event(event)
+    ahead = mirror.revision
+    assert ahead is not None and ahead > later.revision
+    up = AgentStatus("drone", link="up", battery=0.5)
+    mirror.on_agent_statuses({"drone": up})
+    mirror.on_snapshot(later, moved=True)  # back in time: an older revision, taken
+    assert mirror.revision == later.revision
+    assert mirror.agent_statuses == {"drone": up}
+
+
 def test_a_late_listener_starts_from_the_current_mission_and_can_leave() -> None:
     mission = make_mission()
     mirror = MissionMirror()

@@ -118,7 +118,9 @@ class MissionMirror:
         if need:
             self._ask_snapshot()
 
-    def on_snapshot(self, state: MissionState, *, restarted: bool = False) -> None:
+    def on_snapshot(
+        self, state: MissionState, *, restarted: bool = False, moved: bool = False
+    ) -> None:
         """Take a full snapshot; older than what the mirror holds, it is ignored.
 
         The mirror keeps ``state`` (do not change it afterwards). Held events after its
@@ -126,13 +128,18 @@ class MissionMirror:
         that started anew (its revisions may have begun again), so it is taken whatever its
         revision, and held events are dropped, as are the robot statuses the old server
         gave (listeners hear each robot as unknown until the new server speaks of it).
+        ``moved``: a replay moved to another time; its mission is taken whatever its
+        revision and held events are dropped, but the robot statuses stay: the replay
+        published those of the new time before it said that it moved, and a paused replay
+        publishes none again.
         """
         with self.lock:
-            if restarted:
+            if restarted or moved:
                 self._pending.clear()
+            if restarted:
                 self._forget_statuses()
             stale = self._state is not None and state.revision < self._state.revision
-            if not stale or restarted:
+            if not stale or restarted or moved:
                 self._state = state
                 self._notify(MirrorUpdate(state.revision, (MissionReset(state),)))
             # else: an answer to a fetch overtaken by events; the mirror is ahead of it.

@@ -202,13 +202,14 @@ class MissionFollower:
         if seeks == (before or 0) or self._closed.is_set():
             return
         # A replay moved back publishes revisions the mirror has seen, with other content:
-        # its mission is taken whatever its revision, as a restarted server's is.
+        # its mission is taken whatever its revision, as a restarted server's is; the
+        # robots' states it published for the new time stay.
         _log.info("the replay moved; fetching its mission")
         self._fetcher.submit(lambda client: client.fetch_mission(), self._on_moved_snapshot)
 
     def _on_moved_snapshot(self, outcome: Outcome[MissionState]) -> None:
         if outcome.value is not None:
-            self.mirror.on_snapshot(outcome.value, restarted=True)
+            self.mirror.on_snapshot(outcome.value, moved=True)
         else:
             self._on_snapshot(outcome)  # says so and tries again
 
