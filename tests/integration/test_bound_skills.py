@@ -142,6 +142,7 @@ def test_an_action_bound_skill_sends_goals_and_reports_feedback_and_result(
     state = robot.wait_status([refused], S.FAILURE)
     assert lab.goals == [4, -1]
     assert state.skill(counted).status_text == "reached 4"
+    robot.events.wait_went(counted, S.SUCCESS)  # every event before it has arrived too
     assert any(text.startswith("counted ") for text in robot.status_texts(counted))
     assert state.skill(refused).status_text == "the action server aborted the goal: reached -1"
 

@@ -317,7 +317,8 @@ def test_unsync_while_running_keeps_the_running_skill(rosmc: Start) -> None:
         30.0,
         "the later skills to return to the blueprint",
     )
-    op.wait_status([first], S.SUCCESS)
+    # Its SUCCESS event: the mission may show it before the event reaches this subscriber.
+    op.events.wait_went(first, S.SUCCESS)
     # The running skill went on to its end: never stopped, never sent back.
     assert op.events.statuses(first)[-2:] == [S.RUNNING, S.SUCCESS], op.events.statuses(first)
     time.sleep(0.5)  # the later skills stay in the blueprint: nothing to wait on

@@ -213,6 +213,7 @@ def test_a_held_robot_is_said_everywhere_and_resume_frees_its_partners(
         # Held once, for the blackout: in contact, the ground's beats keep its policy (hold
         # after 1 s of silence) quiet for the rest of the 12 s work; a beat every 2 s, as
         # before the beats followed the policy, held it again and again.
+        op.events.wait_went(work, S.SUCCESS)  # the mission may show it before the event
         went = op.events.statuses(work)
         assert went[went.index(S.RUNNING) :] == [S.RUNNING, S.PAUSED, S.RUNNING, S.SUCCESS], went
         wait_until(lambda: not notice.isVisible(), 30.0, "the notice goes")

@@ -326,6 +326,7 @@ def test_a_stopped_skill_runs_again_on_start(op: Operator) -> None:
     op.wait_status([drive], S.IDLE_SYNCHRONIZED, timeout=60.0)  # stopped: it stays so
     c.control(ControlCommand.START, SCIENCE)
     op.wait_status([drive, back], S.SUCCESS, timeout=90.0)
+    op.events.wait_went(drive, S.SUCCESS)  # the mission may show it before the event
     went = op.events.statuses(drive)
     assert went[-4:] == [S.RUNNING, S.IDLE_SYNCHRONIZED, S.RUNNING, S.SUCCESS], went
     skill = op.mission().skill(drive)

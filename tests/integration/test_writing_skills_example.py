@@ -45,6 +45,7 @@ def test_the_guide_example_robot_runs_its_skill(ros_master: RosMaster, tmp_path:
         assert state.skill(sweep).status_text == "swept 3 corners"
         # Progress reaches the ground paced (the newest text once a second): the first and
         # the last text before the finish always, in the order said.
+        operator.events.wait_went(sweep, SkillStatus.SUCCESS)  # and every event before it
         said = [text for text in operator.status_texts(sweep) if text.startswith("corner")]
         assert said[0] == "corner 1 of 3 at (0.0, 0.0)", said
         assert said[-1] == "corner 3 of 3 at (2.0, 2.0)" and said == sorted(said), said
