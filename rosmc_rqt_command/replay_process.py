@@ -4,7 +4,8 @@ Both run as child processes on the GUI's ROS master, under one prefix (``/replay
 replay begins paused at the start and holds at the end (``--paused --hold``); the marker
 node is the one ``roslaunch rosmc markers.launch ns:=/replay`` starts, so rviz started
 with ``roslaunch rosmc rviz.launch ns:=/replay`` follows the same replay. They are ended
-(SIGTERM, then SIGKILL) when the GUI returns to the live mission or closes.
+(SIGTERM, then SIGKILL) when the GUI returns to the live mission or closes, and get SIGTERM
+from the kernel if the GUI dies (:mod:`.replay_child`).
 """
 
 from __future__ import annotations
@@ -18,8 +19,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-REPLAY_CODE = "import sys; from rosmc_server.cli import main; sys.exit(main())"
-MARKERS_CODE = "import sys; from rosmc_rviz_markers.ros.node import main; sys.exit(main())"
+CHILD = "rosmc_rqt_command.replay_child"  # each child ends when this process does
 GRACE = 5.0
 """Seconds a child gets to leave after SIGTERM before it is killed."""
 
@@ -41,15 +41,15 @@ class ReplayProcess:
 
     def start(self) -> None:
         """Start the replay and the marker node (returns at once)."""
-        replay = ["replay", str(self.path), "--prefix", self.prefix, "--paused", "--hold"]
+        replay = [str(self.path), "--prefix", self.prefix, "--paused", "--hold"]
         markers = [f"__ns:={self.prefix}/rosmc", f"_ns:={self.prefix}"]
-        for code, args in ((REPLAY_CODE, replay), (MARKERS_CODE, markers)):
+        for kind, args in (("replay", replay), ("markers", markers)):
             self._children.append(
                 subprocess.Popen(
-                    [sys.executable, "-c", code, *args],
+                    [sys.executable, "-m", CHILD, str(os.getpid()), kind, *args],
                     stdin=subprocess.DEVNULL,
                     stdout=subprocess.DEVNULL,
-                    stderr=self._log if code is REPLAY_CODE else subprocess.DEVNULL,
+                    stderr=self._log if kind == "replay" else subprocess.DEVNULL,
                     start_new_session=True,  # Ctrl-C in the GUI's terminal is the GUI's
                 )
             )

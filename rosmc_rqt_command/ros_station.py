@@ -3,8 +3,9 @@
 ROS interface:
     Publishes ``/rosmc/station/show_3d`` (std_msgs/Empty: rviz, come to the front) and
     ``/rosmc/station/view_source`` (std_msgs/String, latched: "" live, or the replay's
-    prefix, which rviz follows; "" when the window starts, so a window that came back
-    after a crash brings rviz back to the live mission).
+    prefix, which rviz follows), only when this window opens a replay or returns to live:
+    a second window that starts leaves rviz on the first one's replay. A window that
+    crashes takes its replay with it, and rviz then returns to live by itself.
     Subscribes ``/rosmc/station/show_command`` (std_msgs/Empty: this window, to the front).
     Reads ``/use_sim_time``: with it the clock is the simulation's time, without it UTC.
 """
@@ -15,30 +16,19 @@ import logging
 import os
 import subprocess
 import time
-import xmlrpc.client
 
-import rosgraph
 import rospy
 from python_qt_binding.QtCore import QObject, Signal
 from std_msgs.msg import Empty, String
 
 from rosmc_server import interface
+from rosmc_server.common.ros.graph_join import node_running
 
 from .core.station_layout import MISSION, UTC
 from .qt.station_menu import ClockReading, StationHooks
 
 _log = logging.getLogger(__name__)
 RVIZ_LAUNCH = ["roslaunch", "rosmc", "rviz.launch"]
-
-
-def node_running(name: str) -> bool:
-    """Whether the ROS master knows a node ``name`` that answers."""
-    try:
-        uri = rosgraph.Master(rospy.get_name()).lookupNode(name)
-        xmlrpc.client.ServerProxy(uri).getPid(rospy.get_name())
-    except (rosgraph.MasterError, OSError, xmlrpc.client.Error):
-        return False
-    return True
 
 
 class StationLink(QObject):  # type: ignore[misc]
@@ -53,7 +43,6 @@ class StationLink(QObject):  # type: ignore[misc]
         self._source = rospy.Publisher(
             interface.VIEW_SOURCE_TOPIC, String, queue_size=1, latch=True
         )
-        self._source.publish(String(data=""))
         self._started: subprocess.Popen[bytes] | None = None
         self._subscriber = rospy.Subscriber(
             interface.SHOW_COMMAND_TOPIC, Empty, lambda _msg: self.raise_requested.emit()

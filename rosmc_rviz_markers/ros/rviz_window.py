@@ -15,7 +15,8 @@ its child:
   view*) brings rviz's window to the front (with ``xdotool``).
 
 When rviz exits by itself (closed, crashed), this node exits with its code, so roslaunch's
-``respawn`` starts both again.
+``respawn`` starts both again. When the replay rviz follows goes away without a word (its
+command window crashed, taking the replay with it), rviz returns to the live mission.
 """
 
 from __future__ import annotations
@@ -30,21 +31,24 @@ import subprocess
 import sys
 import tempfile
 import threading
-from collections.abc import Sequence
+import time
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
+import rosgraph
 import rospy
 from std_msgs.msg import Empty, String
 
 from rosmc_rqt_command.core.station_layout import Rect, rviz_config_at, split_screen
 from rosmc_server import interface
-from rosmc_server.common.ros.graph_join import join_graph
+from rosmc_server.common.ros.graph_join import join_graph, node_running
 from rosmc_server.common.ros.logging_bridge import bridge_logging_to_rosout
 
 from .. import topics
 
 _log = logging.getLogger(__name__)
 GRACE = 5.0  # seconds rviz gets to leave after SIGTERM
+PRESENCE_PERIOD = 1.0  # seconds between looks at whether the followed replay still runs
 # What rviz subscribes that a replay publishes behind its prefix.
 FOLLOWED = (
     *(topics.topic(topics.MARKERS_NS, "") + f"/{leaf}" for leaf in ("update", "update_full")),
@@ -59,6 +63,22 @@ FOLLOWED = (
 def remaps(prefix: str) -> list[str]:
     """rviz's command-line remappings that show the mission under ``prefix``."""
     return [f"{name}:={interface.prefixed(name, prefix)}" for name in FOLLOWED if prefix]
+
+
+def replay_running(prefix: str) -> bool:
+    """Whether a running node publishes the replay's state under ``prefix``.
+
+    A replay that ended without unregistering (killed) stays listed by the master; only
+    a node that answers counts.
+    """
+    topic = interface.prefixed(interface.REPLAY_STATE_TOPIC, prefix)
+    master = rosgraph.Master(rospy.get_name())
+    try:
+        publishers, _subscribers, _services = master.getSystemState()
+    except (rosgraph.MasterError, OSError):
+        return True  # the master does not answer: nothing is known to be gone
+    nodes = [node for name, nodes in publishers if name == topic for node in nodes]
+    return any(node_running(node, master) for node in nodes)
 
 
 def screen_area() -> Rect | None:
@@ -78,7 +98,13 @@ def screen_area() -> Rect | None:
 class RvizWindow:
     """rviz as a child process that is started again on another source (see the module)."""
 
-    def __init__(self, config: Path, name: str, prefix: str) -> None:
+    def __init__(
+        self,
+        config: Path,
+        name: str,
+        prefix: str,
+        replay_up: Callable[[str], bool] | None = None,
+    ) -> None:
         self._config = config
         self._name = name
         self._wanted = prefix
@@ -86,6 +112,10 @@ class RvizWindow:
         self._child: subprocess.Popen[bytes] | None = None
         self._wake = threading.Condition()
         self._stopping = False
+        # Whether the replay under a prefix runs; None: the source is fixed (``--ns``).
+        self._replay_up = replay_up
+        self._replay_seen = False  # the followed replay was seen running since rviz started
+        self._next_look = 0.0
 
     def want(self, prefix: str) -> None:
         """Show the mission under ``prefix`` ("" the live one) from now on (any thread)."""
@@ -115,6 +145,23 @@ class RvizWindow:
             if wanted != self._shown:
                 self._end_child()
                 self._start(wanted)
+            self._look_at_replay()
+
+    def _look_at_replay(self) -> None:
+        """Back to live once the followed replay, seen running, has gone without a word.
+
+        Only a replay seen running counts as gone: rviz may be told to follow one before
+        it has started.
+        """
+        shown, now = self._shown, time.monotonic()
+        if not shown or self._replay_up is None or now < self._next_look:
+            return
+        self._next_look = now + PRESENCE_PERIOD
+        if self._replay_up(shown):
+            self._replay_seen = True
+        elif self._replay_seen:
+            _log.warning("the replay under %s is gone; rviz shows the live mission", shown)
+            self.want("")
 
     def _due(self) -> bool:
         child = self._child
@@ -127,6 +174,7 @@ class RvizWindow:
         _log.info("rviz shows %s", f"the replay under {prefix}" if prefix else "the live mission")
         self._child = subprocess.Popen(args, stdin=subprocess.DEVNULL)
         self._shown = prefix
+        self._replay_seen = False
 
     def _end_child(self) -> None:
         child, self._child = self._child, None
@@ -180,10 +228,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     join_graph("rviz_operator", disable_signals=True)
     bridge_logging_to_rosout()
     config = placed_config(options.config)
-    window = RvizWindow(config, rospy.get_name().lstrip("/"), options.ns)
+    follows = not options.ns  # the operator's rviz follows the command window's source
+    replay_up = replay_running if follows else None
+    window = RvizWindow(config, rospy.get_name().lstrip("/"), options.ns, replay_up)
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda *_: window.stop())
-    if not options.ns:  # the operator's rviz follows the command window's source
+    if follows:
         rospy.Subscriber(
             interface.VIEW_SOURCE_TOPIC, String, lambda msg: window.want(msg.data.strip())
         )

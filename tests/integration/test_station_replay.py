@@ -6,7 +6,9 @@ as the standalone window is. The recording is opened with the mouse (File > Open
 recording…, the path typed into the dialog): rviz is started again on the replay's topics
 and the replay's marker node shows the replayed time; *Return to live* puts rviz back on the
 live topics. The window's clock shows the replayed time and then the live clock again.
-rviz killed with SIGKILL comes back (``respawn``) on the live topics.
+rviz killed with SIGKILL comes back (``respawn``) on the live topics. A replay that is
+killed while rviz follows it (as a crashed window takes its replay along) sends rviz back to
+the live topics by itself.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ from __future__ import annotations
 import os
 import re
 import signal
+import sys
 import xmlrpc.client
 from collections.abc import Iterator
 from typing import Any
@@ -21,6 +24,7 @@ from typing import Any
 import pytest
 import rosgraph
 import rospy
+from std_msgs.msg import String
 from visualization_msgs.msg import MarkerArray
 
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
@@ -31,8 +35,10 @@ from python_qt_binding.QtWidgets import QApplication
 
 from rosmc_rqt_command.qt.station_menu import StationHooks, StationMenu
 from rosmc_rqt_command.standalone import join_station
+from rosmc_rviz_markers.ros.rviz_window import replay_running
+from rosmc_server import interface
 from tests.conftest import LaunchProcess, RosMaster
-from tests.integration.server_fixtures import StartServer
+from tests.integration.server_fixtures import REPO, StartServer
 from tests.integration.test_command_gui_server import Window, answer_file_dialog, shown
 from tests.integration.test_command_gui_server import wait_until as qt_wait
 from tests.integration.test_rviz import gui_programs, load_tool  # noqa: F401
@@ -108,6 +114,12 @@ def window(client_node: Any) -> Iterator[tuple[Window, StationMenu]]:
     app.processEvents()
 
 
+def on_live() -> bool:
+    """rviz is on the live mission's topics (and on no replay's)."""
+    topics = subscribed(VIEW)
+    return "/rosmc/markers/update" in topics and not any("replay" in t for t in topics)
+
+
 def seconds(text: str | None) -> int | None:
     """The seconds a clock text shows (None if it shows none)."""
     found = re.search(r"(\d+):(\d\d):(\d\d)$", text or "")
@@ -155,10 +167,6 @@ def test_open_recording_shows_the_replay_in_rviz_and_return_to_live_brings_it_ba
     # Return to live: rviz on the live topics again, the replay's processes gone.
     QTest.mouseClick(bar.live_button, Qt.LeftButton)
 
-    def on_live() -> bool:
-        topics = subscribed(VIEW)
-        return "/rosmc/markers/update" in topics and "/replay/tf" not in topics
-
     qt_wait(on_live, START, "rviz on the live topics")
     assert not widget.backend.read_only
     qt_wait(lambda: menu.clock.text().startswith("UTC "), 10, "the live clock again")
@@ -170,3 +178,29 @@ def test_open_recording_shows_the_replay_in_rviz_and_return_to_live_brings_it_ba
     os.kill(first, signal.SIGKILL)
     qt_wait(lambda: view_pid() not in (None, first), START, "rviz back")
     qt_wait(on_live, START, "rviz back on the live topics")
+
+
+@pytest.mark.usefixtures("gui_programs", "rviz")
+def test_rviz_returns_to_live_when_the_replay_it_follows_is_gone(
+    ros_master: RosMaster, launch_process: LaunchProcess
+) -> None:
+    """A replay that ends without a word (its window crashed, taking it along): rviz goes live."""
+    prefix = "/replay_gone"
+    rosmc = [sys.executable, str(REPO / "scripts" / "rosmc")]
+    replay = launch_process(
+        [*rosmc, "replay", str(SAMPLE), "--prefix", prefix, "--paused", "--hold"],
+        env=ros_master.env,
+        name="replay",
+    )
+    qt_wait(lambda: replay_running(prefix), START, "the replay running")
+    source = rospy.Publisher(interface.VIEW_SOURCE_TOPIC, String, queue_size=1, latch=True)
+    try:
+        source.publish(String(data=prefix))  # what the window said, and never takes back
+        update = f"{prefix}/rosmc/markers/update"
+        qt_wait(lambda: update in subscribed(VIEW), START, "rviz on the replay's topics")
+
+        os.kill(replay.pid, signal.SIGKILL)  # nothing unregistered: the master still lists it
+
+        qt_wait(on_live, START, "rviz back on the live topics")
+    finally:
+        source.unregister()

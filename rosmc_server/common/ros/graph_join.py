@@ -84,6 +84,24 @@ def clear_stale_registration(node: str, master: rosgraph.Master | None = None) -
     return True
 
 
+def node_running(node: str, master: rosgraph.Master | None = None) -> bool:
+    """Whether the master knows ``node`` and the process at its URI answers as a ROS node.
+
+    A node killed with -9 stays registered; only an answer tells that it runs.
+    """
+    master = master or rosgraph.Master(rospy.get_name())
+    try:
+        uri = str(master.lookupNode(node))
+    except (rosgraph.MasterError, OSError):
+        return False
+    proxy = xmlrpc.client.ServerProxy(uri, transport=_TimedTransport(PROBE_TIMEOUT))
+    try:
+        code, _message, _pid = cast(tuple[int, str, int], proxy.getPid(master.caller_id))
+    except (OSError, xmlrpc.client.Error):
+        return False
+    return code == 1
+
+
 def _registrations_of(master: rosgraph.Master, node: str) -> Registrations:
     """The topics ``node`` publishes and subscribes and the services it offers, per the master."""
     publishers, subscribers, services = master.getSystemState()
@@ -149,4 +167,4 @@ class _TimedTransport(xmlrpc.client.Transport):
         return connection
 
 
-__all__ = ["clear_stale_registration", "join_graph", "resolved_node_name"]
+__all__ = ["clear_stale_registration", "join_graph", "node_running", "resolved_node_name"]
