@@ -61,6 +61,7 @@ from .replay_control import ReplayControl
 from .replay_library import GET_LIBRARY, serve_library
 from .replay_mission import ReplayMission
 from .replay_output import TYPES, ReplayOutput, first_telemetry
+from .replay_progress import ReplayProgress
 
 _log = logging.getLogger(__name__)
 
@@ -74,8 +75,6 @@ CONNECT_TIMEOUT = 5.0
 """Longest the replay then waits for the subscribers it knows of to connect."""
 LINGER = 1.0
 """Seconds the last messages get to reach their subscribers before the node leaves."""
-SEEK_ANSWER = 10.0
-"""Longest a seek request waits for the replay to publish the state at its new position."""
 
 GET_MISSION = interface.service_name("get_mission")
 
@@ -142,9 +141,7 @@ class RecordingReplayer:
             self._clock.pause()
         self._stop = threading.Event()
         self._lock = threading.RLock()  # the history, and what was published
-        self._handled = threading.Condition(self._lock)  # a seek's state is out
-        self._handled_seeks = 0
-        self._playing = False
+        self._progress = ReplayProgress(self._lock)  # what the playing thread published
         self._output: ReplayOutput | None = None
         self._control: ReplayControl | None = None
         self._revision = -1  # of the last snapshot published on /rosmc/mission
@@ -157,14 +154,23 @@ class RecordingReplayer:
             return replace(self._clock.status(), revision=self._mission.current)
 
     def pause(self) -> PlaybackStatus:
-        """Stop where it is."""
-        self._clock.pause()
+        """Stop where it is; returns once every record due until there is out.
+
+        A record that came due just before the pause is published after it by the playing
+        thread; waiting for it keeps the answer's revision the one subscribers end with.
+        """
+        paused = self._clock.pause()
+        playlist = self._playlist
+        self._progress.await_due(
+            lambda index: index < len(playlist) and playlist.offset(index) <= paused.position,
+            self._stop,
+        )
         return self.status()
 
     def resume(self) -> PlaybackStatus:
         """Go on; at the end of the recording, play it again from the start."""
         moved = self._clock.resume()
-        self._await_seek(moved.seeks)
+        self._progress.await_seek(moved.seeks, self._stop)
         return self.status()
 
     def seek(self, seconds: float, *, relative: bool = False) -> PlaybackStatus:
@@ -177,7 +183,7 @@ class RecordingReplayer:
             InvalidRequest: ``seconds`` is not a number.
         """
         moved = self._clock.seek(seconds, relative=relative)
-        self._await_seek(moved.seeks)
+        self._progress.await_seek(moved.seeks, self._stop)
         return self.status()
 
     def set_rate(self, rate: float) -> PlaybackStatus:
@@ -249,17 +255,14 @@ class RecordingReplayer:
         try:
             return self._play()
         finally:
-            with self._handled:
-                self._playing = False
-                self._handled.notify_all()
+            self._progress.playing(False)
             self._control.close()
             service.shutdown()
             library.shutdown()
             self._clock.close()
 
     def _play(self) -> int:
-        with self._handled:
-            self._playing = True
+        self._progress.playing(True)
         if self._stop.wait(WARM_UP):
             return self._mission.current
         self._out().wait_for_subscribers(CONNECT_TIMEOUT, self._stop)
@@ -274,6 +277,7 @@ class RecordingReplayer:
             if status.seeks != seen:
                 seen = status.seeks
                 index = self._jump(status)
+                self._progress.next_record(index)
                 continue
             if index >= len(playlist):
                 if not self._config.hold:
@@ -289,6 +293,7 @@ class RecordingReplayer:
                 continue
             replaced = self._publish(playlist.records[index])
             index += 1
+            self._progress.next_record(index)
             now = time.monotonic()
             quiet = (
                 index == len(playlist)
@@ -300,29 +305,17 @@ class RecordingReplayer:
         self._stop.wait(LINGER)
         return self._mission.current
 
-    def _await_seek(self, seeks: int) -> None:
-        """Wait until the state at seek number ``seeks`` is out (while the replay plays)."""
-        deadline = time.monotonic() + SEEK_ANSWER
-        with self._handled:
-            while self._playing and self._handled_seeks < seeks and not self._stop.is_set():
-                left = deadline - time.monotonic()
-                if left <= 0:
-                    _log.warning("the replay took longer than %g s to seek", SEEK_ANSWER)
-                    return
-                self._handled.wait(left)
-
     # -- publishing -----------------------------------------------------------------------
     def _jump(self, status: PlaybackStatus) -> int:
         """Publish the state at ``status.position``; return the index of the record after it."""
         position = status.position
-        with self._handled:
+        with self._progress.condition:
             self.mission_at(position)  # built here, published (from the cache) below
             self._publish_snapshot(self._mission.current, position)
             self._out().publish_state_at(
                 self._playlist, position, moved=status.seeks > 0, paused=status.paused
             )
-            self._handled_seeks = status.seeks
-            self._handled.notify_all()
+            self._progress.seek_out(status.seeks)
         self._announce()
         _log.debug("replay: at %.2f s, revision %d", position, self._mission.current)
         return self._playlist.index_after(position)
