@@ -94,7 +94,7 @@ def node_running(node: str, master: rosgraph.Master | None = None) -> bool:
         uri = str(master.lookupNode(node))
     except (rosgraph.MasterError, OSError):
         return False
-    proxy = xmlrpc.client.ServerProxy(uri, transport=_TimedTransport(PROBE_TIMEOUT))
+    proxy = _node_api(uri)
     try:
         code, _message, _pid = cast(tuple[int, str, int], proxy.getPid(master.caller_id))
     except (OSError, xmlrpc.client.Error):
@@ -123,7 +123,7 @@ def _answers_as(uri: str, node: str, registrations: Registrations) -> bool:
     name has some. With none registered the answer is yes, so nothing is removed.
     """
     published, subscribed, _services = registrations
-    proxy = xmlrpc.client.ServerProxy(uri, transport=_TimedTransport(PROBE_TIMEOUT))
+    proxy = _node_api(uri)
     try:
         their_publications = _topics(proxy.getPublications(node))
         their_subscriptions = _topics(proxy.getSubscriptions(node))
@@ -152,6 +152,11 @@ def _unregister(master: rosgraph.Master, uri: str, registrations: Registrations)
             continue  # taken over or gone since getSystemState
     for key in SUBSCRIBED_PARAMS:
         master.unsubscribeParam(uri, key)
+
+
+def _node_api(uri: str) -> xmlrpc.client.ServerProxy:
+    """The node API at ``uri``, giving up after :data:`PROBE_TIMEOUT` (a silent node is gone)."""
+    return xmlrpc.client.ServerProxy(uri, transport=_TimedTransport(PROBE_TIMEOUT))
 
 
 class _TimedTransport(xmlrpc.client.Transport):
